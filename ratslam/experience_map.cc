@@ -1,0 +1,182 @@
+#include "ratslam/experience_map.h"
+
+#include <boost/graph/adjacency_list.hpp>
+#include <boost/graph/dijkstra_shortest_paths.hpp>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "ratslam/circular.h"
+
+namespace ratslam {
+
+bool ExperienceMapOptions::IsValid(std::string* error) const {
+  auto fail = [error](const std::string& message) {
+    if (error) *error = message;
+    return false;
+  };
+  if (relaxation_sweeps < 0) return fail("relaxation_sweeps: must not be negative");
+  if (!(relaxation_correction >= 0.0 && relaxation_correction <= 0.5)) {
+    return fail("relaxation_correction: must be in [0, 0.5]");
+  }
+  return true;
+}
+
+ExperienceMap::ExperienceMap(const ExperienceMapOptions& options) : options_(options) {
+  std::string error;
+  if (!options.IsValid(&error)) throw std::invalid_argument("ExperienceMapOptions: " + error);
+}
+
+void ExperienceMap::Integrate(double forward_m, double rotation_rad) {
+  LocalOffset& o = state_.offset;
+  const double heading = o.facing_rad + 0.5 * rotation_rad;
+  o.forward_m += forward_m * std::cos(heading);
+  o.left_m += forward_m * std::sin(heading);
+  o.facing_rad = WrapAngle(o.facing_rad + rotation_rad);
+}
+
+void ExperienceMap::CurrentPose(double* x_m, double* y_m, double* theta_rad) const {
+  double x = 0.0, y = 0.0, theta = 0.0;
+  if (state_.current) {
+    const Experience& e = state_.experiences[*state_.current];
+    x = e.x_m;
+    y = e.y_m;
+    theta = e.theta_rad;
+  }
+  const LocalOffset& o = state_.offset;
+  *x_m = x + o.forward_m * std::cos(theta) - o.left_m * std::sin(theta);
+  *y_m = y + o.forward_m * std::sin(theta) + o.left_m * std::cos(theta);
+  *theta_rad = WrapAngle(theta + o.facing_rad);
+}
+
+void ExperienceMap::AddLink(uint32_t from, uint32_t to, double time_s,
+                            std::optional<double> facing_override, bool loop_closure) {
+  const LocalOffset& o = state_.offset;
+  Link link;
+  link.id = static_cast<uint32_t>(state_.links.size());
+  link.from = from;
+  link.to = to;
+  link.distance_m = std::hypot(o.forward_m, o.left_m);
+  link.heading_rad = std::atan2(o.left_m, o.forward_m);
+  link.facing_rad = facing_override ? WrapAngle(*facing_override) : o.facing_rad;
+  link.duration_s = time_s - state_.offset_start_time_s;
+  link.loop_closure = loop_closure;
+  state_.experiences[from].link_ids.push_back(link.id);
+  state_.experiences[to].link_ids.push_back(link.id);
+  state_.links.push_back(link);
+}
+
+uint32_t ExperienceMap::CreateExperience(uint32_t template_id, const PoseCellPosition& pose_cells,
+                                         double time_s) {
+  Experience e;
+  e.id = static_cast<uint32_t>(state_.experiences.size());
+  CurrentPose(&e.x_m, &e.y_m, &e.theta_rad);
+  e.template_id = template_id;
+  e.pose_cells = pose_cells;
+  e.time_s = time_s;
+  state_.experiences.push_back(e);
+  if (state_.current) AddLink(*state_.current, e.id, time_s, std::nullopt, false);
+  state_.current = e.id;
+  state_.offset = LocalOffset();
+  state_.offset_start_time_s = time_s;
+  return e.id;
+}
+
+StatusOr<bool> ExperienceMap::LinkTo(uint32_t id, double time_s,
+                                     std::optional<double> facing_override_rad) {
+  if (id >= state_.experiences.size()) {
+    return Status::Error("experience map: link to unknown experience " + std::to_string(id));
+  }
+  bool added = false;
+  if (state_.current && *state_.current != id) {
+    const uint32_t from = *state_.current;
+    bool exists = false;
+    for (uint32_t link_id : state_.experiences[from].link_ids) {
+      const Link& l = state_.links[link_id];
+      if ((l.from == from && l.to == id) || (l.from == id && l.to == from)) exists = true;
+    }
+    if (!exists) {
+      AddLink(from, id, time_s, facing_override_rad, true);
+      added = true;
+    }
+  }
+  state_.current = id;
+  state_.offset = LocalOffset();
+  state_.offset_start_time_s = time_s;
+  return added;
+}
+
+void ExperienceMap::Relax() {
+  const double c = options_.relaxation_correction;
+  std::vector<Experience>& ex = state_.experiences;
+  for (int sweep = 0; sweep < options_.relaxation_sweeps; ++sweep) {
+    for (const Link& l : state_.links) {
+      Experience& a = ex[l.from];
+      Experience& b = ex[l.to];
+      // Where the link says b should be, seen from a.
+      const double px = a.x_m + l.distance_m * std::cos(a.theta_rad + l.heading_rad);
+      const double py = a.y_m + l.distance_m * std::sin(a.theta_rad + l.heading_rad);
+      const double ex_m = b.x_m - px;
+      const double ey_m = b.y_m - py;
+      const double et = WrapAngle(b.theta_rad - (a.theta_rad + l.facing_rad));
+      const bool a_fixed = options_.anchor_first_experience && l.from == 0;
+      const bool b_fixed = options_.anchor_first_experience && l.to == 0;
+      if (!a_fixed) {
+        a.x_m += ex_m * c;
+        a.y_m += ey_m * c;
+        a.theta_rad = WrapAngle(a.theta_rad + et * c);
+      }
+      if (!b_fixed) {
+        b.x_m -= ex_m * c;
+        b.y_m -= ey_m * c;
+        b.theta_rad = WrapAngle(b.theta_rad - et * c);
+      }
+    }
+  }
+}
+
+std::vector<uint32_t> ExperienceMap::ShortestPath(uint32_t from, uint32_t to) const {
+  const size_t n = state_.experiences.size();
+  if (from >= n || to >= n) return {};
+  using Graph = boost::adjacency_list<boost::vecS, boost::vecS, boost::undirectedS,
+                                      boost::no_property,
+                                      boost::property<boost::edge_weight_t, double>>;
+  Graph graph(n);
+  for (const Link& l : state_.links) boost::add_edge(l.from, l.to, l.distance_m, graph);
+  std::vector<Graph::vertex_descriptor> predecessor(n);
+  std::vector<double> distance(n, std::numeric_limits<double>::infinity());
+  boost::dijkstra_shortest_paths(
+      graph, from,
+      boost::predecessor_map(predecessor.data()).distance_map(distance.data()));
+  if (!std::isfinite(distance[to])) return {};
+  std::vector<uint32_t> path;
+  for (auto v = static_cast<Graph::vertex_descriptor>(to);; v = predecessor[v]) {
+    path.push_back(static_cast<uint32_t>(v));
+    if (v == from) break;
+  }
+  return {path.rbegin(), path.rend()};
+}
+
+Status ExperienceMap::SetState(State state) {
+  const size_t n = state.experiences.size();
+  for (size_t i = 0; i < n; ++i) {
+    if (state.experiences[i].id != i) {
+      return Status::Error("experience map state: experience " + std::to_string(i) + " has id " +
+                           std::to_string(state.experiences[i].id));
+    }
+  }
+  for (size_t i = 0; i < state.links.size(); ++i) {
+    const Link& l = state.links[i];
+    if (l.id != i || l.from >= n || l.to >= n) {
+      return Status::Error("experience map state: link " + std::to_string(i) +
+                           " is inconsistent with the experiences");
+    }
+  }
+  if (state.current && *state.current >= n) {
+    return Status::Error("experience map state: current experience does not exist");
+  }
+  state_ = std::move(state);
+  return Status::Ok();
+}
+
+}  // namespace ratslam

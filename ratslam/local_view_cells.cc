@@ -1,0 +1,107 @@
+#include "ratslam/local_view_cells.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+#include "ratslam/circular.h"
+
+namespace ratslam {
+
+bool LocalViewOptions::IsValid(std::string* error) const {
+  auto fail = [error](const std::string& message) {
+    if (error) *error = message;
+    return false;
+  };
+  if (!(injection_gain >= 0.0) || !std::isfinite(injection_gain)) {
+    return fail("injection_gain: must be a non-negative number");
+  }
+  if (!(decay_per_match >= 0.0) || !std::isfinite(decay_per_match)) {
+    return fail("decay_per_match: must be a non-negative number");
+  }
+  if (!(decay_restore_per_frame >= 0.0) || !std::isfinite(decay_restore_per_frame)) {
+    return fail("decay_restore_per_frame: must be a non-negative number");
+  }
+  if (!std::isfinite(decay_floor)) return fail("decay_floor: must be a number");
+  if (!(energy_limit > 0.0) || !std::isfinite(energy_limit)) {
+    return fail("energy_limit: must be a positive number");
+  }
+  if (!(energy_decay_rate >= 0.0) || !std::isfinite(energy_decay_rate)) {
+    return fail("energy_decay_rate: must be a non-negative number");
+  }
+  if (skip_recent_templates < 0) return fail("skip_recent_templates: must not be negative");
+  return true;
+}
+
+LocalViewCells::LocalViewCells(const LocalViewOptions& options, int dim_theta_cells)
+    : options_(options), dim_theta_cells_(dim_theta_cells) {
+  std::string error;
+  if (!options.IsValid(&error)) throw std::invalid_argument("LocalViewOptions: " + error);
+  if (dim_theta_cells < 1) throw std::invalid_argument("LocalViewCells: dim_theta_cells < 1");
+}
+
+double LocalViewCells::DecayAtStartOfFrame(const ViewTemplate& t, uint64_t frame) const {
+  // Restores since the stored value are applied lazily, so a frame costs O(1), not O(templates).
+  const double elapsed = frame > t.decay_frame + 1 ? static_cast<double>(frame - t.decay_frame - 1)
+                                                   : 0.0;
+  return std::max(options_.decay_floor, t.decay - options_.decay_restore_per_frame * elapsed);
+}
+
+StatusOr<std::optional<Injection>> LocalViewCells::Observe(const ViewDecision& decision,
+                                                           const PoseCellPosition& current_pose) {
+  const uint64_t frame = ++state_.frame;
+  const size_t count = state_.templates.size();
+  if (decision.is_new) {
+    if (decision.template_id != count) {
+      return Status::Error("view decision: new template id " +
+                           std::to_string(decision.template_id) + " but " +
+                           std::to_string(count) + " templates exist (ids must be consecutive)");
+    }
+    ViewTemplate t;
+    t.id = decision.template_id;
+    t.pose_cells = current_pose;
+    t.created_time_s = decision.time_s;
+    t.decay = options_.decay_floor;
+    t.decay_frame = frame;
+    state_.templates.push_back(std::move(t));
+    return std::optional<Injection>();
+  }
+  if (decision.template_id >= count) {
+    return Status::Error("view decision: template id " + std::to_string(decision.template_id) +
+                         " does not exist (" + std::to_string(count) + " templates)");
+  }
+  ViewTemplate& t = state_.templates[decision.template_id];
+  ++t.match_count;
+  const double decay = DecayAtStartOfFrame(t, frame) + options_.decay_per_match;
+  t.decay = std::max(options_.decay_floor, decay - options_.decay_restore_per_frame);
+  t.decay_frame = frame;
+  const bool recent = decision.template_id + static_cast<uint64_t>(options_.skip_recent_templates) >=
+                      count;
+  if (recent) return std::optional<Injection>();
+  const double energy = options_.injection_gain *
+                        (options_.energy_limit - std::exp(options_.energy_decay_rate * decay)) /
+                        options_.energy_limit;
+  if (!(energy > 0.0)) return std::optional<Injection>();
+  Injection injection;
+  injection.position = t.pose_cells;
+  injection.position.theta =
+      WrapCoordinate(t.pose_cells.theta + decision.heading_change_rad /
+                                              (2.0 * std::numbers::pi) * dim_theta_cells_,
+                     dim_theta_cells_);
+  injection.energy = energy;
+  return std::optional<Injection>(injection);
+}
+
+Status LocalViewCells::SetState(State state) {
+  for (size_t i = 0; i < state.templates.size(); ++i) {
+    if (state.templates[i].id != i) {
+      return Status::Error("local view state: template " + std::to_string(i) + " has id " +
+                           std::to_string(state.templates[i].id));
+    }
+  }
+  state_ = std::move(state);
+  return Status::Ok();
+}
+
+}  // namespace ratslam

@@ -1,0 +1,101 @@
+// Local view cells: the store of view templates, front-end agnostic. Each template remembers the
+// pose-cell position at its creation; seeing it again injects energy there (Milford and Wyeth
+// 2008), with a per-template decay that weakens repeated consecutive injections (the decay model
+// of OpenRatSLAM, Ball et al. 2013: E = gain * (limit - exp(rate * decay)) / limit).
+#ifndef RATSLAM_LOCAL_VIEW_CELLS_H_
+#define RATSLAM_LOCAL_VIEW_CELLS_H_
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "ratslam/pose_cell_network.h"
+#include "ratslam/status.h"
+
+namespace ratslam {
+
+struct LocalViewOptions {
+  double injection_gain = 0.15;            // energy injected by a fully rested template
+  double decay_per_match = 1.0;            // added to a template's decay on each match
+  double decay_restore_per_frame = 0.05;   // removed from every template's decay each frame
+  double decay_floor = 1.0;                // decay never falls below this
+  double energy_limit = 30.0;              // "limit" in the energy formula above
+  double energy_decay_rate = 1.2;          // "rate" in the energy formula above
+  int skip_recent_templates = 10;          // the newest templates never inject
+
+  bool IsValid(std::string* error) const;
+
+  template <typename Visitor>
+  void VisitFields(Visitor&& v) {
+    v("injection_gain", injection_gain, "pose-cell energy injected by a rested template match");
+    v("decay_per_match", decay_per_match, "added to a template's decay on each match");
+    v("decay_restore_per_frame", decay_restore_per_frame,
+      "removed from every template's decay each view frame");
+    v("decay_floor", decay_floor, "lowest value of a template's decay");
+    v("energy_limit", energy_limit, "E = gain * (limit - exp(rate * decay)) / limit: limit");
+    v("energy_decay_rate", energy_decay_rate, "E = gain * (limit - exp(rate * decay)) / limit: rate");
+    v("skip_recent_templates", skip_recent_templates,
+      "matches to this many newest templates inject no energy");
+  }
+};
+
+// What a front end decided about the current view.
+struct ViewDecision {
+  double time_s = 0.0;
+  uint32_t template_id = 0;  // for a new template: must equal the number of templates so far
+  bool is_new = false;
+  // Current heading minus the heading the template was stored with (panoramic camera or compass);
+  // the injection lands at the stored theta plus this change.
+  double heading_change_rad = 0.0;
+};
+
+struct ViewTemplate {
+  uint32_t id = 0;
+  PoseCellPosition pose_cells;       // pose-cell position when the template was created
+  double created_time_s = 0.0;
+  double decay = 1.0;                // value after the restore of frame decay_frame
+  uint64_t decay_frame = 0;
+  uint32_t match_count = 0;
+  std::vector<uint32_t> experience_ids;  // experiences created or linked with this template
+};
+
+// Energy to inject, and where.
+struct Injection {
+  PoseCellPosition position;
+  double energy = 0.0;
+};
+
+class LocalViewCells {
+ public:
+  struct State {
+    std::vector<ViewTemplate> templates;
+    uint64_t frame = 0;  // view frames seen
+  };
+
+  // `options` must be valid; throws std::invalid_argument otherwise.
+  LocalViewCells(const LocalViewOptions& options, int dim_theta_cells);
+
+  // Processes one view frame. A new template is stored at `current_pose`; a repeat returns the
+  // injection it causes (none for recent or exhausted templates). Fails on an id that does not
+  // fit the store.
+  StatusOr<std::optional<Injection>> Observe(const ViewDecision& decision,
+                                             const PoseCellPosition& current_pose);
+
+  size_t size() const { return state_.templates.size(); }
+  const ViewTemplate& at(uint32_t id) const { return state_.templates[id]; }
+  ViewTemplate& at(uint32_t id) { return state_.templates[id]; }
+  const State& state() const { return state_; }
+  Status SetState(State state);
+
+ private:
+  double DecayAtStartOfFrame(const ViewTemplate& t, uint64_t frame) const;
+
+  LocalViewOptions options_;
+  int dim_theta_cells_;
+  State state_;
+};
+
+}  // namespace ratslam
+
+#endif  // RATSLAM_LOCAL_VIEW_CELLS_H_

@@ -1,0 +1,130 @@
+#include "ratslam/ratslam.h"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace ratslam {
+
+bool ActionOptions::IsValid(std::string* error) const {
+  if (!(match_distance_cells > 0.0) || !std::isfinite(match_distance_cells)) {
+    if (error) *error = "match_distance_cells: must be a positive number";
+    return false;
+  }
+  return true;
+}
+
+bool RatslamOptions::IsValid(std::string* error) const {
+  std::string inner;
+  auto check = [&](bool ok, const char* section) {
+    if (!ok && error) *error = std::string(section) + "." + inner;
+    return ok;
+  };
+  return check(pose_cells.IsValid(&inner), "pose_cells") &&
+         check(local_view.IsValid(&inner), "local_view") &&
+         check(experience_map.IsValid(&inner), "experience_map") &&
+         check(action.IsValid(&inner), "action");
+}
+
+namespace {
+const RatslamOptions& Validated(const RatslamOptions& options) {
+  std::string error;
+  if (!options.IsValid(&error)) throw std::invalid_argument("RatslamOptions: " + error);
+  return options;
+}
+}  // namespace
+
+Ratslam::Ratslam(const RatslamOptions& options)
+    : options_(Validated(options)),
+      pose_cells_(options.pose_cells),
+      local_view_(options.local_view, options.pose_cells.dim_theta_cells),
+      experience_map_(options.experience_map) {}
+
+Status Ratslam::OnView(const ViewDecision& decision) {
+  StatusOr<std::optional<Injection>> injection =
+      local_view_.Observe(decision, pose_cells_.BestPosition());
+  if (!injection.ok()) return injection.status();
+  ++counters_.view_frames;
+  current_template_ = decision.template_id;
+  if (injection.value()) {
+    pose_cells_.Inject(injection.value()->position, injection.value()->energy);
+    ++counters_.injections;
+  }
+  return Status::Ok();
+}
+
+StatusOr<ActionKind> Ratslam::OnOdometry(const OdometryStep& step,
+                                         std::optional<double> facing_override_rad) {
+  if (!std::isfinite(step.forward_m) || !std::isfinite(step.rotation_rad)) {
+    return Status::Error("odometry step at t=" + std::to_string(step.time_s) + " is not finite");
+  }
+  ++counters_.odometry_steps;
+  pose_cells_.Step(step.forward_m, step.rotation_rad);
+  experience_map_.Integrate(step.forward_m, step.rotation_rad);
+  return Act(step.time_s, facing_override_rad);
+}
+
+StatusOr<ActionKind> Ratslam::Act(double time_s, std::optional<double> facing_override_rad) {
+  if (!current_template_) return ActionKind::kNone;
+  const PoseCellPosition best = pose_cells_.BestPosition();
+  ViewTemplate& view = local_view_.at(*current_template_);
+  const int dim_xy = options_.pose_cells.dim_xy_cells;
+  const int dim_theta = options_.pose_cells.dim_theta_cells;
+
+  std::optional<uint32_t> nearest;
+  double nearest_distance = std::numeric_limits<double>::infinity();
+  int candidates = 0;
+  for (uint32_t id : view.experience_ids) {
+    const double d =
+        PoseCellDistance(experience_map_.experience(id).pose_cells, best, dim_xy, dim_theta);
+    if (d < options_.action.match_distance_cells) ++candidates;
+    if (d < nearest_distance) {
+      nearest_distance = d;
+      nearest = id;
+    }
+  }
+
+  ActionKind action = ActionKind::kNone;
+  if (!nearest || nearest_distance >= options_.action.match_distance_cells) {
+    const uint32_t id = experience_map_.CreateExperience(*current_template_, best, time_s);
+    view.experience_ids.push_back(id);
+    action = ActionKind::kCreatedExperience;
+  } else if (experience_map_.current() == nearest) {
+    return ActionKind::kNone;
+  } else if (candidates > 1 && options_.action.refuse_ambiguous_links) {
+    ++counters_.refused_ambiguous;
+    return ActionKind::kRefusedAmbiguous;
+  } else {
+    StatusOr<bool> linked = experience_map_.LinkTo(*nearest, time_s, facing_override_rad);
+    if (!linked.ok()) return linked.status();
+    if (linked.value()) ++counters_.loop_closures;
+    action = ActionKind::kLinkedExisting;
+  }
+  experience_map_.Relax();
+  return action;
+}
+
+Ratslam::State Ratslam::GetState() const {
+  return {pose_cells_.GetState(), local_view_.state(), experience_map_.state(), current_template_,
+          counters_};
+}
+
+Status Ratslam::SetState(const State& state) {
+  RATSLAM_RETURN_IF_ERROR(pose_cells_.SetState(state.pose_cells));
+  RATSLAM_RETURN_IF_ERROR(local_view_.SetState(state.local_view));
+  RATSLAM_RETURN_IF_ERROR(experience_map_.SetState(state.experience_map));
+  for (const Experience& e : state.experience_map.experiences) {
+    if (e.template_id >= state.local_view.templates.size()) {
+      return Status::Error("state: experience " + std::to_string(e.id) +
+                           " refers to a template that does not exist");
+    }
+  }
+  if (state.current_template && *state.current_template >= state.local_view.templates.size()) {
+    return Status::Error("state: current template does not exist");
+  }
+  current_template_ = state.current_template;
+  counters_ = state.counters;
+  return Status::Ok();
+}
+
+}  // namespace ratslam

@@ -1,0 +1,103 @@
+// The RatSLAM spine: odometry drives the pose cells and the experience map; view decisions from
+// any front end drive the local view cells; after each odometry step the action logic creates an
+// experience or links to an existing one (Milford and Wyeth 2008, Ball et al. 2013).
+#ifndef RATSLAM_RATSLAM_H_
+#define RATSLAM_RATSLAM_H_
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "ratslam/experience_map.h"
+#include "ratslam/local_view_cells.h"
+#include "ratslam/pose_cell_network.h"
+#include "ratslam/status.h"
+
+namespace ratslam {
+
+struct ActionOptions {
+  double match_distance_cells = 2.0;  // experiences of the current template closer than this
+                                      // (in pose cells) are candidates for a link
+  bool refuse_ambiguous_links = false;  // no link when several candidates are in range
+
+  bool IsValid(std::string* error) const;
+
+  template <typename Visitor>
+  void VisitFields(Visitor&& v) {
+    v("match_distance_cells", match_distance_cells,
+      "pose-cell distance within which an experience of the current template is re-used");
+    v("refuse_ambiguous_links", refuse_ambiguous_links,
+      "make no link when several experiences are within match_distance_cells");
+  }
+};
+
+struct RatslamOptions {
+  PoseCellOptions pose_cells;
+  LocalViewOptions local_view;
+  ExperienceMapOptions experience_map;
+  ActionOptions action;
+
+  bool IsValid(std::string* error) const;
+};
+
+struct OdometryStep {
+  double time_s = 0.0;
+  double forward_m = 0.0;     // distance travelled along the heading during the step
+  double rotation_rad = 0.0;  // heading change during the step (counter-clockwise positive)
+};
+
+enum class ActionKind { kNone, kCreatedExperience, kLinkedExisting, kRefusedAmbiguous };
+
+class Ratslam {
+ public:
+  struct Counters {
+    uint64_t odometry_steps = 0;
+    uint64_t view_frames = 0;
+    uint64_t injections = 0;
+    uint64_t loop_closures = 0;      // links made to an experience that existed already
+    uint64_t refused_ambiguous = 0;
+  };
+
+  // `options` must be valid (IsValid); throws std::invalid_argument otherwise.
+  explicit Ratslam(const RatslamOptions& options);
+
+  // One view frame from a front end.
+  Status OnView(const ViewDecision& decision);
+  // One odometry step followed by the action logic; `facing_override_rad` replaces the facing
+  // change of a loop-closure link made in this step (compass front ends).
+  StatusOr<ActionKind> OnOdometry(const OdometryStep& step,
+                                  std::optional<double> facing_override_rad = std::nullopt);
+
+  const PoseCellNetwork& pose_cells() const { return pose_cells_; }
+  const LocalViewCells& local_view() const { return local_view_; }
+  const ExperienceMap& experience_map() const { return experience_map_; }
+  std::optional<uint32_t> current_template() const { return current_template_; }
+  const Counters& counters() const { return counters_; }
+  const RatslamOptions& options() const { return options_; }
+
+  struct State {
+    PoseCellNetwork::State pose_cells;
+    LocalViewCells::State local_view;
+    ExperienceMap::State experience_map;
+    std::optional<uint32_t> current_template;
+    Counters counters;
+  };
+  State GetState() const;
+  // Fails, leaving this object unusable for further steps only if partially applied state is
+  // inconsistent; callers load into a fresh object.
+  Status SetState(const State& state);
+
+ private:
+  StatusOr<ActionKind> Act(double time_s, std::optional<double> facing_override_rad);
+
+  RatslamOptions options_;
+  PoseCellNetwork pose_cells_;
+  LocalViewCells local_view_;
+  ExperienceMap experience_map_;
+  std::optional<uint32_t> current_template_;
+  Counters counters_;
+};
+
+}  // namespace ratslam
+
+#endif  // RATSLAM_RATSLAM_H_
