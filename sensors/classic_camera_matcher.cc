@@ -1,0 +1,277 @@
+#include "sensors/classic_camera_matcher.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+#include "ratslam/circular.h"
+
+namespace ratslam {
+namespace {
+
+// Local contrast normalisation maps z-scores to intensities as 0.5 + z / kPatchZSpan, so that
+// +-3 standard deviations span the 0..1 range.
+constexpr double kPatchZSpan = 6.0;
+
+uint8_t Quantise(double value) {
+  return static_cast<uint8_t>(std::lround(std::clamp(value, 0.0, 1.0) * 255.0));
+}
+
+// Shifted, masked copies of the query, one per compared offset, in the stored-template layout.
+struct PreparedQuery {
+  std::vector<uint8_t> rows;   // shifts * height * stride
+  std::vector<uint8_t> masks;  // shifts * stride: 0xFF where the offset overlaps
+  std::vector<int> overlap_columns;
+};
+
+PreparedQuery Prepare(const std::vector<uint8_t>& query, const std::vector<int>& shifts, int width,
+                      int height, int stride, bool panoramic) {
+  PreparedQuery p;
+  const size_t per_shift = static_cast<size_t>(height) * stride;
+  p.rows.assign(shifts.size() * per_shift, 0);
+  p.masks.assign(shifts.size() * stride, 0);
+  for (size_t k = 0; k < shifts.size(); ++k) {
+    const int s = shifts[k];
+    int overlap = 0;
+    for (int u = 0; u < width; ++u) {
+      // Template column u meets query column u + s.
+      int source = u + s;
+      if (panoramic) {
+        source = WrapIndex(source, width);
+      } else if (source < 0 || source >= width) {
+        continue;
+      }
+      ++overlap;
+      p.masks[k * stride + u] = 0xFF;
+      for (int r = 0; r < height; ++r) {
+        p.rows[k * per_shift + static_cast<size_t>(r) * stride + u] =
+            query[static_cast<size_t>(r) * stride + source];
+      }
+    }
+    p.overlap_columns.push_back(overlap);
+  }
+  return p;
+}
+
+// Sum of absolute differences between a stored template (masked) and one prepared shift.
+inline uint32_t MaskedSad(const uint8_t* stored, const uint8_t* prepared, const uint8_t* mask,
+                          int height, int stride) {
+#if defined(__SSE2__)
+  __m128i acc = _mm_setzero_si128();
+  for (int r = 0; r < height; ++r) {
+    const uint8_t* t = stored + static_cast<size_t>(r) * stride;
+    const uint8_t* q = prepared + static_cast<size_t>(r) * stride;
+    for (int c = 0; c < stride; c += 16) {
+      const __m128i tv = _mm_and_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(t + c)),
+                                       _mm_loadu_si128(reinterpret_cast<const __m128i*>(mask + c)));
+      const __m128i qv = _mm_loadu_si128(reinterpret_cast<const __m128i*>(q + c));
+      acc = _mm_add_epi64(acc, _mm_sad_epu8(tv, qv));
+    }
+  }
+  return static_cast<uint32_t>(_mm_cvtsi128_si32(acc) +
+                               _mm_cvtsi128_si32(_mm_unpackhi_epi64(acc, acc)));
+#else
+  uint32_t sum = 0;
+  for (int r = 0; r < height; ++r) {
+    for (int c = 0; c < stride; ++c) {
+      const int t = stored[static_cast<size_t>(r) * stride + c] & mask[c];
+      sum += std::abs(t - prepared[static_cast<size_t>(r) * stride + c]);
+    }
+  }
+  return sum;
+#endif
+}
+
+}  // namespace
+
+bool ClassicCameraOptions::IsValid(std::string* error) const {
+  auto fail = [error](const std::string& message) {
+    if (error) *error = message;
+    return false;
+  };
+  if (crop_left_px < 0) return fail("crop_left_px: must not be negative");
+  if (crop_top_px < 0) return fail("crop_top_px: must not be negative");
+  if (crop_right_px != -1 && crop_right_px <= crop_left_px) {
+    return fail("crop_right_px: must be -1 or greater than crop_left_px");
+  }
+  if (crop_bottom_px != -1 && crop_bottom_px <= crop_top_px) {
+    return fail("crop_bottom_px: must be -1 or greater than crop_top_px");
+  }
+  if (template_width_px < 1 || template_width_px > 4096) {
+    return fail("template_width_px: must be in [1, 4096]");
+  }
+  if (template_height_px < 1 || template_height_px > 4096) {
+    return fail("template_height_px: must be in [1, 4096]");
+  }
+  if (shift_px < 0 || shift_px >= template_width_px) {
+    return fail("shift_px: must be in [0, template_width_px)");
+  }
+  if (shift_step_px < 1) return fail("shift_step_px: must be at least 1");
+  if (!(match_threshold >= 0.0 && match_threshold <= 1.0)) {
+    return fail("match_threshold: must be in [0, 1]");
+  }
+  if (!(global_normalisation_mean >= 0.0 && global_normalisation_mean <= 1.0)) {
+    return fail("global_normalisation_mean: must be in [0, 1]");
+  }
+  if (patch_normalisation_radius_px < 0) {
+    return fail("patch_normalisation_radius_px: must not be negative");
+  }
+  return true;
+}
+
+ClassicCameraMatcher::ClassicCameraMatcher(const ClassicCameraOptions& options)
+    : options_(options) {
+  std::string error;
+  if (!options.IsValid(&error)) throw std::invalid_argument("ClassicCameraOptions: " + error);
+  row_stride_ = (options.template_width_px + 15) / 16 * 16;
+  bytes_per_template_ = static_cast<size_t>(row_stride_) * options.template_height_px;
+  for (int s = -options.shift_px; s <= options.shift_px; s += options.shift_step_px) {
+    shifts_.push_back(s);
+  }
+}
+
+StatusOr<std::vector<uint8_t>> ClassicCameraMatcher::MakeTemplate(
+    const GrayImageView& image) const {
+  const int right = options_.crop_right_px < 0 ? image.width : options_.crop_right_px;
+  const int bottom = options_.crop_bottom_px < 0 ? image.height : options_.crop_bottom_px;
+  const int crop_w = right - options_.crop_left_px;
+  const int crop_h = bottom - options_.crop_top_px;
+  const int w = options_.template_width_px;
+  const int h = options_.template_height_px;
+  if (image.pixels == nullptr || right > image.width || bottom > image.height) {
+    return Status::Error("image of " + std::to_string(image.width) + "x" +
+                         std::to_string(image.height) + " px is smaller than the crop");
+  }
+  if (crop_w < w || crop_h < h) {
+    return Status::Error("crop of " + std::to_string(crop_w) + "x" + std::to_string(crop_h) +
+                         " px is smaller than the " + std::to_string(w) + "x" +
+                         std::to_string(h) + " template");
+  }
+  // Block means over integer block boundaries.
+  std::vector<double> values(static_cast<size_t>(w) * h);
+  for (int ty = 0; ty < h; ++ty) {
+    const int y0 = options_.crop_top_px + ty * crop_h / h;
+    const int y1 = options_.crop_top_px + (ty + 1) * crop_h / h;
+    for (int tx = 0; tx < w; ++tx) {
+      const int x0 = options_.crop_left_px + tx * crop_w / w;
+      const int x1 = options_.crop_left_px + (tx + 1) * crop_w / w;
+      uint64_t sum = 0;
+      for (int y = y0; y < y1; ++y) {
+        const uint8_t* row = image.pixels + static_cast<size_t>(y) * image.stride_bytes;
+        for (int x = x0; x < x1; ++x) sum += row[x];
+      }
+      values[static_cast<size_t>(ty) * w + tx] =
+          static_cast<double>(sum) / (255.0 * (x1 - x0) * (y1 - y0));
+    }
+  }
+  if (options_.global_normalisation_mean > 0.0) {
+    double mean = 0.0;
+    for (double v : values) mean += v;
+    mean /= static_cast<double>(values.size());
+    if (mean > 0.0) {
+      for (double& v : values) v *= options_.global_normalisation_mean / mean;
+    }
+  }
+  if (options_.patch_normalisation_radius_px > 0) {
+    const int p = options_.patch_normalisation_radius_px;
+    std::vector<double> normalised(values.size());
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        double sum = 0.0, sum2 = 0.0;
+        int n = 0;
+        for (int yy = std::max(0, y - p); yy <= std::min(h - 1, y + p); ++yy) {
+          for (int xx = std::max(0, x - p); xx <= std::min(w - 1, x + p); ++xx) {
+            const double v = values[static_cast<size_t>(yy) * w + xx];
+            sum += v;
+            sum2 += v * v;
+            ++n;
+          }
+        }
+        const double mean = sum / n;
+        const double sd = std::sqrt(std::max(0.0, sum2 / n - mean * mean));
+        const double v = values[static_cast<size_t>(y) * w + x];
+        normalised[static_cast<size_t>(y) * w + x] =
+            sd > 1e-9 ? 0.5 + (v - mean) / sd / kPatchZSpan : 0.5;
+      }
+    }
+    values.swap(normalised);
+  }
+  std::vector<uint8_t> result(bytes_per_template_, 0);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      result[static_cast<size_t>(y) * row_stride_ + x] =
+          Quantise(values[static_cast<size_t>(y) * w + x]);
+    }
+  }
+  return result;
+}
+
+TemplateComparison ClassicCameraMatcher::Compare(const std::vector<uint8_t>& query) const {
+  TemplateComparison best;
+  if (state_.template_count == 0 || query.size() != bytes_per_template_) return best;
+  const int h = options_.template_height_px;
+  const PreparedQuery prepared = Prepare(query, shifts_, options_.template_width_px, h,
+                                         row_stride_, options_.panoramic);
+  const size_t per_shift = static_cast<size_t>(h) * row_stride_;
+  std::vector<double> scale(shifts_.size());
+  for (size_t k = 0; k < shifts_.size(); ++k) {
+    scale[k] = 1.0 / (255.0 * h * prepared.overlap_columns[k]);
+  }
+  const uint8_t* base = state_.templates.data();
+  for (uint32_t id = 0; id < state_.template_count; ++id) {
+    const uint8_t* t = base + id * bytes_per_template_;
+    for (size_t k = 0; k < shifts_.size(); ++k) {
+      const uint32_t sad =
+          MaskedSad(t, prepared.rows.data() + k * per_shift,
+                    prepared.masks.data() + k * row_stride_, h, row_stride_);
+      const double difference = sad * scale[k];
+      if (difference < best.mean_difference) {
+        best.mean_difference = difference;
+        best.template_id = static_cast<int32_t>(id);
+        best.shift_px = shifts_[k];
+      }
+    }
+  }
+  return best;
+}
+
+uint32_t ClassicCameraMatcher::Add(const std::vector<uint8_t>& query) {
+  state_.templates.insert(state_.templates.end(), query.begin(), query.end());
+  return state_.template_count++;
+}
+
+StatusOr<ViewDecision> ClassicCameraMatcher::Observe(const GrayImageView& image, double time_s) {
+  StatusOr<std::vector<uint8_t>> query = MakeTemplate(image);
+  if (!query.ok()) return query.status();
+  const TemplateComparison best = Compare(query.value());
+  ViewDecision decision;
+  decision.time_s = time_s;
+  if (best.template_id >= 0 && best.mean_difference <= options_.match_threshold) {
+    decision.template_id = static_cast<uint32_t>(best.template_id);
+    decision.is_new = false;
+    if (options_.panoramic) {
+      // The view turned left by shift columns of a 360-degree image (columns run clockwise).
+      decision.heading_change_rad =
+          WrapAngle(2.0 * std::numbers::pi * best.shift_px / options_.template_width_px);
+    }
+  } else {
+    decision.template_id = Add(query.value());
+    decision.is_new = true;
+  }
+  return decision;
+}
+
+Status ClassicCameraMatcher::SetState(State state) {
+  if (state.templates.size() != static_cast<size_t>(state.template_count) * bytes_per_template_) {
+    return Status::Error("camera matcher state: template bytes do not match the template size");
+  }
+  state_ = std::move(state);
+  return Status::Ok();
+}
+
+}  // namespace ratslam

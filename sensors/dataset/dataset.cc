@@ -1,0 +1,304 @@
+#include "sensors/dataset/dataset.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <toml++/toml.h>
+
+#include "ratslam/circular.h"
+#include "sensors/dataset/csv.h"
+
+namespace ratslam {
+namespace fs = std::filesystem;
+namespace {
+
+constexpr int kFormatVersion = 1;
+
+// Fails when time goes backwards between consecutive rows.
+Status CheckTimeOrder(const CsvTable& table, size_t row, double previous, double current) {
+  if (row > 0 && current < previous) {
+    return table.ErrorAt(row, "time_s", "time goes backwards (" + std::to_string(current) +
+                                            " after " + std::to_string(previous) + ")");
+  }
+  return Status::Ok();
+}
+
+#define ASSIGN_OR_RETURN_NUMBER(lhs, table, row, column)  \
+  do {                                                    \
+    StatusOr<double> value_ = (table).Number(row, column); \
+    if (!value_.ok()) return value_.status();             \
+    lhs = value_.value();                                 \
+  } while (false)
+
+Status ReadOdometry(const std::string& path, Dataset* d) {
+  StatusOr<CsvTable> t =
+      CsvTable::Read(path, {"time_s", "forward_speed_m_per_s", "turn_rate_rad_per_s"});
+  if (!t.ok()) return t.status();
+  for (size_t r = 0; r < t->rows(); ++r) {
+    OdometryRow row;
+    ASSIGN_OR_RETURN_NUMBER(row.time_s, *t, r, "time_s");
+    ASSIGN_OR_RETURN_NUMBER(row.forward_speed_m_per_s, *t, r, "forward_speed_m_per_s");
+    ASSIGN_OR_RETURN_NUMBER(row.turn_rate_rad_per_s, *t, r, "turn_rate_rad_per_s");
+    RATSLAM_RETURN_IF_ERROR(
+        CheckTimeOrder(*t, r, r ? d->odometry.back().time_s : 0.0, row.time_s));
+    d->odometry.push_back(row);
+  }
+  return Status::Ok();
+}
+
+Status ReadImages(const std::string& path, Dataset* d) {
+  StatusOr<CsvTable> t = CsvTable::Read(path, {"time_s", "file"});
+  if (!t.ok()) return t.status();
+  for (size_t r = 0; r < t->rows(); ++r) {
+    ImageRow row;
+    ASSIGN_OR_RETURN_NUMBER(row.time_s, *t, r, "time_s");
+    StatusOr<std::string> file = t->Text(r, "file");
+    if (!file.ok()) return file.status();
+    if (fs::path(*file).is_absolute() || file->find("..") != std::string::npos) {
+      return t->ErrorAt(r, "file", "must be a relative path inside the image folder");
+    }
+    row.file = *file;
+    row.line = t->line(r);
+    RATSLAM_RETURN_IF_ERROR(CheckTimeOrder(*t, r, r ? d->images.back().time_s : 0.0, row.time_s));
+    d->images.push_back(row);
+  }
+  return Status::Ok();
+}
+
+Status ReadGroundTruth(const std::string& path, Dataset* d) {
+  StatusOr<CsvTable> t = CsvTable::Read(path, {"time_s", "x_m", "y_m"}, {"theta_rad", "floor"});
+  if (!t.ok()) return t.status();
+  for (size_t r = 0; r < t->rows(); ++r) {
+    GroundTruthRow row;
+    ASSIGN_OR_RETURN_NUMBER(row.time_s, *t, r, "time_s");
+    ASSIGN_OR_RETURN_NUMBER(row.x_m, *t, r, "x_m");
+    ASSIGN_OR_RETURN_NUMBER(row.y_m, *t, r, "y_m");
+    if (t->has_column("theta_rad")) ASSIGN_OR_RETURN_NUMBER(row.theta_rad, *t, r, "theta_rad");
+    if (t->has_column("floor")) {
+      double floor = 0.0;
+      ASSIGN_OR_RETURN_NUMBER(floor, *t, r, "floor");
+      if (floor != std::floor(floor) || std::abs(floor) > 1000) {
+        return t->ErrorAt(r, "floor", "must be a whole number");
+      }
+      row.floor = static_cast<int>(floor);
+    }
+    RATSLAM_RETURN_IF_ERROR(
+        CheckTimeOrder(*t, r, r ? d->ground_truth.back().time_s : 0.0, row.time_s));
+    d->ground_truth.push_back(row);
+  }
+  return Status::Ok();
+}
+
+Status ReadWifi(const std::string& path, Dataset* d) {
+  StatusOr<CsvTable> t = CsvTable::Read(path, {"time_s", "bssid", "rssi_dbm"});
+  if (!t.ok()) return t.status();
+  for (size_t r = 0; r < t->rows(); ++r) {
+    double time_s = 0.0;
+    WifiReading reading;
+    ASSIGN_OR_RETURN_NUMBER(time_s, *t, r, "time_s");
+    ASSIGN_OR_RETURN_NUMBER(reading.rssi_dbm, *t, r, "rssi_dbm");
+    StatusOr<std::string> bssid = t->Text(r, "bssid");
+    if (!bssid.ok()) return bssid.status();
+    reading.bssid = *bssid;
+    if (!d->wifi.empty() && time_s < d->wifi.back().time_s) {
+      return t->ErrorAt(r, "time_s", "time goes backwards");
+    }
+    if (d->wifi.empty() || d->wifi.back().time_s != time_s) d->wifi.push_back({time_s, {}});
+    d->wifi.back().readings.push_back(reading);
+  }
+  return Status::Ok();
+}
+
+Status ReadCompass(const std::string& path, Dataset* d) {
+  StatusOr<CsvTable> t = CsvTable::Read(path, {"time_s", "heading_rad"});
+  if (!t.ok()) return t.status();
+  for (size_t r = 0; r < t->rows(); ++r) {
+    CompassRow row;
+    ASSIGN_OR_RETURN_NUMBER(row.time_s, *t, r, "time_s");
+    ASSIGN_OR_RETURN_NUMBER(row.heading_rad, *t, r, "heading_rad");
+    RATSLAM_RETURN_IF_ERROR(CheckTimeOrder(*t, r, r ? d->compass.back().time_s : 0.0, row.time_s));
+    d->compass.push_back(row);
+  }
+  return Status::Ok();
+}
+
+std::string Number(double value) {
+  char buffer[40];
+  std::snprintf(buffer, sizeof buffer, "%.17g", value);
+  return buffer;
+}
+
+}  // namespace
+
+std::string Dataset::ImagePath(const ImageRow& row) const {
+  return (fs::path(folder) / image_folder / row.file).string();
+}
+
+StatusOr<Dataset> ReadDataset(const std::string& folder) {
+  const std::string manifest_path = (fs::path(folder) / "manifest.toml").string();
+  if (!fs::is_directory(folder)) return Status::Error(folder + ": not a data-set folder");
+  if (!fs::exists(manifest_path)) return Status::Error(manifest_path + ": missing manifest");
+  toml::table manifest;
+  try {
+    manifest = toml::parse_file(manifest_path);
+  } catch (const toml::parse_error& e) {
+    return Status::Error(manifest_path + ":" + std::to_string(e.source().begin.line) + ": " +
+                         std::string(e.description()));
+  }
+  auto error_at = [&](const toml::node* node, const std::string& message) {
+    const int line = node ? static_cast<int>(node->source().begin.line) : 0;
+    return Status::Error(manifest_path + ":" + std::to_string(line) + ": " + message);
+  };
+  Dataset d;
+  d.folder = folder;
+  static const std::vector<std::string> kTopKeys = {"format", "format_version", "name", "streams"};
+  static const std::vector<std::string> kStreams = {"odometry", "images",  "image_folder",
+                                                    "ground_truth", "wifi", "compass"};
+  for (const auto& [key, node] : manifest) {
+    if (std::find(kTopKeys.begin(), kTopKeys.end(), key.str()) == kTopKeys.end()) {
+      return error_at(&node, "unknown key '" + std::string(key.str()) + "'");
+    }
+  }
+  if (manifest["format"].value_or(std::string()) != "ratslam-replay") {
+    return error_at(manifest.get("format"), "format must be \"ratslam-replay\"");
+  }
+  if (manifest["format_version"].value_or(0) != kFormatVersion) {
+    return error_at(manifest.get("format_version"),
+                    "unsupported format_version (this program reads " +
+                        std::to_string(kFormatVersion) + ")");
+  }
+  d.name = manifest["name"].value_or(fs::path(folder).filename().string());
+  const toml::table* streams = manifest["streams"].as_table();
+  if (!streams) return error_at(nullptr, "missing [streams] table");
+  std::map<std::string, std::string> files;
+  for (const auto& [key, node] : *streams) {
+    if (std::find(kStreams.begin(), kStreams.end(), key.str()) == kStreams.end()) {
+      return error_at(&node, "unknown stream '" + std::string(key.str()) + "'");
+    }
+    if (!node.is_string()) return error_at(&node, std::string(key.str()) + " must be a string");
+    files[std::string(key.str())] = *node.value<std::string>();
+  }
+  if (!files.count("odometry")) return error_at(streams, "streams.odometry is required");
+  if (files.count("image_folder")) d.image_folder = files["image_folder"];
+  auto path_of = [&](const std::string& stream) {
+    return (fs::path(folder) / files[stream]).string();
+  };
+  RATSLAM_RETURN_IF_ERROR(ReadOdometry(path_of("odometry"), &d));
+  if (files.count("images")) RATSLAM_RETURN_IF_ERROR(ReadImages(path_of("images"), &d));
+  if (files.count("ground_truth")) {
+    RATSLAM_RETURN_IF_ERROR(ReadGroundTruth(path_of("ground_truth"), &d));
+  }
+  if (files.count("wifi")) RATSLAM_RETURN_IF_ERROR(ReadWifi(path_of("wifi"), &d));
+  if (files.count("compass")) RATSLAM_RETURN_IF_ERROR(ReadCompass(path_of("compass"), &d));
+  return d;
+}
+
+Status WriteDataset(const Dataset& d, const std::string& folder) {
+  std::error_code ec;
+  fs::create_directories(fs::path(folder) / d.image_folder, ec);
+  if (ec) return Status::Error(folder + ": cannot create folder: " + ec.message());
+  auto open = [&](const std::string& name, std::ofstream& out) {
+    out.open(fs::path(folder) / name);
+    return out ? Status::Ok() : Status::Error((fs::path(folder) / name).string() + ": cannot write");
+  };
+  std::ofstream manifest;
+  RATSLAM_RETURN_IF_ERROR(open("manifest.toml", manifest));
+  manifest << "format = \"ratslam-replay\"\nformat_version = " << kFormatVersion << "\n"
+           << "name = \"" << d.name << "\"\n\n[streams]\nodometry = \"odometry.csv\"\n";
+  if (!d.images.empty()) {
+    manifest << "images = \"images.csv\"\nimage_folder = \"" << d.image_folder << "\"\n";
+  }
+  if (!d.ground_truth.empty()) manifest << "ground_truth = \"ground_truth.csv\"\n";
+  if (!d.wifi.empty()) manifest << "wifi = \"wifi.csv\"\n";
+  if (!d.compass.empty()) manifest << "compass = \"compass.csv\"\n";
+
+  std::ofstream out;
+  RATSLAM_RETURN_IF_ERROR(open("odometry.csv", out));
+  out << "time_s,forward_speed_m_per_s,turn_rate_rad_per_s\n";
+  for (const OdometryRow& r : d.odometry) {
+    out << Number(r.time_s) << ',' << Number(r.forward_speed_m_per_s) << ','
+        << Number(r.turn_rate_rad_per_s) << '\n';
+  }
+  out.close();
+  if (!d.images.empty()) {
+    RATSLAM_RETURN_IF_ERROR(open("images.csv", out));
+    out << "time_s,file\n";
+    for (const ImageRow& r : d.images) out << Number(r.time_s) << ',' << r.file << '\n';
+    out.close();
+  }
+  if (!d.ground_truth.empty()) {
+    RATSLAM_RETURN_IF_ERROR(open("ground_truth.csv", out));
+    out << "time_s,x_m,y_m,theta_rad,floor\n";
+    for (const GroundTruthRow& r : d.ground_truth) {
+      out << Number(r.time_s) << ',' << Number(r.x_m) << ',' << Number(r.y_m) << ','
+          << Number(r.theta_rad) << ',' << r.floor << '\n';
+    }
+    out.close();
+  }
+  if (!d.wifi.empty()) {
+    RATSLAM_RETURN_IF_ERROR(open("wifi.csv", out));
+    out << "time_s,bssid,rssi_dbm\n";
+    for (const WifiScan& s : d.wifi) {
+      for (const WifiReading& r : s.readings) {
+        out << Number(s.time_s) << ',' << r.bssid << ',' << Number(r.rssi_dbm) << '\n';
+      }
+    }
+    out.close();
+  }
+  if (!d.compass.empty()) {
+    RATSLAM_RETURN_IF_ERROR(open("compass.csv", out));
+    out << "time_s,heading_rad\n";
+    for (const CompassRow& r : d.compass) {
+      out << Number(r.time_s) << ',' << Number(r.heading_rad) << '\n';
+    }
+    out.close();
+  }
+  return out.good() || !out.is_open() ? Status::Ok() : Status::Error(folder + ": write failed");
+}
+
+std::vector<Event> MergeEvents(const Dataset& d) {
+  std::vector<Event> events;
+  events.reserve(d.odometry.size() + d.images.size() + d.wifi.size() + d.compass.size());
+  for (uint32_t i = 0; i < d.compass.size(); ++i) {
+    events.push_back({d.compass[i].time_s, EventType::kCompass, i});
+  }
+  for (uint32_t i = 0; i < d.wifi.size(); ++i) {
+    events.push_back({d.wifi[i].time_s, EventType::kWifi, i});
+  }
+  for (uint32_t i = 0; i < d.images.size(); ++i) {
+    events.push_back({d.images[i].time_s, EventType::kImage, i});
+  }
+  for (uint32_t i = 0; i < d.odometry.size(); ++i) {
+    events.push_back({d.odometry[i].time_s, EventType::kOdometry, i});
+  }
+  std::stable_sort(events.begin(), events.end(), [](const Event& a, const Event& b) {
+    if (a.time_s != b.time_s) return a.time_s < b.time_s;
+    return a.type < b.type;
+  });
+  return events;
+}
+
+std::optional<GroundTruthRow> InterpolateGroundTruth(const std::vector<GroundTruthRow>& rows,
+                                                     double time_s) {
+  if (rows.empty() || time_s < rows.front().time_s || time_s > rows.back().time_s) {
+    return std::nullopt;
+  }
+  auto after = std::lower_bound(rows.begin(), rows.end(), time_s,
+                                [](const GroundTruthRow& r, double t) { return r.time_s < t; });
+  if (after->time_s == time_s || after == rows.begin()) return *after;
+  const GroundTruthRow& b = *after;
+  const GroundTruthRow& a = *(after - 1);
+  const double f = (time_s - a.time_s) / (b.time_s - a.time_s);
+  GroundTruthRow r;
+  r.time_s = time_s;
+  r.x_m = a.x_m + f * (b.x_m - a.x_m);
+  r.y_m = a.y_m + f * (b.y_m - a.y_m);
+  r.theta_rad = WrapAngle(a.theta_rad + f * WrapAngle(b.theta_rad - a.theta_rad));
+  r.floor = f < 0.5 ? a.floor : b.floor;
+  return r;
+}
+
+}  // namespace ratslam

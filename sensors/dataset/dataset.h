@@ -1,0 +1,90 @@
+// The replay data-set format: a folder with `manifest.toml` and one CSV per stream, plus an
+// image folder. Times are in seconds; units are in the column names. See configs/README.md
+// ("Replay data-set format") for the full description.
+#ifndef RATSLAM_SENSORS_DATASET_DATASET_H_
+#define RATSLAM_SENSORS_DATASET_DATASET_H_
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "ratslam/status.h"
+
+namespace ratslam {
+
+// Velocities that hold from the previous odometry row's time to this row's time.
+struct OdometryRow {
+  double time_s = 0.0;
+  double forward_speed_m_per_s = 0.0;
+  double turn_rate_rad_per_s = 0.0;
+};
+
+struct ImageRow {
+  double time_s = 0.0;
+  std::string file;  // relative to the image folder
+  int line = 0;      // line in images.csv, for error messages
+};
+
+struct GroundTruthRow {
+  double time_s = 0.0;
+  double x_m = 0.0;
+  double y_m = 0.0;
+  double theta_rad = 0.0;
+  int floor = 0;
+};
+
+struct WifiReading {
+  std::string bssid;
+  double rssi_dbm = 0.0;
+};
+
+struct WifiScan {
+  double time_s = 0.0;
+  std::vector<WifiReading> readings;
+};
+
+struct CompassRow {
+  double time_s = 0.0;
+  double heading_rad = 0.0;
+};
+
+struct Dataset {
+  std::string name;
+  std::string folder;       // where it was read from (empty for one made in memory)
+  std::string image_folder = "images";  // relative to `folder`
+  std::vector<OdometryRow> odometry;
+  std::vector<ImageRow> images;
+  std::vector<GroundTruthRow> ground_truth;
+  std::vector<WifiScan> wifi;
+  std::vector<CompassRow> compass;
+
+  std::string ImagePath(const ImageRow& row) const;
+};
+
+// Reads a replay data-set folder. Errors name the file, line and column.
+StatusOr<Dataset> ReadDataset(const std::string& folder);
+
+// Writes `dataset` (without images) into `folder` (created if needed): manifest and CSVs with
+// every number printed so that it reads back bit for bit.
+Status WriteDataset(const Dataset& dataset, const std::string& folder);
+
+// Events in replay order.
+enum class EventType : uint8_t { kCompass = 0, kWifi = 1, kImage = 2, kOdometry = 3 };
+struct Event {
+  double time_s = 0.0;
+  EventType type = EventType::kOdometry;
+  uint32_t index = 0;  // into the stream's vector
+};
+// All events sorted by time; at equal times compass, Wi-Fi, images, then odometry (so that an
+// odometry step's action sees the view of the same instant), then by index.
+std::vector<Event> MergeEvents(const Dataset& dataset);
+
+// Ground-truth position at `time_s`, linearly interpolated; nullopt outside the covered span.
+std::optional<GroundTruthRow> InterpolateGroundTruth(const std::vector<GroundTruthRow>& rows,
+                                                     double time_s);
+
+}  // namespace ratslam
+
+#endif  // RATSLAM_SENSORS_DATASET_DATASET_H_

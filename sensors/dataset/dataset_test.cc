@@ -1,0 +1,184 @@
+#include "sensors/dataset/dataset.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "sensors/dataset/image_loader.h"
+#include "sensors/dataset/synthetic_dataset.h"
+
+namespace ratslam {
+namespace {
+namespace fs = std::filesystem;
+
+class DatasetTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    folder_ = fs::temp_directory_path() /
+              ("ratslam_dataset_test_" + std::to_string(::getpid()) + "_" +
+               ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(folder_);
+    fs::create_directories(folder_);
+    Write("manifest.toml",
+          "format = \"ratslam-replay\"\nformat_version = 1\nname = \"t\"\n[streams]\n"
+          "odometry = \"odometry.csv\"\nground_truth = \"ground_truth.csv\"\n"
+          "wifi = \"wifi.csv\"\n");
+    Write("odometry.csv", "time_s,forward_speed_m_per_s,turn_rate_rad_per_s\n0,0,0\n0.1,1,0.5\n");
+    Write("ground_truth.csv", "time_s,x_m,y_m\n0,0,0\n1,10,-4\n");
+    Write("wifi.csv", "time_s,bssid,rssi_dbm\n0.5,aa:bb,-40\n0.5,cc:dd,-71\n0.9,aa:bb,-45\n");
+  }
+  void TearDown() override { fs::remove_all(folder_); }
+  void Write(const std::string& name, const std::string& text) {
+    std::ofstream(folder_ / name) << text;
+  }
+  std::string ReadError() {
+    StatusOr<Dataset> d = ReadDataset(folder_.string());
+    EXPECT_FALSE(d.ok());
+    return d.status().message();
+  }
+  fs::path folder_;
+};
+
+TEST_F(DatasetTest, ReadsValidFolder) {
+  StatusOr<Dataset> d = ReadDataset(folder_.string());
+  ASSERT_TRUE(d.ok()) << d.status().message();
+  ASSERT_EQ(d->odometry.size(), 2u);
+  EXPECT_EQ(d->odometry[1].turn_rate_rad_per_s, 0.5);
+  ASSERT_EQ(d->wifi.size(), 2u);  // readings at equal times form one scan
+  EXPECT_EQ(d->wifi[0].readings.size(), 2u);
+  EXPECT_EQ(d->wifi[0].readings[1].rssi_dbm, -71);
+}
+
+TEST_F(DatasetTest, WriteThenReadIsExact) {
+  Dataset d = ReadDataset(folder_.string()).value();
+  d.odometry[1].forward_speed_m_per_s = 0.1 + 0.2;  // not representable in short decimal
+  d.compass.push_back({0.3, -2.5});
+  const fs::path copy = folder_ / "copy";
+  ASSERT_TRUE(WriteDataset(d, copy.string()).ok());
+  Dataset back = ReadDataset(copy.string()).value();
+  EXPECT_EQ(back.odometry[1].forward_speed_m_per_s, 0.1 + 0.2);
+  EXPECT_EQ(back.compass.size(), 1u);
+  EXPECT_EQ(back.ground_truth[1].y_m, -4);
+  EXPECT_EQ(back.wifi[0].readings[0].bssid, "aa:bb");
+}
+
+TEST_F(DatasetTest, TruncatedRowNamesFileAndLine) {
+  Write("odometry.csv", "time_s,forward_speed_m_per_s,turn_rate_rad_per_s\n0,0,0\n0.1,1\n");
+  const std::string error = ReadError();
+  EXPECT_NE(error.find("odometry.csv:3"), std::string::npos) << error;
+  EXPECT_NE(error.find("truncated"), std::string::npos) << error;
+}
+
+TEST_F(DatasetTest, NanNamesColumn) {
+  Write("odometry.csv", "time_s,forward_speed_m_per_s,turn_rate_rad_per_s\n0,nan,0\n");
+  const std::string error = ReadError();
+  EXPECT_NE(error.find("odometry.csv:2: column 'forward_speed_m_per_s'"), std::string::npos)
+      << error;
+}
+
+TEST_F(DatasetTest, NotANumberNamesColumn) {
+  Write("ground_truth.csv", "time_s,x_m,y_m\n0,0,0\n1,ten,0\n");
+  const std::string error = ReadError();
+  EXPECT_NE(error.find("ground_truth.csv:3: column 'x_m': not a number: 'ten'"),
+            std::string::npos)
+      << error;
+}
+
+TEST_F(DatasetTest, TimeGoingBackwardsIsAnError) {
+  Write("odometry.csv", "time_s,forward_speed_m_per_s,turn_rate_rad_per_s\n1,0,0\n0.5,0,0\n");
+  const std::string error = ReadError();
+  EXPECT_NE(error.find("odometry.csv:3: column 'time_s': time goes backwards"),
+            std::string::npos)
+      << error;
+}
+
+TEST_F(DatasetTest, MissingAndUnknownColumns) {
+  Write("odometry.csv", "time_s,forward_speed_m_per_s\n0,0\n");
+  EXPECT_NE(ReadError().find("missing required column 'turn_rate_rad_per_s'"), std::string::npos);
+  Write("odometry.csv", "time_s,forward_speed_m_per_s,turn_rate_rad_per_sec\n0,0,0\n");
+  EXPECT_NE(ReadError().find("unknown column 'turn_rate_rad_per_sec'"), std::string::npos);
+}
+
+TEST_F(DatasetTest, MissingStreamFileAndUnknownManifestKey) {
+  fs::remove(folder_ / "wifi.csv");
+  EXPECT_NE(ReadError().find("wifi.csv: cannot open file"), std::string::npos);
+  Write("manifest.toml",
+        "format = \"ratslam-replay\"\nformat_version = 1\n[streams]\nodometry = \"odometry.csv\"\n"
+        "odometer = \"x.csv\"\n");
+  const std::string error = ReadError();
+  EXPECT_NE(error.find("manifest.toml:5: unknown stream 'odometer'"), std::string::npos) << error;
+}
+
+TEST_F(DatasetTest, EventsAreOrderedByTimeThenStream) {
+  Dataset d;
+  d.odometry = {{0.0, 0, 0}, {0.1, 0, 0}};
+  d.images = {{0.1, "a.png", 2}};
+  d.compass = {{0.1, 0.0}};
+  const std::vector<Event> events = MergeEvents(d);
+  ASSERT_EQ(events.size(), 4u);
+  EXPECT_EQ(events[0].type, EventType::kOdometry);
+  EXPECT_EQ(events[1].type, EventType::kCompass);
+  EXPECT_EQ(events[2].type, EventType::kImage);
+  EXPECT_EQ(events[3].type, EventType::kOdometry);
+}
+
+TEST(GroundTruthTest, InterpolatesAndRefusesOutsideSpan) {
+  std::vector<GroundTruthRow> rows = {{0.0, 0.0, 0.0, 0.0, 0}, {2.0, 4.0, -2.0, 0.0, 0}};
+  auto mid = InterpolateGroundTruth(rows, 0.5);
+  ASSERT_TRUE(mid.has_value());
+  EXPECT_DOUBLE_EQ(mid->x_m, 1.0);
+  EXPECT_DOUBLE_EQ(mid->y_m, -0.5);
+  EXPECT_FALSE(InterpolateGroundTruth(rows, 2.5).has_value());
+}
+
+TEST(SyntheticDatasetTest, SameSeedSameBytesAndImagesRepeatAcrossLaps) {
+  SyntheticOptions options;
+  options.laps = 2;
+  options.loop_length_m = 14;
+  options.loop_width_m = 10;
+  options.rate_hz = 2;
+  options.lap_offset_m = 0.0;
+  options.pixel_noise_grey = 0.0;
+  const fs::path a = fs::temp_directory_path() / ("ratslam_synth_a_" + std::to_string(::getpid()));
+  const fs::path b = fs::temp_directory_path() / ("ratslam_synth_b_" + std::to_string(::getpid()));
+  StatusOr<Dataset> da = WriteSyntheticDataset(options, a.string());
+  ASSERT_TRUE(da.ok()) << da.status().message();
+  ASSERT_TRUE(WriteSyntheticDataset(options, b.string()).ok());
+  auto bytes = [](const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  EXPECT_EQ(bytes(a / "odometry.csv"), bytes(b / "odometry.csv"));
+  EXPECT_EQ(bytes(a / "images" / "000003.png"), bytes(b / "images" / "000003.png"));
+  // The loop of ~45 m at 1 m/s and 2 Hz: frame k and frame k + one lap see the same place.
+  const Dataset& d = da.value();
+  const double perimeter = 2 * (14 - 8) + 2 * (10 - 8) + 2 * 3.14159265358979 * 4;
+  const size_t lap_frames = static_cast<size_t>(std::lround(perimeter * 2));
+  FileImageLoader loader;
+  const GrayImage first = loader.Load(d.ImagePath(d.images[1])).value();
+  const GrayImage again = loader.Load(d.ImagePath(d.images[1 + lap_frames])).value();
+  const GrayImage elsewhere = loader.Load(d.ImagePath(d.images[1 + lap_frames / 2])).value();
+  auto mean_difference = [](const GrayImage& x, const GrayImage& y) {
+    double sum = 0;
+    for (size_t i = 0; i < x.pixels.size(); ++i) sum += std::abs(x.pixels[i] - y.pixels[i]);
+    return sum / x.pixels.size();
+  };
+  EXPECT_LT(mean_difference(first, again), 0.25 * mean_difference(first, elsewhere));
+  fs::remove_all(a);
+  fs::remove_all(b);
+}
+
+TEST(ImageLoaderTest, MissingAndCorruptFilesAreErrors) {
+  FileImageLoader loader;
+  EXPECT_NE(loader.Load("/nonexistent/x.png").status().message().find("image file missing"),
+            std::string::npos);
+  const fs::path bad = fs::temp_directory_path() / ("ratslam_bad_" + std::to_string(::getpid()) + ".png");
+  std::ofstream(bad) << "not a png";
+  EXPECT_FALSE(loader.Load(bad.string()).ok());
+  fs::remove(bad);
+}
+
+}  // namespace
+}  // namespace ratslam

@@ -1,0 +1,34 @@
+// Loads grey images for the camera front ends. Behind an interface so that tests can feed images
+// from memory and replays can read them from disk.
+#ifndef RATSLAM_SENSORS_DATASET_IMAGE_LOADER_H_
+#define RATSLAM_SENSORS_DATASET_IMAGE_LOADER_H_
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "ratslam/status.h"
+
+namespace ratslam {
+
+struct GrayImage {
+  int width = 0;
+  int height = 0;
+  std::vector<uint8_t> pixels;  // rows top to bottom, no padding
+};
+
+class ImageLoader {
+ public:
+  virtual ~ImageLoader() = default;
+  virtual StatusOr<GrayImage> Load(const std::string& path) = 0;
+};
+
+// Reads any format OpenCV's imgcodecs reads (PNG, JPEG, PGM, ...) and converts it to grey.
+class FileImageLoader : public ImageLoader {
+ public:
+  StatusOr<GrayImage> Load(const std::string& path) override;
+};
+
+}  // namespace ratslam
+
+#endif  // RATSLAM_SENSORS_DATASET_IMAGE_LOADER_H_
