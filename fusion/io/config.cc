@@ -1,0 +1,313 @@
+#include "fusion/io/config.h"
+
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <limits>
+#include <map>
+#include <set>
+#include <sstream>
+#include <toml++/toml.h>
+
+namespace ratslam {
+namespace {
+
+std::string Location(const std::string& source, const toml::node* node) {
+  return source + ":" + (node ? std::to_string(node->source().begin.line) : std::string("?"));
+}
+
+// Reads the fields of one options struct from a TOML table.
+class SectionReader {
+ public:
+  SectionReader(const toml::table& table, std::string section, std::string source)
+      : table_(table), section_(std::move(section)), source_(std::move(source)) {}
+
+  template <typename T>
+  void operator()(const char* key, T& field, const char* /*doc*/) {
+    if (!status_.ok()) return;
+    const toml::node* node = table_.get(key);
+    if (!node) return;
+    used_.insert(key);
+    Status s = Assign(*node, field);
+    if (!s.ok()) {
+      status_ = Status::Error(Location(source_, node) + ": [" + section_ + "] " + key + ": " +
+                              s.message());
+    }
+  }
+
+  Status Finish() const {
+    if (!status_.ok()) return status_;
+    for (const auto& [key, node] : table_) {
+      if (!used_.count(std::string(key.str()))) {
+        return Status::Error(Location(source_, &node) + ": unknown key '" +
+                             std::string(key.str()) + "' in [" + section_ + "]");
+      }
+    }
+    return Status::Ok();
+  }
+
+ private:
+  static Status Assign(const toml::node& node, int& field) {
+    const auto* v = node.as_integer();
+    if (!v) return Status::Error("expected an integer");
+    const int64_t value = v->get();
+    if (value < std::numeric_limits<int>::min() || value > std::numeric_limits<int>::max()) {
+      return Status::Error("integer out of range");
+    }
+    field = static_cast<int>(value);
+    return Status::Ok();
+  }
+  static Status Assign(const toml::node& node, double& field) {
+    if (const auto* f = node.as_floating_point()) {
+      if (!std::isfinite(f->get())) return Status::Error("must be a finite number");
+      field = f->get();
+    } else if (const auto* i = node.as_integer()) {
+      field = static_cast<double>(i->get());
+    } else {
+      return Status::Error("expected a number");
+    }
+    return Status::Ok();
+  }
+  static Status Assign(const toml::node& node, bool& field) {
+    const auto* b = node.as_boolean();
+    if (!b) return Status::Error("expected true or false");
+    field = b->get();
+    return Status::Ok();
+  }
+  static Status Assign(const toml::node& node, FrontEndKind& field) {
+    const auto* s = node.as_string();
+    if (!s) return Status::Error("expected a string");
+    StatusOr<FrontEndKind> kind = FrontEndKindFromString(s->get());
+    if (!kind.ok()) return kind.status();
+    field = kind.value();
+    return Status::Ok();
+  }
+
+  const toml::table& table_;
+  std::string section_;
+  std::string source_;
+  std::set<std::string> used_;
+  Status status_;
+};
+
+std::string FormatDouble(double value) {
+  char buffer[64];
+  const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
+  std::string text(buffer, result.ptr);
+  if (text.find_first_of(".eEn") == std::string::npos) text += ".0";  // keep it a TOML float
+  return text;
+}
+
+class SectionPrinter {
+ public:
+  SectionPrinter(std::ostringstream& out, bool comments) : out_(out), comments_(comments) {}
+  template <typename T>
+  void operator()(const char* key, T& field, const char* doc) {
+    if (comments_) out_ << "# " << doc << "\n";
+    out_ << key << " = " << Format(field) << "\n";
+  }
+
+ private:
+  static std::string Format(int v) { return std::to_string(v); }
+  static std::string Format(double v) { return FormatDouble(v); }
+  static std::string Format(bool v) { return v ? "true" : "false"; }
+  static std::string Format(FrontEndKind v) {
+    std::string quoted(1, '"');  // appended piecewise: GCC 12 warns falsely on "\"" + s
+    quoted += ToString(v);
+    quoted += '"';
+    return quoted;
+  }
+  std::ostringstream& out_;
+  bool comments_;
+};
+
+// Line of `section.key` in the parsed file, for validity errors found after reading.
+std::string LocateField(const toml::table& root, const std::string& source,
+                        const std::string& dotted) {
+  const auto dot = dotted.find('.');
+  const auto colon = dotted.find(':');
+  if (dot == std::string::npos || colon == std::string::npos) return source;
+  const std::string section = dotted.substr(0, dot);
+  const std::string key = dotted.substr(dot + 1, colon - dot - 1);
+  const toml::table* table = root[section].as_table();
+  if (!table) return source;
+  const toml::node* node = table->get(key);
+  return Location(source, node ? node : table);
+}
+
+}  // namespace
+
+StatusOr<PipelineOptions> ParseConfig(const std::string& text, const std::string& source_name) {
+  toml::table root;
+  try {
+    root = toml::parse(text, source_name);
+  } catch (const toml::parse_error& e) {
+    return Status::Error(source_name + ":" + std::to_string(e.source().begin.line) + ": " +
+                         std::string(e.description()));
+  }
+  PipelineOptions options;
+  std::set<std::string> sections;
+  Status status;
+  options.VisitSections([&](const char* name, auto& section) {
+    sections.insert(name);
+    if (!status.ok()) return;
+    const toml::node* node = root.get(name);
+    if (!node) return;
+    const toml::table* table = node->as_table();
+    if (!table) {
+      status = Status::Error(Location(source_name, node) + ": [" + name + "] must be a table");
+      return;
+    }
+    SectionReader reader(*table, name, source_name);
+    section.VisitFields(reader);
+    status = reader.Finish();
+  });
+  if (!status.ok()) return status;
+  for (const auto& [key, node] : root) {
+    if (!sections.count(std::string(key.str()))) {
+      return Status::Error(Location(source_name, &node) + ": unknown section '" +
+                           std::string(key.str()) + "'");
+    }
+  }
+  std::string error;
+  if (!options.IsValid(&error)) {
+    return Status::Error(LocateField(root, source_name, error) + ": " + error);
+  }
+  return options;
+}
+
+StatusOr<PipelineOptions> LoadConfigFile(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return Status::Error(path + ": cannot open config file");
+  std::stringstream text;
+  text << in.rdbuf();
+  return ParseConfig(text.str(), path);
+}
+
+std::string PrintConfig(const PipelineOptions& options, bool comments) {
+  PipelineOptions copy = options;
+  std::ostringstream out;
+  bool first = true;
+  copy.VisitSections([&](const char* name, auto& section) {
+    if (!first) out << "\n";
+    first = false;
+    out << "[" << name << "]\n";
+    SectionPrinter printer(out, comments);
+    section.VisitFields(printer);
+  });
+  return out.str();
+}
+
+uint64_t ConfigFingerprint(const PipelineOptions& options) {
+  uint64_t hash = 0xcbf29ce484222325ULL;
+  for (unsigned char c : PrintConfig(options, false)) {
+    hash ^= c;
+    hash *= 0x100000001b3ULL;
+  }
+  return hash;
+}
+
+StatusOr<ImportedConfig> ImportOpenRatslamIni(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return Status::Error(path + ": cannot open INI file");
+  ImportedConfig imported;
+  PipelineOptions& o = imported.options;
+  using Setter = std::function<Status(double)>;
+  auto whole = [](int& field) {
+    return [&field](double v) {
+      if (v != std::floor(v)) return Status::Error("expected a whole number");
+      field = static_cast<int>(v);
+      return Status::Ok();
+    };
+  };
+  auto real = [](double& field) {
+    return [&field](double v) {
+      field = v;
+      return Status::Ok();
+    };
+  };
+  // OpenRatSLAM key -> our field (key names from the OpenRatSLAM configuration files).
+  std::map<std::string, Setter> setters = {
+      {"pc_dim_xy", whole(o.ratslam.pose_cells.dim_xy_cells)},
+      {"pc_dim_th", whole(o.ratslam.pose_cells.dim_theta_cells)},
+      {"pc_cell_x_size", real(o.ratslam.pose_cells.cell_size_m)},
+      {"pc_w_e_dim", whole(o.ratslam.pose_cells.excitation_size_cells)},
+      {"pc_w_i_dim", whole(o.ratslam.pose_cells.inhibition_size_cells)},
+      {"pc_w_e_var", real(o.ratslam.pose_cells.excitation_variance_cells2)},
+      {"pc_w_i_var", real(o.ratslam.pose_cells.inhibition_variance_cells2)},
+      {"pc_global_inhib", real(o.ratslam.pose_cells.global_inhibition)},
+      {"pc_vt_inject_energy", real(o.ratslam.local_view.injection_gain)},
+      {"pc_vt_restore", real(o.ratslam.local_view.decay_restore_per_frame)},
+      {"vt_active_decay",
+       [&o](double v) {
+         o.ratslam.local_view.decay_per_match = v;
+         o.ratslam.local_view.decay_floor = v;
+         return Status::Ok();
+       }},
+      {"exp_delta_pc_threshold", real(o.ratslam.action.match_distance_cells)},
+      {"exp_loops", whole(o.ratslam.experience_map.relaxation_sweeps)},
+      {"exp_correction", real(o.ratslam.experience_map.relaxation_correction)},
+      {"vt_match_threshold", real(o.camera.match_threshold)},
+      {"vt_shift_match", whole(o.camera.shift_px)},
+      {"vt_step_match", whole(o.camera.shift_step_px)},
+      {"vt_normalisation", real(o.camera.global_normalisation_mean)},
+      {"vt_patch_normalisation", whole(o.camera.patch_normalisation_radius_px)},
+      {"vt_patch_normalise", whole(o.camera.patch_normalisation_radius_px)},
+      {"template_x_size", whole(o.camera.template_width_px)},
+      {"template_y_size", whole(o.camera.template_height_px)},
+      {"image_crop_x_min", whole(o.camera.crop_left_px)},
+      {"image_crop_x_max", whole(o.camera.crop_right_px)},
+      {"image_crop_y_min", whole(o.camera.crop_top_px)},
+      {"image_crop_y_max", whole(o.camera.crop_bottom_px)},
+      {"vt_panoramic",
+       [&o](double v) {
+         o.camera.panoramic = v != 0.0;
+         return Status::Ok();
+       }},
+  };
+  std::string line, section;
+  int number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    const std::string where = path + ":" + std::to_string(number);
+    const auto comment = line.find_first_of("#;");
+    if (comment != std::string::npos) line.erase(comment);
+    const auto begin = line.find_first_not_of(" \t\r");
+    if (begin == std::string::npos) continue;
+    line = line.substr(begin, line.find_last_not_of(" \t\r") - begin + 1);
+    if (line.front() == '[') {
+      if (line.back() != ']') return Status::Error(where + ": malformed section header");
+      section = line.substr(1, line.size() - 2);
+      continue;
+    }
+    const auto eq = line.find('=');
+    if (eq == std::string::npos) return Status::Error(where + ": expected key=value");
+    auto trim = [](std::string s) {
+      const auto b = s.find_first_not_of(" \t");
+      const auto e = s.find_last_not_of(" \t");
+      return b == std::string::npos ? std::string() : s.substr(b, e - b + 1);
+    };
+    const std::string key = trim(line.substr(0, eq));
+    const std::string value = trim(line.substr(eq + 1));
+    auto it = setters.find(key);
+    if (it == setters.end()) {
+      imported.notes.push_back(where + ": [" + section + "] " + key + " = " + value +
+                               " (not used: no equivalent)");
+      continue;
+    }
+    double number_value = 0.0;
+    const auto parsed = std::from_chars(value.data(), value.data() + value.size(), number_value);
+    if (value.empty() || parsed.ec != std::errc() || parsed.ptr != value.data() + value.size() ||
+        !std::isfinite(number_value)) {
+      return Status::Error(where + ": " + key + ": not a number: '" + value + "'");
+    }
+    Status s = it->second(number_value);
+    if (!s.ok()) return Status::Error(where + ": " + key + ": " + s.message());
+  }
+  std::string error;
+  if (!o.IsValid(&error)) return Status::Error(path + ": imported values are invalid: " + error);
+  return imported;
+}
+
+}  // namespace ratslam

@@ -1,0 +1,37 @@
+// Configuration files: TOML with one section per component (see configs/README.md). Unknown
+// sections and keys, wrong types and out-of-range values are errors that name the file and line.
+// Also an importer for OpenRatSLAM's INI configuration files.
+#ifndef RATSLAM_FUSION_IO_CONFIG_H_
+#define RATSLAM_FUSION_IO_CONFIG_H_
+
+#include <string>
+#include <vector>
+
+#include "fusion/replay_pipeline.h"
+#include "ratslam/status.h"
+
+namespace ratslam {
+
+// Parses TOML text; `source_name` is used in error messages ("file:line: ...").
+StatusOr<PipelineOptions> ParseConfig(const std::string& text, const std::string& source_name);
+StatusOr<PipelineOptions> LoadConfigFile(const std::string& path);
+
+// The resolved configuration as TOML, every key present; with `comments`, each key is preceded
+// by its documentation line. ParseConfig(PrintConfig(x)) == x.
+std::string PrintConfig(const PipelineOptions& options, bool comments = true);
+
+// A stable 64-bit fingerprint of the resolved configuration (FNV-1a of PrintConfig without
+// comments), stored in map files so that a map is resumed only with the config that made it.
+uint64_t ConfigFingerprint(const PipelineOptions& options);
+
+struct ImportedConfig {
+  PipelineOptions options;
+  std::vector<std::string> notes;  // keys that were not mapped, with their lines
+};
+// Reads an OpenRatSLAM INI file (sections [general], [ratslam], [draw], ...), maps its RatSLAM
+// keys onto our options (starting from our defaults) and reports every key it did not use.
+StatusOr<ImportedConfig> ImportOpenRatslamIni(const std::string& path);
+
+}  // namespace ratslam
+
+#endif  // RATSLAM_FUSION_IO_CONFIG_H_

@@ -1,0 +1,105 @@
+#include "fusion/io/config.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+namespace ratslam {
+namespace {
+
+std::string ErrorOf(const std::string& text) {
+  StatusOr<PipelineOptions> o = ParseConfig(text, "c.toml");
+  EXPECT_FALSE(o.ok());
+  return o.status().message();
+}
+
+TEST(ConfigTest, DefaultsAreValidAndEmptyFileGivesDefaults) {
+  std::string error;
+  EXPECT_TRUE(PipelineOptions().IsValid(&error)) << error;
+  StatusOr<PipelineOptions> o = ParseConfig("", "empty.toml");
+  ASSERT_TRUE(o.ok());
+  EXPECT_EQ(PrintConfig(o.value()), PrintConfig(PipelineOptions()));
+}
+
+TEST(ConfigTest, ReadsValuesAndAcceptsIntegersForReals) {
+  StatusOr<PipelineOptions> o = ParseConfig(
+      "[pose_cells]\ndim_xy_cells = 30\ncell_size_m = 2\n[camera]\npanoramic = true\n"
+      "[front_end]\nkind = \"classic_camera\"\n",
+      "c.toml");
+  ASSERT_TRUE(o.ok()) << o.status().message();
+  EXPECT_EQ(o->ratslam.pose_cells.dim_xy_cells, 30);
+  EXPECT_EQ(o->ratslam.pose_cells.cell_size_m, 2.0);
+  EXPECT_TRUE(o->camera.panoramic);
+}
+
+TEST(ConfigTest, UnknownKeyNamesLine) {
+  EXPECT_EQ(ErrorOf("[pose_cells]\ndim_xy_cells = 30\ndim_xy_cell = 3\n"),
+            "c.toml:3: unknown key 'dim_xy_cell' in [pose_cells]");
+}
+
+TEST(ConfigTest, UnknownSectionNamesLine) {
+  EXPECT_EQ(ErrorOf("\n[posecells]\nx = 1\n"), "c.toml:2: unknown section 'posecells'");
+}
+
+TEST(ConfigTest, WrongTypeNamesLineAndKey) {
+  EXPECT_EQ(ErrorOf("[experience_map]\n\nrelaxation_sweeps = 2.5\n"),
+            "c.toml:3: [experience_map] relaxation_sweeps: expected an integer");
+  EXPECT_EQ(ErrorOf("[camera]\npanoramic = 1\n"), "c.toml:2: [camera] panoramic: expected true or false");
+}
+
+TEST(ConfigTest, OutOfRangeValueNamesLine) {
+  EXPECT_EQ(ErrorOf("[pose_cells]\n\n\nexcitation_size_cells = 4\n"),
+            "c.toml:4: pose_cells.excitation_size_cells: must be odd and at least 1");
+}
+
+TEST(ConfigTest, BadEnumListsValidNames) {
+  const std::string error = ErrorOf("[front_end]\nkind = \"wifi\"\n");
+  EXPECT_NE(error.find("c.toml:2"), std::string::npos) << error;
+  EXPECT_NE(error.find("valid: classic_camera"), std::string::npos) << error;
+}
+
+TEST(ConfigTest, SyntaxErrorNamesLine) {
+  EXPECT_EQ(ErrorOf("[camera]\nshift_px = = 3\n").rfind("c.toml:2:", 0), 0u);
+}
+
+TEST(ConfigTest, PrintThenParseRoundTrips) {
+  PipelineOptions options;
+  options.ratslam.pose_cells.cell_size_m = 0.1 + 0.2;
+  options.camera.match_threshold = 1e-7;
+  options.ratslam.action.refuse_ambiguous_links = true;
+  StatusOr<PipelineOptions> back = ParseConfig(PrintConfig(options), "printed");
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  EXPECT_EQ(back->ratslam.pose_cells.cell_size_m, 0.1 + 0.2);
+  EXPECT_EQ(back->camera.match_threshold, 1e-7);
+  EXPECT_EQ(PrintConfig(back.value()), PrintConfig(options));
+  EXPECT_EQ(ConfigFingerprint(back.value()), ConfigFingerprint(options));
+  EXPECT_NE(ConfigFingerprint(PipelineOptions()), ConfigFingerprint(options));
+}
+
+TEST(ConfigTest, ImportsOpenRatslamIniAndReportsUnusedKeys) {
+  const auto path = std::filesystem::temp_directory_path() / "ratslam_import_test.ini";
+  std::ofstream(path) << "[general]\ntopic_root=irat_red\n\n[ratslam]\n"
+                         "vt_match_threshold=0.085\npc_dim_xy=30\npc_cell_x_size=0.015\n"
+                         "exp_loops=20\nvt_active_decay = 1.5 ; comment\nvt_panoramic=1\n"
+                         "[draw]\nenable=1\n";
+  StatusOr<ImportedConfig> imported = ImportOpenRatslamIni(path.string());
+  ASSERT_TRUE(imported.ok()) << imported.status().message();
+  const PipelineOptions& o = imported->options;
+  EXPECT_EQ(o.camera.match_threshold, 0.085);
+  EXPECT_EQ(o.ratslam.pose_cells.dim_xy_cells, 30);
+  EXPECT_EQ(o.ratslam.pose_cells.cell_size_m, 0.015);
+  EXPECT_EQ(o.ratslam.experience_map.relaxation_sweeps, 20);
+  EXPECT_EQ(o.ratslam.local_view.decay_floor, 1.5);
+  EXPECT_TRUE(o.camera.panoramic);
+  ASSERT_EQ(imported->notes.size(), 2u);
+  EXPECT_NE(imported->notes[0].find(":2: [general] topic_root"), std::string::npos);
+  std::ofstream(path) << "[ratslam]\npc_dim_xy=thirty\n";
+  StatusOr<ImportedConfig> bad = ImportOpenRatslamIni(path.string());
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.status().message().find(":2: pc_dim_xy: not a number"), std::string::npos);
+  std::filesystem::remove(path);
+}
+
+}  // namespace
+}  // namespace ratslam

@@ -1,0 +1,31 @@
+// Saving and resuming a replay: the whole pipeline state (pose cells, templates, experiences,
+// links, the data-set position and everything recorded so far) in one binary file, written
+// atomically (temporary file, flush to disk, rename). Loading checks every count against the
+// bytes present, so a truncated or corrupt file is an error, never a crash.
+#ifndef RATSLAM_FUSION_IO_MAP_FILE_H_
+#define RATSLAM_FUSION_IO_MAP_FILE_H_
+
+#include <cstdint>
+#include <string>
+
+#include "fusion/replay_pipeline.h"
+#include "ratslam/status.h"
+
+namespace ratslam {
+
+struct MapFile {
+  uint64_t config_fingerprint = 0;  // ConfigFingerprint of the options that made the map
+  std::string dataset_name;
+  ReplayPipeline::State state;
+};
+
+// Serialises to bytes / parses bytes (`source` names the file in errors).
+std::string EncodeMapFile(const MapFile& map);
+StatusOr<MapFile> DecodeMapFile(const std::string& bytes, const std::string& source);
+
+Status SaveMapFile(const MapFile& map, const std::string& path);
+StatusOr<MapFile> LoadMapFile(const std::string& path);
+
+}  // namespace ratslam
+
+#endif  // RATSLAM_FUSION_IO_MAP_FILE_H_

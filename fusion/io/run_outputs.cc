@@ -1,0 +1,179 @@
+#include "fusion/io/run_outputs.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "fusion/io/file_util.h"
+#include "fusion/trajectory_metrics.h"
+#include "ratslam/circular.h"
+
+namespace ratslam {
+namespace {
+
+std::string Num(double value) {
+  char buffer[40];
+  std::snprintf(buffer, sizeof buffer, "%.17g", value);
+  return buffer;
+}
+
+std::string TumLine(double t, double x, double y, double theta) {
+  return Num(t) + " " + Num(x) + " " + Num(y) + " 0 0 0 " + Num(std::sin(theta / 2)) + " " +
+         Num(std::cos(theta / 2)) + "\n";
+}
+
+}  // namespace
+
+void RecordPose(const ExperienceMap& map, const TrajectoryRecord& record, double* x_m,
+                double* y_m, double* theta_rad) {
+  double x = 0, y = 0, theta = 0;
+  if (record.experience_id >= 0) {
+    const Experience& e = map.experience(static_cast<uint32_t>(record.experience_id));
+    x = e.x_m;
+    y = e.y_m;
+    theta = e.theta_rad;
+  }
+  const LocalOffset& o = record.offset;
+  *x_m = x + o.forward_m * std::cos(theta) - o.left_m * std::sin(theta);
+  *y_m = y + o.forward_m * std::sin(theta) + o.left_m * std::cos(theta);
+  *theta_rad = WrapAngle(theta + o.facing_rad);
+}
+
+RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, const RunInfo& info) {
+  const ReplayPipeline::State& state = pipeline.state();
+  const Ratslam& slam = pipeline.slam();
+  const ExperienceMap& map = slam.experience_map();
+  RunSummary s;
+  s.frames = state.frames.size();
+  s.templates = slam.local_view().size();
+  s.experiences = map.num_experiences();
+  s.links = map.num_links();
+  s.loop_closures = slam.counters().loop_closures;
+
+  if (!dataset.ground_truth.empty()) {
+    // The experience map: every experience against the true position at its creation.
+    std::vector<Point2> estimate, truth;
+    for (const Experience& e : map.experiences()) {
+      if (auto gt = InterpolateGroundTruth(dataset.ground_truth, e.time_s)) {
+        estimate.push_back({e.x_m, e.y_m});
+        truth.push_back({gt->x_m, gt->y_m});
+      }
+    }
+    if (auto a = AlignRigid2D(estimate, truth)) s.map_ate_m = a->rmse_m;
+    // The corrected trajectory and raw odometry, at the same odometry times.
+    std::vector<Point2> corrected, odometry;
+    truth.clear();
+    for (const TrajectoryRecord& r : state.trajectory) {
+      if (auto gt = InterpolateGroundTruth(dataset.ground_truth, r.time_s)) {
+        double x, y, theta;
+        RecordPose(map, r, &x, &y, &theta);
+        corrected.push_back({x, y});
+        odometry.push_back({r.odometry_x_m, r.odometry_y_m});
+        truth.push_back({gt->x_m, gt->y_m});
+      }
+    }
+    if (auto a = AlignRigid2D(corrected, truth)) s.trajectory_ate_m = a->rmse_m;
+    if (auto a = AlignRigid2D(odometry, truth)) s.odometry_ate_m = a->rmse_m;
+    s.ate_points = truth.size();
+  }
+
+  nlohmann::ordered_json j;
+  j["dataset"] = dataset.name;
+  j["frames"] = s.frames;
+  j["templates"] = s.templates;
+  j["experiences"] = s.experiences;
+  j["links"] = s.links;
+  j["loop_closures"] = s.loop_closures;
+  j["odometry_steps"] = state.trajectory.size();
+  j["view_injections"] = slam.counters().injections;
+  j["refused_ambiguous_links"] = slam.counters().refused_ambiguous;
+  j["wifi_scans_unused"] = state.wifi_scans_seen;
+  j["compass_readings_unused"] = state.compass_readings_seen;
+  j["events_done"] = state.next_event;
+  j["events_total"] = state.events_total;
+  j["finished"] = pipeline.finished();
+  j["interrupted"] = info.interrupted;
+  j["data_time_s"] = state.trajectory.empty() ? 0.0 : state.trajectory.back().time_s;
+  j["wall_seconds"] = info.wall_seconds;
+  j["frames_per_second"] =
+      info.wall_seconds > 0 ? static_cast<double>(info.frames_this_run) / info.wall_seconds : 0.0;
+  j["config"] = info.config_path.empty() ? "(defaults)" : info.config_path;
+  char fingerprint[20];
+  std::snprintf(fingerprint, sizeof fingerprint, "%016llx",
+                static_cast<unsigned long long>(info.config_fingerprint));
+  j["config_fingerprint"] = fingerprint;
+  if (!info.resumed_from.empty()) j["resumed_from"] = info.resumed_from;
+  if (s.map_ate_m) j["map_ate_m"] = *s.map_ate_m;
+  if (s.trajectory_ate_m) j["trajectory_ate_m"] = *s.trajectory_ate_m;
+  if (s.odometry_ate_m) j["odometry_ate_m"] = *s.odometry_ate_m;
+  if (s.ate_points) j["ate_points"] = s.ate_points;
+  s.json = j.dump(2) + "\n";
+  return s;
+}
+
+StatusOr<RunSummary> WriteRunOutputs(const std::string& folder, const ReplayPipeline& pipeline,
+                                     const Dataset& dataset, const RunInfo& info) {
+  namespace fs = std::filesystem;
+  auto path = [&](const char* name) { return (fs::path(folder) / name).string(); };
+  const ExperienceMap& map = pipeline.slam().experience_map();
+  const ReplayPipeline::State& state = pipeline.state();
+
+  std::ostringstream experiences;
+  experiences << "id,x_m,y_m,theta_rad,template_id,time_s,pose_cell_x,pose_cell_y,pose_cell_theta\n";
+  for (const Experience& e : map.experiences()) {
+    experiences << e.id << ',' << Num(e.x_m) << ',' << Num(e.y_m) << ',' << Num(e.theta_rad) << ','
+                << e.template_id << ',' << Num(e.time_s) << ',' << Num(e.pose_cells.x) << ','
+                << Num(e.pose_cells.y) << ',' << Num(e.pose_cells.theta) << '\n';
+  }
+  RATSLAM_RETURN_IF_ERROR(WriteFileAtomically(path("experiences.csv"), experiences.str()));
+
+  std::ostringstream links;
+  links << "id,from_id,to_id,distance_m,heading_rad,facing_rad,duration_s,loop_closure\n";
+  for (const Link& l : map.links()) {
+    links << l.id << ',' << l.from << ',' << l.to << ',' << Num(l.distance_m) << ','
+          << Num(l.heading_rad) << ',' << Num(l.facing_rad) << ',' << Num(l.duration_s) << ','
+          << (l.loop_closure ? 1 : 0) << '\n';
+  }
+  RATSLAM_RETURN_IF_ERROR(WriteFileAtomically(path("links.csv"), links.str()));
+
+  std::ostringstream trajectory, odometry;
+  trajectory << "# timestamp tx ty tz qx qy qz qw (experience map, final relaxation)\n";
+  odometry << "# timestamp tx ty tz qx qy qz qw (raw odometry)\n";
+  for (const TrajectoryRecord& r : state.trajectory) {
+    double x, y, theta;
+    RecordPose(map, r, &x, &y, &theta);
+    trajectory << TumLine(r.time_s, x, y, theta);
+    odometry << TumLine(r.time_s, r.odometry_x_m, r.odometry_y_m, r.odometry_theta_rad);
+  }
+  RATSLAM_RETURN_IF_ERROR(WriteFileAtomically(path("trajectory_tum.txt"), trajectory.str()));
+  RATSLAM_RETURN_IF_ERROR(WriteFileAtomically(path("odometry_tum.txt"), odometry.str()));
+
+  // g2o: poses, and each link as a relative pose in its source's frame; unit information.
+  std::ostringstream g2o;
+  for (const Experience& e : map.experiences()) {
+    g2o << "VERTEX_SE2 " << e.id << ' ' << Num(e.x_m) << ' ' << Num(e.y_m) << ' '
+        << Num(e.theta_rad) << '\n';
+  }
+  for (const Link& l : map.links()) {
+    g2o << "EDGE_SE2 " << l.from << ' ' << l.to << ' ' << Num(l.distance_m * std::cos(l.heading_rad))
+        << ' ' << Num(l.distance_m * std::sin(l.heading_rad)) << ' ' << Num(l.facing_rad)
+        << " 1 0 0 1 0 1\n";
+  }
+  RATSLAM_RETURN_IF_ERROR(WriteFileAtomically(path("experience_map.g2o"), g2o.str()));
+
+  std::ostringstream frames;
+  frames << "time_s,template_id,new_template,experience_id\n";
+  for (const FrameRecord& f : state.frames) {
+    frames << Num(f.time_s) << ',' << f.template_id << ',' << (f.is_new ? 1 : 0) << ','
+           << f.experience_id << '\n';
+  }
+  RATSLAM_RETURN_IF_ERROR(WriteFileAtomically(path("frames.csv"), frames.str()));
+
+  RunSummary summary = Summarise(pipeline, dataset, info);
+  RATSLAM_RETURN_IF_ERROR(WriteFileAtomically(path("summary.json"), summary.json));
+  return summary;
+}
+
+}  // namespace ratslam

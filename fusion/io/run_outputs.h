@@ -1,0 +1,44 @@
+// What a replay writes beside its outputs: experiences and links (CSV), the trajectory in TUM
+// format, the experience graph in g2o format, and summary.json with counts, speed and, when the
+// data set has ground truth, absolute trajectory errors after rigid alignment.
+#ifndef RATSLAM_FUSION_IO_RUN_OUTPUTS_H_
+#define RATSLAM_FUSION_IO_RUN_OUTPUTS_H_
+
+#include <optional>
+#include <string>
+
+#include "fusion/replay_pipeline.h"
+#include "ratslam/status.h"
+
+namespace ratslam {
+
+struct RunInfo {
+  double wall_seconds = 0.0;        // of this process's replay (not of earlier resumed parts)
+  uint64_t frames_this_run = 0;     // view frames processed by this process
+  bool interrupted = false;         // stopped by a signal
+  std::string config_path;          // as given, or empty for built-in defaults
+  uint64_t config_fingerprint = 0;
+  std::string resumed_from;         // map file, or empty
+};
+
+struct RunSummary {
+  uint64_t frames = 0, templates = 0, experiences = 0, links = 0, loop_closures = 0;
+  std::optional<double> map_ate_m, trajectory_ate_m, odometry_ate_m;
+  size_t ate_points = 0;
+  std::string json;  // the whole summary.json text
+};
+
+// The corrected pose of a trajectory record in the final map.
+void RecordPose(const ExperienceMap& map, const TrajectoryRecord& record, double* x_m,
+                double* y_m, double* theta_rad);
+
+RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, const RunInfo& info);
+
+// Writes experiences.csv, links.csv, trajectory_tum.txt, odometry_tum.txt, experience_map.g2o,
+// frames.csv and summary.json into `folder` (which must exist), each file atomically.
+StatusOr<RunSummary> WriteRunOutputs(const std::string& folder, const ReplayPipeline& pipeline,
+                                     const Dataset& dataset, const RunInfo& info);
+
+}  // namespace ratslam
+
+#endif  // RATSLAM_FUSION_IO_RUN_OUTPUTS_H_

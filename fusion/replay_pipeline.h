@@ -1,0 +1,137 @@
+// Lock-step replay: one loop consumes a data set's time-stamped events in order (compass, Wi-Fi,
+// images, odometry), routes views through the selected front end into the RatSLAM spine, and
+// records what happened. Results depend only on the data and the options, never on wall-clock
+// speed. The whole state can be taken out and put back, so that a replay can stop and resume.
+#ifndef RATSLAM_FUSION_REPLAY_PIPELINE_H_
+#define RATSLAM_FUSION_REPLAY_PIPELINE_H_
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "ratslam/ratslam.h"
+#include "ratslam/status.h"
+#include "sensors/classic_camera_matcher.h"
+#include "sensors/dataset/dataset.h"
+#include "sensors/dataset/image_loader.h"
+
+namespace ratslam {
+
+enum class FrontEndKind { kClassicCamera };
+std::string ToString(FrontEndKind kind);
+// Fails with the list of valid names.
+StatusOr<FrontEndKind> FrontEndKindFromString(const std::string& name);
+
+struct FrontEndOptions {
+  FrontEndKind kind = FrontEndKind::kClassicCamera;  // which front end decides the local view
+
+  bool IsValid(std::string*) const { return true; }
+  template <typename Visitor>
+  void VisitFields(Visitor&& v) {
+    v("kind", kind, "front end that decides the active local view: classic_camera");
+  }
+};
+
+// Everything a replay is configured by; one TOML section per member.
+struct PipelineOptions {
+  FrontEndOptions front_end;
+  ClassicCameraOptions camera;
+  RatslamOptions ratslam;
+
+  bool IsValid(std::string* error) const;
+
+  // Visits (section name, options struct) pairs in file order.
+  template <typename Visitor>
+  void VisitSections(Visitor&& v) {
+    v("front_end", front_end);
+    v("camera", camera);
+    v("pose_cells", ratslam.pose_cells);
+    v("local_view", ratslam.local_view);
+    v("experience_map", ratslam.experience_map);
+    v("action", ratslam.action);
+  }
+};
+
+// One odometry step's outcome: where the map puts the robot (by experience and offset, so that
+// the final relaxed map gives the final trajectory) and where raw odometry puts it.
+struct TrajectoryRecord {
+  double time_s = 0.0;
+  int64_t experience_id = -1;  // -1 before the first experience
+  LocalOffset offset;
+  double odometry_x_m = 0.0, odometry_y_m = 0.0, odometry_theta_rad = 0.0;
+};
+
+// One view frame's outcome, for template graphs.
+struct FrameRecord {
+  double time_s = 0.0;
+  uint32_t template_id = 0;
+  bool is_new = false;
+  int64_t experience_id = -1;  // current experience after the frame
+};
+
+struct ReplayProgress {
+  uint64_t events_done = 0;
+  uint64_t events_total = 0;
+  double data_time_s = 0.0;
+};
+
+struct ReplayControl {
+  double until_time_s = std::numeric_limits<double>::infinity();  // stop after this data time
+  const std::atomic<bool>* stop_requested = nullptr;  // checked between events
+  std::function<void(const ReplayProgress&)> progress;  // called every progress_every events
+  uint64_t progress_every = 500;
+};
+
+class ReplayPipeline {
+ public:
+  struct State {
+    Ratslam::State ratslam;
+    ClassicCameraMatcher::State camera;
+    uint64_t next_event = 0;
+    uint64_t events_total = 0;  // of the data set it was made from
+    double last_odometry_time_s = 0.0;
+    bool have_odometry = false;
+    double odometry_x_m = 0.0, odometry_y_m = 0.0, odometry_theta_rad = 0.0;
+    std::vector<TrajectoryRecord> trajectory;
+    std::vector<FrameRecord> frames;
+    uint64_t wifi_scans_seen = 0;
+    uint64_t compass_readings_seen = 0;
+  };
+
+  // `options` must be valid; throws std::invalid_argument otherwise. `dataset` and `images`
+  // must outlive the pipeline.
+  ReplayPipeline(const PipelineOptions& options, const Dataset& dataset, ImageLoader* images);
+
+  // Replays events from the current position until the data set ends, `until_time_s` passes, or
+  // a stop is requested. On an error the state stays valid up to the last complete event.
+  Status Run(const ReplayControl& control);
+
+  bool finished() const { return state_.next_event >= events_.size(); }
+  const Ratslam& slam() const { return *slam_; }
+  const State& state() const { return state_; }
+  // A snapshot of the complete state (spine included).
+  State Snapshot() const;
+  // Restores a snapshot; fails if it does not belong to this data set and these options.
+  Status Restore(const State& state);
+  const std::vector<Event>& events() const { return events_; }
+
+ private:
+  Status HandleOdometry(const Event& event);
+  Status HandleImage(const Event& event);
+
+  PipelineOptions options_;
+  const Dataset& dataset_;
+  ImageLoader* images_;
+  std::vector<Event> events_;
+  std::unique_ptr<Ratslam> slam_;
+  ClassicCameraMatcher camera_;
+  State state_;  // the parts not held by slam_ and camera_
+};
+
+}  // namespace ratslam
+
+#endif  // RATSLAM_FUSION_REPLAY_PIPELINE_H_
