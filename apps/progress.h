@@ -1,0 +1,29 @@
+// Progress output for long replays: a bar on a terminal, a line every ten percent otherwise.
+#ifndef RATSLAM_APPS_PROGRESS_H_
+#define RATSLAM_APPS_PROGRESS_H_
+
+#include <cstdio>
+#include <string>
+
+#include "fusion/replay_pipeline.h"
+
+namespace ratslam {
+
+class ProgressPrinter {
+ public:
+  // Writes to `stream` (normally stderr); `quiet` prints nothing.
+  ProgressPrinter(std::FILE* stream, bool quiet);
+  void Update(const ReplayProgress& progress);
+  void Finish();
+
+ private:
+  std::FILE* stream_;
+  bool quiet_;
+  bool terminal_;
+  int last_decile_ = -1;
+  bool drew_bar_ = false;
+};
+
+}  // namespace ratslam
+
+#endif  // RATSLAM_APPS_PROGRESS_H_

@@ -1,0 +1,356 @@
+// The `ratslam` command line: replay a data set, run the demo, print or import configurations,
+// and write the built-in synthetic data set.
+#include <atomic>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <limits>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "apps/demo_config.h"
+#include "apps/progress.h"
+#include "fusion/io/config.h"
+#include "fusion/io/file_util.h"
+#include "fusion/io/map_file.h"
+#include "fusion/io/run_outputs.h"
+#include "fusion/replay_pipeline.h"
+#include "sensors/dataset/dataset.h"
+#include "sensors/dataset/image_loader.h"
+#include "sensors/dataset/synthetic_dataset.h"
+
+namespace ratslam {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr int kExitOk = 0;
+constexpr int kExitError = 1;
+constexpr int kExitUsage = 2;
+constexpr int kExitInterrupted = 130;
+
+std::atomic<bool> g_stop_requested{false};
+
+extern "C" void OnSignal(int) { g_stop_requested.store(true); }
+
+const char kUsage[] =
+    "usage:\n"
+    "  ratslam replay --data D --out O [--config C] [--save-map F] [--load-map F]\n"
+    "                 [--until T] [--quiet]\n"
+    "      Replays data set D (a replay-format folder) and writes the map, trajectory and\n"
+    "      summary into O. --until T stops after data time T seconds; --save-map F saves the\n"
+    "      whole state to F; --load-map F resumes from F. Ctrl-C stops cleanly and saves.\n"
+    "  ratslam demo --out O [--quiet]\n"
+    "      Writes the built-in synthetic data set to O/data and replays it into O.\n"
+    "  ratslam print-config [--config C]\n"
+    "      Prints the resolved configuration (the defaults when no file is given).\n"
+    "  ratslam import-openratslam FILE.ini\n"
+    "      Converts an OpenRatSLAM configuration file to ours (TOML on stdout).\n"
+    "  ratslam synthesize --out D [--seed S] [--laps N]\n"
+    "      Writes the built-in synthetic data set into D.\n";
+
+// Parsed "--flag value" pairs and bare flags.
+struct Arguments {
+  std::map<std::string, std::string> values;
+  std::vector<std::string> positional;
+  bool quiet = false;
+};
+
+std::optional<Arguments> ParseArguments(int argc, char** argv, int first,
+                                        const std::vector<std::string>& flags_with_values) {
+  Arguments args;
+  for (int i = first; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--quiet") {
+      args.quiet = true;
+    } else if (a.rfind("--", 0) == 0) {
+      if (std::find(flags_with_values.begin(), flags_with_values.end(), a) ==
+          flags_with_values.end()) {
+        std::cerr << "ratslam: unknown option " << a << "\n";
+        return std::nullopt;
+      }
+      if (i + 1 >= argc) {
+        std::cerr << "ratslam: " << a << " needs a value\n";
+        return std::nullopt;
+      }
+      args.values[a] = argv[++i];
+    } else {
+      args.positional.push_back(a);
+    }
+  }
+  return args;
+}
+
+std::optional<double> ParseNumber(const std::string& flag, const std::string& text) {
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  if (text.empty() || *end != '\0' || !std::isfinite(value)) {
+    std::cerr << "ratslam: " << flag << ": not a number: '" << text << "'\n";
+    return std::nullopt;
+  }
+  return value;
+}
+
+struct ReplayRequest {
+  PipelineOptions options;
+  std::string config_path;  // empty: built-in
+  std::string data;
+  std::string out;
+  std::string save_map;
+  std::string load_map;
+  double until_s = std::numeric_limits<double>::infinity();
+  bool quiet = false;
+};
+
+int RunReplay(const ReplayRequest& request) {
+  StatusOr<Dataset> dataset = ReadDataset(request.data);
+  if (!dataset.ok()) {
+    std::cerr << "ratslam: " << dataset.status().message() << "\n";
+    return kExitError;
+  }
+  std::error_code ec;
+  fs::create_directories(request.out, ec);
+  if (ec) {
+    std::cerr << "ratslam: " << request.out << ": cannot create: " << ec.message() << "\n";
+    return kExitError;
+  }
+  const std::string resolved =
+      "# Resolved configuration of this run (ratslam print-config format).\n" +
+      PrintConfig(request.options);
+  Status written = WriteFileAtomically((fs::path(request.out) / "config.toml").string(), resolved);
+  if (!written.ok()) {
+    std::cerr << "ratslam: " << written.message() << "\n";
+    return kExitError;
+  }
+
+  FileImageLoader images;
+  ReplayPipeline pipeline(request.options, dataset.value(), &images);
+  const uint64_t fingerprint = ConfigFingerprint(request.options);
+  if (!request.load_map.empty()) {
+    StatusOr<MapFile> map = LoadMapFile(request.load_map);
+    if (!map.ok()) {
+      std::cerr << "ratslam: " << map.status().message() << "\n";
+      return kExitError;
+    }
+    if (map->config_fingerprint != fingerprint) {
+      std::cerr << "ratslam: " << request.load_map
+                << ": the map was made with a different configuration\n";
+      return kExitError;
+    }
+    if (map->dataset_name != dataset->name) {
+      std::cerr << "ratslam: " << request.load_map << ": the map was made from data set '"
+                << map->dataset_name << "', not '" << dataset->name << "'\n";
+      return kExitError;
+    }
+    Status restored = pipeline.Restore(map->state);
+    if (!restored.ok()) {
+      std::cerr << "ratslam: " << request.load_map << ": " << restored.message() << "\n";
+      return kExitError;
+    }
+  }
+
+  std::signal(SIGINT, OnSignal);
+  std::signal(SIGTERM, OnSignal);
+  ProgressPrinter progress(stderr, request.quiet);
+  ReplayControl control;
+  control.until_time_s = request.until_s;
+  control.stop_requested = &g_stop_requested;
+  control.progress = [&progress](const ReplayProgress& p) { progress.Update(p); };
+  const uint64_t frames_before = pipeline.state().frames.size();
+  const auto start = std::chrono::steady_clock::now();
+  const Status run = pipeline.Run(control);
+  const double wall_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  progress.Finish();
+  std::signal(SIGINT, SIG_DFL);
+  std::signal(SIGTERM, SIG_DFL);
+  const bool interrupted = g_stop_requested.load();
+
+  // Whatever happened, write what exists.
+  RunInfo info;
+  info.wall_seconds = wall_seconds;
+  info.frames_this_run = pipeline.state().frames.size() - frames_before;
+  info.interrupted = interrupted;
+  info.config_path = request.config_path;
+  info.config_fingerprint = fingerprint;
+  info.resumed_from = request.load_map;
+  StatusOr<RunSummary> summary = WriteRunOutputs(request.out, pipeline, dataset.value(), info);
+  if (!summary.ok()) {
+    std::cerr << "ratslam: " << summary.status().message() << "\n";
+    return kExitError;
+  }
+  std::string save_path = request.save_map;
+  if (save_path.empty() && (interrupted || !run.ok())) {
+    save_path = (fs::path(request.out) / "interrupted.map").string();
+  }
+  if (!save_path.empty()) {
+    MapFile map{fingerprint, dataset->name, pipeline.Snapshot()};
+    Status saved = SaveMapFile(map, save_path);
+    if (!saved.ok()) {
+      std::cerr << "ratslam: " << saved.message() << "\n";
+      return kExitError;
+    }
+  }
+  std::cout << summary->json;
+  if (!run.ok()) {
+    std::cerr << "ratslam: " << run.message() << "\n"
+              << "ratslam: outputs up to the last complete event are in " << request.out
+              << "; the state is saved in " << save_path << "\n";
+    return kExitError;
+  }
+  if (interrupted) {
+    std::cerr << "ratslam: interrupted; state saved in " << save_path << "\n";
+    return kExitInterrupted;
+  }
+  return kExitOk;
+}
+
+std::optional<PipelineOptions> LoadOptions(const Arguments& args, std::string* path) {
+  auto it = args.values.find("--config");
+  if (it == args.values.end()) return PipelineOptions();
+  *path = it->second;
+  StatusOr<PipelineOptions> options = LoadConfigFile(it->second);
+  if (!options.ok()) {
+    std::cerr << "ratslam: " << options.status().message() << "\n";
+    return std::nullopt;
+  }
+  return options.value();
+}
+
+int Replay(int argc, char** argv) {
+  auto args = ParseArguments(argc, argv, 2,
+                             {"--config", "--data", "--out", "--save-map", "--load-map", "--until"});
+  if (!args || !args->positional.empty() || !args->values.count("--data") ||
+      !args->values.count("--out")) {
+    std::cerr << kUsage;
+    return kExitUsage;
+  }
+  ReplayRequest request;
+  auto options = LoadOptions(*args, &request.config_path);
+  if (!options) return kExitError;
+  request.options = *options;
+  request.data = args->values["--data"];
+  request.out = args->values["--out"];
+  request.save_map = args->values.count("--save-map") ? args->values["--save-map"] : "";
+  request.load_map = args->values.count("--load-map") ? args->values["--load-map"] : "";
+  if (args->values.count("--until")) {
+    auto until = ParseNumber("--until", args->values["--until"]);
+    if (!until) return kExitUsage;
+    request.until_s = *until;
+  }
+  request.quiet = args->quiet;
+  return RunReplay(request);
+}
+
+int Synthesize(const SyntheticOptions& options, const std::string& folder) {
+  StatusOr<Dataset> d = WriteSyntheticDataset(options, folder);
+  if (!d.ok()) {
+    std::cerr << "ratslam: " << d.status().message() << "\n";
+    return kExitError;
+  }
+  std::cerr << "ratslam: wrote " << d->images.size() << " frames of '" << d->name << "' to "
+            << folder << "\n";
+  return kExitOk;
+}
+
+int Demo(int argc, char** argv) {
+  auto args = ParseArguments(argc, argv, 2, {"--out"});
+  if (!args || !args->positional.empty() || !args->values.count("--out")) {
+    std::cerr << kUsage;
+    return kExitUsage;
+  }
+  const std::string out = args->values["--out"];
+  const std::string data = (fs::path(out) / "data").string();
+  if (int code = Synthesize(DemoSyntheticOptions(), data); code != kExitOk) return code;
+  ReplayRequest request;
+  request.options = DemoPipelineOptions();
+  request.config_path = "(built-in demo configuration, as configs/demo.toml)";
+  request.data = data;
+  request.out = out;
+  request.quiet = args->quiet;
+  return RunReplay(request);
+}
+
+int PrintConfigCommand(int argc, char** argv) {
+  auto args = ParseArguments(argc, argv, 2, {"--config"});
+  if (!args || !args->positional.empty()) {
+    std::cerr << kUsage;
+    return kExitUsage;
+  }
+  std::string path;
+  auto options = LoadOptions(*args, &path);
+  if (!options) return kExitError;
+  std::cout << PrintConfig(*options);
+  return kExitOk;
+}
+
+int ImportOpenRatslam(int argc, char** argv) {
+  auto args = ParseArguments(argc, argv, 2, {});
+  if (!args || args->positional.size() != 1) {
+    std::cerr << kUsage;
+    return kExitUsage;
+  }
+  StatusOr<ImportedConfig> imported = ImportOpenRatslamIni(args->positional[0]);
+  if (!imported.ok()) {
+    std::cerr << "ratslam: " << imported.status().message() << "\n";
+    return kExitError;
+  }
+  std::cout << "# Imported from " << args->positional[0] << ".\n";
+  for (const std::string& note : imported->notes) {
+    std::cout << "# " << note << "\n";
+    std::cerr << "ratslam: " << note << "\n";
+  }
+  std::cout << PrintConfig(imported->options);
+  return kExitOk;
+}
+
+int SynthesizeCommand(int argc, char** argv) {
+  auto args = ParseArguments(argc, argv, 2, {"--out", "--seed", "--laps"});
+  if (!args || !args->positional.empty() || !args->values.count("--out")) {
+    std::cerr << kUsage;
+    return kExitUsage;
+  }
+  SyntheticOptions options = DemoSyntheticOptions();
+  if (args->values.count("--seed")) {
+    auto seed = ParseNumber("--seed", args->values["--seed"]);
+    if (!seed || *seed < 0) return kExitUsage;
+    options.seed = static_cast<uint64_t>(*seed);
+  }
+  if (args->values.count("--laps")) {
+    auto laps = ParseNumber("--laps", args->values["--laps"]);
+    if (!laps) return kExitUsage;
+    options.laps = static_cast<int>(*laps);
+  }
+  return Synthesize(options, args->values["--out"]);
+}
+
+}  // namespace
+}  // namespace ratslam
+
+int main(int argc, char** argv) {
+  using namespace ratslam;
+  if (argc < 2) {
+    std::cerr << kUsage;
+    return kExitUsage;
+  }
+  const std::string command = argv[1];
+  if (command == "replay") return Replay(argc, argv);
+  if (command == "demo") return Demo(argc, argv);
+  if (command == "print-config") return PrintConfigCommand(argc, argv);
+  if (command == "import-openratslam") return ImportOpenRatslam(argc, argv);
+  if (command == "synthesize") return SynthesizeCommand(argc, argv);
+  if (command == "--help" || command == "help" || command == "-h") {
+    std::cout << kUsage;
+    return kExitOk;
+  }
+  std::cerr << "ratslam: unknown command '" << command << "'\n" << kUsage;
+  return kExitUsage;
+}

@@ -1,0 +1,179 @@
+// Runs the `ratslam` program as a user would and checks its outputs.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "apps/demo_config.h"
+#include "sensors/dataset/synthetic_dataset.h"
+
+namespace ratslam {
+namespace {
+namespace fs = std::filesystem;
+
+const char* const kOutputs[] = {"experiences.csv", "links.csv", "trajectory_tum.txt",
+                                "odometry_tum.txt", "experience_map.g2o", "frames.csv",
+                                "config.toml"};
+
+std::string Slurp(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+struct Result {
+  int exit_code;
+  std::string err;
+};
+
+Result RunRatslam(const std::string& arguments, const fs::path& scratch) {
+  const fs::path err = scratch / "stderr.txt";
+  const std::string command = std::string(RATSLAM_BINARY) + " " + arguments + " > " +
+                              (scratch / "stdout.txt").string() + " 2> " + err.string();
+  const int status = std::system(command.c_str());
+  return {WEXITSTATUS(status), Slurp(err)};
+}
+
+nlohmann::json Summary(const fs::path& out) {
+  return nlohmann::json::parse(Slurp(out / "summary.json"));
+}
+
+class ReplayEndToEndTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    root_ = fs::temp_directory_path() / ("ratslam_e2e_" + std::to_string(::getpid()));
+    fs::remove_all(root_);
+    fs::create_directories(root_);
+    StatusOr<Dataset> d = WriteSyntheticDataset(DemoSyntheticOptions(), (root_ / "data").string());
+    ASSERT_TRUE(d.ok()) << d.status().message();
+    config_ = (fs::path(RATSLAM_SOURCE_DIR) / "configs" / "demo.toml").string();
+  }
+  static void TearDownTestSuite() { fs::remove_all(root_); }
+  static std::string ReplayArgs(const fs::path& out) {
+    return "replay --quiet --config " + config_ + " --data " + (root_ / "data").string() +
+           " --out " + out.string();
+  }
+  static fs::path root_;
+  static std::string config_;
+};
+fs::path ReplayEndToEndTest::root_;
+std::string ReplayEndToEndTest::config_;
+
+TEST_F(ReplayEndToEndTest, DemoDataClosesLoopsAndBeatsOdometry) {
+  const fs::path out = root_ / "full";
+  ASSERT_EQ(RunRatslam(ReplayArgs(out), root_).exit_code, 0);
+  const nlohmann::json s = Summary(out);
+  EXPECT_EQ(s["finished"], true);
+  EXPECT_EQ(s["frames"], 3634);
+  EXPECT_GT(s["loop_closures"].get<int>(), 10);
+  // Raw odometry drifts by metres over three laps; the map must be several times better.
+  const double map_ate = s["map_ate_m"], odometry_ate = s["odometry_ate_m"];
+  EXPECT_GT(odometry_ate, 3.0);
+  EXPECT_LT(map_ate, 0.2 * odometry_ate) << "map " << map_ate << " odometry " << odometry_ate;
+  for (const char* name : kOutputs) EXPECT_TRUE(fs::exists(out / name)) << name;
+  // g2o: one vertex per experience, one edge per link.
+  const std::string g2o = Slurp(out / "experience_map.g2o");
+  size_t vertices = 0, edges = 0;
+  for (size_t p = g2o.find("VERTEX_SE2"); p != std::string::npos; p = g2o.find("VERTEX_SE2", p + 1))
+    ++vertices;
+  for (size_t p = g2o.find("EDGE_SE2"); p != std::string::npos; p = g2o.find("EDGE_SE2", p + 1))
+    ++edges;
+  EXPECT_EQ(vertices, s["experiences"].get<size_t>());
+  EXPECT_EQ(edges, s["links"].get<size_t>());
+}
+
+TEST_F(ReplayEndToEndTest, SameInputSameOutputBitForBit) {
+  const fs::path a = root_ / "det_a", b = root_ / "det_b";
+  ASSERT_EQ(RunRatslam(ReplayArgs(a), root_).exit_code, 0);
+  ASSERT_EQ(RunRatslam(ReplayArgs(b), root_).exit_code, 0);
+  for (const char* name : kOutputs) EXPECT_EQ(Slurp(a / name), Slurp(b / name)) << name;
+}
+
+TEST_F(ReplayEndToEndTest, SaveAndResumeEqualsUninterruptedRun) {
+  const fs::path whole = root_ / "whole", part = root_ / "part", rest = root_ / "rest";
+  const fs::path map = root_ / "half.map";
+  ASSERT_EQ(RunRatslam(ReplayArgs(whole), root_).exit_code, 0);
+  ASSERT_EQ(RunRatslam(ReplayArgs(part) + " --until 150 --save-map " + map.string(), root_).exit_code, 0);
+  EXPECT_EQ(Summary(part)["finished"], false);
+  EXPECT_LE(Summary(part)["data_time_s"].get<double>(), 150.0);
+  ASSERT_EQ(RunRatslam(ReplayArgs(rest) + " --load-map " + map.string(), root_).exit_code, 0);
+  for (const char* name : kOutputs) EXPECT_EQ(Slurp(whole / name), Slurp(rest / name)) << name;
+  nlohmann::json a = Summary(whole), b = Summary(rest);
+  for (auto* j : {&a, &b}) {
+    j->erase("wall_seconds");
+    j->erase("frames_per_second");
+    j->erase("resumed_from");
+  }
+  EXPECT_EQ(a, b);
+}
+
+TEST_F(ReplayEndToEndTest, ResumeWithAnotherConfigIsRefused) {
+  const fs::path part = root_ / "part2", map = root_ / "part2.map";
+  ASSERT_EQ(RunRatslam(ReplayArgs(part) + " --until 20 --save-map " + map.string(), root_).exit_code, 0);
+  const Result r = RunRatslam("replay --quiet --data " + (root_ / "data").string() + " --out " +
+                           (root_ / "other").string() + " --load-map " + map.string(),
+                       root_);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("different configuration"), std::string::npos) << r.err;
+}
+
+TEST_F(ReplayEndToEndTest, BadConfigNamesLineAndRunsNothing) {
+  const fs::path bad = root_ / "bad.toml";
+  std::ofstream(bad) << "[camera]\nmatch_threshold = 0.03\nmatch_treshold = 0.1\n";
+  const Result r = RunRatslam("replay --quiet --config " + bad.string() + " --data " +
+                           (root_ / "data").string() + " --out " + (root_ / "bad").string(),
+                       root_);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("bad.toml:3: unknown key 'match_treshold' in [camera]"), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(root_ / "bad" / "summary.json"));
+}
+
+TEST_F(ReplayEndToEndTest, MissingImageKeepsOutputsAndStateThenResumes) {
+  // A copy of the data set with one image missing in the middle.
+  const fs::path data = root_ / "broken_data";
+  fs::copy(root_ / "data", data, fs::copy_options::recursive);
+  const fs::path image = data / "images" / "001000.png";
+  const fs::path aside = root_ / "001000.png";
+  fs::rename(image, aside);
+  const fs::path out = root_ / "broken";
+  const Result r = RunRatslam("replay --quiet --config " + config_ + " --data " + data.string() +
+                           " --out " + out.string(),
+                       root_);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("images.csv:1002"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("image file missing"), std::string::npos) << r.err;
+  const nlohmann::json partial = Summary(out);
+  EXPECT_EQ(partial["finished"], false);
+  EXPECT_EQ(partial["frames"], 1000);
+  ASSERT_TRUE(fs::exists(out / "interrupted.map"));
+  // Put the image back and resume from the saved state: same result as an unbroken run.
+  fs::rename(aside, image);
+  const fs::path resumed = root_ / "resumed";
+  ASSERT_EQ(RunRatslam("replay --quiet --config " + config_ + " --data " + data.string() + " --out " +
+                    resumed.string() + " --load-map " + (out / "interrupted.map").string(),
+                root_)
+                .exit_code,
+            0);
+  const fs::path whole = root_ / "whole_for_broken";
+  ASSERT_EQ(RunRatslam(ReplayArgs(whole), root_).exit_code, 0);
+  EXPECT_EQ(Slurp(whole / "experiences.csv"), Slurp(resumed / "experiences.csv"));
+  EXPECT_EQ(Slurp(whole / "trajectory_tum.txt"), Slurp(resumed / "trajectory_tum.txt"));
+}
+
+TEST_F(ReplayEndToEndTest, PrintConfigFailsWithLineNumber) {
+  const fs::path bad = root_ / "bad2.toml";
+  std::ofstream(bad) << "[pose_cells]\n\ndim_theta_cells = \"many\"\n";
+  const Result r = RunRatslam("print-config --config " + bad.string(), root_);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("bad2.toml:3: [pose_cells] dim_theta_cells: expected an integer"),
+            std::string::npos)
+      << r.err;
+}
+
+}  // namespace
+}  // namespace ratslam
