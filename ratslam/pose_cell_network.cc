@@ -90,21 +90,30 @@ PoseCellNetwork::PoseCellNetwork(const PoseCellOptions& options) : options_(opti
   scratch_b_.assign(cells, 0.0);
   residual_x_.assign(dim_t_, 0.0);
   residual_y_.assign(dim_t_, 0.0);
+  for (int i = 0; i < dim_x_; ++i) phasors_x_.push_back(std::polar(1.0, kTwoPi * i / dim_x_));
+  for (int i = 0; i < dim_t_; ++i) phasors_t_.push_back(std::polar(1.0, kTwoPi * i / dim_t_));
+  marks_scratch_[0].assign(dim_x_, 0);
+  marks_scratch_[1].assign(dim_y_, 0);
+  marks_scratch_[2].assign(dim_t_, 0);
   Reset({dim_x_ / 2.0, dim_y_ / 2.0, 0.0});
 }
 
 template <typename Fn>
 void PoseCellNetwork::ForEachInBox(const Box& box, Fn&& fn) const {
+  // Wrapped coordinates advance incrementally: no division per cell.
+  int t = box[2].start;
   for (int it = 0; it < box[2].length; ++it) {
-    const int t = (box[2].start + it) % dim_t_;
+    int y = box[1].start;
     for (int iy = 0; iy < box[1].length; ++iy) {
-      const int y = (box[1].start + iy) % dim_y_;
       const int row = Index(0, y, t);
+      int x = box[0].start;
       for (int ix = 0; ix < box[0].length; ++ix) {
-        const int x = (box[0].start + ix) % dim_x_;
         fn(x, y, t, row + x);
+        if (++x == dim_x_) x = 0;
       }
+      if (++y == dim_y_) y = 0;
     }
+    if (++t == dim_t_) t = 0;
   }
 }
 
@@ -128,7 +137,7 @@ void PoseCellNetwork::Reset(const PoseCellPosition& position) {
 PoseCellNetwork::Box PoseCellNetwork::ConvolveAxis(const std::vector<double>& kernel, int axis,
                                                    const Box& in_box,
                                                    const std::vector<double>& in,
-                                                   std::vector<double>& out) const {
+                                                   std::vector<double>& out, bool grow) const {
   const int sizes[3] = {dim_x_, dim_y_, dim_t_};
   const int strides[3] = {1, dim_x_, dim_x_ * dim_y_};
   const int n = sizes[axis];
@@ -136,13 +145,18 @@ PoseCellNetwork::Box PoseCellNetwork::ConvolveAxis(const std::vector<double>& ke
   const Interval in_interval = in_box[axis];
   Box out_box = in_box;
   Interval& out_interval = out_box[axis];
-  if (in_interval.length + 2 * radius >= n) {
+  if (!grow) {
+    out_interval = in_interval;
+  } else if (in_interval.length + 2 * radius >= n) {
     out_interval = {0, n};
   } else {
     out_interval = {WrapIndex(in_interval.start - radius, n), in_interval.length + 2 * radius};
   }
   // offsets[j] is the memory offset of axis position out.start - radius + j.
-  std::vector<int> offsets(out_interval.length + 2 * radius);
+  std::vector<int>& offsets = offsets_scratch_;
+  offsets.resize(out_interval.length + 2 * radius);
+  line_scratch_.resize(offsets.size());
+  acc_scratch_.resize(offsets.size());
   for (size_t j = 0; j < offsets.size(); ++j) {
     offsets[j] =
         WrapIndex(static_cast<long long>(out_interval.start) - radius + static_cast<long long>(j),
@@ -160,21 +174,27 @@ PoseCellNetwork::Box PoseCellNetwork::ConvolveAxis(const std::vector<double>& ke
       const int base = a * strides[other_a] + b * strides[other_b];
       const double* src = in.data() + base;
       double* dst = out.data() + base;
-      for (int o = 0; o < out_interval.length; ++o) {
-        const int* taps = offsets.data() + o;
-        double sum = 0.0;
-        for (int k = 0; k < ksize; ++k) sum += weights[k] * src[taps[k]];
-        dst[taps[radius]] = sum;
+      // Gather the (wrapped) input line, then accumulate tap by tap over the whole output line:
+      // the inner loop has no dependency chain and vectorises; each output still sums its taps
+      // in kernel order.
+      double* line = line_scratch_.data();
+      double* acc = acc_scratch_.data();
+      for (size_t j = 0; j < offsets.size(); ++j) line[j] = src[offsets[j]];
+      for (int o = 0; o < out_interval.length; ++o) acc[o] = 0.0;
+      for (int k = 0; k < ksize; ++k) {
+        const double w = weights[k];
+        const double* shifted = line + k;
+        for (int o = 0; o < out_interval.length; ++o) acc[o] += w * shifted[o];
       }
+      for (int o = 0; o < out_interval.length; ++o) dst[offsets[o + radius]] = acc[o];
     }
   }
   return out_box;
 }
 
 PoseCellNetwork::Box PoseCellNetwork::SupportOf(const Box& box) const {
-  std::vector<uint8_t> marks[3] = {std::vector<uint8_t>(dim_x_, 0),
-                                   std::vector<uint8_t>(dim_y_, 0),
-                                   std::vector<uint8_t>(dim_t_, 0)};
+  std::vector<uint8_t>* marks = marks_scratch_;
+  for (int axis = 0; axis < 3; ++axis) std::fill(marks[axis].begin(), marks[axis].end(), 0);
   bool any = false;
   ForEachInBox(box, [&](int x, int y, int t, int index) {
     if (activity_[index] != 0.0) {
@@ -219,14 +239,16 @@ void PoseCellNetwork::Step(double forward_m, double rotation_rad) {
   const Box excited = ConvolveAxis(excitation_kernel_, 2, b2, activity_, scratch_a_);
   ZeroBox(b2, activity_);
 
-  // Local inhibition: I = E (*) K_inhibition, into activity_.
-  const Box c1 = ConvolveAxis(inhibition_kernel_, 0, excited, scratch_a_, activity_);
-  const Box c2 = ConvolveAxis(inhibition_kernel_, 1, c1, activity_, scratch_b_);
-  ZeroBox(c1, activity_);
-  const Box inhibited = ConvolveAxis(inhibition_kernel_, 2, c2, scratch_b_, activity_);
-  ZeroBox(c2, scratch_b_);
+  // Local inhibition: I = E (*) K_inhibition, into activity_. Outside the excited box E is 0,
+  // so E - I - global_inhibition < 0 there and the result is 0: I is needed only inside that
+  // box, and as E is zero outside it at every separable stage, each pass may be clipped to it.
+  const Box& inhibited = excited;
+  ConvolveAxis(inhibition_kernel_, 0, excited, scratch_a_, activity_, /*grow=*/false);
+  ConvolveAxis(inhibition_kernel_, 1, excited, activity_, scratch_b_, /*grow=*/false);
+  ConvolveAxis(inhibition_kernel_, 2, excited, scratch_b_, activity_, /*grow=*/false);
+  ZeroBox(excited, scratch_b_);
 
-  // A = max(E - I - global_inhibition, 0). The inhibited box contains the excited one.
+  // A = max(E - I - global_inhibition, 0).
   const double global = options_.global_inhibition;
   double total = 0.0;
   ForEachInBox(inhibited, [&](int, int, int, int index) {
@@ -362,14 +384,36 @@ PoseCellPosition PoseCellNetwork::BestPosition() const {
     return 2 * r + 1 >= n ? Interval{0, n} : Interval{WrapIndex(center - r, n), 2 * r + 1};
   };
   const Box box = {window(best_x, dim_x_), window(best_y, dim_y_), window(best_t, dim_t_)};
+  // Per-layer sums of the cell phasors, then one rotation by each layer's residual phasor:
+  // sum over cells of a * e^{i 2 pi (x + r_t) / n} = sum_t e^{i 2 pi r_t / n} sum_{x,y} a e^{...}.
   std::complex<double> sum_x, sum_y, sum_t;
-  ForEachInBox(box, [&](int x, int y, int t, int index) {
-    const double a = activity_[index];
-    if (a == 0.0) return;
-    sum_x += std::polar(a, kTwoPi * (x + residual_x_[t]) / dim_x_);
-    sum_y += std::polar(a, kTwoPi * (y + residual_y_[t]) / dim_y_);
-    sum_t += std::polar(a, kTwoPi * (t + residual_theta_) / dim_t_);
-  });
+  int t = box[2].start;
+  for (int it = 0; it < box[2].length; ++it) {
+    std::complex<double> layer_x, layer_y;
+    double layer_total = 0.0;
+    int y = box[1].start;
+    for (int iy = 0; iy < box[1].length; ++iy) {
+      int x = box[0].start;
+      const double* row = activity_.data() + Index(0, y, t);
+      double row_total = 0.0;
+      for (int ix = 0; ix < box[0].length; ++ix) {
+        const double a = row[x];
+        layer_x += a * phasors_x_[x];
+        row_total += a;
+        if (++x == dim_x_) x = 0;
+      }
+      layer_y += row_total * phasors_x_[y];  // dim_y_ == dim_x_
+      layer_total += row_total;
+      if (++y == dim_y_) y = 0;
+    }
+    if (layer_total > 0.0) {
+      sum_x += layer_x * std::polar(1.0, kTwoPi * residual_x_[t] / dim_x_);
+      sum_y += layer_y * std::polar(1.0, kTwoPi * residual_y_[t] / dim_y_);
+      sum_t += layer_total * phasors_t_[t];
+    }
+    if (++t == dim_t_) t = 0;
+  }
+  sum_t *= std::polar(1.0, kTwoPi * residual_theta_ / dim_t_);
   return {CircularMean(sum_x, dim_x_), CircularMean(sum_y, dim_y_), CircularMean(sum_t, dim_t_)};
 }
 

@@ -13,6 +13,7 @@
 #define RATSLAM_POSE_CELL_NETWORK_H_
 
 #include <array>
+#include <complex>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -114,9 +115,11 @@ class PoseCellNetwork {
 
   int Index(int x, int y, int theta) const { return (theta * dim_y_ + y) * dim_x_ + x; }
   // Convolves `in` (zero outside `in_box`) with a 1D kernel along `axis`, writing the result
-  // into `out` (which must be zero over the returned box); returns the grown box.
+  // into `out` over the returned box: `in_box` grown by the kernel radius, or `in_box` itself
+  // (the result clipped to it) when `grow` is false.
   Box ConvolveAxis(const std::vector<double>& kernel, int axis, const Box& in_box,
-                   const std::vector<double>& in, std::vector<double>& out) const;
+                   const std::vector<double>& in, std::vector<double>& out,
+                   bool grow = true) const;
   void ZeroBox(const Box& box, std::vector<double>& buffer) const;
   // The minimal box holding every non-zero cell of activity_ inside `box`.
   Box SupportOf(const Box& box) const;
@@ -134,6 +137,11 @@ class PoseCellNetwork {
   Box box_;  // activity_ is zero outside it
   std::vector<double> residual_x_, residual_y_;
   double residual_theta_ = 0.0;
+  std::vector<std::complex<double>> phasors_x_;  // e^{i 2 pi x / dim_x}, also used for y
+  std::vector<std::complex<double>> phasors_t_;  // e^{i 2 pi t / dim_theta}
+  mutable std::vector<int> offsets_scratch_;
+  mutable std::vector<double> line_scratch_, acc_scratch_;
+  mutable std::vector<uint8_t> marks_scratch_[3];
 };
 
 }  // namespace ratslam

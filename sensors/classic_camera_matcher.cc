@@ -5,8 +5,9 @@
 #include <numbers>
 #include <stdexcept>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
+#if defined(__x86_64__)
+#include <immintrin.h>
+#define RATSLAM_HAVE_X86_SIMD 1
 #endif
 
 #include "ratslam/circular.h"
@@ -59,9 +60,10 @@ PreparedQuery Prepare(const std::vector<uint8_t>& query, const std::vector<int>&
 }
 
 // Sum of absolute differences between a stored template (masked) and one prepared shift.
-inline uint32_t MaskedSad(const uint8_t* stored, const uint8_t* prepared, const uint8_t* mask,
-                          int height, int stride) {
-#if defined(__SSE2__)
+// Rows are padded to a multiple of 32 bytes with zeros.
+inline uint32_t MaskedSadPortable(const uint8_t* stored, const uint8_t* prepared,
+                                  const uint8_t* mask, int height, int stride) {
+#if defined(RATSLAM_HAVE_X86_SIMD)
   __m128i acc = _mm_setzero_si128();
   for (int r = 0; r < height; ++r) {
     const uint8_t* t = stored + static_cast<size_t>(r) * stride;
@@ -85,6 +87,54 @@ inline uint32_t MaskedSad(const uint8_t* stored, const uint8_t* prepared, const 
   }
   return sum;
 #endif
+}
+
+#if defined(RATSLAM_HAVE_X86_SIMD)
+__attribute__((target("avx2"))) inline uint32_t MaskedSadAvx2(const uint8_t* stored,
+                                                               const uint8_t* prepared,
+                                                               const uint8_t* mask, int height,
+                                                               int stride) {
+  __m256i acc = _mm256_setzero_si256();
+  for (int r = 0; r < height; ++r) {
+    const uint8_t* t = stored + static_cast<size_t>(r) * stride;
+    const uint8_t* q = prepared + static_cast<size_t>(r) * stride;
+    for (int c = 0; c < stride; c += 32) {
+      const __m256i tv =
+          _mm256_and_si256(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(t + c)),
+                           _mm256_loadu_si256(reinterpret_cast<const __m256i*>(mask + c)));
+      const __m256i qv = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(q + c));
+      acc = _mm256_add_epi64(acc, _mm256_sad_epu8(tv, qv));
+    }
+  }
+  const __m128i sum = _mm_add_epi64(_mm256_castsi256_si128(acc), _mm256_extracti128_si256(acc, 1));
+  return static_cast<uint32_t>(_mm_cvtsi128_si32(sum) +
+                               _mm_cvtsi128_si32(_mm_unpackhi_epi64(sum, sum)));
+}
+#endif
+
+// Best (difference, template, shift) over all stored templates, with the SAD kernel `Sad`.
+template <uint32_t (*Sad)(const uint8_t*, const uint8_t*, const uint8_t*, int, int)>
+#if defined(RATSLAM_HAVE_X86_SIMD)
+__attribute__((target("avx2")))
+#endif
+void SearchTemplates(const uint8_t* base, uint32_t count, size_t bytes_per_template,
+                     const PreparedQuery& prepared, const std::vector<double>& scale,
+                     const std::vector<int>& shifts, int height, int stride,
+                     TemplateComparison* best) {
+  const size_t per_shift = static_cast<size_t>(height) * stride;
+  for (uint32_t id = 0; id < count; ++id) {
+    const uint8_t* t = base + id * bytes_per_template;
+    for (size_t k = 0; k < shifts.size(); ++k) {
+      const uint32_t sad = Sad(t, prepared.rows.data() + k * per_shift,
+                               prepared.masks.data() + k * stride, height, stride);
+      const double difference = sad * scale[k];
+      if (difference < best->mean_difference) {
+        best->mean_difference = difference;
+        best->template_id = static_cast<int32_t>(id);
+        best->shift_px = shifts[k];
+      }
+    }
+  }
 }
 
 }  // namespace
@@ -128,7 +178,7 @@ ClassicCameraMatcher::ClassicCameraMatcher(const ClassicCameraOptions& options)
     : options_(options) {
   std::string error;
   if (!options.IsValid(&error)) throw std::invalid_argument("ClassicCameraOptions: " + error);
-  row_stride_ = (options.template_width_px + 15) / 16 * 16;
+  row_stride_ = (options.template_width_px + 31) / 32 * 32;  // whole 32-byte SIMD words
   bytes_per_template_ = static_cast<size_t>(row_stride_) * options.template_height_px;
   for (int s = -options.shift_px; s <= options.shift_px; s += options.shift_step_px) {
     shifts_.push_back(s);
@@ -217,26 +267,21 @@ TemplateComparison ClassicCameraMatcher::Compare(const std::vector<uint8_t>& que
   const int h = options_.template_height_px;
   const PreparedQuery prepared = Prepare(query, shifts_, options_.template_width_px, h,
                                          row_stride_, options_.panoramic);
-  const size_t per_shift = static_cast<size_t>(h) * row_stride_;
   std::vector<double> scale(shifts_.size());
   for (size_t k = 0; k < shifts_.size(); ++k) {
     scale[k] = 1.0 / (255.0 * h * prepared.overlap_columns[k]);
   }
   const uint8_t* base = state_.templates.data();
-  for (uint32_t id = 0; id < state_.template_count; ++id) {
-    const uint8_t* t = base + id * bytes_per_template_;
-    for (size_t k = 0; k < shifts_.size(); ++k) {
-      const uint32_t sad =
-          MaskedSad(t, prepared.rows.data() + k * per_shift,
-                    prepared.masks.data() + k * row_stride_, h, row_stride_);
-      const double difference = sad * scale[k];
-      if (difference < best.mean_difference) {
-        best.mean_difference = difference;
-        best.template_id = static_cast<int32_t>(id);
-        best.shift_px = shifts_[k];
-      }
-    }
+#if defined(RATSLAM_HAVE_X86_SIMD)
+  static const bool kAvx2 = __builtin_cpu_supports("avx2");
+  if (kAvx2) {
+    SearchTemplates<MaskedSadAvx2>(base, state_.template_count, bytes_per_template_, prepared,
+                                   scale, shifts_, h, row_stride_, &best);
+    return best;
   }
+#endif
+  SearchTemplates<MaskedSadPortable>(base, state_.template_count, bytes_per_template_, prepared,
+                                     scale, shifts_, h, row_stride_, &best);
   return best;
 }
 

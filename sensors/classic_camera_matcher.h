@@ -99,7 +99,7 @@ class ClassicCameraMatcher {
 
  private:
   ClassicCameraOptions options_;
-  int row_stride_;  // template width rounded up to a multiple of 16 bytes
+  int row_stride_;  // template width rounded up to a multiple of 32 bytes
   size_t bytes_per_template_;
   std::vector<int> shifts_;
   State state_;
