@@ -1,0 +1,10 @@
+#!/usr/bin/env bash
+# Configures and builds into BUILD_DIR (default build/). Extra arguments go to CMake.
+# Warnings are errors here, as in CI.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+build_dir=${BUILD_DIR:-build}
+generator=()
+command -v ninja >/dev/null && generator=(-G Ninja)
+cmake -S . -B "$build_dir" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release -DRATSLAM_WERROR=ON "$@"
+cmake --build "$build_dir" --parallel "$(nproc)"

@@ -1,0 +1,8 @@
+#!/usr/bin/env bash
+# Fresh Debian 12 machine -> installs packages, builds, and runs the main job: the demo replay of
+# the built-in synthetic data set, writing the map, trajectory and summary into out/demo.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/setup.sh
+bash scripts/build.sh -DRATSLAM_BUILD_TESTS=OFF -DRATSLAM_BUILD_BENCHMARKS=OFF
+./build/apps/ratslam demo --out "${1:-out/demo}"

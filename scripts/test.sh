@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# Fresh Debian 12 machine -> installs packages, builds with warnings as errors, and runs the whole
+# test suite through CTest. SANITIZE=1 builds into build-sanitize/ with address and undefined
+# behaviour sanitizers instead.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/setup.sh
+if [[ "${SANITIZE:-0}" == 1 ]]; then
+  export BUILD_DIR=build-sanitize
+  bash scripts/build.sh -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRATSLAM_SANITIZE=ON \
+    -DRATSLAM_BUILD_BENCHMARKS=OFF
+else
+  export BUILD_DIR=build
+  bash scripts/build.sh
+fi
+ctest --test-dir "$BUILD_DIR" --output-on-failure --parallel "$(nproc)" --timeout 600
