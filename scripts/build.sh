@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Configures and builds into BUILD_DIR (default build/). Extra arguments go to CMake.
+# Configures and builds into BUILD_DIR (default build/); BUILD_TARGET limits the build to one
+# target (default: everything). Extra arguments go to CMake.
 # Warnings are errors here, as in CI.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -7,4 +8,6 @@ build_dir=${BUILD_DIR:-build}
 generator=()
 command -v ninja >/dev/null && generator=(-G Ninja)
 cmake -S . -B "$build_dir" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release -DRATSLAM_WERROR=ON "$@"
-cmake --build "$build_dir" --parallel "$(nproc)"
+target=()
+[[ -n "${BUILD_TARGET:-}" ]] && target=(--target "$BUILD_TARGET")
+cmake --build "$build_dir" --parallel "$(nproc)" "${target[@]}"

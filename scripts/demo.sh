@@ -4,5 +4,5 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
-bash scripts/build.sh -DRATSLAM_BUILD_TESTS=OFF -DRATSLAM_BUILD_BENCHMARKS=OFF
+BUILD_TARGET=ratslam bash scripts/build.sh
 ./build/apps/ratslam demo --out "${1:-out/demo}"
