@@ -26,6 +26,8 @@
 #include "sensors/dataset/dataset.h"
 #include "sensors/dataset/image_loader.h"
 #include "sensors/dataset/synthetic_dataset.h"
+#include "viewer/renderer.h"
+#include "viewer/run_images.h"
 
 namespace ratslam {
 namespace {
@@ -44,12 +46,14 @@ extern "C" void OnSignal(int) { g_stop_requested.store(true); }
 const char kUsage[] =
     "usage:\n"
     "  ratslam replay --data D --out O [--config C] [--save-map F] [--load-map F]\n"
-    "                 [--until T] [--quiet]\n"
+    "                 [--until T] [--render] [--quiet]\n"
     "      Replays data set D (a replay-format folder) and writes the map, trajectory and\n"
     "      summary into O. --until T stops after data time T seconds; --save-map F saves the\n"
     "      whole state to F; --load-map F resumes from F. Ctrl-C stops cleanly and saves.\n"
+    "      --render also writes experience_map.png, template_graph.png and pose_cells.png.\n"
     "  ratslam demo --out O [--quiet]\n"
-    "      Writes the built-in synthetic data set to O/data and replays it into O.\n"
+    "      Writes the built-in synthetic data set to O/data, replays it into O and renders\n"
+    "      the images.\n"
     "  ratslam print-config [--config C]\n"
     "      Prints the resolved configuration (the defaults when no file is given).\n"
     "  ratslam import-openratslam FILE.ini\n"
@@ -62,6 +66,7 @@ struct Arguments {
   std::map<std::string, std::string> values;
   std::vector<std::string> positional;
   bool quiet = false;
+  bool render = false;
 };
 
 std::optional<Arguments> ParseArguments(int argc, char** argv, int first,
@@ -71,6 +76,8 @@ std::optional<Arguments> ParseArguments(int argc, char** argv, int first,
     const std::string a = argv[i];
     if (a == "--quiet") {
       args.quiet = true;
+    } else if (a == "--render") {
+      args.render = true;
     } else if (a.rfind("--", 0) == 0) {
       if (std::find(flags_with_values.begin(), flags_with_values.end(), a) ==
           flags_with_values.end()) {
@@ -108,6 +115,7 @@ struct ReplayRequest {
   std::string load_map;
   double until_s = std::numeric_limits<double>::infinity();
   bool quiet = false;
+  bool render = false;  // write experience_map.png, template_graph.png, pose_cells.png
 };
 
 int RunReplay(const ReplayRequest& request) {
@@ -200,6 +208,16 @@ int RunReplay(const ReplayRequest& request) {
     }
   }
   std::cout << summary->json;
+  if (request.render) {
+    StatusOr<std::unique_ptr<SceneRenderer>> renderer = CreateOsMesaRenderer();
+    Status rendered = renderer.ok() ? WriteRunImages(*renderer.value(), pipeline, dataset.value(),
+                                                     request.out)
+                                    : renderer.status();
+    if (!rendered.ok()) {
+      std::cerr << "ratslam: images not written: " << rendered.message() << "\n";
+      return kExitError;
+    }
+  }
   if (!run.ok()) {
     std::cerr << "ratslam: " << run.message() << "\n"
               << "ratslam: outputs up to the last complete event are in " << request.out
@@ -247,6 +265,7 @@ int Replay(int argc, char** argv) {
     request.until_s = *until;
   }
   request.quiet = args->quiet;
+  request.render = args->render;
   return RunReplay(request);
 }
 
@@ -276,6 +295,7 @@ int Demo(int argc, char** argv) {
   request.data = data;
   request.out = out;
   request.quiet = args->quiet;
+  request.render = true;
   return RunReplay(request);
 }
 

@@ -1,0 +1,458 @@
+#include "viewer/figures.h"
+
+#include "viewer/image.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <numbers>
+
+namespace ratslam {
+namespace {
+
+constexpr Rgba kWhite{255, 255, 255, 255};
+constexpr Rgba kInk{30, 30, 30, 255};
+constexpr Rgba kGrid{225, 225, 225, 255};
+constexpr Rgba kLoopClosure{220, 50, 32, 255};
+constexpr Rgba kGroundTruth{160, 160, 160, 200};
+
+std::string FormatNumber(double value) {
+  char buffer[32];
+  if (std::abs(value) >= 1e5 || (std::abs(value) < 1e-3 && value != 0.0)) {
+    std::snprintf(buffer, sizeof buffer, "%.3g", value);
+  } else {
+    std::snprintf(buffer, sizeof buffer, "%.6g", value);
+  }
+  return buffer;
+}
+
+Rgba WithAlpha(Rgba c, uint8_t alpha) {
+  c.a = alpha;
+  return c;
+}
+
+Rgba Mix(Rgba a, Rgba b, double t) {
+  auto lerp = [t](uint8_t x, uint8_t y) {
+    return static_cast<uint8_t>(std::lround(x + (y - x) * t));
+  };
+  return {lerp(a.r, b.r), lerp(a.g, b.g), lerp(a.b, b.b), lerp(a.a, b.a)};
+}
+
+// A horizontal gradient strip for colour bars.
+SceneImage ColorBar(float left, float top, float width, float height) {
+  SceneImage bar;
+  bar.left = left;
+  bar.top = top;
+  bar.width = width;
+  bar.height = height;
+  bar.pixels_wide = 256;
+  bar.pixels_high = 1;
+  bar.smooth = true;
+  for (int i = 0; i < 256; ++i) {
+    const Rgba c = SequentialColor(i / 255.0);
+    bar.rgba.insert(bar.rgba.end(), {c.r, c.g, c.b, 255});
+  }
+  return bar;
+}
+
+// Axes with nice ticks for a plot rectangle mapping [x0, x1] x [y0, y1].
+struct PlotArea {
+  float left, top, width, height;
+  double x0, x1, y0, y1;
+  ScenePoint Map(double x, double y) const {
+    return {static_cast<float>(left + (x - x0) / (x1 - x0) * width),
+            static_cast<float>(top + height - (y - y0) / (y1 - y0) * height)};
+  }
+};
+
+void DrawAxes(Scene& scene, const PlotArea& p, const std::string& x_label,
+              const std::string& y_label, bool grid = true) {
+  const double x_step = NiceStep(p.x1 - p.x0, 8), y_step = NiceStep(p.y1 - p.y0, 6);
+  for (double x = std::ceil(p.x0 / x_step) * x_step; x <= p.x1 + 1e-9; x += x_step) {
+    const ScenePoint a = p.Map(x, p.y0);
+    if (grid) scene.Line({a.x, p.top}, {a.x, p.top + p.height}, 1.0f, kGrid);
+    scene.Line(a, {a.x, a.y + 6}, 1.5f, kInk);
+    scene.Text({a.x, a.y + 24}, FormatNumber(x), 15, kInk, TextAnchor::kCenter);
+  }
+  for (double y = std::ceil(p.y0 / y_step) * y_step; y <= p.y1 + 1e-9; y += y_step) {
+    const ScenePoint a = p.Map(p.x0, y);
+    if (grid) scene.Line({p.left, a.y}, {p.left + p.width, a.y}, 1.0f, kGrid);
+    scene.Line({a.x - 6, a.y}, a, 1.5f, kInk);
+    scene.Text({a.x - 10, a.y + 5}, FormatNumber(y), 15, kInk, TextAnchor::kRight);
+  }
+  scene.Line({p.left, p.top + p.height}, {p.left + p.width, p.top + p.height}, 1.5f, kInk);
+  scene.Line({p.left, p.top}, {p.left, p.top + p.height}, 1.5f, kInk);
+  scene.Text({p.left + p.width / 2, p.top + p.height + 48}, x_label, 16, kInk, TextAnchor::kCenter);
+  scene.Text({p.left - 10, p.top - 14}, y_label, 16, kInk, TextAnchor::kLeft);
+}
+
+}  // namespace
+
+Rgba SequentialColor(double t) {
+  // Anchors of a dark-blue to yellow ramp with monotonically rising lightness.
+  static const Rgba kAnchors[] = {{48, 18, 90, 255},   {40, 70, 140, 255}, {30, 120, 142, 255},
+                                  {40, 165, 120, 255}, {130, 200, 70, 255}, {240, 225, 40, 255}};
+  constexpr int kSegments = static_cast<int>(std::size(kAnchors)) - 1;
+  t = std::clamp(std::isfinite(t) ? t : 0.0, 0.0, 1.0) * kSegments;
+  const int i = std::min(static_cast<int>(t), kSegments - 1);
+  return Mix(kAnchors[i], kAnchors[i + 1], t - i);
+}
+
+Rgba CategoryColor(int index) {
+  static const Rgba kColors[] = {{31, 119, 180, 255}, {214, 39, 40, 255},  {44, 160, 44, 255},
+                                 {148, 103, 189, 255}, {255, 127, 14, 255}, {23, 190, 207, 255},
+                                 {140, 86, 75, 255},  {227, 119, 194, 255}};
+  const int n = static_cast<int>(std::size(kColors));
+  return kColors[((index % n) + n) % n];
+}
+
+double NiceStep(double range, int target_count) {
+  if (!(range > 0.0) || !std::isfinite(range)) return 1.0;
+  const double raw = range / std::max(1, target_count);
+  const double power = std::pow(10.0, std::floor(std::log10(raw)));
+  for (double m : {1.0, 2.0, 5.0}) {
+    if (m * power >= raw) return m * power;
+  }
+  return 10.0 * power;
+}
+
+std::vector<Point2> AlignGroundTruthToMap(const std::vector<Point2>& map_points,
+                                          const std::vector<Point2>& truth_points,
+                                          const std::vector<Point2>& truth_path) {
+  // AlignRigid2D maps its first argument onto its second: align truth onto the map.
+  const std::optional<RigidAlignment2D> a = AlignRigid2D(truth_points, map_points);
+  if (!a) return {};
+  const double c = std::cos(a->rotation_rad), s = std::sin(a->rotation_rad);
+  std::vector<Point2> out;
+  out.reserve(truth_path.size());
+  for (const Point2& p : truth_path) {
+    out.push_back({c * p.x - s * p.y + a->translation_x_m, s * p.x + c * p.y + a->translation_y_m});
+  }
+  return out;
+}
+
+Scene ExperienceMapScene(const ExperienceMapImageData& data,
+                         const ExperienceMapImageOptions& options, WorldToImage* transform) {
+  Scene scene(options.width_px, options.height_px, kWhite);
+  const float w = static_cast<float>(options.width_px), h = static_cast<float>(options.height_px);
+  const float margin = 40, top_band = 50, bottom_band = 70;
+
+  // World bounds over experiences and ground truth.
+  double min_x = std::numeric_limits<double>::infinity(), max_x = -min_x;
+  double min_y = min_x, max_y = -min_x;
+  auto include = [&](double x, double y) {
+    min_x = std::min(min_x, x);
+    max_x = std::max(max_x, x);
+    min_y = std::min(min_y, y);
+    max_y = std::max(max_y, y);
+  };
+  for (const Experience& e : data.experiences) include(e.x_m, e.y_m);
+  for (const Point2& p : data.ground_truth) include(p.x, p.y);
+  if (!std::isfinite(min_x)) {
+    min_x = min_y = -1;
+    max_x = max_y = 1;
+  }
+  const double span_x = std::max(max_x - min_x, 1e-3), span_y = std::max(max_y - min_y, 1e-3);
+  const double plot_w = w - 2 * margin, plot_h = h - top_band - bottom_band;
+  WorldToImage to_image;
+  to_image.scale_px_per_m = std::min(plot_w / span_x, plot_h / span_y);
+  to_image.center_x_m = 0.5 * (min_x + max_x);
+  to_image.center_y_m = 0.5 * (min_y + max_y);
+  to_image.center_x_px = margin + 0.5 * plot_w;
+  to_image.center_y_px = top_band + 0.5 * plot_h;
+  if (transform) *transform = to_image;
+
+  // Time or session of each experience, for colouring.
+  double t_min = std::numeric_limits<double>::infinity(), t_max = -t_min;
+  for (const Experience& e : data.experiences) {
+    t_min = std::min(t_min, e.time_s);
+    t_max = std::max(t_max, e.time_s);
+  }
+  auto session_of = [&](double t) {
+    const auto& starts = options.session_start_times_s;
+    return static_cast<int>(std::upper_bound(starts.begin(), starts.end(), t) - starts.begin()) - 1;
+  };
+  auto color_of = [&](const Experience& e) {
+    if (options.coloring == MapColoring::kSession) return CategoryColor(std::max(0, session_of(e.time_s)));
+    return SequentialColor(t_max > t_min ? (e.time_s - t_min) / (t_max - t_min) : 0.0);
+  };
+
+  // Stay legible from a few links to 100k: thinner, more transparent strokes for larger maps.
+  const size_t n_links = data.links.size();
+  const float link_width = n_links > 20000 ? 1.0f : (n_links > 2000 ? 1.5f : 2.5f);
+  const uint8_t link_alpha = n_links > 20000 ? 140 : 230;
+  const float node_radius = data.experiences.size() > 20000 ? 0.0f
+                            : data.experiences.size() > 2000 ? 1.5f : 3.0f;
+
+  if (data.ground_truth.size() > 1) {
+    std::vector<ScenePoint> path;
+    for (const Point2& p : data.ground_truth) path.push_back(to_image(p.x, p.y));
+    scene.Polyline(path, 1.5f, kGroundTruth);
+  }
+  for (const Link& l : data.links) {
+    if (l.loop_closure) continue;
+    const Experience& a = data.experiences[l.from];
+    const Experience& b = data.experiences[l.to];
+    scene.Line(to_image(a.x_m, a.y_m), to_image(b.x_m, b.y_m), link_width,
+               WithAlpha(color_of(b), link_alpha));
+  }
+  if (node_radius > 0) {
+    for (const Experience& e : data.experiences) {
+      scene.Disc(to_image(e.x_m, e.y_m), node_radius, color_of(e), 10);
+    }
+  }
+  size_t loop_closures = 0;
+  for (const Link& l : data.links) {
+    if (!l.loop_closure) continue;
+    ++loop_closures;
+    const Experience& a = data.experiences[l.from];
+    const Experience& b = data.experiences[l.to];
+    scene.Line(to_image(a.x_m, a.y_m), to_image(b.x_m, b.y_m), link_width + 1.0f,
+               WithAlpha(kLoopClosure, 220));
+  }
+  if (data.current && *data.current < data.experiences.size()) {
+    // The current pose: an arrow head pointing along the experience's facing.
+    const Experience& e = data.experiences[*data.current];
+    const ScenePoint c = to_image(e.x_m, e.y_m);
+    const float size = 16, dx = std::cos(e.theta_rad), dy = -std::sin(e.theta_rad);
+    scene.Triangle({c.x + dx * size, c.y + dy * size},
+                   {c.x - dx * size * 0.6f - dy * size * 0.5f, c.y - dy * size * 0.6f + dx * size * 0.5f},
+                   {c.x - dx * size * 0.6f + dy * size * 0.5f, c.y - dy * size * 0.6f - dx * size * 0.5f},
+                   {0, 0, 0, 255});
+  }
+
+  // Title and counts.
+  const std::string title = options.title.empty() ? "experience map" : options.title;
+  scene.Text({margin, 32}, title + "   " + std::to_string(data.experiences.size()) +
+                               " experiences, " + std::to_string(n_links) + " links, " +
+                               std::to_string(loop_closures) + " loop closures",
+             18, kInk);
+
+  // Scale bar, bottom left: a nice length near a fifth of the plot width.
+  const double bar_m = NiceStep(0.2 * plot_w / to_image.scale_px_per_m, 1);
+  const float bar_px = static_cast<float>(bar_m * to_image.scale_px_per_m);
+  const float bar_y = h - 30;
+  scene.Line({margin, bar_y}, {margin + bar_px, bar_y}, 3.0f, kInk);
+  scene.Line({margin, bar_y - 7}, {margin, bar_y + 7}, 2.0f, kInk);
+  scene.Line({margin + bar_px, bar_y - 7}, {margin + bar_px, bar_y + 7}, 2.0f, kInk);
+  scene.Text({margin + bar_px / 2, bar_y - 12}, FormatNumber(bar_m) + " m", 16, kInk,
+             TextAnchor::kCenter);
+
+  // Legend, bottom right.
+  float legend_x = w - margin;
+  if (options.coloring == MapColoring::kTime && std::isfinite(t_min)) {
+    const float bar_w = 220;
+    scene.Image(ColorBar(legend_x - bar_w, bar_y - 8, bar_w, 14));
+    scene.Text({legend_x - bar_w, bar_y + 26}, FormatNumber(t_min) + " s", 14, kInk, TextAnchor::kCenter);
+    scene.Text({legend_x, bar_y + 26}, FormatNumber(t_max) + " s", 14, kInk, TextAnchor::kCenter);
+    scene.Text({legend_x - bar_w / 2, bar_y - 14}, "experience created at", 14, kInk,
+               TextAnchor::kCenter);
+    legend_x -= bar_w + 40;
+  } else if (options.coloring == MapColoring::kSession) {
+    for (int i = static_cast<int>(options.session_start_times_s.size()) - 1; i >= 0; --i) {
+      scene.Rect(legend_x - 110, bar_y - 8, 14, 14, CategoryColor(i));
+      scene.Text({legend_x - 90, bar_y + 5}, "session " + std::to_string(i + 1), 14, kInk);
+      legend_x -= 130;
+    }
+  }
+  // Legend entries: a line sample, then its label to the right.
+  legend_x -= 150;
+  scene.Line({legend_x, bar_y}, {legend_x + 30, bar_y}, 3.0f, kLoopClosure);
+  scene.Text({legend_x + 38, bar_y + 5}, "loop closure", 14, kInk);
+  if (data.ground_truth.size() > 1) {
+    legend_x -= 160;
+    scene.Line({legend_x, bar_y}, {legend_x + 30, bar_y}, 2.0f, kGroundTruth);
+    scene.Text({legend_x + 38, bar_y + 5}, "ground truth", 14, kInk);
+  }
+  return scene;
+}
+
+Scene TemplateGraphScene(const std::vector<TemplateGraphPoint>& points,
+                         const TemplateGraphImageOptions& options) {
+  Scene scene(options.width_px, options.height_px, kWhite);
+  double t0 = std::numeric_limits<double>::infinity(), t1 = -t0, id_max = 1;
+  for (const TemplateGraphPoint& p : points) {
+    t0 = std::min(t0, p.time_s);
+    t1 = std::max(t1, p.time_s);
+    id_max = std::max({id_max, static_cast<double>(p.template_id),
+                       static_cast<double>(p.experience_id)});
+  }
+  if (!std::isfinite(t0)) t0 = 0, t1 = 1;
+  if (t1 <= t0) t1 = t0 + 1;
+  PlotArea plot{90, 90, static_cast<float>(options.width_px - 130),
+                static_cast<float>(options.height_px - 170), t0, t1, 0, id_max * 1.02};
+  for (const TimeSpan& span : options.shaded_spans) {
+    const ScenePoint a = plot.Map(std::max(span.start_s, t0), 0);
+    const ScenePoint b = plot.Map(std::min(span.end_s, t1), 0);
+    if (b.x <= a.x) continue;
+    scene.Rect(a.x, plot.top, b.x - a.x, plot.height, {200, 210, 235, 110});
+    scene.Text({0.5f * (a.x + b.x), plot.top + 20}, span.label, 14, kInk, TextAnchor::kCenter);
+  }
+  DrawAxes(scene, plot, "time (s)", "template id (circles), experience id (dots)");
+  const bool many = points.size() > 20000;
+  const Rgba source_colors[] = {{31, 119, 180, 255}, {44, 160, 44, 255}, {150, 150, 150, 255}};
+  for (const TemplateGraphPoint& p : points) {
+    const Rgba c = source_colors[static_cast<int>(p.source)];
+    const ScenePoint at = plot.Map(p.time_s, p.template_id);
+    if (p.source == ViewSource::kNew) {
+      scene.Disc(at, many ? 1.0f : 1.8f, c, 8);
+    } else {
+      scene.Ring(at, many ? 1.2f : 2.2f, many ? 2.2f : 3.6f, 0, 2 * std::numbers::pi_v<float>, c, 10);
+    }
+  }
+  for (const TemplateGraphPoint& p : points) {
+    if (p.experience_id < 0) continue;
+    scene.Disc(plot.Map(p.time_s, static_cast<double>(p.experience_id)), many ? 0.8f : 1.3f,
+               {230, 110, 0, 255}, 6);
+  }
+  // Legend, top right, only for what the graph contains.
+  bool present[3] = {false, false, false};
+  for (const TemplateGraphPoint& p : points) present[static_cast<int>(p.source)] = true;
+  const char* names[3] = {"camera match", "Wi-Fi match", "new template"};
+  float lx = plot.left + plot.width;
+  const float ly = 34;
+  auto entry_width = [](const std::string& s) { return 12.0f + TextWidthPx(s, 14) + 24.0f; };
+  const std::string exp_label = "experience";
+  lx -= entry_width(exp_label);
+  scene.Disc({lx, ly - 5}, 2.5f, {230, 110, 0, 255}, 8);
+  scene.Text({lx + 10, ly}, exp_label, 14, kInk);
+  for (int s = 2; s >= 0; --s) {
+    if (!present[s]) continue;
+    lx -= entry_width(names[s]);
+    if (s == 2) {
+      scene.Disc({lx, ly - 5}, 2.5f, source_colors[s], 8);
+    } else {
+      scene.Ring({lx, ly - 5}, 2.2f, 3.8f, 0, 2 * std::numbers::pi_v<float>, source_colors[s], 10);
+    }
+    scene.Text({lx + 10, ly}, names[s], 14, kInk);
+  }
+  scene.Text({plot.left, 30}, options.title.empty() ? "template graph" : options.title, 18, kInk);
+  return scene;
+}
+
+Scene PoseCellScene(const PoseCellNetwork& network, const PoseCellImageOptions& options) {
+  Scene scene(options.width_px, options.height_px, kWhite);
+  const int n = network.dim_xy(), nt = network.dim_theta();
+  std::vector<double> xy(static_cast<size_t>(n) * n, 0.0), theta(nt, 0.0);
+  double xy_max = 0.0, theta_max = 0.0;
+  for (int t = 0; t < nt; ++t) {
+    for (int y = 0; y < n; ++y) {
+      for (int x = 0; x < n; ++x) {
+        const double a = network.Activity(x, y, t);
+        xy[static_cast<size_t>(y) * n + x] += a;
+        theta[t] += a;
+      }
+    }
+  }
+  for (double v : xy) xy_max = std::max(xy_max, v);
+  for (double v : theta) theta_max = std::max(theta_max, v);
+
+  // Left: x-y heat map, y up (image row 0 is the largest y).
+  const float side = std::min(options.height_px - 190.0f, options.width_px * 0.5f - 100.0f);
+  const float left = 80, top = 90;
+  SceneImage heat;
+  heat.left = left;
+  heat.top = top;
+  heat.width = heat.height = side;
+  heat.pixels_wide = heat.pixels_high = n;
+  for (int row = 0; row < n; ++row) {
+    const int y = n - 1 - row;
+    for (int x = 0; x < n; ++x) {
+      const Rgba c = SequentialColor(xy_max > 0 ? xy[static_cast<size_t>(y) * n + x] / xy_max : 0);
+      heat.rgba.insert(heat.rgba.end(), {c.r, c.g, c.b, 255});
+    }
+  }
+  scene.Image(std::move(heat));
+  const PoseCellPosition best = network.BestPosition();
+  const float cell = side / n;
+  const ScenePoint best_px{left + static_cast<float>(best.x + 0.5) * cell,
+                           top + side - static_cast<float>(best.y + 0.5) * cell};
+  scene.Line({best_px.x - 10, best_px.y}, {best_px.x + 10, best_px.y}, 2.0f, {255, 255, 255, 255});
+  scene.Line({best_px.x, best_px.y - 10}, {best_px.x, best_px.y + 10}, 2.0f, {255, 255, 255, 255});
+  PlotArea axes{left, top, side, side, 0, static_cast<double>(n), 0, static_cast<double>(n)};
+  DrawAxes(scene, axes, "x (cells)", "y (cells)", /*grid=*/false);
+
+  // Right: theta marginal on a ring, 0 to the right, counter-clockwise.
+  const ScenePoint center{options.width_px * 0.75f, top + side / 2};
+  const float radius = side * 0.38f;
+  const float step = 2 * std::numbers::pi_v<float> / nt;
+  for (int t = 0; t < nt; ++t) {
+    const Rgba c = SequentialColor(theta_max > 0 ? theta[t] / theta_max : 0);
+    scene.Ring(center, radius * 0.75f, radius, (t - 0.5f) * step, (t + 0.5f) * step, c, 4);
+  }
+  const float best_angle = static_cast<float>(best.theta) * step;
+  scene.Line(center, {center.x + radius * 0.7f * std::cos(best_angle),
+                      center.y - radius * 0.7f * std::sin(best_angle)},
+             3.0f, kInk);
+  for (int deg = 0; deg < 360; deg += 90) {
+    const float a = deg * std::numbers::pi_v<float> / 180;
+    const TextAnchor anchor = deg == 0 ? TextAnchor::kLeft
+                              : deg == 180 ? TextAnchor::kRight : TextAnchor::kCenter;
+    const float offset = deg % 180 == 0 ? 12.0f : 24.0f;
+    scene.Text({center.x + (radius + offset) * std::cos(a),
+                center.y - (radius + offset) * std::sin(a) + 5},
+               std::to_string(deg) + " deg", 14, kInk, anchor);
+  }
+  char label[128];
+  std::snprintf(label, sizeof label, "best pose: x %.2f, y %.2f, theta %.2f cells (%.0f deg)",
+                best.x, best.y, best.theta, best.theta * 360.0 / nt);
+  scene.Text({left, static_cast<float>(options.height_px - 16)}, label, 15, kInk);
+  scene.Text({center.x, top - 14}, "heading (activity summed over x, y)", 15, kInk, TextAnchor::kCenter);
+  scene.Text({left, 28}, options.title.empty() ? "pose-cell activity (summed over theta)" : options.title,
+             18, kInk);
+  return scene;
+}
+
+Scene SimilarityMatrixScene(const std::vector<float>& matrix, const std::vector<double>& times_s,
+                            const SimilarityImageOptions& options) {
+  const int n = static_cast<int>(times_s.size());
+  const int size = options.size_px;
+  Scene scene(size + 170, size + 130, kWhite);
+  const float left = 90, top = 60;
+  if (n > 0 && matrix.size() == static_cast<size_t>(n) * n) {
+    SceneImage heat;
+    heat.left = left;
+    heat.top = top;
+    heat.width = heat.height = static_cast<float>(size);
+    heat.pixels_wide = heat.pixels_high = n;
+    for (float v : matrix) {
+      const Rgba c = SequentialColor(v);
+      heat.rgba.insert(heat.rgba.end(), {c.r, c.g, c.b, 255});
+    }
+    scene.Image(std::move(heat));
+    // Time runs down the rows, as in a matrix; the y axis labels show it.
+    const double t0 = times_s.front(), t1 = times_s.back() > t0 ? times_s.back() : t0 + 1;
+    const double step = NiceStep(t1 - t0, 8);
+    for (double t = std::ceil(t0 / step) * step; t <= t1 + 1e-9; t += step) {
+      const float f = static_cast<float>((t - t0) / (t1 - t0)) * size;
+      scene.Line({left + f, top + size}, {left + f, top + size + 6}, 1.5f, kInk);
+      scene.Text({left + f, top + size + 24}, FormatNumber(t), 15, kInk, TextAnchor::kCenter);
+      scene.Line({left - 6, top + f}, {left, top + f}, 1.5f, kInk);
+      scene.Text({left - 10, top + f + 5}, FormatNumber(t), 15, kInk, TextAnchor::kRight);
+    }
+  }
+  scene.Text({left + size / 2.0f, top + size + 50}, "time (s)", 16, kInk, TextAnchor::kCenter);
+  scene.Text({left - 10, top - 12}, "time (s)", 16, kInk);
+  // Colour bar on the right, low values at the bottom.
+  SceneImage bar = ColorBar(0, 0, 0, 0);
+  SceneImage vertical;
+  vertical.left = left + size + 30;
+  vertical.top = top;
+  vertical.width = 20;
+  vertical.height = static_cast<float>(size);
+  vertical.pixels_wide = 1;
+  vertical.pixels_high = 256;
+  vertical.smooth = true;
+  for (int i = 255; i >= 0; --i) {
+    vertical.rgba.insert(vertical.rgba.end(), bar.rgba.begin() + i * 4, bar.rgba.begin() + i * 4 + 4);
+  }
+  scene.Image(std::move(vertical));
+  scene.Text({left + size + 55, top + 12}, "1", 14, kInk);
+  scene.Text({left + size + 55, top + size}, "0", 14, kInk);
+  scene.Text({left + size + 25, top - 12}, options.value_label, 14, kInk);
+  scene.Text({left, 30}, options.title.empty() ? "similarity matrix" : options.title, 18, kInk);
+  return scene;
+}
+
+}  // namespace ratslam

@@ -1,0 +1,112 @@
+// Figures as scenes: the experience map, the template graph (template and experience ids over
+// time, as in the Wi-Fi RatSLAM paper's figures 5a, 6 and 8a), pose-cell activity, and a
+// similarity matrix. Pure functions of their data; render with a SceneRenderer.
+#ifndef RATSLAM_VIEWER_FIGURES_H_
+#define RATSLAM_VIEWER_FIGURES_H_
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "fusion/trajectory_metrics.h"
+#include "ratslam/experience_map.h"
+#include "ratslam/pose_cell_network.h"
+#include "viewer/scene.h"
+
+namespace ratslam {
+
+// A perceptual sequential colour map for t in [0, 1] (dark blue, teal, green, yellow).
+Rgba SequentialColor(double t);
+// Distinct colours for categories (sessions, floors).
+Rgba CategoryColor(int index);
+
+// 1, 2 or 5 times a power of ten, near range / target_count.
+double NiceStep(double range, int target_count);
+
+// World metres to image pixels with equal x and y scale (y up in the world, down in the image).
+struct WorldToImage {
+  double scale_px_per_m = 1.0;
+  double center_x_m = 0.0, center_y_m = 0.0;
+  double center_x_px = 0.0, center_y_px = 0.0;
+  ScenePoint operator()(double x_m, double y_m) const {
+    return {static_cast<float>(center_x_px + scale_px_per_m * (x_m - center_x_m)),
+            static_cast<float>(center_y_px - scale_px_per_m * (y_m - center_y_m))};
+  }
+};
+
+enum class MapColoring { kTime, kSession };
+
+struct ExperienceMapImageOptions {
+  int width_px = 1600;
+  int height_px = 1200;
+  MapColoring coloring = MapColoring::kTime;
+  std::vector<double> session_start_times_s;  // ascending; sessions for kSession colouring
+  std::string title;
+};
+
+struct ExperienceMapImageData {
+  std::vector<Experience> experiences;
+  std::vector<Link> links;
+  std::optional<uint32_t> current;    // experience where the robot is
+  std::vector<Point2> ground_truth;   // already in the map's frame (see AlignGroundTruthToMap)
+};
+
+// The experience map with equal aspect, a scale bar in metres, loop-closure links highlighted,
+// the current pose as an arrow, and a time colour bar or a session legend. `transform` receives
+// the world-to-pixel mapping used.
+Scene ExperienceMapScene(const ExperienceMapImageData& data, const ExperienceMapImageOptions& options,
+                         WorldToImage* transform = nullptr);
+
+// Moves ground-truth points (paired with map points by index) into the map frame with the
+// best-fit rigid transform; returns all `truth_path` points transformed.
+std::vector<Point2> AlignGroundTruthToMap(const std::vector<Point2>& map_points,
+                                          const std::vector<Point2>& truth_points,
+                                          const std::vector<Point2>& truth_path);
+
+enum class ViewSource { kCamera, kWifi, kNew };
+
+struct TemplateGraphPoint {
+  double time_s = 0.0;
+  uint32_t template_id = 0;
+  int64_t experience_id = -1;  // -1: none yet
+  ViewSource source = ViewSource::kCamera;
+};
+
+struct TimeSpan {
+  double start_s = 0.0, end_s = 0.0;
+  std::string label;
+};
+
+struct TemplateGraphImageOptions {
+  int width_px = 1600;
+  int height_px = 900;
+  std::vector<TimeSpan> shaded_spans;  // e.g. sessions, day and night
+  std::string title;
+};
+
+// Template id (circles, coloured by the deciding sensor) and experience id (dots) against time.
+Scene TemplateGraphScene(const std::vector<TemplateGraphPoint>& points,
+                         const TemplateGraphImageOptions& options);
+
+struct PoseCellImageOptions {
+  int width_px = 1200;
+  int height_px = 620;
+  std::string title;
+};
+
+// The activity summed over theta as an x-y heat map, and the theta marginal as a ring.
+Scene PoseCellScene(const PoseCellNetwork& network, const PoseCellImageOptions& options);
+
+struct SimilarityImageOptions {
+  int size_px = 1000;
+  std::string title;
+  std::string value_label = "similarity";
+};
+
+// An n x n matrix (row-major, values in [0, 1]) sampled at `times_s` as a heat map.
+Scene SimilarityMatrixScene(const std::vector<float>& matrix, const std::vector<double>& times_s,
+                            const SimilarityImageOptions& options);
+
+}  // namespace ratslam
+
+#endif  // RATSLAM_VIEWER_FIGURES_H_

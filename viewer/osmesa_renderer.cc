@@ -1,0 +1,367 @@
+#include <dlfcn.h>
+
+#include <GL/osmesa.h>
+#include <GL/glext.h>
+
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "viewer/renderer.h"
+
+namespace ratslam {
+namespace {
+
+// The OpenGL entry points we use, resolved through OSMesaGetProcAddress.
+struct GlFunctions {
+#define RATSLAM_GL_FUNCTIONS(X)                                                          \
+  X(decltype(&::glGetError), GetError, "glGetError")                                           \
+  X(decltype(&::glGetIntegerv), GetIntegerv, "glGetIntegerv")                                  \
+  X(decltype(&::glViewport), Viewport, "glViewport")                                           \
+  X(decltype(&::glClearColor), ClearColor, "glClearColor")                                     \
+  X(decltype(&::glClear), Clear, "glClear")                                                    \
+  X(decltype(&::glEnable), Enable, "glEnable")                                                 \
+  X(PFNGLBLENDFUNCSEPARATEPROC, BlendFuncSeparate, "glBlendFuncSeparate")                \
+  X(decltype(&::glReadPixels), ReadPixels, "glReadPixels")                                     \
+  X(decltype(&::glPixelStorei), PixelStorei, "glPixelStorei")                                  \
+  X(decltype(&::glFinish), Finish, "glFinish")                                                 \
+  X(PFNGLGENBUFFERSPROC, GenBuffers, "glGenBuffers")                                     \
+  X(PFNGLDELETEBUFFERSPROC, DeleteBuffers, "glDeleteBuffers")                            \
+  X(PFNGLBINDBUFFERPROC, BindBuffer, "glBindBuffer")                                     \
+  X(PFNGLBUFFERDATAPROC, BufferData, "glBufferData")                                     \
+  X(PFNGLGENVERTEXARRAYSPROC, GenVertexArrays, "glGenVertexArrays")                      \
+  X(PFNGLDELETEVERTEXARRAYSPROC, DeleteVertexArrays, "glDeleteVertexArrays")             \
+  X(PFNGLBINDVERTEXARRAYPROC, BindVertexArray, "glBindVertexArray")                      \
+  X(PFNGLVERTEXATTRIBPOINTERPROC, VertexAttribPointer, "glVertexAttribPointer")          \
+  X(PFNGLENABLEVERTEXATTRIBARRAYPROC, EnableVertexAttribArray, "glEnableVertexAttribArray") \
+  X(PFNGLCREATESHADERPROC, CreateShader, "glCreateShader")                               \
+  X(PFNGLDELETESHADERPROC, DeleteShader, "glDeleteShader")                               \
+  X(PFNGLSHADERSOURCEPROC, ShaderSource, "glShaderSource")                               \
+  X(PFNGLCOMPILESHADERPROC, CompileShader, "glCompileShader")                            \
+  X(PFNGLGETSHADERIVPROC, GetShaderiv, "glGetShaderiv")                                  \
+  X(PFNGLGETSHADERINFOLOGPROC, GetShaderInfoLog, "glGetShaderInfoLog")                   \
+  X(PFNGLCREATEPROGRAMPROC, CreateProgram, "glCreateProgram")                            \
+  X(PFNGLDELETEPROGRAMPROC, DeleteProgram, "glDeleteProgram")                            \
+  X(PFNGLATTACHSHADERPROC, AttachShader, "glAttachShader")                               \
+  X(PFNGLLINKPROGRAMPROC, LinkProgram, "glLinkProgram")                                  \
+  X(PFNGLGETPROGRAMIVPROC, GetProgramiv, "glGetProgramiv")                               \
+  X(PFNGLGETPROGRAMINFOLOGPROC, GetProgramInfoLog, "glGetProgramInfoLog")                \
+  X(PFNGLUSEPROGRAMPROC, UseProgram, "glUseProgram")                                     \
+  X(PFNGLGETUNIFORMLOCATIONPROC, GetUniformLocation, "glGetUniformLocation")             \
+  X(PFNGLUNIFORM2FPROC, Uniform2f, "glUniform2f")                                        \
+  X(PFNGLUNIFORM1IPROC, Uniform1i, "glUniform1i")                                        \
+  X(decltype(&::glDrawArrays), DrawArrays, "glDrawArrays")                                     \
+  X(decltype(&::glGenTextures), GenTextures, "glGenTextures")                                  \
+  X(decltype(&::glDeleteTextures), DeleteTextures, "glDeleteTextures")                         \
+  X(decltype(&::glBindTexture), BindTexture, "glBindTexture")                                  \
+  X(decltype(&::glTexImage2D), TexImage2D, "glTexImage2D")                                     \
+  X(decltype(&::glTexParameteri), TexParameteri, "glTexParameteri")                            \
+  X(PFNGLACTIVETEXTUREPROC, ActiveTexture, "glActiveTexture")                            \
+  X(PFNGLGENFRAMEBUFFERSPROC, GenFramebuffers, "glGenFramebuffers")                      \
+  X(PFNGLDELETEFRAMEBUFFERSPROC, DeleteFramebuffers, "glDeleteFramebuffers")             \
+  X(PFNGLBINDFRAMEBUFFERPROC, BindFramebuffer, "glBindFramebuffer")                      \
+  X(PFNGLCHECKFRAMEBUFFERSTATUSPROC, CheckFramebufferStatus, "glCheckFramebufferStatus") \
+  X(PFNGLGENRENDERBUFFERSPROC, GenRenderbuffers, "glGenRenderbuffers")                   \
+  X(PFNGLDELETERENDERBUFFERSPROC, DeleteRenderbuffers, "glDeleteRenderbuffers")          \
+  X(PFNGLBINDRENDERBUFFERPROC, BindRenderbuffer, "glBindRenderbuffer")                   \
+  X(PFNGLRENDERBUFFERSTORAGEMULTISAMPLEPROC, RenderbufferStorageMultisample,             \
+    "glRenderbufferStorageMultisample")                                                  \
+  X(PFNGLRENDERBUFFERSTORAGEPROC, RenderbufferStorage, "glRenderbufferStorage")          \
+  X(PFNGLFRAMEBUFFERRENDERBUFFERPROC, FramebufferRenderbuffer, "glFramebufferRenderbuffer") \
+  X(PFNGLBLITFRAMEBUFFERPROC, BlitFramebuffer, "glBlitFramebuffer")
+#define RATSLAM_DECLARE(type, name, symbol) type name = nullptr;
+  RATSLAM_GL_FUNCTIONS(RATSLAM_DECLARE)
+#undef RATSLAM_DECLARE
+};
+
+using CreateContextAttribsFn = OSMesaContext (*)(const int*, OSMesaContext);
+using MakeCurrentFn = GLboolean (*)(OSMesaContext, void*, GLenum, GLsizei, GLsizei);
+using DestroyContextFn = void (*)(OSMesaContext);
+using GetProcAddressFn = OSMESAproc (*)(const char*);
+
+const char kColorVertexShader[] = R"(#version 330 core
+layout(location = 0) in vec2 position_px;
+layout(location = 1) in vec4 color;
+uniform vec2 viewport_px;
+out vec4 vertex_color;
+void main() {
+  // Scene pixels have y down; normalised device coordinates have y up.
+  gl_Position = vec4(position_px.x / viewport_px.x * 2.0 - 1.0,
+                     1.0 - position_px.y / viewport_px.y * 2.0, 0.0, 1.0);
+  vertex_color = color;
+}
+)";
+const char kColorFragmentShader[] = R"(#version 330 core
+in vec4 vertex_color;
+out vec4 fragment_color;
+void main() { fragment_color = vertex_color; }
+)";
+const char kTextureVertexShader[] = R"(#version 330 core
+layout(location = 0) in vec2 position_px;
+layout(location = 1) in vec2 texture_coordinate;
+uniform vec2 viewport_px;
+out vec2 uv;
+void main() {
+  gl_Position = vec4(position_px.x / viewport_px.x * 2.0 - 1.0,
+                     1.0 - position_px.y / viewport_px.y * 2.0, 0.0, 1.0);
+  uv = texture_coordinate;
+}
+)";
+const char kTextureFragmentShader[] = R"(#version 330 core
+in vec2 uv;
+uniform sampler2D image;
+out vec4 fragment_color;
+void main() { fragment_color = texture(image, uv); }
+)";
+
+class OsMesaRenderer : public SceneRenderer {
+ public:
+  ~OsMesaRenderer() override {
+    if (gl_.DeleteProgram && context_ && make_current_(context_, dummy_.data(), GL_UNSIGNED_BYTE, 4, 4)) {
+      gl_.DeleteProgram(color_program_);
+      gl_.DeleteProgram(texture_program_);
+    }
+    if (context_) destroy_context_(context_);
+    if (library_) dlclose(library_);
+  }
+
+  Status Init() {
+    // The library name differs between Mesa releases; try the usual sonames.
+    for (const char* name : {"libOSMesa.so.8", "libOSMesa.so.6", "libOSMesa.so"}) {
+      library_ = dlopen(name, RTLD_NOW | RTLD_LOCAL);
+      if (library_) break;
+    }
+    if (!library_) {
+      return Status::Error(
+          "OSMesa is not available (cannot load libOSMesa.so.8; install the Debian package "
+          "libosmesa6): images cannot be rendered");
+    }
+    auto create = reinterpret_cast<CreateContextAttribsFn>(dlsym(library_, "OSMesaCreateContextAttribs"));
+    make_current_ = reinterpret_cast<MakeCurrentFn>(dlsym(library_, "OSMesaMakeCurrent"));
+    destroy_context_ = reinterpret_cast<DestroyContextFn>(dlsym(library_, "OSMesaDestroyContext"));
+    auto get_proc = reinterpret_cast<GetProcAddressFn>(dlsym(library_, "OSMesaGetProcAddress"));
+    if (!create || !make_current_ || !destroy_context_ || !get_proc) {
+      return Status::Error("OSMesa library lacks OSMesaCreateContextAttribs (Mesa too old?)");
+    }
+    const int attributes[] = {OSMESA_FORMAT, OSMESA_RGBA, OSMESA_DEPTH_BITS, 0,
+                              OSMESA_PROFILE, OSMESA_CORE_PROFILE,
+                              OSMESA_CONTEXT_MAJOR_VERSION, 3, OSMESA_CONTEXT_MINOR_VERSION, 3,
+                              0};
+    context_ = create(attributes, nullptr);
+    if (!context_) return Status::Error("OSMesa: cannot create an OpenGL 3.3 core context");
+    dummy_.assign(4 * 4 * 4, 0);
+    if (!make_current_(context_, dummy_.data(), GL_UNSIGNED_BYTE, 4, 4)) {
+      return Status::Error("OSMesa: cannot make the context current");
+    }
+#define RATSLAM_LOAD(type, name, symbol)                                    \
+  gl_.name = reinterpret_cast<type>(get_proc(symbol));                      \
+  if (!gl_.name) return Status::Error(std::string("OSMesa: missing ") + symbol);
+    RATSLAM_GL_FUNCTIONS(RATSLAM_LOAD)
+#undef RATSLAM_LOAD
+    StatusOr<GLuint> color = Program(kColorVertexShader, kColorFragmentShader);
+    if (!color.ok()) return color.status();
+    color_program_ = color.value();
+    StatusOr<GLuint> texture = Program(kTextureVertexShader, kTextureFragmentShader);
+    if (!texture.ok()) return texture.status();
+    texture_program_ = texture.value();
+    gl_.GetIntegerv(GL_MAX_SAMPLES, &max_samples_);
+    gl_.GetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_size_);
+    return Status::Ok();
+  }
+
+  StatusOr<RgbaImage> Render(const Scene& scene) override {
+    const int w = scene.width(), h = scene.height();
+    if (w <= 0 || h <= 0 || w > max_size_ || h > max_size_) {
+      return Status::Error("image size " + std::to_string(w) + "x" + std::to_string(h) +
+                           " outside 1.." + std::to_string(max_size_));
+    }
+    if (!make_current_(context_, dummy_.data(), GL_UNSIGNED_BYTE, 4, 4)) {
+      return Status::Error("OSMesa: cannot make the context current");
+    }
+    // A multisampled framebuffer for antialiasing, resolved into a plain one for reading.
+    const int samples = std::min(8, static_cast<int>(max_samples_));
+    GLuint framebuffers[2], renderbuffers[2];
+    gl_.GenFramebuffers(2, framebuffers);
+    gl_.GenRenderbuffers(2, renderbuffers);
+    gl_.BindRenderbuffer(GL_RENDERBUFFER, renderbuffers[0]);
+    gl_.RenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_RGBA8, w, h);
+    gl_.BindFramebuffer(GL_FRAMEBUFFER, framebuffers[0]);
+    gl_.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, renderbuffers[0]);
+    gl_.BindRenderbuffer(GL_RENDERBUFFER, renderbuffers[1]);
+    gl_.RenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, w, h);
+    gl_.BindFramebuffer(GL_FRAMEBUFFER, framebuffers[1]);
+    gl_.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, renderbuffers[1]);
+    const bool complete = gl_.CheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+    gl_.BindFramebuffer(GL_FRAMEBUFFER, framebuffers[0]);
+    const bool ms_complete = gl_.CheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+    RgbaImage image;
+    Status status;
+    if (!complete || !ms_complete) {
+      status = Status::Error("OSMesa: framebuffer incomplete for " + std::to_string(w) + "x" +
+                             std::to_string(h));
+    } else {
+      gl_.Viewport(0, 0, w, h);
+      const Rgba bg = scene.background();
+      gl_.ClearColor(bg.r / 255.f, bg.g / 255.f, bg.b / 255.f, bg.a / 255.f);
+      gl_.Clear(GL_COLOR_BUFFER_BIT);
+      gl_.Enable(GL_BLEND);
+      gl_.BlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+      gl_.Enable(GL_MULTISAMPLE);
+      for (const SceneImage& img : scene.images()) DrawImage(img, w, h);
+      DrawTriangles(scene.triangles(), w, h);
+      gl_.BindFramebuffer(GL_READ_FRAMEBUFFER, framebuffers[0]);
+      gl_.BindFramebuffer(GL_DRAW_FRAMEBUFFER, framebuffers[1]);
+      gl_.BlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+      gl_.BindFramebuffer(GL_FRAMEBUFFER, framebuffers[1]);
+      std::vector<uint8_t> bottom_up(static_cast<size_t>(w) * h * 4);
+      gl_.PixelStorei(GL_PACK_ALIGNMENT, 1);
+      gl_.ReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, bottom_up.data());
+      gl_.Finish();
+      if (const GLenum error = gl_.GetError(); error != GL_NO_ERROR) {
+        status = Status::Error("OpenGL error " + std::to_string(error) + " while rendering");
+      }
+      // OpenGL's first row is the bottom one: flip so that row 0 is the top.
+      image.width = w;
+      image.height = h;
+      image.pixels.resize(bottom_up.size());
+      const size_t row = static_cast<size_t>(w) * 4;
+      for (int y = 0; y < h; ++y) {
+        std::memcpy(&image.pixels[y * row], &bottom_up[(h - 1 - y) * row], row);
+      }
+    }
+    gl_.BindFramebuffer(GL_FRAMEBUFFER, 0);
+    gl_.DeleteFramebuffers(2, framebuffers);
+    gl_.DeleteRenderbuffers(2, renderbuffers);
+    if (!status.ok()) return status;
+    DrawTexts(scene, &image);
+    return image;
+  }
+
+ private:
+  StatusOr<GLuint> Shader(GLenum type, const char* source) {
+    const GLuint shader = gl_.CreateShader(type);
+    gl_.ShaderSource(shader, 1, &source, nullptr);
+    gl_.CompileShader(shader);
+    GLint ok = 0;
+    gl_.GetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+    if (!ok) {
+      char log[1024] = {};
+      gl_.GetShaderInfoLog(shader, sizeof log, nullptr, log);
+      gl_.DeleteShader(shader);
+      return Status::Error(std::string("OpenGL shader does not compile: ") + log);
+    }
+    return shader;
+  }
+
+  StatusOr<GLuint> Program(const char* vertex, const char* fragment) {
+    StatusOr<GLuint> vs = Shader(GL_VERTEX_SHADER, vertex);
+    if (!vs.ok()) return vs.status();
+    StatusOr<GLuint> fs = Shader(GL_FRAGMENT_SHADER, fragment);
+    if (!fs.ok()) return fs.status();
+    const GLuint program = gl_.CreateProgram();
+    gl_.AttachShader(program, vs.value());
+    gl_.AttachShader(program, fs.value());
+    gl_.LinkProgram(program);
+    gl_.DeleteShader(vs.value());
+    gl_.DeleteShader(fs.value());
+    GLint ok = 0;
+    gl_.GetProgramiv(program, GL_LINK_STATUS, &ok);
+    if (!ok) {
+      char log[1024] = {};
+      gl_.GetProgramInfoLog(program, sizeof log, nullptr, log);
+      gl_.DeleteProgram(program);
+      return Status::Error(std::string("OpenGL program does not link: ") + log);
+    }
+    return program;
+  }
+
+  void DrawTriangles(const std::vector<Scene::Vertex>& vertices, int w, int h) {
+    if (vertices.empty()) return;
+    static_assert(sizeof(Scene::Vertex) == 12, "vertex layout: 2 floats, 4 bytes");
+    GLuint vao, vbo;
+    gl_.GenVertexArrays(1, &vao);
+    gl_.BindVertexArray(vao);
+    gl_.GenBuffers(1, &vbo);
+    gl_.BindBuffer(GL_ARRAY_BUFFER, vbo);
+    gl_.BufferData(GL_ARRAY_BUFFER, vertices.size() * sizeof(Scene::Vertex), vertices.data(),
+                   GL_STREAM_DRAW);
+    gl_.VertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, sizeof(Scene::Vertex), nullptr);
+    gl_.EnableVertexAttribArray(0);
+    gl_.VertexAttribPointer(1, 4, GL_UNSIGNED_BYTE, GL_TRUE, sizeof(Scene::Vertex),
+                            reinterpret_cast<const void*>(8));
+    gl_.EnableVertexAttribArray(1);
+    gl_.UseProgram(color_program_);
+    gl_.Uniform2f(gl_.GetUniformLocation(color_program_, "viewport_px"), w, h);
+    gl_.DrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(vertices.size()));
+    gl_.DeleteBuffers(1, &vbo);
+    gl_.DeleteVertexArrays(1, &vao);
+  }
+
+  void DrawImage(const SceneImage& img, int w, int h) {
+    if (img.pixels_wide <= 0 || img.pixels_high <= 0 ||
+        img.rgba.size() != static_cast<size_t>(img.pixels_wide) * img.pixels_high * 4) {
+      return;
+    }
+    GLuint texture;
+    gl_.GenTextures(1, &texture);
+    gl_.ActiveTexture(GL_TEXTURE0);
+    gl_.BindTexture(GL_TEXTURE_2D, texture);
+    gl_.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    gl_.TexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, img.pixels_wide, img.pixels_high, 0, GL_RGBA,
+                   GL_UNSIGNED_BYTE, img.rgba.data());
+    const GLint filter = img.smooth ? GL_LINEAR : GL_NEAREST;
+    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, filter);
+    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, filter);
+    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    // Texture row 0 is the image's top row, drawn at the rectangle's top (v = 0).
+    const float l = img.left, t = img.top, r = img.left + img.width, b = img.top + img.height;
+    const float quad[] = {l, t, 0, 0, r, t, 1, 0, r, b, 1, 1, l, t, 0, 0, r, b, 1, 1, l, b, 0, 1};
+    GLuint vao, vbo;
+    gl_.GenVertexArrays(1, &vao);
+    gl_.BindVertexArray(vao);
+    gl_.GenBuffers(1, &vbo);
+    gl_.BindBuffer(GL_ARRAY_BUFFER, vbo);
+    gl_.BufferData(GL_ARRAY_BUFFER, sizeof quad, quad, GL_STREAM_DRAW);
+    gl_.VertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, 4 * sizeof(float), nullptr);
+    gl_.EnableVertexAttribArray(0);
+    gl_.VertexAttribPointer(1, 2, GL_FLOAT, GL_FALSE, 4 * sizeof(float),
+                            reinterpret_cast<const void*>(2 * sizeof(float)));
+    gl_.EnableVertexAttribArray(1);
+    gl_.UseProgram(texture_program_);
+    gl_.Uniform2f(gl_.GetUniformLocation(texture_program_, "viewport_px"), w, h);
+    gl_.Uniform1i(gl_.GetUniformLocation(texture_program_, "image"), 0);
+    gl_.DrawArrays(GL_TRIANGLES, 0, 6);
+    gl_.DeleteBuffers(1, &vbo);
+    gl_.DeleteVertexArrays(1, &vao);
+    gl_.DeleteTextures(1, &texture);
+  }
+
+  void* library_ = nullptr;
+  OSMesaContext context_ = nullptr;
+  MakeCurrentFn make_current_ = nullptr;
+  DestroyContextFn destroy_context_ = nullptr;
+  std::vector<uint8_t> dummy_;
+  GlFunctions gl_;
+  GLuint color_program_ = 0, texture_program_ = 0;
+  GLint max_samples_ = 1, max_size_ = 0;
+};
+
+}  // namespace
+
+StatusOr<std::unique_ptr<SceneRenderer>> CreateOsMesaRenderer() {
+  auto renderer = std::make_unique<OsMesaRenderer>();
+  Status status = renderer->Init();
+  if (!status.ok()) return status;
+  return std::unique_ptr<SceneRenderer>(std::move(renderer));
+}
+
+Status RenderToPng(const Scene& scene, const std::string& path) {
+  StatusOr<std::unique_ptr<SceneRenderer>> renderer = CreateOsMesaRenderer();
+  if (!renderer.ok()) return renderer.status();
+  StatusOr<RgbaImage> image = renderer.value()->Render(scene);
+  if (!image.ok()) return image.status();
+  return WritePng(image.value(), path);
+}
+
+}  // namespace ratslam

@@ -1,0 +1,106 @@
+// Rendering through OSMesa: orientation, colours, antialiasing, errors. Skips (with the reason)
+// where no OSMesa context can be made.
+#include "viewer/renderer.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+namespace ratslam {
+namespace {
+
+std::unique_ptr<SceneRenderer> MakeRenderer() {
+  StatusOr<std::unique_ptr<SceneRenderer>> renderer = CreateOsMesaRenderer();
+  if (!renderer.ok()) return nullptr;
+  return std::move(renderer.value());
+}
+
+#define REQUIRE_RENDERER(r)                                                          \
+  auto r = MakeRenderer();                                                           \
+  if (!r) GTEST_SKIP() << "OSMesa unavailable: " << CreateOsMesaRenderer().status().message()
+
+TEST(OsMesaRendererTest, ImageIsTheRightWayUpAndColoursAreExact) {
+  REQUIRE_RENDERER(renderer);
+  Scene scene(64, 48, {255, 255, 255, 255});
+  scene.Rect(0, 0, 64, 10, {255, 0, 0, 255});   // top band red
+  scene.Rect(0, 38, 64, 10, {0, 0, 255, 255});  // bottom band blue
+  scene.Rect(0, 10, 8, 28, {0, 255, 0, 255});   // left band green
+  StatusOr<RgbaImage> image = renderer->Render(scene);
+  ASSERT_TRUE(image.ok()) << image.status().message();
+  ASSERT_EQ(image->width, 64);
+  ASSERT_EQ(image->height, 48);
+  const Rgba top = image->At(32, 2), bottom = image->At(32, 45), left = image->At(2, 24),
+             middle = image->At(40, 24);
+  EXPECT_EQ((std::array<int, 3>{top.r, top.g, top.b}), (std::array<int, 3>{255, 0, 0}));
+  EXPECT_EQ((std::array<int, 3>{bottom.r, bottom.g, bottom.b}), (std::array<int, 3>{0, 0, 255}));
+  EXPECT_EQ((std::array<int, 3>{left.r, left.g, left.b}), (std::array<int, 3>{0, 255, 0}));
+  EXPECT_EQ((std::array<int, 3>{middle.r, middle.g, middle.b}), (std::array<int, 3>{255, 255, 255}));
+}
+
+TEST(OsMesaRendererTest, DiagonalLinesAreAntialiased) {
+  REQUIRE_RENDERER(renderer);
+  Scene scene(64, 64, {255, 255, 255, 255});
+  scene.Line({5, 5}, {60, 40}, 2.0f, {0, 0, 0, 255});
+  StatusOr<RgbaImage> image = renderer->Render(scene);
+  ASSERT_TRUE(image.ok()) << image.status().message();
+  int partial = 0, dark = 0;
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) {
+      const int v = image->At(x, y).r;
+      if (v > 20 && v < 235) ++partial;
+      if (v <= 20) ++dark;
+    }
+  EXPECT_GT(dark, 40);
+  EXPECT_GT(partial, 40) << "edge pixels should take intermediate grey levels";
+}
+
+TEST(OsMesaRendererTest, TexturedImageKeepsRowOrder) {
+  REQUIRE_RENDERER(renderer);
+  Scene scene(40, 40, {255, 255, 255, 255});
+  SceneImage img;
+  img.left = 0;
+  img.top = 0;
+  img.width = 40;
+  img.height = 40;
+  img.pixels_wide = 1;
+  img.pixels_high = 2;
+  img.rgba = {255, 0, 0, 255, 0, 0, 255, 255};  // row 0 red, row 1 blue
+  scene.Image(img);
+  StatusOr<RgbaImage> image = renderer->Render(scene);
+  ASSERT_TRUE(image.ok());
+  EXPECT_EQ(image->At(20, 5).r, 255);
+  EXPECT_EQ(image->At(20, 35).b, 255);
+}
+
+TEST(OsMesaRendererTest, TextIsDrawn) {
+  REQUIRE_RENDERER(renderer);
+  Scene scene(200, 50, {255, 255, 255, 255});
+  scene.Text({10, 35}, "ratslam 42", 24, {0, 0, 0, 255});
+  StatusOr<RgbaImage> image = renderer->Render(scene);
+  ASSERT_TRUE(image.ok());
+  int dark = 0;
+  for (int y = 0; y < 50; ++y)
+    for (int x = 0; x < 200; ++x) dark += image->At(x, y).r < 128;
+  EXPECT_GT(dark, 100);
+}
+
+TEST(OsMesaRendererTest, OversizedImageIsAnErrorNotACrash) {
+  REQUIRE_RENDERER(renderer);
+  Scene scene(100000, 10, {255, 255, 255, 255});
+  EXPECT_FALSE(renderer->Render(scene).ok());
+}
+
+TEST(PngTest, WriteReadRoundTrip) {
+  RgbaImage image{3, 2, {1, 2, 3, 255, 4, 5, 6, 255, 7, 8, 9, 255, 10, 11, 12, 255, 13, 14, 15,
+                         255, 16, 17, 18, 128}};
+  const auto path = std::filesystem::temp_directory_path() / "ratslam_png_test.png";
+  ASSERT_TRUE(WritePng(image, path.string()).ok());
+  StatusOr<RgbaImage> back = ReadPng(path.string());
+  ASSERT_TRUE(back.ok());
+  EXPECT_EQ(back->pixels, image.pixels);
+  std::filesystem::remove(path);
+  EXPECT_FALSE(ReadPng(path.string()).ok());
+}
+
+}  // namespace
+}  // namespace ratslam

@@ -1,0 +1,65 @@
+#include "viewer/run_images.h"
+
+#include <filesystem>
+
+#include "fusion/trajectory_metrics.h"
+
+namespace ratslam {
+
+ExperienceMapImageData ExperienceMapDataOf(const ReplayPipeline& pipeline, const Dataset& dataset) {
+  const ExperienceMap& map = pipeline.slam().experience_map();
+  ExperienceMapImageData data;
+  data.experiences = map.experiences();
+  data.links = map.links();
+  data.current = map.current();
+  if (!dataset.ground_truth.empty()) {
+    std::vector<Point2> map_points, truth_points, truth_path;
+    for (const Experience& e : map.experiences()) {
+      if (auto gt = InterpolateGroundTruth(dataset.ground_truth, e.time_s)) {
+        map_points.push_back({e.x_m, e.y_m});
+        truth_points.push_back({gt->x_m, gt->y_m});
+      }
+    }
+    // Only the part of the ground truth the run has reached.
+    const double until = pipeline.state().trajectory.empty()
+                             ? -1.0
+                             : pipeline.state().trajectory.back().time_s;
+    for (const GroundTruthRow& row : dataset.ground_truth) {
+      if (row.time_s <= until) truth_path.push_back({row.x_m, row.y_m});
+    }
+    data.ground_truth = AlignGroundTruthToMap(map_points, truth_points, truth_path);
+  }
+  return data;
+}
+
+std::vector<TemplateGraphPoint> TemplateGraphOf(const ReplayPipeline& pipeline) {
+  std::vector<TemplateGraphPoint> points;
+  points.reserve(pipeline.state().frames.size());
+  for (const FrameRecord& f : pipeline.state().frames) {
+    points.push_back({f.time_s, f.template_id, f.experience_id,
+                      f.is_new ? ViewSource::kNew : ViewSource::kCamera});
+  }
+  return points;
+}
+
+Status WriteRunImages(SceneRenderer& renderer, const ReplayPipeline& pipeline,
+                      const Dataset& dataset, const std::string& folder) {
+  namespace fs = std::filesystem;
+  auto write = [&](const Scene& scene, const char* name) -> Status {
+    StatusOr<RgbaImage> image = renderer.Render(scene);
+    if (!image.ok()) return image.status().WithContext(name);
+    return WritePng(image.value(), (fs::path(folder) / name).string());
+  };
+  ExperienceMapImageOptions map_options;
+  map_options.title = "experience map (" + dataset.name + ")";
+  RATSLAM_RETURN_IF_ERROR(
+      write(ExperienceMapScene(ExperienceMapDataOf(pipeline, dataset), map_options),
+            "experience_map.png"));
+  TemplateGraphImageOptions graph_options;
+  graph_options.title = "template graph (" + dataset.name + ")";
+  RATSLAM_RETURN_IF_ERROR(
+      write(TemplateGraphScene(TemplateGraphOf(pipeline), graph_options), "template_graph.png"));
+  return write(PoseCellScene(pipeline.slam().pose_cells(), {}), "pose_cells.png");
+}
+
+}  // namespace ratslam
