@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <numbers>
 
@@ -87,6 +88,47 @@ void DrawAxes(Scene& scene, const PlotArea& p, const std::string& x_label,
   scene.Text({p.left - 10, p.top - 14}, y_label, 16, kInk, TextAnchor::kLeft);
 }
 
+constexpr float kLegendGap = 24;
+constexpr float kColorBarWidth = 180;
+
+// A legend entry: its width and how to draw it with its left end at x, centre line at y.
+struct LegendItem {
+  float width;
+  std::function<void(Scene&, float x, float y)> draw;
+};
+
+// Greedy rows of legend items no wider than `max_width`.
+std::vector<std::vector<size_t>> FlowRows(const std::vector<LegendItem>& items, float max_width) {
+  std::vector<std::vector<size_t>> rows(1);
+  float used = 0;
+  for (size_t i = 0; i < items.size(); ++i) {
+    const float need = items[i].width + (rows.back().empty() ? 0 : kLegendGap);
+    if (!rows.back().empty() && used + need > max_width) {
+      rows.emplace_back();
+      used = 0;
+    }
+    used += rows.back().empty() ? items[i].width : need;
+    rows.back().push_back(i);
+  }
+  return rows;
+}
+
+float RowLength(const std::vector<LegendItem>& items, const std::vector<size_t>& row) {
+  float length = 0;
+  for (size_t i : row) length += items[i].width + (length > 0 ? kLegendGap : 0);
+  return length;
+}
+
+// Draws one row right-aligned at `right`.
+void DrawRow(Scene& scene, const std::vector<LegendItem>& items, const std::vector<size_t>& row,
+             float right, float y) {
+  float x = right - RowLength(items, row);
+  for (size_t i : row) {
+    items[i].draw(scene, x, y);
+    x += items[i].width + kLegendGap;
+  }
+}
+
 }  // namespace
 
 Rgba SequentialColor(double t) {
@@ -136,7 +178,10 @@ Scene ExperienceMapScene(const ExperienceMapImageData& data,
                          const ExperienceMapImageOptions& options, WorldToImage* transform) {
   Scene scene(options.width_px, options.height_px, kWhite);
   const float w = static_cast<float>(options.width_px), h = static_cast<float>(options.height_px);
-  const float margin = 40, top_band = 50, bottom_band = 70;
+  const float margin = 30, top_band = 66;
+  // The bottom band holds the scale bar and the legend; the legend moves to a row of its own
+  // when both do not fit side by side (small images).
+  float bottom_band = 60;
 
   // World bounds over experiences and ground truth.
   double min_x = std::numeric_limits<double>::infinity(), max_x = -min_x;
@@ -154,6 +199,50 @@ Scene ExperienceMapScene(const ExperienceMapImageData& data,
     max_x = max_y = 1;
   }
   const double span_x = std::max(max_x - min_x, 1e-3), span_y = std::max(max_y - min_y, 1e-3);
+  // Legend items (a sample and a label each), flowed right to left into rows; the first row sits
+  // beside the scale bar when it fits there, further rows stack above it.
+  std::vector<LegendItem> items;
+  if (data.ground_truth.size() > 1) {
+    items.push_back({38 + TextWidthPx("ground truth", 14), [](Scene& s, float x, float y) {
+                       s.Line({x, y}, {x + 30, y}, 2.0f, kGroundTruth);
+                       s.Text({x + 38, y + 5}, "ground truth", 14, kInk);
+                     }});
+  }
+  items.push_back({38 + TextWidthPx("loop closure", 14), [](Scene& s, float x, float y) {
+                     s.Line({x, y}, {x + 30, y}, 3.0f, kLoopClosure);
+                     s.Text({x + 38, y + 5}, "loop closure", 14, kInk);
+                   }});
+  double t_first = std::numeric_limits<double>::infinity(), t_last = -t_first;
+  for (const Experience& e : data.experiences) {
+    t_first = std::min(t_first, e.time_s);
+    t_last = std::max(t_last, e.time_s);
+  }
+  if (options.coloring == MapColoring::kTime && std::isfinite(t_first)) {
+    items.push_back({kColorBarWidth + 20, [t_first, t_last](Scene& s, float x, float y) {
+                       s.Image(ColorBar(x, y - 7, kColorBarWidth, 14));
+                       s.Text({x, y + 24}, FormatNumber(t_first) + " s", 13, kInk, TextAnchor::kCenter);
+                       s.Text({x + kColorBarWidth, y + 24}, FormatNumber(t_last) + " s", 13, kInk,
+                              TextAnchor::kCenter);
+                       s.Text({x + kColorBarWidth / 2, y - 12}, "experience created at", 13, kInk,
+                              TextAnchor::kCenter);
+                     }});
+  } else if (options.coloring == MapColoring::kSession) {
+    for (size_t i = 0; i < options.session_start_times_s.size(); ++i) {
+      const std::string label = "session " + std::to_string(i + 1);
+      items.push_back({20 + TextWidthPx(label, 14), [i, label](Scene& s, float x, float y) {
+                         s.Rect(x, y - 7, 14, 14, CategoryColor(static_cast<int>(i)));
+                         s.Text({x + 20, y + 5}, label, 14, kInk);
+                       }});
+    }
+  }
+  const float row_width = w - 2 * margin;
+  const std::vector<std::vector<size_t>> rows = FlowRows(items, row_width);
+  auto row_length = [&](const std::vector<size_t>& row) { return RowLength(items, row); };
+  constexpr float kScaleBarRoom = 160;  // the scale bar and its label
+  const bool first_row_beside_bar = row_length(rows.front()) + kScaleBarRoom < row_width &&
+                                    rows.size() == 1;
+  const size_t stacked_rows = first_row_beside_bar ? 0 : rows.size();
+  bottom_band += 46 * stacked_rows;
   const double plot_w = w - 2 * margin, plot_h = h - top_band - bottom_band;
   WorldToImage to_image;
   to_image.scale_px_per_m = std::min(plot_w / span_x, plot_h / span_y);
@@ -222,48 +311,28 @@ Scene ExperienceMapScene(const ExperienceMapImageData& data,
                    {0, 0, 0, 255});
   }
 
-  // Title and counts.
-  const std::string title = options.title.empty() ? "experience map" : options.title;
-  scene.Text({margin, 32}, title + "   " + std::to_string(data.experiences.size()) +
-                               " experiences, " + std::to_string(n_links) + " links, " +
-                               std::to_string(loop_closures) + " loop closures",
-             18, kInk);
+  // Title, and the counts on a line of their own.
+  scene.Text({margin, 26}, options.title.empty() ? "experience map" : options.title, 18, kInk);
+  scene.Text({margin, 50}, std::to_string(data.experiences.size()) + " experiences, " +
+                               std::to_string(n_links) + " links, " +
+                               std::to_string(loop_closures) +
+                               (loop_closures == 1 ? " loop closure" : " loop closures"),
+             14, kInk);
 
   // Scale bar, bottom left: a nice length near a fifth of the plot width.
   const double bar_m = NiceStep(0.2 * plot_w / to_image.scale_px_per_m, 1);
   const float bar_px = static_cast<float>(bar_m * to_image.scale_px_per_m);
-  const float bar_y = h - 30;
+  const float bar_y = h - 16;
   scene.Line({margin, bar_y}, {margin + bar_px, bar_y}, 3.0f, kInk);
   scene.Line({margin, bar_y - 7}, {margin, bar_y + 7}, 2.0f, kInk);
   scene.Line({margin + bar_px, bar_y - 7}, {margin + bar_px, bar_y + 7}, 2.0f, kInk);
   scene.Text({margin + bar_px / 2, bar_y - 12}, FormatNumber(bar_m) + " m", 16, kInk,
              TextAnchor::kCenter);
 
-  // Legend, bottom right.
-  float legend_x = w - margin;
-  if (options.coloring == MapColoring::kTime && std::isfinite(t_min)) {
-    const float bar_w = 220;
-    scene.Image(ColorBar(legend_x - bar_w, bar_y - 8, bar_w, 14));
-    scene.Text({legend_x - bar_w, bar_y + 26}, FormatNumber(t_min) + " s", 14, kInk, TextAnchor::kCenter);
-    scene.Text({legend_x, bar_y + 26}, FormatNumber(t_max) + " s", 14, kInk, TextAnchor::kCenter);
-    scene.Text({legend_x - bar_w / 2, bar_y - 14}, "experience created at", 14, kInk,
-               TextAnchor::kCenter);
-    legend_x -= bar_w + 40;
-  } else if (options.coloring == MapColoring::kSession) {
-    for (int i = static_cast<int>(options.session_start_times_s.size()) - 1; i >= 0; --i) {
-      scene.Rect(legend_x - 110, bar_y - 8, 14, 14, CategoryColor(i));
-      scene.Text({legend_x - 90, bar_y + 5}, "session " + std::to_string(i + 1), 14, kInk);
-      legend_x -= 130;
-    }
-  }
-  // Legend entries: a line sample, then its label to the right.
-  legend_x -= 150;
-  scene.Line({legend_x, bar_y}, {legend_x + 30, bar_y}, 3.0f, kLoopClosure);
-  scene.Text({legend_x + 38, bar_y + 5}, "loop closure", 14, kInk);
-  if (data.ground_truth.size() > 1) {
-    legend_x -= 160;
-    scene.Line({legend_x, bar_y}, {legend_x + 30, bar_y}, 2.0f, kGroundTruth);
-    scene.Text({legend_x + 38, bar_y + 5}, "ground truth", 14, kInk);
+  // Legend rows, right-aligned, the last row lowest.
+  for (size_t r = 0; r < rows.size(); ++r) {
+    const float y = first_row_beside_bar ? bar_y : bar_y - 46.0f * (rows.size() - r);
+    DrawRow(scene, items, rows[r], w - margin, y);
   }
   return scene;
 }
@@ -280,8 +349,36 @@ Scene TemplateGraphScene(const std::vector<TemplateGraphPoint>& points,
   }
   if (!std::isfinite(t0)) t0 = 0, t1 = 1;
   if (t1 <= t0) t1 = t0 + 1;
-  PlotArea plot{90, 90, static_cast<float>(options.width_px - 130),
-                static_cast<float>(options.height_px - 170), t0, t1, 0, id_max * 1.02};
+  const Rgba source_colors[] = {{31, 119, 180, 255}, {44, 160, 44, 255}, {150, 150, 150, 255}};
+  constexpr Rgba kExperienceColor{230, 110, 0, 255};
+  // Legend, only for what the graph contains, in rows under the title.
+  bool present[3] = {false, false, false};
+  for (const TemplateGraphPoint& p : points) present[static_cast<int>(p.source)] = true;
+  const char* names[3] = {"camera match", "Wi-Fi match", "new template"};
+  std::vector<LegendItem> items;
+  for (int s = 0; s < 3; ++s) {
+    if (!present[s]) continue;
+    const std::string name = names[s];
+    const Rgba color = source_colors[s];
+    items.push_back({12 + TextWidthPx(name, 14), [s, name, color](Scene& sc, float x, float y) {
+                       if (s == 2) {
+                         sc.Disc({x + 3, y}, 2.5f, color, 8);
+                       } else {
+                         sc.Ring({x + 3, y}, 2.2f, 3.8f, 0, 2 * std::numbers::pi_v<float>, color, 10);
+                       }
+                       sc.Text({x + 12, y + 5}, name, 14, kInk);
+                     }});
+  }
+  items.push_back({12 + TextWidthPx("experience", 14), [](Scene& sc, float x, float y) {
+                     sc.Disc({x + 3, y}, 2.5f, kExperienceColor, 8);
+                     sc.Text({x + 12, y + 5}, "experience", 14, kInk);
+                   }});
+  const float right = static_cast<float>(options.width_px) - 30;
+  const std::vector<std::vector<size_t>> rows = FlowRows(items, right - 20);
+  for (size_t r = 0; r < rows.size(); ++r) DrawRow(scene, items, rows[r], right, 52 + 24.0f * r);
+  const float plot_top = 52 + 24.0f * rows.size() + 30;
+  PlotArea plot{80, plot_top, static_cast<float>(options.width_px - 110),
+                static_cast<float>(options.height_px) - plot_top - 70, t0, t1, 0, id_max * 1.02};
   for (const TimeSpan& span : options.shaded_spans) {
     const ScenePoint a = plot.Map(std::max(span.start_s, t0), 0);
     const ScenePoint b = plot.Map(std::min(span.end_s, t1), 0);
@@ -291,7 +388,6 @@ Scene TemplateGraphScene(const std::vector<TemplateGraphPoint>& points,
   }
   DrawAxes(scene, plot, "time (s)", "template id (circles), experience id (dots)");
   const bool many = points.size() > 20000;
-  const Rgba source_colors[] = {{31, 119, 180, 255}, {44, 160, 44, 255}, {150, 150, 150, 255}};
   for (const TemplateGraphPoint& p : points) {
     const Rgba c = source_colors[static_cast<int>(p.source)];
     const ScenePoint at = plot.Map(p.time_s, p.template_id);
@@ -304,30 +400,9 @@ Scene TemplateGraphScene(const std::vector<TemplateGraphPoint>& points,
   for (const TemplateGraphPoint& p : points) {
     if (p.experience_id < 0) continue;
     scene.Disc(plot.Map(p.time_s, static_cast<double>(p.experience_id)), many ? 0.8f : 1.3f,
-               {230, 110, 0, 255}, 6);
+               kExperienceColor, 6);
   }
-  // Legend, top right, only for what the graph contains.
-  bool present[3] = {false, false, false};
-  for (const TemplateGraphPoint& p : points) present[static_cast<int>(p.source)] = true;
-  const char* names[3] = {"camera match", "Wi-Fi match", "new template"};
-  float lx = plot.left + plot.width;
-  const float ly = 34;
-  auto entry_width = [](const std::string& s) { return 12.0f + TextWidthPx(s, 14) + 24.0f; };
-  const std::string exp_label = "experience";
-  lx -= entry_width(exp_label);
-  scene.Disc({lx, ly - 5}, 2.5f, {230, 110, 0, 255}, 8);
-  scene.Text({lx + 10, ly}, exp_label, 14, kInk);
-  for (int s = 2; s >= 0; --s) {
-    if (!present[s]) continue;
-    lx -= entry_width(names[s]);
-    if (s == 2) {
-      scene.Disc({lx, ly - 5}, 2.5f, source_colors[s], 8);
-    } else {
-      scene.Ring({lx, ly - 5}, 2.2f, 3.8f, 0, 2 * std::numbers::pi_v<float>, source_colors[s], 10);
-    }
-    scene.Text({lx + 10, ly}, names[s], 14, kInk);
-  }
-  scene.Text({plot.left, 30}, options.title.empty() ? "template graph" : options.title, 18, kInk);
+  scene.Text({20, 26}, options.title.empty() ? "template graph" : options.title, 18, kInk);
   return scene;
 }
 
@@ -398,8 +473,8 @@ Scene PoseCellScene(const PoseCellNetwork& network, const PoseCellImageOptions& 
   std::snprintf(label, sizeof label, "best pose: x %.2f, y %.2f, theta %.2f cells (%.0f deg)",
                 best.x, best.y, best.theta, best.theta * 360.0 / nt);
   scene.Text({left, static_cast<float>(options.height_px - 16)}, label, 15, kInk);
-  scene.Text({center.x, top - 14}, "heading (activity summed over x, y)", 15, kInk, TextAnchor::kCenter);
-  scene.Text({left, 28}, options.title.empty() ? "pose-cell activity (summed over theta)" : options.title,
+  scene.Text({center.x, top - 30}, "heading (activity summed over x, y)", 15, kInk, TextAnchor::kCenter);
+  scene.Text({20, 26}, options.title.empty() ? "pose-cell activity (summed over theta)" : options.title,
              18, kInk);
   return scene;
 }
@@ -408,8 +483,8 @@ Scene SimilarityMatrixScene(const std::vector<float>& matrix, const std::vector<
                             const SimilarityImageOptions& options) {
   const int n = static_cast<int>(times_s.size());
   const int size = options.size_px;
-  Scene scene(size + 170, size + 130, kWhite);
-  const float left = 90, top = 60;
+  Scene scene(size + 190, size + 150, kWhite);
+  const float left = 80, top = 80;
   if (n > 0 && matrix.size() == static_cast<size_t>(n) * n) {
     SceneImage heat;
     heat.left = left;
@@ -450,8 +525,8 @@ Scene SimilarityMatrixScene(const std::vector<float>& matrix, const std::vector<
   scene.Image(std::move(vertical));
   scene.Text({left + size + 55, top + 12}, "1", 14, kInk);
   scene.Text({left + size + 55, top + size}, "0", 14, kInk);
-  scene.Text({left + size + 25, top - 12}, options.value_label, 14, kInk);
-  scene.Text({left, 30}, options.title.empty() ? "similarity matrix" : options.title, 18, kInk);
+  scene.Text({left + size + 40, top - 12}, options.value_label, 14, kInk, TextAnchor::kCenter);
+  scene.Text({20, 26}, options.title.empty() ? "similarity matrix" : options.title, 18, kInk);
   return scene;
 }
 

@@ -2,6 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
+#include "viewer/renderer.h"
+
 namespace ratslam {
 namespace {
 
@@ -9,6 +13,93 @@ TEST(NiceStepTest, PicksOneTwoFive) {
   EXPECT_DOUBLE_EQ(NiceStep(100, 10), 10);
   EXPECT_DOUBLE_EQ(NiceStep(37, 8), 5);
   EXPECT_DOUBLE_EQ(NiceStep(0.9, 5), 0.2);
+}
+
+TEST(SequentialColorTest, LightnessRisesMonotonically) {
+  double previous = -1;
+  for (int i = 0; i <= 100; ++i) {
+    const Rgba c = SequentialColor(i / 100.0);
+    const double lightness = 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b;
+    EXPECT_GE(lightness, previous - 1e-9) << i;
+    previous = lightness;
+  }
+}
+
+Experience At(uint32_t id, double x, double y, double theta = 0.0) {
+  Experience e;
+  e.id = id;
+  e.x_m = x;
+  e.y_m = y;
+  e.theta_rad = theta;
+  e.time_s = id;
+  return e;
+}
+
+// Three experiences on an L: (0,0), (20,0), (20,10).
+ExperienceMapImageData LMap() {
+  ExperienceMapImageData data;
+  data.experiences = {At(0, 0, 0), At(1, 20, 0), At(2, 20, 10, M_PI / 2)};
+  Link a;
+  a.id = 0;
+  a.from = 0;
+  a.to = 1;
+  Link b = a;
+  b.id = 1;
+  b.from = 1;
+  b.to = 2;
+  data.links = {a, b};
+  return data;
+}
+
+TEST(ExperienceMapSceneTest, EqualAspectAndYUp) {
+  WorldToImage t;
+  ExperienceMapScene(LMap(), {}, &t);
+  const ScenePoint origin = t(0, 0), east = t(20, 0), north = t(20, 10);
+  // 20 m along x spans twice the pixels of 10 m along y: equal scale on both axes.
+  EXPECT_NEAR(east.x - origin.x, 2.0 * (east.y - north.y), 1e-3);
+  EXPECT_GT(east.x, origin.x);
+  EXPECT_LT(north.y, east.y) << "larger world y must be higher in the image";
+}
+
+TEST(AlignGroundTruthToMapTest, RotatedTruthLandsOnTheMap) {
+  const std::vector<Point2> map = {{0, 0}, {10, 0}, {10, 5}};
+  std::vector<Point2> truth;
+  for (const Point2& p : map) truth.push_back({-p.y + 3, p.x - 1});  // rotated 90 deg, moved
+  const std::vector<Point2> aligned = AlignGroundTruthToMap(map, truth, truth);
+  ASSERT_EQ(aligned.size(), 3u);
+  for (size_t i = 0; i < 3; ++i) {
+    EXPECT_NEAR(aligned[i].x, map[i].x, 1e-9);
+    EXPECT_NEAR(aligned[i].y, map[i].y, 1e-9);
+  }
+}
+
+// Rendered: nodes appear at the pixels the transform gives, the right way up.
+TEST(ExperienceMapSceneTest, RenderedNodesAreWhereTheWorldSays) {
+  StatusOr<std::unique_ptr<SceneRenderer>> renderer = CreateOsMesaRenderer();
+  if (!renderer.ok()) GTEST_SKIP() << "OSMesa unavailable: " << renderer.status().message();
+  ExperienceMapImageOptions options;
+  options.width_px = 400;
+  options.height_px = 300;
+  WorldToImage t;
+  const Scene scene = ExperienceMapScene(LMap(), options, &t);
+  StatusOr<RgbaImage> image = renderer.value()->Render(scene);
+  ASSERT_TRUE(image.ok()) << image.status().message();
+  auto is_ink = [&](ScenePoint p) {
+    const Rgba c = image->At(static_cast<int>(std::lround(p.x)), static_cast<int>(std::lround(p.y)));
+    return c.r + c.g + c.b < 600;
+  };
+  EXPECT_TRUE(is_ink(t(0, 0)));
+  EXPECT_TRUE(is_ink(t(20, 0)));
+  EXPECT_TRUE(is_ink(t(20, 10)));
+  EXPECT_TRUE(is_ink(t(10, 0)));    // on the first link
+  EXPECT_FALSE(is_ink(t(5, 8)));    // empty corner of the L
+  EXPECT_FALSE(is_ink(t(0, 10)));   // mirrored position of node 2: would be inked if upside down
+}
+
+TEST(TemplateGraphSceneTest, EmptyInputStillGivesAFigure) {
+  const Scene scene = TemplateGraphScene({}, {});
+  EXPECT_EQ(scene.width(), 1600);
+  EXPECT_FALSE(scene.texts().empty());
 }
 
 }  // namespace

@@ -1,0 +1,149 @@
+// Golden images: small fixed figures rendered with OSMesa and compared with committed reference
+// PNGs (tests/golden/) by per-pixel difference statistics, not bit equality, so that another
+// Mesa release passes while a real change in a figure fails. After an intended change, run with
+// RATSLAM_UPDATE_GOLDEN=1, look at the new images, and commit them.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+
+#include "viewer/figures.h"
+#include "viewer/renderer.h"
+
+namespace ratslam {
+namespace {
+namespace fs = std::filesystem;
+
+void ExpectMatchesGolden(const Scene& scene, const std::string& name) {
+  StatusOr<std::unique_ptr<SceneRenderer>> renderer = CreateOsMesaRenderer();
+  if (!renderer.ok()) GTEST_SKIP() << "OSMesa unavailable: " << renderer.status().message();
+  StatusOr<RgbaImage> actual = renderer.value()->Render(scene);
+  ASSERT_TRUE(actual.ok()) << actual.status().message();
+  const fs::path golden = fs::path(RATSLAM_SOURCE_DIR) / "tests" / "golden" / (name + ".png");
+  if (std::getenv("RATSLAM_UPDATE_GOLDEN")) {
+    ASSERT_TRUE(WritePng(actual.value(), golden.string()).ok());
+    GTEST_SKIP() << "updated " << golden;
+  }
+  StatusOr<RgbaImage> expected = ReadPng(golden.string());
+  ASSERT_TRUE(expected.ok()) << expected.status().message();
+  ASSERT_EQ(actual->width, expected->width);
+  ASSERT_EQ(actual->height, expected->height);
+  double sum = 0.0;
+  size_t large = 0;
+  for (size_t i = 0; i < actual->pixels.size(); ++i) {
+    const int d = std::abs(int(actual->pixels[i]) - int(expected->pixels[i]));
+    sum += d;
+    large += d > 40;
+  }
+  const double mean = sum / actual->pixels.size();
+  const double large_fraction = static_cast<double>(large) / actual->pixels.size();
+  const fs::path written = fs::temp_directory_path() / ("ratslam_actual_" + name + ".png");
+  if (mean > 1.0 || large_fraction > 0.005) (void)WritePng(actual.value(), written.string());
+  EXPECT_LE(mean, 1.0) << name << ": mean channel difference; actual image in " << written;
+  EXPECT_LE(large_fraction, 0.005) << name << ": share of very different channels; actual in "
+                                   << written;
+}
+
+Experience At(uint32_t id, double x, double y, double theta, double t) {
+  Experience e;
+  e.id = id;
+  e.x_m = x;
+  e.y_m = y;
+  e.theta_rad = theta;
+  e.time_s = t;
+  return e;
+}
+
+TEST(GoldenImageTest, ExperienceMap) {
+  // A 20 m x 10 m loop of 12 experiences with drift, closed back to the start.
+  ExperienceMapImageData data;
+  for (uint32_t i = 0; i < 12; ++i) {
+    const double a = 2 * M_PI * i / 12;
+    data.experiences.push_back(At(i, 10 * std::cos(a) + 0.1 * i, 5 * std::sin(a), a + M_PI / 2, i * 2.0));
+    data.ground_truth.push_back({10 * std::cos(a), 5 * std::sin(a)});
+  }
+  data.ground_truth.push_back(data.ground_truth.front());
+  for (uint32_t i = 0; i < 12; ++i) {
+    Link l;
+    l.id = i;
+    l.from = i;
+    l.to = (i + 1) % 12;
+    l.loop_closure = i == 11;
+    data.links.push_back(l);
+  }
+  data.current = 11;
+  ExperienceMapImageOptions options;
+  options.width_px = 480;
+  options.height_px = 360;
+  options.title = "golden";
+  ExpectMatchesGolden(ExperienceMapScene(data, options), "experience_map");
+}
+
+TEST(GoldenImageTest, ExperienceMapBySession) {
+  ExperienceMapImageData data;
+  for (uint32_t i = 0; i < 20; ++i) data.experiences.push_back(At(i, i, (i % 10) * 0.5, 0, i));
+  for (uint32_t i = 0; i + 1 < 20; ++i) {
+    Link l;
+    l.id = i;
+    l.from = i;
+    l.to = i + 1;
+    data.links.push_back(l);
+  }
+  ExperienceMapImageOptions options;
+  options.width_px = 480;
+  options.height_px = 300;
+  options.coloring = MapColoring::kSession;
+  options.session_start_times_s = {0, 10};
+  options.title = "sessions";
+  ExpectMatchesGolden(ExperienceMapScene(data, options), "experience_map_sessions");
+}
+
+TEST(GoldenImageTest, TemplateGraph) {
+  std::vector<TemplateGraphPoint> points;
+  for (int i = 0; i < 60; ++i) {
+    TemplateGraphPoint p;
+    p.time_s = i;
+    p.template_id = i < 30 ? i : i - 30;
+    p.experience_id = i < 30 ? i : i - 28;
+    p.source = i < 30 ? ViewSource::kNew : (i % 3 ? ViewSource::kCamera : ViewSource::kWifi);
+    points.push_back(p);
+  }
+  TemplateGraphImageOptions options;
+  options.width_px = 640;
+  options.height_px = 360;
+  options.shaded_spans = {{30, 59, "night"}};
+  options.title = "golden";
+  ExpectMatchesGolden(TemplateGraphScene(points, options), "template_graph");
+}
+
+TEST(GoldenImageTest, PoseCells) {
+  PoseCellOptions o;
+  o.dim_xy_cells = 21;
+  PoseCellNetwork network(o);
+  network.Reset({5.3, 7.6, 10.0});
+  for (int i = 0; i < 10; ++i) network.Step(0.5, 0.1);
+  PoseCellImageOptions options;
+  options.width_px = 800;
+  options.height_px = 420;
+  ExpectMatchesGolden(PoseCellScene(network, options), "pose_cells");
+}
+
+TEST(GoldenImageTest, SimilarityMatrix) {
+  const int n = 30;
+  std::vector<float> m(n * n);
+  std::vector<double> times;
+  for (int i = 0; i < n; ++i) {
+    times.push_back(i * 2.0);
+    for (int j = 0; j < n; ++j) {
+      const int d = std::min(std::abs(i - j), std::abs(std::abs(i - j) - 15));  // revisit at +15
+      m[i * n + j] = static_cast<float>(std::exp(-d * d / 4.0));
+    }
+  }
+  SimilarityImageOptions options;
+  options.size_px = 300;
+  ExpectMatchesGolden(SimilarityMatrixScene(m, times, options), "similarity_matrix");
+}
+
+}  // namespace
+}  // namespace ratslam
