@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/cli.h"
 #include "apps/demo_config.h"
 #include "apps/progress.h"
 #include "fusion/io/config.h"
@@ -33,11 +34,6 @@ namespace ratslam {
 namespace {
 
 namespace fs = std::filesystem;
-
-constexpr int kExitOk = 0;
-constexpr int kExitError = 1;
-constexpr int kExitUsage = 2;
-constexpr int kExitInterrupted = 130;
 
 std::atomic<bool> g_stop_requested{false};
 
@@ -59,52 +55,13 @@ const char kUsage[] =
     "  ratslam import-openratslam FILE.ini\n"
     "      Converts an OpenRatSLAM configuration file to ours (TOML on stdout).\n"
     "  ratslam synthesize --out D [--seed S] [--laps N]\n"
-    "      Writes the built-in synthetic data set into D.\n";
-
-// Parsed "--flag value" pairs and bare flags.
-struct Arguments {
-  std::map<std::string, std::string> values;
-  std::vector<std::string> positional;
-  bool quiet = false;
-  bool render = false;
-};
-
-std::optional<Arguments> ParseArguments(int argc, char** argv, int first,
-                                        const std::vector<std::string>& flags_with_values) {
-  Arguments args;
-  for (int i = first; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--quiet") {
-      args.quiet = true;
-    } else if (a == "--render") {
-      args.render = true;
-    } else if (a.rfind("--", 0) == 0) {
-      if (std::find(flags_with_values.begin(), flags_with_values.end(), a) ==
-          flags_with_values.end()) {
-        std::cerr << "ratslam: unknown option " << a << "\n";
-        return std::nullopt;
-      }
-      if (i + 1 >= argc) {
-        std::cerr << "ratslam: " << a << " needs a value\n";
-        return std::nullopt;
-      }
-      args.values[a] = argv[++i];
-    } else {
-      args.positional.push_back(a);
-    }
-  }
-  return args;
-}
-
-std::optional<double> ParseNumber(const std::string& flag, const std::string& text) {
-  char* end = nullptr;
-  const double value = std::strtod(text.c_str(), &end);
-  if (text.empty() || *end != '\0' || !std::isfinite(value)) {
-    std::cerr << "ratslam: " << flag << ": not a number: '" << text << "'\n";
-    return std::nullopt;
-  }
-  return value;
-}
+    "      Writes the built-in synthetic data set into D.\n"
+    "  ratslam render experience-map --run O [--data D] [--out F] [--size WxH]\n"
+    "                 [--color time|session] [--sessions T1,T2,...]\n"
+    "  ratslam render template-graph --run O [--out F] [--size WxH] [--spans A-B:label,...]\n"
+    "  ratslam render pose-cells --map F [--config C] --out F\n"
+    "  ratslam render similarity --data D [--config C] --out F [--frames N]\n"
+    "      Images from a run folder, a saved map, or a data set (PNG).\n";
 
 struct ReplayRequest {
   PipelineOptions options;
@@ -367,6 +324,7 @@ int main(int argc, char** argv) {
   if (command == "print-config") return PrintConfigCommand(argc, argv);
   if (command == "import-openratslam") return ImportOpenRatslam(argc, argv);
   if (command == "synthesize") return SynthesizeCommand(argc, argv);
+  if (command == "render") return RenderCommand(argc, argv);
   if (command == "--help" || command == "help" || command == "-h") {
     std::cout << kUsage;
     return kExitOk;

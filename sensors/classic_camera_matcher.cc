@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 
@@ -112,28 +113,25 @@ __attribute__((target("avx2"))) inline uint32_t MaskedSadAvx2(const uint8_t* sto
 }
 #endif
 
-// Best (difference, template, shift) over all stored templates, with the SAD kernel `Sad`.
-template <uint32_t (*Sad)(const uint8_t*, const uint8_t*, const uint8_t*, int, int)>
+// Calls visit(template id, smallest difference over the shifts) for every stored template, with
+// the SAD kernel `Sad`. The minimum is taken without branches: a per-shift argmin mispredicts.
+template <uint32_t (*Sad)(const uint8_t*, const uint8_t*, const uint8_t*, int, int), typename Visit>
 #if defined(RATSLAM_HAVE_X86_SIMD)
 __attribute__((target("avx2")))
 #endif
-void SearchTemplates(const uint8_t* base, uint32_t count, size_t bytes_per_template,
+void ForEachTemplate(const uint8_t* base, uint32_t count, size_t bytes_per_template,
                      const PreparedQuery& prepared, const std::vector<double>& scale,
-                     const std::vector<int>& shifts, int height, int stride,
-                     TemplateComparison* best) {
+                     const std::vector<int>& shifts, int height, int stride, Visit&& visit) {
   const size_t per_shift = static_cast<size_t>(height) * stride;
   for (uint32_t id = 0; id < count; ++id) {
     const uint8_t* t = base + id * bytes_per_template;
+    double best = std::numeric_limits<double>::infinity();
     for (size_t k = 0; k < shifts.size(); ++k) {
       const uint32_t sad = Sad(t, prepared.rows.data() + k * per_shift,
                                prepared.masks.data() + k * stride, height, stride);
-      const double difference = sad * scale[k];
-      if (difference < best->mean_difference) {
-        best->mean_difference = difference;
-        best->template_id = static_cast<int32_t>(id);
-        best->shift_px = shifts[k];
-      }
+      best = std::min(best, sad * scale[k]);
     }
+    visit(id, best);
   }
 }
 
@@ -261,9 +259,8 @@ StatusOr<std::vector<uint8_t>> ClassicCameraMatcher::MakeTemplate(
   return result;
 }
 
-TemplateComparison ClassicCameraMatcher::Compare(const std::vector<uint8_t>& query) const {
-  TemplateComparison best;
-  if (state_.template_count == 0 || query.size() != bytes_per_template_) return best;
+template <typename Visit>
+void ClassicCameraMatcher::VisitTemplates(const std::vector<uint8_t>& query, Visit&& visit) const {
   const int h = options_.template_height_px;
   const PreparedQuery prepared = Prepare(query, shifts_, options_.template_width_px, h,
                                          row_stride_, options_.panoramic);
@@ -275,14 +272,49 @@ TemplateComparison ClassicCameraMatcher::Compare(const std::vector<uint8_t>& que
 #if defined(RATSLAM_HAVE_X86_SIMD)
   static const bool kAvx2 = __builtin_cpu_supports("avx2");
   if (kAvx2) {
-    SearchTemplates<MaskedSadAvx2>(base, state_.template_count, bytes_per_template_, prepared,
-                                   scale, shifts_, h, row_stride_, &best);
-    return best;
+    ForEachTemplate<MaskedSadAvx2>(base, state_.template_count, bytes_per_template_, prepared,
+                                   scale, shifts_, h, row_stride_, visit);
+    return;
   }
 #endif
-  SearchTemplates<MaskedSadPortable>(base, state_.template_count, bytes_per_template_, prepared,
-                                     scale, shifts_, h, row_stride_, &best);
+  ForEachTemplate<MaskedSadPortable>(base, state_.template_count, bytes_per_template_, prepared,
+                                     scale, shifts_, h, row_stride_, visit);
+}
+
+TemplateComparison ClassicCameraMatcher::Compare(const std::vector<uint8_t>& query) const {
+  TemplateComparison best;
+  if (state_.template_count == 0 || query.size() != bytes_per_template_) return best;
+  VisitTemplates(query, [&best](uint32_t id, double difference) {
+    if (difference < best.mean_difference) {
+      best.mean_difference = difference;
+      best.template_id = static_cast<int32_t>(id);
+    }
+  });
+  // The winning shift: recomputed for the winning template only (the first shift attaining it).
+  const int h = options_.template_height_px;
+  const PreparedQuery prepared = Prepare(query, shifts_, options_.template_width_px, h,
+                                         row_stride_, options_.panoramic);
+  const uint8_t* t = state_.templates.data() + best.template_id * bytes_per_template_;
+  for (size_t k = 0; k < shifts_.size(); ++k) {
+    const uint32_t sad = MaskedSadPortable(t, prepared.rows.data() + k * h * row_stride_,
+                                           prepared.masks.data() + k * row_stride_, h, row_stride_);
+    // Same expression as the scan (sad * scale), so equality is exact.
+    if (sad * (1.0 / (255.0 * h * prepared.overlap_columns[k])) == best.mean_difference) {
+      best.shift_px = shifts_[k];
+      break;
+    }
+  }
   return best;
+}
+
+std::vector<double> ClassicCameraMatcher::Differences(const std::vector<uint8_t>& query) const {
+  std::vector<double> differences;
+  if (query.size() != bytes_per_template_) return differences;
+  differences.reserve(state_.template_count);
+  VisitTemplates(query, [&differences](uint32_t, double difference) {
+    differences.push_back(difference);
+  });
+  return differences;
 }
 
 uint32_t ClassicCameraMatcher::Add(const std::vector<uint8_t>& query) {

@@ -88,6 +88,8 @@ class ClassicCameraMatcher {
   StatusOr<std::vector<uint8_t>> MakeTemplate(const GrayImageView& image) const;
   // Compares a template (from MakeTemplate) with every stored one.
   TemplateComparison Compare(const std::vector<uint8_t>& query) const;
+  // The smallest mean difference over the shifts to every stored template, by id.
+  std::vector<double> Differences(const std::vector<uint8_t>& query) const;
   // Stores a template (from MakeTemplate); returns its id.
   uint32_t Add(const std::vector<uint8_t>& query);
 
@@ -98,6 +100,9 @@ class ClassicCameraMatcher {
   Status SetState(State state);
 
  private:
+  template <typename Visit>
+  void VisitTemplates(const std::vector<uint8_t>& query, Visit&& visit) const;
+
   ClassicCameraOptions options_;
   int row_stride_;  // template width rounded up to a multiple of 32 bytes
   size_t bytes_per_template_;

@@ -331,7 +331,8 @@ Scene ExperienceMapScene(const ExperienceMapImageData& data,
 
   // Legend rows, right-aligned, the last row lowest.
   for (size_t r = 0; r < rows.size(); ++r) {
-    const float y = first_row_beside_bar ? bar_y : bar_y - 46.0f * (rows.size() - r);
+    // Beside the scale bar the row sits higher, leaving room for colour-bar labels below it.
+    const float y = first_row_beside_bar ? bar_y - 16 : bar_y - 46.0f * (rows.size() - r);
     DrawRow(scene, items, rows[r], w - margin, y);
   }
   return scene;

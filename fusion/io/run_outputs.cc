@@ -81,6 +81,7 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
 
   nlohmann::ordered_json j;
   j["dataset"] = dataset.name;
+  if (!dataset.folder.empty()) j["data_folder"] = dataset.folder;
   j["frames"] = s.frames;
   j["templates"] = s.templates;
   j["experiences"] = s.experiences;

@@ -1,0 +1,73 @@
+// Small helpers shared by the `ratslam` sub-commands.
+#ifndef RATSLAM_APPS_CLI_H_
+#define RATSLAM_APPS_CLI_H_
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <iostream>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace ratslam {
+
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitError = 1;
+inline constexpr int kExitUsage = 2;
+inline constexpr int kExitInterrupted = 130;
+
+
+// Parsed "--flag value" pairs and bare flags.
+struct Arguments {
+  std::map<std::string, std::string> values;
+  std::vector<std::string> positional;
+  bool quiet = false;
+  bool render = false;
+};
+
+inline std::optional<Arguments> ParseArguments(int argc, char** argv, int first,
+                                        const std::vector<std::string>& flags_with_values) {
+  Arguments args;
+  for (int i = first; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--quiet") {
+      args.quiet = true;
+    } else if (a == "--render") {
+      args.render = true;
+    } else if (a.rfind("--", 0) == 0) {
+      if (std::find(flags_with_values.begin(), flags_with_values.end(), a) ==
+          flags_with_values.end()) {
+        std::cerr << "ratslam: unknown option " << a << "\n";
+        return std::nullopt;
+      }
+      if (i + 1 >= argc) {
+        std::cerr << "ratslam: " << a << " needs a value\n";
+        return std::nullopt;
+      }
+      args.values[a] = argv[++i];
+    } else {
+      args.positional.push_back(a);
+    }
+  }
+  return args;
+}
+
+inline std::optional<double> ParseNumber(const std::string& flag, const std::string& text) {
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  if (text.empty() || *end != '\0' || !std::isfinite(value)) {
+    std::cerr << "ratslam: " << flag << ": not a number: '" << text << "'\n";
+    return std::nullopt;
+  }
+  return value;
+}
+
+
+// `ratslam render ...` (render_command.cc).
+int RenderCommand(int argc, char** argv);
+
+}  // namespace ratslam
+
+#endif  // RATSLAM_APPS_CLI_H_

@@ -1,0 +1,247 @@
+// `ratslam render ...`: images from a run folder, a saved map, or a data set.
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+
+#include "apps/cli.h"
+#include "fusion/io/config.h"
+#include "fusion/io/map_file.h"
+#include "sensors/dataset/dataset.h"
+#include "sensors/dataset/image_loader.h"
+#include "viewer/figures.h"
+#include "viewer/renderer.h"
+#include "viewer/run_reader.h"
+#include "viewer/similarity.h"
+
+namespace ratslam {
+namespace {
+
+namespace fs = std::filesystem;
+
+const char kRenderUsage[] =
+    "usage:\n"
+    "  ratslam render experience-map --run O [--data D] [--out F] [--size WxH]\n"
+    "                 [--color time|session] [--sessions T1,T2,...]\n"
+    "  ratslam render template-graph --run O [--out F] [--size WxH] [--spans A-B:label,...]\n"
+    "  ratslam render pose-cells --map F [--config C] --out F\n"
+    "  ratslam render similarity --data D [--config C] --out F [--frames N]\n";
+
+int Fail(const std::string& message) {
+  std::cerr << "ratslam: " << message << "\n";
+  return kExitError;
+}
+
+bool ParseSize(const Arguments& args, int* width, int* height) {
+  auto it = args.values.find("--size");
+  if (it == args.values.end()) return true;
+  char x = 0;
+  std::istringstream in(it->second);
+  if (!(in >> *width >> x >> *height) || x != 'x' || *width < 64 || *height < 64 ||
+      *width > 16384 || *height > 16384) {
+    std::cerr << "ratslam: --size must be WxH with 64..16384 pixels each, not '" << it->second
+              << "'\n";
+    return false;
+  }
+  return true;
+}
+
+std::optional<std::vector<double>> ParseTimes(const std::string& text) {
+  std::vector<double> times;
+  std::istringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    auto t = ParseNumber("--sessions", item);
+    if (!t) return std::nullopt;
+    times.push_back(*t);
+  }
+  std::sort(times.begin(), times.end());
+  return times;
+}
+
+std::optional<std::vector<TimeSpan>> ParseSpans(const std::string& text) {
+  std::vector<TimeSpan> spans;
+  std::istringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    const auto dash = item.find('-', 1);
+    const auto colon = item.find(':');
+    if (dash == std::string::npos) {
+      std::cerr << "ratslam: --spans item '" << item << "' is not START-END[:label]\n";
+      return std::nullopt;
+    }
+    auto start = ParseNumber("--spans", item.substr(0, dash));
+    auto end = ParseNumber("--spans", item.substr(dash + 1, colon == std::string::npos
+                                                                ? std::string::npos
+                                                                : colon - dash - 1));
+    if (!start || !end) return std::nullopt;
+    spans.push_back({*start, *end, colon == std::string::npos ? "" : item.substr(colon + 1)});
+  }
+  return spans;
+}
+
+Status Write(const Scene& scene, const std::string& path) {
+  Status status = RenderToPng(scene, path);
+  if (status.ok()) std::cerr << "ratslam: wrote " << path << "\n";
+  return status;
+}
+
+std::optional<PipelineOptions> OptionsFrom(const Arguments& args) {
+  auto it = args.values.find("--config");
+  if (it == args.values.end()) return PipelineOptions();
+  StatusOr<PipelineOptions> options = LoadConfigFile(it->second);
+  if (!options.ok()) {
+    std::cerr << "ratslam: " << options.status().message() << "\n";
+    return std::nullopt;
+  }
+  return options.value();
+}
+
+int RenderExperienceMap(const Arguments& args) {
+  if (!args.values.count("--run")) return Fail(std::string("--run is required\n") + kRenderUsage);
+  const std::string run_folder = args.values.at("--run");
+  StatusOr<RunFolder> run = ReadRunFolder(run_folder);
+  if (!run.ok()) return Fail(run.status().message());
+  ExperienceMapImageOptions options;
+  if (!ParseSize(args, &options.width_px, &options.height_px)) return kExitUsage;
+  if (auto it = args.values.find("--color"); it != args.values.end()) {
+    if (it->second == "time") {
+      options.coloring = MapColoring::kTime;
+    } else if (it->second == "session") {
+      options.coloring = MapColoring::kSession;
+    } else {
+      return Fail("--color must be time or session, not '" + it->second + "'");
+    }
+  }
+  if (auto it = args.values.find("--sessions"); it != args.values.end()) {
+    auto times = ParseTimes(it->second);
+    if (!times) return kExitUsage;
+    options.session_start_times_s = *times;
+  } else if (options.coloring == MapColoring::kSession) {
+    options.session_start_times_s = {run->experiences.empty() ? 0.0 : run->experiences[0].time_s};
+  }
+  ExperienceMapImageData data;
+  data.experiences = run->experiences;
+  data.links = run->links;
+  if (!run->frames.empty() && run->frames.back().experience_id >= 0) {
+    data.current = static_cast<uint32_t>(run->frames.back().experience_id);
+  }
+  const std::string data_folder =
+      args.values.count("--data") ? args.values.at("--data") : run->dataset_folder;
+  if (!data_folder.empty()) {
+    StatusOr<Dataset> dataset = ReadDataset(data_folder);
+    if (!dataset.ok()) return Fail(dataset.status().message());
+    std::vector<Point2> map_points, truth_points, truth_path;
+    for (const Experience& e : data.experiences) {
+      if (auto gt = InterpolateGroundTruth(dataset->ground_truth, e.time_s)) {
+        map_points.push_back({e.x_m, e.y_m});
+        truth_points.push_back({gt->x_m, gt->y_m});
+      }
+    }
+    // Only the part of the ground truth the run reached.
+    const double until = run->frames.empty() ? 0.0 : run->frames.back().time_s;
+    for (const GroundTruthRow& row : dataset->ground_truth) {
+      if (row.time_s <= until) truth_path.push_back({row.x_m, row.y_m});
+    }
+    data.ground_truth = AlignGroundTruthToMap(map_points, truth_points, truth_path);
+    options.title = "experience map (" + dataset->name + ")";
+  }
+  const std::string out = args.values.count("--out")
+                              ? args.values.at("--out")
+                              : (fs::path(run_folder) / "experience_map.png").string();
+  Status status = Write(ExperienceMapScene(data, options), out);
+  return status.ok() ? kExitOk : Fail(status.message());
+}
+
+int RenderTemplateGraph(const Arguments& args) {
+  if (!args.values.count("--run")) return Fail(std::string("--run is required\n") + kRenderUsage);
+  const std::string run_folder = args.values.at("--run");
+  StatusOr<RunFolder> run = ReadRunFolder(run_folder);
+  if (!run.ok()) return Fail(run.status().message());
+  TemplateGraphImageOptions options;
+  if (!ParseSize(args, &options.width_px, &options.height_px)) return kExitUsage;
+  if (auto it = args.values.find("--spans"); it != args.values.end()) {
+    auto spans = ParseSpans(it->second);
+    if (!spans) return kExitUsage;
+    options.shaded_spans = *spans;
+  }
+  std::vector<TemplateGraphPoint> points;
+  for (const FrameRecord& f : run->frames) {
+    points.push_back({f.time_s, f.template_id, f.experience_id,
+                      f.is_new ? ViewSource::kNew : ViewSource::kCamera});
+  }
+  const std::string out = args.values.count("--out")
+                              ? args.values.at("--out")
+                              : (fs::path(run_folder) / "template_graph.png").string();
+  Status status = Write(TemplateGraphScene(points, options), out);
+  return status.ok() ? kExitOk : Fail(status.message());
+}
+
+int RenderPoseCells(const Arguments& args) {
+  if (!args.values.count("--map") || !args.values.count("--out")) {
+    return Fail(std::string("--map and --out are required\n") + kRenderUsage);
+  }
+  auto options = OptionsFrom(args);
+  if (!options) return kExitError;
+  StatusOr<MapFile> map = LoadMapFile(args.values.at("--map"));
+  if (!map.ok()) return Fail(map.status().message());
+  PoseCellNetwork network(options->ratslam.pose_cells);
+  Status restored = network.SetState(map->state.ratslam.pose_cells);
+  if (!restored.ok()) {
+    return Fail(args.values.at("--map") + ": " + restored.message() +
+                " (pass the --config the map was made with)");
+  }
+  PoseCellImageOptions image_options;
+  image_options.title = "pose-cell activity (" + map->dataset_name + ", summed over theta)";
+  Status status = Write(PoseCellScene(network, image_options), args.values.at("--out"));
+  return status.ok() ? kExitOk : Fail(status.message());
+}
+
+int RenderSimilarity(const Arguments& args) {
+  if (!args.values.count("--data") || !args.values.count("--out")) {
+    return Fail(std::string("--data and --out are required\n") + kRenderUsage);
+  }
+  auto options = OptionsFrom(args);
+  if (!options) return kExitError;
+  int frames = 600;
+  if (auto it = args.values.find("--frames"); it != args.values.end()) {
+    auto n = ParseNumber("--frames", it->second);
+    if (!n || *n < 2 || *n > 5000) return Fail("--frames must be in 2..5000");
+    frames = static_cast<int>(*n);
+  }
+  StatusOr<Dataset> dataset = ReadDataset(args.values.at("--data"));
+  if (!dataset.ok()) return Fail(dataset.status().message());
+  FileImageLoader images;
+  StatusOr<SimilarityMatrix> m = CameraSimilarityMatrix(dataset.value(), &images, options->camera, frames);
+  if (!m.ok()) return Fail(m.status().message());
+  SimilarityImageOptions image_options;
+  image_options.title = "camera template similarity (" + dataset->name + ")";
+  image_options.value_label = "similarity";
+  Status status = Write(SimilarityMatrixScene(m->values, m->times_s, image_options),
+                        args.values.at("--out"));
+  return status.ok() ? kExitOk : Fail(status.message());
+}
+
+}  // namespace
+
+int RenderCommand(int argc, char** argv) {
+  if (argc < 3) {
+    std::cerr << kRenderUsage;
+    return kExitUsage;
+  }
+  const std::string what = argv[2];
+  auto args = ParseArguments(argc, argv, 3,
+                             {"--run", "--data", "--out", "--size", "--color", "--sessions",
+                              "--spans", "--map", "--config", "--frames"});
+  if (!args || !args->positional.empty()) {
+    std::cerr << kRenderUsage;
+    return kExitUsage;
+  }
+  if (what == "experience-map") return RenderExperienceMap(*args);
+  if (what == "template-graph") return RenderTemplateGraph(*args);
+  if (what == "pose-cells") return RenderPoseCells(*args);
+  if (what == "similarity") return RenderSimilarity(*args);
+  std::cerr << "ratslam: unknown image '" << what << "'\n" << kRenderUsage;
+  return kExitUsage;
+}
+
+}  // namespace ratslam

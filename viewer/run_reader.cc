@@ -1,0 +1,105 @@
+#include "viewer/run_reader.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "sensors/dataset/csv.h"
+
+namespace ratslam {
+namespace {
+namespace fs = std::filesystem;
+
+#define READ_NUMBER(lhs, table, row, column)                 \
+  do {                                                       \
+    StatusOr<double> value_ = (table).Number(row, column);   \
+    if (!value_.ok()) return value_.status();                \
+    lhs = value_.value();                                    \
+  } while (false)
+
+Status ReadId(const CsvTable& t, size_t row, const std::string& column, int64_t min,
+              int64_t* out) {
+  double v = 0;
+  READ_NUMBER(v, t, row, column);
+  if (v != std::floor(v) || v < static_cast<double>(min) || v > 4e9) {
+    return t.ErrorAt(row, column, "not a valid id");
+  }
+  *out = static_cast<int64_t>(v);
+  return Status::Ok();
+}
+
+}  // namespace
+
+StatusOr<RunFolder> ReadRunFolder(const std::string& folder) {
+  RunFolder run;
+  StatusOr<CsvTable> ex = CsvTable::Read(
+      (fs::path(folder) / "experiences.csv").string(),
+      {"id", "x_m", "y_m", "theta_rad", "template_id", "time_s"},
+      {"pose_cell_x", "pose_cell_y", "pose_cell_theta"});
+  if (!ex.ok()) return ex.status();
+  for (size_t r = 0; r < ex->rows(); ++r) {
+    Experience e;
+    int64_t id = 0, template_id = 0;
+    RATSLAM_RETURN_IF_ERROR(ReadId(*ex, r, "id", 0, &id));
+    if (id != static_cast<int64_t>(r)) return ex->ErrorAt(r, "id", "ids must be 0, 1, 2, ...");
+    RATSLAM_RETURN_IF_ERROR(ReadId(*ex, r, "template_id", 0, &template_id));
+    e.id = static_cast<uint32_t>(id);
+    e.template_id = static_cast<uint32_t>(template_id);
+    READ_NUMBER(e.x_m, *ex, r, "x_m");
+    READ_NUMBER(e.y_m, *ex, r, "y_m");
+    READ_NUMBER(e.theta_rad, *ex, r, "theta_rad");
+    READ_NUMBER(e.time_s, *ex, r, "time_s");
+    run.experiences.push_back(e);
+  }
+  StatusOr<CsvTable> li = CsvTable::Read(
+      (fs::path(folder) / "links.csv").string(),
+      {"id", "from_id", "to_id", "distance_m", "heading_rad", "facing_rad", "duration_s",
+       "loop_closure"});
+  if (!li.ok()) return li.status();
+  const int64_t n = static_cast<int64_t>(run.experiences.size());
+  for (size_t r = 0; r < li->rows(); ++r) {
+    Link l;
+    int64_t id = 0, from = 0, to = 0, loop = 0;
+    RATSLAM_RETURN_IF_ERROR(ReadId(*li, r, "id", 0, &id));
+    RATSLAM_RETURN_IF_ERROR(ReadId(*li, r, "from_id", 0, &from));
+    RATSLAM_RETURN_IF_ERROR(ReadId(*li, r, "to_id", 0, &to));
+    RATSLAM_RETURN_IF_ERROR(ReadId(*li, r, "loop_closure", 0, &loop));
+    if (from >= n) return li->ErrorAt(r, "from_id", "no such experience");
+    if (to >= n) return li->ErrorAt(r, "to_id", "no such experience");
+    l.id = static_cast<uint32_t>(id);
+    l.from = static_cast<uint32_t>(from);
+    l.to = static_cast<uint32_t>(to);
+    l.loop_closure = loop != 0;
+    READ_NUMBER(l.distance_m, *li, r, "distance_m");
+    READ_NUMBER(l.heading_rad, *li, r, "heading_rad");
+    READ_NUMBER(l.facing_rad, *li, r, "facing_rad");
+    READ_NUMBER(l.duration_s, *li, r, "duration_s");
+    run.links.push_back(l);
+  }
+  StatusOr<CsvTable> fr = CsvTable::Read((fs::path(folder) / "frames.csv").string(),
+                                         {"time_s", "template_id", "new_template", "experience_id"});
+  if (!fr.ok()) return fr.status();
+  for (size_t r = 0; r < fr->rows(); ++r) {
+    FrameRecord f;
+    int64_t template_id = 0, is_new = 0, experience = 0;
+    READ_NUMBER(f.time_s, *fr, r, "time_s");
+    RATSLAM_RETURN_IF_ERROR(ReadId(*fr, r, "template_id", 0, &template_id));
+    RATSLAM_RETURN_IF_ERROR(ReadId(*fr, r, "new_template", 0, &is_new));
+    RATSLAM_RETURN_IF_ERROR(ReadId(*fr, r, "experience_id", -1, &experience));
+    f.template_id = static_cast<uint32_t>(template_id);
+    f.is_new = is_new != 0;
+    f.experience_id = experience;
+    run.frames.push_back(f);
+  }
+  std::ifstream summary(fs::path(folder) / "summary.json");
+  if (summary) {
+    const nlohmann::json j = nlohmann::json::parse(summary, nullptr, /*allow_exceptions=*/false);
+    if (j.is_object() && j.contains("data_folder") && j["data_folder"].is_string()) {
+      run.dataset_folder = j["data_folder"].get<std::string>();
+    }
+  }
+  return run;
+}
+
+}  // namespace ratslam

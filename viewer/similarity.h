@@ -1,0 +1,29 @@
+// Pairwise camera similarity between frames of a data set, for similarity-matrix images.
+#ifndef RATSLAM_VIEWER_SIMILARITY_H_
+#define RATSLAM_VIEWER_SIMILARITY_H_
+
+#include <vector>
+
+#include "ratslam/status.h"
+#include "sensors/classic_camera_matcher.h"
+#include "sensors/dataset/dataset.h"
+#include "sensors/dataset/image_loader.h"
+
+namespace ratslam {
+
+struct SimilarityMatrix {
+  std::vector<double> times_s;  // the sampled frames
+  std::vector<float> values;    // row-major, 1 = identical, 0 = as different as the 95th percentile
+  double reference_difference = 0.0;  // the mean difference that maps to 0
+};
+
+// Samples at most `max_frames` evenly spaced frames, makes their templates with `options`, and
+// compares every pair (best shift). Similarity = clamp(1 - d / d95, 0, 1), d95 the 95th
+// percentile of all pairwise differences.
+StatusOr<SimilarityMatrix> CameraSimilarityMatrix(const Dataset& dataset, ImageLoader* images,
+                                                  const ClassicCameraOptions& options,
+                                                  int max_frames);
+
+}  // namespace ratslam
+
+#endif  // RATSLAM_VIEWER_SIMILARITY_H_
