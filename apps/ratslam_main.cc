@@ -27,6 +27,8 @@
 #include "sensors/dataset/dataset.h"
 #include "sensors/dataset/image_loader.h"
 #include "sensors/dataset/synthetic_dataset.h"
+#include "viewer/animation.h"
+#include "viewer/figures.h"
 #include "viewer/renderer.h"
 #include "viewer/run_images.h"
 
@@ -42,11 +44,12 @@ extern "C" void OnSignal(int) { g_stop_requested.store(true); }
 const char kUsage[] =
     "usage:\n"
     "  ratslam replay --data D --out O [--config C] [--save-map F] [--load-map F]\n"
-    "                 [--until T] [--render] [--quiet]\n"
+    "                 [--until T] [--render] [--animate N] [--quiet]\n"
     "      Replays data set D (a replay-format folder) and writes the map, trajectory and\n"
     "      summary into O. --until T stops after data time T seconds; --save-map F saves the\n"
     "      whole state to F; --load-map F resumes from F. Ctrl-C stops cleanly and saves.\n"
-    "      --render also writes experience_map.png, template_graph.png and pose_cells.png.\n"
+    "      --render also writes experience_map.png, template_graph.png and pose_cells.png;\n"
+    "      --animate N writes an experience-map frame every N events to O/animation/.\n"
     "  ratslam demo --out O [--quiet]\n"
     "      Writes the built-in synthetic data set to O/data, replays it into O and renders\n"
     "      the images.\n"
@@ -73,6 +76,7 @@ struct ReplayRequest {
   double until_s = std::numeric_limits<double>::infinity();
   bool quiet = false;
   bool render = false;  // write experience_map.png, template_graph.png, pose_cells.png
+  uint64_t animate_every = 0;  // events between animation frames; 0: no animation
 };
 
 int RunReplay(const ReplayRequest& request) {
@@ -129,12 +133,45 @@ int RunReplay(const ReplayRequest& request) {
   control.until_time_s = request.until_s;
   control.stop_requested = &g_stop_requested;
   control.progress = [&progress](const ReplayProgress& p) { progress.Update(p); };
+  // Animation: a frame of the experience map every `animate_every` events.
+  std::unique_ptr<SceneRenderer> animation_renderer;
+  std::unique_ptr<AnimationWriter> animation;
+  if (request.animate_every > 0) {
+    StatusOr<std::unique_ptr<SceneRenderer>> renderer = CreateOsMesaRenderer();
+    if (!renderer.ok()) {
+      std::cerr << "ratslam: --animate: " << renderer.status().message() << "\n";
+      return kExitError;
+    }
+    animation_renderer = std::move(renderer.value());
+    animation = std::make_unique<AnimationWriter>(
+        (fs::path(request.out) / "animation").string(), 10.0);
+    control.checkpoint_every = request.animate_every;
+    control.checkpoint = [&](const ReplayPipeline& p) -> Status {
+      ExperienceMapImageOptions options;
+      options.width_px = 960;
+      options.height_px = 720;
+      char title[96];
+      std::snprintf(title, sizeof title, "%s  t = %.1f s", dataset->name.c_str(),
+                    p.state().trajectory.empty() ? 0.0 : p.state().trajectory.back().time_s);
+      options.title = title;
+      StatusOr<RgbaImage> frame =
+          animation_renderer->Render(ExperienceMapScene(ExperienceMapDataOf(p, dataset.value()), options));
+      if (!frame.ok()) return frame.status();
+      return animation->AddFrame(frame.value());
+    };
+  }
   const uint64_t frames_before = pipeline.state().frames.size();
   const auto start = std::chrono::steady_clock::now();
   const Status run = pipeline.Run(control);
   const double wall_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   progress.Finish();
+  if (animation) {
+    const bool video = animation->Close();
+    std::cerr << "ratslam: wrote " << animation->frames() << " animation frames"
+              << (video ? " and animation.avi" : " (no video writer available)") << " to "
+              << (fs::path(request.out) / "animation").string() << "\n";
+  }
   std::signal(SIGINT, SIG_DFL);
   std::signal(SIGTERM, SIG_DFL);
   const bool interrupted = g_stop_requested.load();
@@ -202,7 +239,8 @@ std::optional<PipelineOptions> LoadOptions(const Arguments& args, std::string* p
 
 int Replay(int argc, char** argv) {
   auto args = ParseArguments(argc, argv, 2,
-                             {"--config", "--data", "--out", "--save-map", "--load-map", "--until"});
+                             {"--config", "--data", "--out", "--save-map", "--load-map", "--until",
+                              "--animate"});
   if (!args || !args->positional.empty() || !args->values.count("--data") ||
       !args->values.count("--out")) {
     std::cerr << kUsage;
@@ -220,6 +258,14 @@ int Replay(int argc, char** argv) {
     auto until = ParseNumber("--until", args->values["--until"]);
     if (!until) return kExitUsage;
     request.until_s = *until;
+  }
+  if (args->values.count("--animate")) {
+    auto every = ParseNumber("--animate", args->values["--animate"]);
+    if (!every || *every < 1) {
+      std::cerr << "ratslam: --animate takes a positive number of events\n";
+      return kExitUsage;
+    }
+    request.animate_every = static_cast<uint64_t>(*every);
   }
   request.quiet = args->quiet;
   request.render = args->render;

@@ -72,6 +72,10 @@ Status ReplayPipeline::Run(const ReplayControl& control) {
     }
     if (!status.ok()) return status;
     ++state_.next_event;
+    if (control.checkpoint && control.checkpoint_every > 0 &&
+        (state_.next_event % control.checkpoint_every == 0 || finished())) {
+      RATSLAM_RETURN_IF_ERROR(control.checkpoint(*this));
+    }
     if (control.progress && (state_.next_event % control.progress_every == 0 || finished())) {
       progress.events_done = state_.next_event;
       progress.data_time_s = event.time_s;

@@ -84,6 +84,10 @@ struct ReplayControl {
   const std::atomic<bool>* stop_requested = nullptr;  // checked between events
   std::function<void(const ReplayProgress&)> progress;  // called every progress_every events
   uint64_t progress_every = 500;
+  // Called every checkpoint_every events with the pipeline (read only), e.g. to draw animation
+  // frames; an error stops the replay.
+  std::function<Status(const class ReplayPipeline&)> checkpoint;
+  uint64_t checkpoint_every = 0;  // 0: never
 };
 
 class ReplayPipeline {

@@ -9,6 +9,8 @@
 
 #include "apps/demo_config.h"
 #include "sensors/dataset/synthetic_dataset.h"
+#include "viewer/image.h"
+#include "viewer/renderer.h"
 
 namespace ratslam {
 namespace {
@@ -163,6 +165,68 @@ TEST_F(ReplayEndToEndTest, MissingImageKeepsOutputsAndStateThenResumes) {
   ASSERT_EQ(RunRatslam(ReplayArgs(whole), root_).exit_code, 0);
   EXPECT_EQ(Slurp(whole / "experiences.csv"), Slurp(resumed / "experiences.csv"));
   EXPECT_EQ(Slurp(whole / "trajectory_tum.txt"), Slurp(resumed / "trajectory_tum.txt"));
+}
+
+// The images a user looks at: written by --render and by `render`, readable, not blank.
+void ExpectPicture(const fs::path& png, int width, int height) {
+  ASSERT_TRUE(fs::exists(png)) << png;
+  StatusOr<RgbaImage> image = ReadPng(png.string());
+  ASSERT_TRUE(image.ok()) << image.status().message();
+  EXPECT_EQ(image->width, width) << png;
+  EXPECT_EQ(image->height, height) << png;
+  size_t ink = 0;
+  for (size_t i = 0; i < image->pixels.size(); i += 4) ink += image->pixels[i] < 200;
+  EXPECT_GT(ink, image->pixels.size() / 4 / 200) << png << " looks blank";
+}
+
+TEST_F(ReplayEndToEndTest, RenderWritesImagesFromRunsAndMaps) {
+  if (!CreateOsMesaRenderer().ok()) GTEST_SKIP() << "OSMesa unavailable";
+  const fs::path out = root_ / "rendered";
+  ASSERT_EQ(RunRatslam(ReplayArgs(out) + " --render --animate 2000 --save-map " +
+                           (out / "m.map").string(),
+                       root_)
+                .exit_code,
+            0);
+  ExpectPicture(out / "experience_map.png", 1600, 1200);
+  ExpectPicture(out / "template_graph.png", 1600, 900);
+  ExpectPicture(out / "pose_cells.png", 1200, 620);
+  // 7268 events, a frame every 2000 plus the last.
+  ExpectPicture(out / "animation" / "frame_000000.png", 960, 720);
+  EXPECT_TRUE(fs::exists(out / "animation" / "frame_000003.png"));
+  EXPECT_FALSE(fs::exists(out / "animation" / "frame_000004.png"));
+
+  const fs::path png = root_ / "from_run.png";
+  ASSERT_EQ(RunRatslam("render experience-map --run " + out.string() + " --size 800x600 --out " +
+                           png.string(),
+                       root_)
+                .exit_code,
+            0);
+  ExpectPicture(png, 800, 600);
+  const fs::path cells = root_ / "cells.png";
+  ASSERT_EQ(RunRatslam("render pose-cells --map " + (out / "m.map").string() + " --config " +
+                           config_ + " --out " + cells.string(),
+                       root_)
+                .exit_code,
+            0);
+  ExpectPicture(cells, 1200, 620);
+  const fs::path similarity = root_ / "similarity.png";
+  ASSERT_EQ(RunRatslam("render similarity --data " + (root_ / "data").string() + " --config " +
+                           config_ + " --frames 200 --out " + similarity.string(),
+                       root_)
+                .exit_code,
+            0);
+  ExpectPicture(similarity, 1190, 1150);
+}
+
+TEST_F(ReplayEndToEndTest, RenderFromBrokenRunFolderNamesTheLine) {
+  const fs::path out = root_ / "broken_run";
+  fs::create_directories(out);
+  std::ofstream(out / "experiences.csv")
+      << "id,x_m,y_m,theta_rad,template_id,time_s\n0,0,0,0,0,0\n1,1,0,0,0,oops\n";
+  const Result r = RunRatslam("render experience-map --run " + out.string(), root_);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("experiences.csv:3: column 'time_s': not a number"), std::string::npos)
+      << r.err;
 }
 
 TEST_F(ReplayEndToEndTest, PrintConfigFailsWithLineNumber) {

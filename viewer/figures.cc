@@ -269,8 +269,10 @@ Scene ExperienceMapScene(const ExperienceMapImageData& data,
 
   // Stay legible from a few links to 100k: thinner, more transparent strokes for larger maps.
   const size_t n_links = data.links.size();
-  const float link_width = n_links > 20000 ? 1.0f : (n_links > 2000 ? 1.5f : 2.5f);
-  const uint8_t link_alpha = n_links > 20000 ? 140 : 230;
+  // Strokes scale with the image (a 2048 px image is not a 1200 px one seen closer).
+  const float zoom = std::max(1.0f, std::min(w, h) / 1200.0f);
+  const float link_width = zoom * (n_links > 20000 ? 1.2f : (n_links > 2000 ? 1.5f : 2.5f));
+  const uint8_t link_alpha = n_links > 20000 ? 200 : 230;
   const float node_radius = data.experiences.size() > 20000 ? 0.0f
                             : data.experiences.size() > 2000 ? 1.5f : 3.0f;
 
@@ -297,8 +299,9 @@ Scene ExperienceMapScene(const ExperienceMapImageData& data,
     ++loop_closures;
     const Experience& a = data.experiences[l.from];
     const Experience& b = data.experiences[l.to];
-    scene.Line(to_image(a.x_m, a.y_m), to_image(b.x_m, b.y_m), link_width + 1.0f,
-               WithAlpha(kLoopClosure, 220));
+    scene.Line(to_image(a.x_m, a.y_m), to_image(b.x_m, b.y_m),
+               n_links > 20000 ? link_width : link_width + 1.0f,
+               WithAlpha(kLoopClosure, n_links > 20000 ? 150 : 220));
   }
   if (data.current && *data.current < data.experiences.size()) {
     // The current pose: an arrow head pointing along the experience's facing.

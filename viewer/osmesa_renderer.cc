@@ -3,6 +3,7 @@
 #include <GL/osmesa.h>
 #include <GL/glext.h>
 
+#include <cstdlib>
 #include <cstring>
 #include <string>
 #include <vector>
@@ -126,10 +127,19 @@ class OsMesaRenderer : public SceneRenderer {
   }
 
   Status Init() {
-    // The library name differs between Mesa releases; try the usual sonames.
-    for (const char* name : {"libOSMesa.so.8", "libOSMesa.so.6", "libOSMesa.so"}) {
-      library_ = dlopen(name, RTLD_NOW | RTLD_LOCAL);
-      if (library_) break;
+    // RATSLAM_OSMESA_LIBRARY names a specific build; otherwise try the usual sonames, which
+    // differ between Mesa releases.
+    if (const char* override_path = std::getenv("RATSLAM_OSMESA_LIBRARY")) {
+      library_ = dlopen(override_path, RTLD_NOW | RTLD_LOCAL);
+      if (!library_) {
+        return Status::Error(std::string("OSMesa is not available: cannot load ") +
+                             override_path + " (RATSLAM_OSMESA_LIBRARY): " + dlerror());
+      }
+    } else {
+      for (const char* name : {"libOSMesa.so.8", "libOSMesa.so.6", "libOSMesa.so"}) {
+        library_ = dlopen(name, RTLD_NOW | RTLD_LOCAL);
+        if (library_) break;
+      }
     }
     if (!library_) {
       return Status::Error(

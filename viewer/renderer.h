@@ -19,7 +19,7 @@ class SceneRenderer {
 
 // Headless OpenGL 3.3 core rendering through OSMesa (llvmpipe), loaded at run time with dlopen:
 // no display, no X, no libGL. Fails with a clear message when libOSMesa is missing or a context
-// cannot be made.
+// cannot be made. The environment variable RATSLAM_OSMESA_LIBRARY selects a specific library.
 StatusOr<std::unique_ptr<SceneRenderer>> CreateOsMesaRenderer();
 
 // Renders `scene` with a new OSMesa renderer and writes it as PNG.

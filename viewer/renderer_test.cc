@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <filesystem>
 
 namespace ratslam {
@@ -88,6 +89,19 @@ TEST(OsMesaRendererTest, OversizedImageIsAnErrorNotACrash) {
   REQUIRE_RENDERER(renderer);
   Scene scene(100000, 10, {255, 255, 255, 255});
   EXPECT_FALSE(renderer->Render(scene).ok());
+}
+
+TEST(OsMesaRendererTest, MissingLibraryIsAClearError) {
+  ::setenv("RATSLAM_OSMESA_LIBRARY", "/nonexistent/libOSMesa.so.8", 1);
+  StatusOr<std::unique_ptr<SceneRenderer>> renderer = CreateOsMesaRenderer();
+  ::unsetenv("RATSLAM_OSMESA_LIBRARY");
+  ASSERT_FALSE(renderer.ok());
+  EXPECT_NE(renderer.status().message().find("OSMesa is not available"), std::string::npos)
+      << renderer.status().message();
+  const Scene scene(10, 10, {0, 0, 0, 255});
+  ::setenv("RATSLAM_OSMESA_LIBRARY", "/nonexistent/libOSMesa.so.8", 1);
+  EXPECT_FALSE(RenderToPng(scene, "/tmp/never_written.png").ok());
+  ::unsetenv("RATSLAM_OSMESA_LIBRARY");
 }
 
 TEST(PngTest, WriteReadRoundTrip) {

@@ -1,0 +1,92 @@
+// Rendering a large experience map (100k links) at 2048x2048: scene building, OSMesa rendering
+// and PNG encoding measured separately, so the share of PNG encoding can be reported.
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include "ratslam/random.h"
+#include "viewer/figures.h"
+#include "viewer/renderer.h"
+
+namespace ratslam {
+namespace {
+
+ExperienceMapImageData LargeMap(int links) {
+  // Twenty laps of a 5,000-experience city-block route (a rounded square of 1 km sides, one
+  // experience per 0.8 m) with lap-to-lap drift; every 50th experience of a lap closes a loop to
+  // the same place on the previous lap, as a long multi-lap replay gives.
+  ExperienceMapImageData data;
+  Random rng(3);
+  const int per_lap = 5000;
+  for (int i = 0; i <= links; ++i) {
+    const int lap = i / per_lap;
+    const double s = 4.0 * (i % per_lap) / per_lap;  // 0..4 around the square
+    const int side = static_cast<int>(s);
+    const double f = s - side;
+    const double corners[5][2] = {{0, 0}, {1000, 0}, {1000, 1000}, {0, 1000}, {0, 0}};
+    Experience e;
+    e.id = i;
+    e.x_m = corners[side][0] + f * (corners[side + 1][0] - corners[side][0]) + 3.0 * lap +
+            rng.Gaussian(0.0, 0.5);
+    e.y_m = corners[side][1] + f * (corners[side + 1][1] - corners[side][1]) - 2.0 * lap +
+            rng.Gaussian(0.0, 0.5);
+    e.theta_rad = side * M_PI / 2;
+    e.time_s = i;
+    data.experiences.push_back(e);
+  }
+  for (int i = 0; i < links; ++i) {
+    Link l;
+    l.id = i;
+    const bool closure = i >= per_lap && i % 50 == 0;
+    l.from = i;
+    l.to = closure ? i - per_lap : i + 1;
+    l.loop_closure = closure;
+    data.links.push_back(l);
+  }
+  return data;
+}
+
+ExperienceMapImageOptions Options() {
+  ExperienceMapImageOptions o;
+  o.width_px = 2048;
+  o.height_px = 2048;
+  return o;
+}
+
+void BM_BuildScene(benchmark::State& state) {
+  const ExperienceMapImageData data = LargeMap(static_cast<int>(state.range(0)));
+  for (auto _ : state) benchmark::DoNotOptimize(ExperienceMapScene(data, Options()));
+}
+BENCHMARK(BM_BuildScene)->Arg(100000)->Unit(benchmark::kMillisecond);
+
+void BM_RenderOsMesa(benchmark::State& state) {
+  auto renderer = CreateOsMesaRenderer();
+  if (!renderer.ok()) {
+    state.SkipWithError(renderer.status().message().c_str());
+    return;
+  }
+  const Scene scene = ExperienceMapScene(LargeMap(static_cast<int>(state.range(0))), Options());
+  for (auto _ : state) benchmark::DoNotOptimize(renderer.value()->Render(scene));
+  state.counters["triangles"] = static_cast<double>(scene.triangles().size() / 3);
+}
+BENCHMARK(BM_RenderOsMesa)->Arg(100000)->Unit(benchmark::kMillisecond);
+
+void BM_EncodePng(benchmark::State& state) {
+  auto renderer = CreateOsMesaRenderer();
+  if (!renderer.ok()) {
+    state.SkipWithError(renderer.status().message().c_str());
+    return;
+  }
+  const Scene scene = ExperienceMapScene(LargeMap(100000), Options());
+  const RgbaImage image = renderer.value()->Render(scene).value();
+  const auto path = std::filesystem::temp_directory_path() / "ratslam_render_benchmark.png";
+  for (auto _ : state) benchmark::DoNotOptimize(WritePng(image, path.string()));
+  std::filesystem::remove(path);
+}
+BENCHMARK(BM_EncodePng)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace ratslam
+
+BENCHMARK_MAIN();
