@@ -167,7 +167,7 @@ int RenderTemplateGraph(const Arguments& args) {
   std::vector<TemplateGraphPoint> points;
   for (const FrameRecord& f : run->frames) {
     points.push_back({f.time_s, f.template_id, f.experience_id,
-                      f.is_new ? ViewSource::kNew : ViewSource::kCamera});
+                      f.source});
   }
   const std::string out = args.values.count("--out")
                               ? args.values.at("--out")
@@ -211,7 +211,7 @@ int RenderSimilarity(const Arguments& args) {
   StatusOr<Dataset> dataset = ReadDataset(args.values.at("--data"));
   if (!dataset.ok()) return Fail(dataset.status().message());
   FileImageLoader images;
-  StatusOr<SimilarityMatrix> m = CameraSimilarityMatrix(dataset.value(), &images, options->camera, frames);
+  StatusOr<SimilarityMatrix> m = CameraSimilarityMatrix(dataset.value(), &images, options->sensors.classic_camera, frames);
   if (!m.ok()) return Fail(m.status().message());
   SimilarityImageOptions image_options;
   image_options.title = "camera template similarity (" + dataset->name + ")";

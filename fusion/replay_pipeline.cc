@@ -7,26 +7,17 @@
 
 namespace ratslam {
 
-std::string ToString(FrontEndKind kind) {
-  switch (kind) {
-    case FrontEndKind::kClassicCamera:
-      return "classic_camera";
-  }
-  return "unknown";
-}
-
-StatusOr<FrontEndKind> FrontEndKindFromString(const std::string& name) {
-  if (name == "classic_camera") return FrontEndKind::kClassicCamera;
-  return Status::Error("unknown front end '" + name + "' (valid: classic_camera)");
-}
-
 bool PipelineOptions::IsValid(std::string* error) const {
   std::string inner;
-  if (!camera.IsValid(&inner)) {
-    if (error) *error = "camera." + inner;
-    return false;
-  }
-  return ratslam.IsValid(error);
+  auto check = [&](bool ok, const char* section) {
+    if (!ok && error) *error = std::string(section) + "." + inner;
+    return ok;
+  };
+  return check(sensors.classic_camera.IsValid(&inner), "camera") &&
+         check(sensors.fused.IsValid(&inner), "fused") &&
+         check(sensors.camera_12x9.IsValid(&inner), "camera_12x9") &&
+         check(sensors.wifi.IsValid(&inner), "wifi") && check(pdr.IsValid(&inner), "pdr") &&
+         ratslam.IsValid(error);
 }
 
 namespace {
@@ -44,7 +35,7 @@ ReplayPipeline::ReplayPipeline(const PipelineOptions& options, const Dataset& da
       images_(images),
       events_(MergeEvents(dataset)),
       slam_(std::make_unique<Ratslam>(options.ratslam)),
-      camera_(options.camera) {
+      front_end_(CreateFrontEnd(options.sensors)) {
   state_.events_total = events_.size();
 }
 
@@ -64,11 +55,15 @@ Status ReplayPipeline::Run(const ReplayControl& control) {
         status = HandleImage(event);
         break;
       case EventType::kWifi:
-        ++state_.wifi_scans_seen;  // no Wi-Fi front end yet: counted, not used
+        status = HandleWifi(event);
         break;
-      case EventType::kCompass:
+      case EventType::kCompass: {
+        const CompassRow& row = dataset_.compass[event.index];
         ++state_.compass_readings_seen;
+        front_end_->OnCompass(row.time_s, row.heading_rad);
+        slam_->SetCompassHeading(front_end_->CompassHeading());
         break;
+      }
     }
     if (!status.ok()) return status;
     ++state_.next_event;
@@ -116,18 +111,33 @@ Status ReplayPipeline::HandleOdometry(const Event& event) {
 }
 
 Status ReplayPipeline::HandleImage(const Event& event) {
+  if (!front_end_->WantsImages()) {
+    ++state_.images_skipped;
+    return Status::Ok();
+  }
   const ImageRow& row = dataset_.images[event.index];
   const std::string where = "images.csv:" + std::to_string(row.line);
   StatusOr<GrayImage> image = images_->Load(dataset_.ImagePath(row));
   if (!image.ok()) return image.status().WithContext(where);
-  const GrayImageView view{image->width, image->height, image->width, image->pixels.data()};
-  StatusOr<ViewDecision> decision = camera_.Observe(view, row.time_s);
+  StatusOr<std::optional<FrameDecision>> decision = front_end_->OnImage(row.time_s, image.value());
   if (!decision.ok()) return decision.status().WithContext(where + ": " + row.file);
-  RATSLAM_RETURN_IF_ERROR(slam_->OnView(decision.value()));
+  return decision.value() ? Apply(*decision.value()) : Status::Ok();
+}
+
+Status ReplayPipeline::HandleWifi(const Event& event) {
+  ++state_.wifi_scans_seen;
+  StatusOr<std::optional<FrameDecision>> decision = front_end_->OnWifi(dataset_.wifi[event.index]);
+  if (!decision.ok()) return decision.status();
+  return decision.value() ? Apply(*decision.value()) : Status::Ok();
+}
+
+Status ReplayPipeline::Apply(const FrameDecision& decision) {
+  RATSLAM_RETURN_IF_ERROR(slam_->OnView(decision.view));
   FrameRecord frame;
-  frame.time_s = row.time_s;
-  frame.template_id = decision->template_id;
-  frame.is_new = decision->is_new;
+  frame.time_s = decision.view.time_s;
+  frame.template_id = decision.view.template_id;
+  frame.is_new = decision.view.is_new;
+  frame.source = decision.source;
   const auto current = slam_->experience_map().current();
   frame.experience_id = current ? static_cast<int64_t>(*current) : -1;
   state_.frames.push_back(frame);
@@ -137,7 +147,7 @@ Status ReplayPipeline::HandleImage(const Event& event) {
 ReplayPipeline::State ReplayPipeline::Snapshot() const {
   State snapshot = state_;
   snapshot.ratslam = slam_->GetState();
-  snapshot.camera = camera_.state();
+  snapshot.front_end = front_end_->EncodeState();
   return snapshot;
 }
 
@@ -150,16 +160,16 @@ Status ReplayPipeline::Restore(const State& state) {
   if (state.next_event > events_.size()) return Status::Error("saved map is past the data set");
   auto slam = std::make_unique<Ratslam>(options_.ratslam);
   RATSLAM_RETURN_IF_ERROR(slam->SetState(state.ratslam));
-  ClassicCameraMatcher camera(options_.camera);
-  RATSLAM_RETURN_IF_ERROR(camera.SetState(state.camera));
-  if (camera.size() != slam->local_view().size()) {
-    return Status::Error("saved map: camera templates and local view cells differ in number");
+  std::unique_ptr<FrontEnd> front_end = CreateFrontEnd(options_.sensors);
+  RATSLAM_RETURN_IF_ERROR(front_end->DecodeState(state.front_end));
+  if (front_end->size() != slam->local_view().size()) {
+    return Status::Error("saved map: front-end templates and local view cells differ in number");
   }
   slam_ = std::move(slam);
-  camera_ = std::move(camera);
+  front_end_ = std::move(front_end);
   state_ = state;
   state_.ratslam = {};
-  state_.camera = {};
+  state_.front_end.clear();
   return Status::Ok();
 }
 

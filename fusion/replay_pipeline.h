@@ -13,33 +13,19 @@
 #include <string>
 #include <vector>
 
+#include "fusion/front_end.h"
 #include "ratslam/ratslam.h"
 #include "ratslam/status.h"
-#include "sensors/classic_camera_matcher.h"
+#include "sensors/pedestrian_dead_reckoning.h"
 #include "sensors/dataset/dataset.h"
 #include "sensors/dataset/image_loader.h"
 
 namespace ratslam {
 
-enum class FrontEndKind { kClassicCamera };
-std::string ToString(FrontEndKind kind);
-// Fails with the list of valid names.
-StatusOr<FrontEndKind> FrontEndKindFromString(const std::string& name);
-
-struct FrontEndOptions {
-  FrontEndKind kind = FrontEndKind::kClassicCamera;  // which front end decides the local view
-
-  bool IsValid(std::string*) const { return true; }
-  template <typename Visitor>
-  void VisitFields(Visitor&& v) {
-    v("kind", kind, "front end that decides the active local view: classic_camera");
-  }
-};
-
 // Everything a replay is configured by; one TOML section per member.
 struct PipelineOptions {
-  FrontEndOptions front_end;
-  ClassicCameraOptions camera;
+  FrontEndSettings sensors;  // front end choice and every sensor's options
+  PdrOptions pdr;            // odometry from phone logs
   RatslamOptions ratslam;
 
   bool IsValid(std::string* error) const;
@@ -47,8 +33,12 @@ struct PipelineOptions {
   // Visits (section name, options struct) pairs in file order.
   template <typename Visitor>
   void VisitSections(Visitor&& v) {
-    v("front_end", front_end);
-    v("camera", camera);
+    v("front_end", sensors.front_end);
+    v("camera", sensors.classic_camera);
+    v("fused", sensors.fused);
+    v("camera_12x9", sensors.camera_12x9);
+    v("wifi", sensors.wifi);
+    v("pdr", pdr);
     v("pose_cells", ratslam.pose_cells);
     v("local_view", ratslam.local_view);
     v("experience_map", ratslam.experience_map);
@@ -71,6 +61,7 @@ struct FrameRecord {
   uint32_t template_id = 0;
   bool is_new = false;
   int64_t experience_id = -1;  // current experience after the frame
+  DecisionSource source = DecisionSource::kNew;
 };
 
 struct ReplayProgress {
@@ -94,7 +85,7 @@ class ReplayPipeline {
  public:
   struct State {
     Ratslam::State ratslam;
-    ClassicCameraMatcher::State camera;
+    std::string front_end;  // the front end's own encoding of its state
     uint64_t next_event = 0;
     uint64_t events_total = 0;  // of the data set it was made from
     double last_odometry_time_s = 0.0;
@@ -104,6 +95,7 @@ class ReplayPipeline {
     std::vector<FrameRecord> frames;
     uint64_t wifi_scans_seen = 0;
     uint64_t compass_readings_seen = 0;
+    uint64_t images_skipped = 0;  // images the front end does not use
   };
 
   // `options` must be valid; throws std::invalid_argument otherwise. `dataset` and `images`
@@ -126,13 +118,15 @@ class ReplayPipeline {
  private:
   Status HandleOdometry(const Event& event);
   Status HandleImage(const Event& event);
+  Status HandleWifi(const Event& event);
+  Status Apply(const FrameDecision& decision);
 
   PipelineOptions options_;
   const Dataset& dataset_;
   ImageLoader* images_;
   std::vector<Event> events_;
   std::unique_ptr<Ratslam> slam_;
-  ClassicCameraMatcher camera_;
+  std::unique_ptr<FrontEnd> front_end_;
   State state_;  // the parts not held by slam_ and camera_
 };
 

@@ -67,15 +67,24 @@ void ExperienceMap::AddLink(uint32_t from, uint32_t to, double time_s,
 }
 
 uint32_t ExperienceMap::CreateExperience(uint32_t template_id, const PoseCellPosition& pose_cells,
-                                         double time_s) {
+                                         double time_s,
+                                         std::optional<double> compass_heading_rad) {
   Experience e;
   e.id = static_cast<uint32_t>(state_.experiences.size());
   CurrentPose(&e.x_m, &e.y_m, &e.theta_rad);
   e.template_id = template_id;
   e.pose_cells = pose_cells;
   e.time_s = time_s;
+  e.compass_heading_rad = compass_heading_rad;
   state_.experiences.push_back(e);
-  if (state_.current) AddLink(*state_.current, e.id, time_s, std::nullopt, false);
+  if (state_.current) {
+    const Experience& from = state_.experiences[*state_.current];
+    std::optional<double> facing;
+    if (compass_heading_rad && from.compass_heading_rad) {
+      facing = *compass_heading_rad - *from.compass_heading_rad;
+    }
+    AddLink(*state_.current, e.id, time_s, facing, false);
+  }
   state_.current = e.id;
   state_.offset = LocalOffset();
   state_.offset_start_time_s = time_s;
@@ -83,7 +92,7 @@ uint32_t ExperienceMap::CreateExperience(uint32_t template_id, const PoseCellPos
 }
 
 StatusOr<bool> ExperienceMap::LinkTo(uint32_t id, double time_s,
-                                     std::optional<double> facing_override_rad) {
+                                     std::optional<double> compass_heading_rad) {
   if (id >= state_.experiences.size()) {
     return Status::Error("experience map: link to unknown experience " + std::to_string(id));
   }
@@ -96,12 +105,20 @@ StatusOr<bool> ExperienceMap::LinkTo(uint32_t id, double time_s,
       if ((l.from == from && l.to == id) || (l.from == id && l.to == from)) exists = true;
     }
     if (!exists) {
-      AddLink(from, id, time_s, facing_override_rad, true);
+      const std::optional<double>& a = state_.experiences[from].compass_heading_rad;
+      const std::optional<double>& b = state_.experiences[id].compass_heading_rad;
+      std::optional<double> facing;
+      if (compass_heading_rad && a && b) facing = *b - *a;
+      AddLink(from, id, time_s, facing, true);
       added = true;
     }
   }
   state_.current = id;
   state_.offset = LocalOffset();
+  const std::optional<double>& target = state_.experiences[id].compass_heading_rad;
+  if (compass_heading_rad && target) {
+    state_.offset.facing_rad = WrapAngle(*compass_heading_rad - *target);
+  }
   state_.offset_start_time_s = time_s;
   return added;
 }

@@ -38,6 +38,7 @@ struct Experience {
   uint32_t template_id = 0;
   PoseCellPosition pose_cells;  // pose-cell position at creation
   double time_s = 0.0;          // creation time
+  std::optional<double> compass_heading_rad;  // absolute heading at creation, if known
   std::vector<uint32_t> link_ids;  // links from or to this experience
 };
 
@@ -76,14 +77,18 @@ class ExperienceMap {
   void Integrate(double forward_m, double rotation_rad);
 
   // Creates an experience at the current pose (current experience plus offset) and links the
-  // current experience to it. Returns its id.
+  // current experience to it. With a compass heading (here and at the current experience) the
+  // link's facing change is the compass difference instead of the odometric one, which removes
+  // rotational drift (Wi-Fi RatSLAM paper, section III-A). Returns its id.
   uint32_t CreateExperience(uint32_t template_id, const PoseCellPosition& pose_cells,
-                            double time_s);
+                            double time_s, std::optional<double> compass_heading_rad = std::nullopt);
   // Links the current experience to the existing experience `id` (unless a link between them
-  // exists already) and makes it current. `facing_override_rad` replaces the odometric facing
-  // change of the new link (e.g. from a compass). Returns true when a link was added.
+  // exists already) and makes it current. With a compass heading now, at `id` and at the current
+  // experience, the link's facing is the compass difference (eq. 2) and dead reckoning continues
+  // from `id` facing the current compass heading, not `id`'s facing: a place revisited in the
+  // opposite direction. Returns true when a link was added.
   StatusOr<bool> LinkTo(uint32_t id, double time_s,
-                        std::optional<double> facing_override_rad = std::nullopt);
+                        std::optional<double> compass_heading_rad = std::nullopt);
 
   // `relaxation_sweeps` passes of relaxation over every link.
   void Relax();

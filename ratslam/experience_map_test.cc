@@ -106,3 +106,43 @@ TEST(ExperienceMapTest, ShortestPathUsesLoopClosureShortcut) {
 
 }  // namespace
 }  // namespace ratslam
+
+namespace ratslam {
+namespace {
+
+// Driving out along x, turning round, and coming back past the start: with a compass, the return
+// link to the first experience has the facing the compass says (pi) whatever the odometry says,
+// and dead reckoning continues facing the way the robot really faces.
+TEST(ExperienceMapCompassTest, RevisitInOppositeDirectionUsesCompassFacing) {
+  ExperienceMap map({});
+  map.CreateExperience(0, {}, 0.0, 0.0);
+  map.Integrate(5.0, 0.0);
+  map.CreateExperience(1, {}, 1.0, 0.0);
+  map.Integrate(5.0, 0.0);
+  map.CreateExperience(2, {}, 2.0, 0.0);
+  map.Integrate(0.0, 3.0);  // odometry says 3.0 rad; the compass says pi
+  map.Integrate(10.0, 0.0);
+  auto added = map.LinkTo(0, 3.0, M_PI);
+  ASSERT_TRUE(added.ok());
+  ASSERT_TRUE(added.value());
+  const Link& closing = map.links().back();
+  EXPECT_TRUE(closing.loop_closure);
+  EXPECT_NEAR(std::abs(closing.facing_rad), 0.0, 1e-12);  // both experiences faced 0
+  // Now at experience 0 facing pi: one more metre of travel goes to -x.
+  map.Integrate(1.0, 0.0);
+  double x, y, theta;
+  map.CurrentPose(&x, &y, &theta);
+  EXPECT_NEAR(x, -1.0, 1e-9);
+  EXPECT_NEAR(std::abs(theta), M_PI, 1e-9);
+}
+
+TEST(ExperienceMapCompassTest, NewLinksTakeCompassFacing) {
+  ExperienceMap map({});
+  map.CreateExperience(0, {}, 0.0, 0.5);
+  map.Integrate(1.0, 0.9);  // odometric turn 0.9 rad; compass says 0.3 rad
+  map.CreateExperience(1, {}, 1.0, 0.8);
+  EXPECT_NEAR(map.links().back().facing_rad, 0.3, 1e-12);
+}
+
+}  // namespace
+}  // namespace ratslam

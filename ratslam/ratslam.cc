@@ -53,18 +53,17 @@ Status Ratslam::OnView(const ViewDecision& decision) {
   return Status::Ok();
 }
 
-StatusOr<ActionKind> Ratslam::OnOdometry(const OdometryStep& step,
-                                         std::optional<double> facing_override_rad) {
+StatusOr<ActionKind> Ratslam::OnOdometry(const OdometryStep& step) {
   if (!std::isfinite(step.forward_m) || !std::isfinite(step.rotation_rad)) {
     return Status::Error("odometry step at t=" + std::to_string(step.time_s) + " is not finite");
   }
   ++counters_.odometry_steps;
   pose_cells_.Step(step.forward_m, step.rotation_rad);
   experience_map_.Integrate(step.forward_m, step.rotation_rad);
-  return Act(step.time_s, facing_override_rad);
+  return Act(step.time_s);
 }
 
-StatusOr<ActionKind> Ratslam::Act(double time_s, std::optional<double> facing_override_rad) {
+StatusOr<ActionKind> Ratslam::Act(double time_s) {
   if (!current_template_) return ActionKind::kNone;
   const PoseCellPosition best = pose_cells_.BestPosition();
   ViewTemplate& view = local_view_.at(*current_template_);
@@ -75,8 +74,9 @@ StatusOr<ActionKind> Ratslam::Act(double time_s, std::optional<double> facing_ov
   double nearest_distance = std::numeric_limits<double>::infinity();
   int candidates = 0;
   for (uint32_t id : view.experience_ids) {
-    const double d =
-        PoseCellDistance(experience_map_.experience(id).pose_cells, best, dim_xy, dim_theta);
+    PoseCellPosition stored = experience_map_.experience(id).pose_cells;
+    if (!options_.action.match_heading) stored.theta = best.theta;
+    const double d = PoseCellDistance(stored, best, dim_xy, dim_theta);
     if (d < options_.action.match_distance_cells) ++candidates;
     if (d < nearest_distance) {
       nearest_distance = d;
@@ -86,7 +86,8 @@ StatusOr<ActionKind> Ratslam::Act(double time_s, std::optional<double> facing_ov
 
   ActionKind action = ActionKind::kNone;
   if (!nearest || nearest_distance >= options_.action.match_distance_cells) {
-    const uint32_t id = experience_map_.CreateExperience(*current_template_, best, time_s);
+    const uint32_t id =
+        experience_map_.CreateExperience(*current_template_, best, time_s, compass_heading_rad_);
     view.experience_ids.push_back(id);
     action = ActionKind::kCreatedExperience;
   } else if (experience_map_.current() == nearest) {
@@ -95,7 +96,7 @@ StatusOr<ActionKind> Ratslam::Act(double time_s, std::optional<double> facing_ov
     ++counters_.refused_ambiguous;
     return ActionKind::kRefusedAmbiguous;
   } else {
-    StatusOr<bool> linked = experience_map_.LinkTo(*nearest, time_s, facing_override_rad);
+    StatusOr<bool> linked = experience_map_.LinkTo(*nearest, time_s, compass_heading_rad_);
     if (!linked.ok()) return linked.status();
     if (linked.value()) ++counters_.loop_closures;
     action = ActionKind::kLinkedExisting;
@@ -106,7 +107,7 @@ StatusOr<ActionKind> Ratslam::Act(double time_s, std::optional<double> facing_ov
 
 Ratslam::State Ratslam::GetState() const {
   return {pose_cells_.GetState(), local_view_.state(), experience_map_.state(), current_template_,
-          counters_};
+          counters_, compass_heading_rad_};
 }
 
 Status Ratslam::SetState(const State& state) {
@@ -124,6 +125,7 @@ Status Ratslam::SetState(const State& state) {
   }
   current_template_ = state.current_template;
   counters_ = state.counters;
+  compass_heading_rad_ = state.compass_heading_rad;
   return Status::Ok();
 }
 

@@ -19,6 +19,8 @@ struct ActionOptions {
   double match_distance_cells = 2.0;  // experiences of the current template closer than this
                                       // (in pose cells) are candidates for a link
   bool refuse_ambiguous_links = false;  // no link when several candidates are in range
+  bool match_heading = true;  // compare pose-cell theta too; off with a compass (a place seen
+                              // facing the other way is the same place)
 
   bool IsValid(std::string* error) const;
 
@@ -28,6 +30,8 @@ struct ActionOptions {
       "pose-cell distance within which an experience of the current template is re-used");
     v("refuse_ambiguous_links", refuse_ambiguous_links,
       "make no link when several experiences are within match_distance_cells");
+    v("match_heading", match_heading,
+      "include pose-cell theta in that distance; false suits an absolute compass heading");
   }
 };
 
@@ -63,10 +67,11 @@ class Ratslam {
 
   // One view frame from a front end.
   Status OnView(const ViewDecision& decision);
-  // One odometry step followed by the action logic; `facing_override_rad` replaces the facing
-  // change of a loop-closure link made in this step (compass front ends).
-  StatusOr<ActionKind> OnOdometry(const OdometryStep& step,
-                                  std::optional<double> facing_override_rad = std::nullopt);
+  // One odometry step followed by the action logic.
+  StatusOr<ActionKind> OnOdometry(const OdometryStep& step);
+  // The latest absolute heading (compass), or none; used by the action logic and stored with new
+  // experiences (see ExperienceMap).
+  void SetCompassHeading(std::optional<double> heading_rad) { compass_heading_rad_ = heading_rad; }
 
   const PoseCellNetwork& pose_cells() const { return pose_cells_; }
   const LocalViewCells& local_view() const { return local_view_; }
@@ -81,6 +86,7 @@ class Ratslam {
     ExperienceMap::State experience_map;
     std::optional<uint32_t> current_template;
     Counters counters;
+    std::optional<double> compass_heading_rad;
   };
   State GetState() const;
   // Fails, leaving this object unusable for further steps only if partially applied state is
@@ -88,7 +94,7 @@ class Ratslam {
   Status SetState(const State& state);
 
  private:
-  StatusOr<ActionKind> Act(double time_s, std::optional<double> facing_override_rad);
+  StatusOr<ActionKind> Act(double time_s);
 
   RatslamOptions options_;
   PoseCellNetwork pose_cells_;
@@ -96,6 +102,7 @@ class Ratslam {
   ExperienceMap experience_map_;
   std::optional<uint32_t> current_template_;
   Counters counters_;
+  std::optional<double> compass_heading_rad_;
 };
 
 }  // namespace ratslam

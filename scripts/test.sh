@@ -7,6 +7,7 @@ cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 if [[ "${SANITIZE:-0}" == 1 ]]; then
   export BUILD_DIR=build-sanitize
+  export LSAN_OPTIONS="suppressions=$PWD/tests/lsan.supp:print_suppressions=0"
   bash scripts/build.sh -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRATSLAM_SANITIZE=ON \
     -DRATSLAM_BUILD_TESTS=ON -DRATSLAM_BUILD_BENCHMARKS=OFF
 else

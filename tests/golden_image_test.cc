@@ -106,7 +106,7 @@ TEST(GoldenImageTest, TemplateGraph) {
     p.time_s = i;
     p.template_id = i < 30 ? i : i - 30;
     p.experience_id = i < 30 ? i : i - 28;
-    p.source = i < 30 ? ViewSource::kNew : (i % 3 ? ViewSource::kCamera : ViewSource::kWifi);
+    p.source = i < 30 ? DecisionSource::kNew : (i % 3 ? DecisionSource::kCamera : DecisionSource::kWifi);
     points.push_back(p);
   }
   TemplateGraphImageOptions options;

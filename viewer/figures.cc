@@ -395,7 +395,7 @@ Scene TemplateGraphScene(const std::vector<TemplateGraphPoint>& points,
   for (const TemplateGraphPoint& p : points) {
     const Rgba c = source_colors[static_cast<int>(p.source)];
     const ScenePoint at = plot.Map(p.time_s, p.template_id);
-    if (p.source == ViewSource::kNew) {
+    if (p.source == DecisionSource::kNew) {
       scene.Disc(at, many ? 1.0f : 1.8f, c, 8);
     } else {
       scene.Ring(at, many ? 1.2f : 2.2f, many ? 2.2f : 3.6f, 0, 2 * std::numbers::pi_v<float>, c, 10);

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "fusion/front_end.h"
 #include "fusion/trajectory_metrics.h"
 #include "ratslam/experience_map.h"
 #include "ratslam/pose_cell_network.h"
@@ -63,13 +64,11 @@ std::vector<Point2> AlignGroundTruthToMap(const std::vector<Point2>& map_points,
                                           const std::vector<Point2>& truth_points,
                                           const std::vector<Point2>& truth_path);
 
-enum class ViewSource { kCamera, kWifi, kNew };
-
 struct TemplateGraphPoint {
   double time_s = 0.0;
   uint32_t template_id = 0;
   int64_t experience_id = -1;  // -1: none yet
-  ViewSource source = ViewSource::kCamera;
+  DecisionSource source = DecisionSource::kCamera;
 };
 
 struct TimeSpan {

@@ -123,7 +123,8 @@ class OsMesaRenderer : public SceneRenderer {
       gl_.DeleteProgram(texture_program_);
     }
     if (context_) destroy_context_(context_);
-    if (library_) dlclose(library_);
+    // The library stays loaded: Mesa keeps process-wide state (llvmpipe threads, LLVM) that is
+    // not meant to be unloaded, and a later renderer reuses it.
   }
 
   Status Init() {

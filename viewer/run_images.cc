@@ -37,7 +37,7 @@ std::vector<TemplateGraphPoint> TemplateGraphOf(const ReplayPipeline& pipeline) 
   points.reserve(pipeline.state().frames.size());
   for (const FrameRecord& f : pipeline.state().frames) {
     points.push_back({f.time_s, f.template_id, f.experience_id,
-                      f.is_new ? ViewSource::kNew : ViewSource::kCamera});
+                      f.source});
   }
   return points;
 }

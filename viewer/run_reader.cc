@@ -78,7 +78,8 @@ StatusOr<RunFolder> ReadRunFolder(const std::string& folder) {
     run.links.push_back(l);
   }
   StatusOr<CsvTable> fr = CsvTable::Read((fs::path(folder) / "frames.csv").string(),
-                                         {"time_s", "template_id", "new_template", "experience_id"});
+                                         {"time_s", "template_id", "new_template", "experience_id"},
+                                         {"source"});
   if (!fr.ok()) return fr.status();
   for (size_t r = 0; r < fr->rows(); ++r) {
     FrameRecord f;
@@ -90,6 +91,20 @@ StatusOr<RunFolder> ReadRunFolder(const std::string& folder) {
     f.template_id = static_cast<uint32_t>(template_id);
     f.is_new = is_new != 0;
     f.experience_id = experience;
+    f.source = f.is_new ? DecisionSource::kNew : DecisionSource::kCamera;
+    if (fr->has_column("source")) {
+      StatusOr<std::string> source = fr->Text(r, "source");
+      if (!source.ok()) return source.status();
+      if (*source == "camera") {
+        f.source = DecisionSource::kCamera;
+      } else if (*source == "wifi") {
+        f.source = DecisionSource::kWifi;
+      } else if (*source == "new") {
+        f.source = DecisionSource::kNew;
+      } else {
+        return fr->ErrorAt(r, "source", "must be camera, wifi or new, not '" + *source + "'");
+      }
+    }
     run.frames.push_back(f);
   }
   std::ifstream summary(fs::path(folder) / "summary.json");

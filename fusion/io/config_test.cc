@@ -30,7 +30,7 @@ TEST(ConfigTest, ReadsValuesAndAcceptsIntegersForReals) {
   ASSERT_TRUE(o.ok()) << o.status().message();
   EXPECT_EQ(o->ratslam.pose_cells.dim_xy_cells, 30);
   EXPECT_EQ(o->ratslam.pose_cells.cell_size_m, 2.0);
-  EXPECT_TRUE(o->camera.panoramic);
+  EXPECT_TRUE(o->sensors.classic_camera.panoramic);
 }
 
 TEST(ConfigTest, UnknownKeyNamesLine) {
@@ -56,7 +56,7 @@ TEST(ConfigTest, OutOfRangeValueNamesLine) {
 TEST(ConfigTest, BadEnumListsValidNames) {
   const std::string error = ErrorOf("[front_end]\nkind = \"wifi\"\n");
   EXPECT_NE(error.find("c.toml:2"), std::string::npos) << error;
-  EXPECT_NE(error.find("valid: classic_camera"), std::string::npos) << error;
+  EXPECT_NE(error.find("valid: classic_camera, fused"), std::string::npos) << error;
 }
 
 TEST(ConfigTest, SyntaxErrorNamesLine) {
@@ -66,12 +66,12 @@ TEST(ConfigTest, SyntaxErrorNamesLine) {
 TEST(ConfigTest, PrintThenParseRoundTrips) {
   PipelineOptions options;
   options.ratslam.pose_cells.cell_size_m = 0.1 + 0.2;
-  options.camera.match_threshold = 1e-7;
+  options.sensors.classic_camera.match_threshold = 1e-7;
   options.ratslam.action.refuse_ambiguous_links = true;
   StatusOr<PipelineOptions> back = ParseConfig(PrintConfig(options), "printed");
   ASSERT_TRUE(back.ok()) << back.status().message();
   EXPECT_EQ(back->ratslam.pose_cells.cell_size_m, 0.1 + 0.2);
-  EXPECT_EQ(back->camera.match_threshold, 1e-7);
+  EXPECT_EQ(back->sensors.classic_camera.match_threshold, 1e-7);
   EXPECT_EQ(PrintConfig(back.value()), PrintConfig(options));
   EXPECT_EQ(ConfigFingerprint(back.value()), ConfigFingerprint(options));
   EXPECT_NE(ConfigFingerprint(PipelineOptions()), ConfigFingerprint(options));
@@ -86,12 +86,12 @@ TEST(ConfigTest, ImportsOpenRatslamIniAndReportsUnusedKeys) {
   StatusOr<ImportedConfig> imported = ImportOpenRatslamIni(path.string());
   ASSERT_TRUE(imported.ok()) << imported.status().message();
   const PipelineOptions& o = imported->options;
-  EXPECT_EQ(o.camera.match_threshold, 0.085);
+  EXPECT_EQ(o.sensors.classic_camera.match_threshold, 0.085);
   EXPECT_EQ(o.ratslam.pose_cells.dim_xy_cells, 30);
   EXPECT_EQ(o.ratslam.pose_cells.cell_size_m, 0.015);
   EXPECT_EQ(o.ratslam.experience_map.relaxation_sweeps, 20);
   EXPECT_EQ(o.ratslam.local_view.decay_floor, 1.5);
-  EXPECT_TRUE(o.camera.panoramic);
+  EXPECT_TRUE(o.sensors.classic_camera.panoramic);
   ASSERT_EQ(imported->notes.size(), 2u);
   EXPECT_NE(imported->notes[0].find(":2: [general] topic_root"), std::string::npos);
   std::ofstream(path) << "[ratslam]\npc_dim_xy=thirty\n";

@@ -7,119 +7,32 @@
 #include <type_traits>
 
 #include "fusion/io/file_util.h"
+#include "ratslam/byte_buffer.h"
 
 namespace ratslam {
 namespace {
 
 constexpr char kMagic[8] = {'R', 'S', 'L', 'M', 'A', 'P', '\0', '\1'};
-constexpr uint32_t kVersion = 1;
-
-class Writer {
- public:
-  template <typename T>
-  void Pod(const T& value) {
-    static_assert(std::is_trivially_copyable_v<T>);
-    bytes_.append(reinterpret_cast<const char*>(&value), sizeof(T));
-  }
-  void Bool(bool v) { Pod<uint8_t>(v ? 1 : 0); }
-  void Count(size_t n) { Pod<uint64_t>(n); }
-  void String(const std::string& s) {
-    Count(s.size());
-    bytes_.append(s);
-  }
-  template <typename T>
-  void PodVector(const std::vector<T>& v) {
-    Count(v.size());
-    if (!v.empty()) bytes_.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
-  }
-  std::string& bytes() { return bytes_; }
-
- private:
-  std::string bytes_;
-};
-
-class Reader {
- public:
-  Reader(const std::string& bytes, std::string source) : bytes_(bytes), source_(std::move(source)) {}
-  template <typename T>
-  bool Pod(T* value) {
-    static_assert(std::is_trivially_copyable_v<T>);
-    if (!Need(sizeof(T))) return false;
-    std::memcpy(value, bytes_.data() + pos_, sizeof(T));
-    pos_ += sizeof(T);
-    return true;
-  }
-  bool Bool(bool* v) {
-    uint8_t b = 0;
-    if (!Pod(&b)) return false;
-    if (b > 1) return Fail("invalid boolean");
-    *v = b == 1;
-    return true;
-  }
-  // A count of elements of `element_size` bytes each; fails if they cannot all be present.
-  bool Count(size_t element_size, size_t* n) {
-    uint64_t count = 0;
-    if (!Pod(&count)) return false;
-    if (element_size > 0 && count > (bytes_.size() - pos_) / element_size) {
-      return Fail("count " + std::to_string(count) + " exceeds the file size (truncated?)");
-    }
-    *n = static_cast<size_t>(count);
-    return true;
-  }
-  bool String(std::string* s) {
-    size_t n = 0;
-    if (!Count(1, &n)) return false;
-    s->assign(bytes_.data() + pos_, n);
-    pos_ += n;
-    return true;
-  }
-  template <typename T>
-  bool PodVector(std::vector<T>* v) {
-    size_t n = 0;
-    if (!Count(sizeof(T), &n)) return false;
-    v->resize(n);
-    if (n) std::memcpy(v->data(), bytes_.data() + pos_, n * sizeof(T));
-    pos_ += n * sizeof(T);
-    return true;
-  }
-  bool Fail(const std::string& message) {
-    if (error_.empty()) {
-      error_ = source_ + ": corrupt map file at byte " + std::to_string(pos_) + ": " + message;
-    }
-    return false;
-  }
-  bool AtEnd() const { return pos_ == bytes_.size(); }
-  const std::string& error() const { return error_; }
-
- private:
-  bool Need(size_t n) {
-    if (bytes_.size() - pos_ < n) return Fail("unexpected end of file (truncated?)");
-    return true;
-  }
-  const std::string& bytes_;
-  std::string source_;
-  size_t pos_ = 0;
-  std::string error_;
-};
+constexpr uint32_t kVersion = 2;
 
 // Field lists, shared by encoding and decoding through overloads on Writer / Reader.
-void Field(Writer& w, const PoseCellPosition& p) {
+void Field(ByteWriter& w, const PoseCellPosition& p) {
   w.Pod(p.x);
   w.Pod(p.y);
   w.Pod(p.theta);
 }
-bool Field(Reader& r, PoseCellPosition* p) { return r.Pod(&p->x) && r.Pod(&p->y) && r.Pod(&p->theta); }
+bool Field(ByteReader& r, PoseCellPosition* p) { return r.Pod(&p->x) && r.Pod(&p->y) && r.Pod(&p->theta); }
 
-void Field(Writer& w, const LocalOffset& o) {
+void Field(ByteWriter& w, const LocalOffset& o) {
   w.Pod(o.forward_m);
   w.Pod(o.left_m);
   w.Pod(o.facing_rad);
 }
-bool Field(Reader& r, LocalOffset* o) {
+bool Field(ByteReader& r, LocalOffset* o) {
   return r.Pod(&o->forward_m) && r.Pod(&o->left_m) && r.Pod(&o->facing_rad);
 }
 
-void Encode(Writer& w, const ReplayPipeline::State& s) {
+void Encode(ByteWriter& w, const ReplayPipeline::State& s) {
   // Pose cells.
   const PoseCellNetwork::State& pc = s.ratslam.pose_cells;
   w.PodVector(pc.active_indices);
@@ -151,6 +64,7 @@ void Encode(Writer& w, const ReplayPipeline::State& s) {
     w.Pod(e.template_id);
     Field(w, e.pose_cells);
     w.Pod(e.time_s);
+    w.Optional(e.compass_heading_rad);
     w.PodVector(e.link_ids);
   }
   w.Count(em.links.size());
@@ -172,9 +86,9 @@ void Encode(Writer& w, const ReplayPipeline::State& s) {
   w.Bool(s.ratslam.current_template.has_value());
   w.Pod(s.ratslam.current_template.value_or(0));
   w.Pod(s.ratslam.counters);
-  // Camera templates.
-  w.Pod(s.camera.template_count);
-  w.PodVector(s.camera.templates);
+  w.Optional(s.ratslam.compass_heading_rad);
+  // The front end's own state.
+  w.String(s.front_end);
   // Pipeline.
   w.Pod(s.next_event);
   w.Pod(s.events_total);
@@ -198,12 +112,14 @@ void Encode(Writer& w, const ReplayPipeline::State& s) {
     w.Pod(f.template_id);
     w.Bool(f.is_new);
     w.Pod(f.experience_id);
+    w.Pod(f.source);
   }
   w.Pod(s.wifi_scans_seen);
   w.Pod(s.compass_readings_seen);
+  w.Pod(s.images_skipped);
 }
 
-bool Decode(Reader& r, ReplayPipeline::State* s) {
+bool Decode(ByteReader& r, ReplayPipeline::State* s) {
   PoseCellNetwork::State& pc = s->ratslam.pose_cells;
   if (!(r.PodVector(&pc.active_indices) && r.PodVector(&pc.active_values) &&
         r.PodVector(&pc.residual_x_cells) && r.PodVector(&pc.residual_y_cells) &&
@@ -227,7 +143,7 @@ bool Decode(Reader& r, ReplayPipeline::State* s) {
   for (Experience& e : em.experiences) {
     if (!(r.Pod(&e.id) && r.Pod(&e.x_m) && r.Pod(&e.y_m) && r.Pod(&e.theta_rad) &&
           r.Pod(&e.template_id) && Field(r, &e.pose_cells) && r.Pod(&e.time_s) &&
-          r.PodVector(&e.link_ids))) {
+          r.Optional(&e.compass_heading_rad) && r.PodVector(&e.link_ids))) {
       return false;
     }
   }
@@ -247,8 +163,8 @@ bool Decode(Reader& r, ReplayPipeline::State* s) {
   if (!(Field(r, &em.offset) && r.Pod(&em.offset_start_time_s))) return false;
   if (!(r.Bool(&has) && r.Pod(&id))) return false;
   if (has) s->ratslam.current_template = id;
-  if (!(r.Pod(&s->ratslam.counters) && r.Pod(&s->camera.template_count) &&
-        r.PodVector(&s->camera.templates))) {
+  if (!(r.Pod(&s->ratslam.counters) && r.Optional(&s->ratslam.compass_heading_rad) &&
+        r.String(&s->front_end))) {
     return false;
   }
   if (!(r.Pod(&s->next_event) && r.Pod(&s->events_total) && r.Pod(&s->last_odometry_time_s) &&
@@ -267,17 +183,19 @@ bool Decode(Reader& r, ReplayPipeline::State* s) {
   s->frames.resize(n);
   for (FrameRecord& f : s->frames) {
     if (!(r.Pod(&f.time_s) && r.Pod(&f.template_id) && r.Bool(&f.is_new) &&
-          r.Pod(&f.experience_id))) {
+          r.Pod(&f.experience_id) && r.Pod(&f.source))) {
       return false;
     }
+    if (static_cast<uint8_t>(f.source) > 2) return r.Fail("invalid decision source");
   }
-  return r.Pod(&s->wifi_scans_seen) && r.Pod(&s->compass_readings_seen);
+  return r.Pod(&s->wifi_scans_seen) && r.Pod(&s->compass_readings_seen) &&
+         r.Pod(&s->images_skipped);
 }
 
 }  // namespace
 
 std::string EncodeMapFile(const MapFile& map) {
-  Writer w;
+  ByteWriter w;
   w.bytes().append(kMagic, sizeof kMagic);
   w.Pod(kVersion);
   w.Pod(map.config_fingerprint);
@@ -291,7 +209,7 @@ StatusOr<MapFile> DecodeMapFile(const std::string& bytes, const std::string& sou
     return Status::Error(source + ": not a RatSLAM map file");
   }
   const std::string body = bytes.substr(sizeof kMagic);
-  Reader r(body, source);
+  ByteReader r(body, source + ": corrupt map file");
   uint32_t version = 0;
   MapFile map;
   if (!r.Pod(&version)) return Status::Error(r.error());

@@ -18,8 +18,7 @@ MapFile SampleMap() {
   map.config_fingerprint = 0x1234;
   map.dataset_name = "sample";
   map.state.ratslam = slam.GetState();
-  map.state.camera.template_count = 2;
-  map.state.camera.templates.assign(2 * 640, 7);
+  map.state.front_end = std::string(1280, '\x07');
   map.state.next_event = 60;
   map.state.events_total = 100;
   map.state.trajectory.push_back({0.1, 3, {1, 2, 3}, 4, 5, 6});

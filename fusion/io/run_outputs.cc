@@ -77,6 +77,19 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
     if (auto a = AlignRigid2D(corrected, truth)) s.trajectory_ate_m = a->rmse_m;
     if (auto a = AlignRigid2D(odometry, truth)) s.odometry_ate_m = a->rmse_m;
     s.ate_points = truth.size();
+
+    // Every template match: how far is the true position now from the true position where the
+    // matched template was stored? A match to another floor is a floor mistake.
+    for (const FrameRecord& f : state.frames) {
+      if (f.is_new) continue;
+      const auto now = InterpolateGroundTruth(dataset.ground_truth, f.time_s);
+      const auto then = InterpolateGroundTruth(
+          dataset.ground_truth, slam.local_view().at(f.template_id).created_time_s);
+      if (!now || !then) continue;
+      ++s.evaluated_matches;
+      s.match_distances_m.push_back(std::hypot(now->x_m - then->x_m, now->y_m - then->y_m));
+      if (now->floor != then->floor) ++s.floor_mistakes;
+    }
   }
 
   nlohmann::ordered_json j;
@@ -90,8 +103,13 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
   j["odometry_steps"] = state.trajectory.size();
   j["view_injections"] = slam.counters().injections;
   j["refused_ambiguous_links"] = slam.counters().refused_ambiguous;
-  j["wifi_scans_unused"] = state.wifi_scans_seen;
-  j["compass_readings_unused"] = state.compass_readings_seen;
+  j["wifi_scans"] = state.wifi_scans_seen;
+  j["compass_readings"] = state.compass_readings_seen;
+  j["images_unused"] = state.images_skipped;
+  size_t by_source[3] = {0, 0, 0};
+  for (const FrameRecord& f : state.frames) ++by_source[static_cast<int>(f.source)];
+  j["frames_by_source"] = {{"camera", by_source[0]}, {"wifi", by_source[1]}, {"new", by_source[2]}};
+  if (dataset.session_start_times_s.size() > 1) j["sessions"] = dataset.session_start_times_s.size();
   j["events_done"] = state.next_event;
   j["events_total"] = state.events_total;
   j["finished"] = pipeline.finished();
@@ -110,6 +128,18 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
   if (s.trajectory_ate_m) j["trajectory_ate_m"] = *s.trajectory_ate_m;
   if (s.odometry_ate_m) j["odometry_ate_m"] = *s.odometry_ate_m;
   if (s.ate_points) j["ate_points"] = s.ate_points;
+  if (!dataset.ground_truth.empty()) {
+    j["matches"] = s.evaluated_matches;
+    nlohmann::ordered_json within;
+    for (int d : {2, 5, 10, 20}) {
+      size_t n = 0;
+      for (double m : s.match_distances_m) n += m <= d;
+      within[std::to_string(d)] =
+          s.evaluated_matches ? static_cast<double>(n) / s.evaluated_matches : 0.0;
+    }
+    j["match_rate_within_m"] = within;
+    j["floor_mistakes"] = s.floor_mistakes;
+  }
   s.json = j.dump(2) + "\n";
   return s;
 }
@@ -165,10 +195,10 @@ StatusOr<RunSummary> WriteRunOutputs(const std::string& folder, const ReplayPipe
   RATSLAM_RETURN_IF_ERROR(WriteFileAtomically(path("experience_map.g2o"), g2o.str()));
 
   std::ostringstream frames;
-  frames << "time_s,template_id,new_template,experience_id\n";
+  frames << "time_s,template_id,new_template,experience_id,source\n";
   for (const FrameRecord& f : state.frames) {
     frames << Num(f.time_s) << ',' << f.template_id << ',' << (f.is_new ? 1 : 0) << ','
-           << f.experience_id << '\n';
+           << f.experience_id << ',' << ToString(f.source) << '\n';
   }
   RATSLAM_RETURN_IF_ERROR(WriteFileAtomically(path("frames.csv"), frames.str()));
 

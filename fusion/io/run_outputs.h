@@ -25,6 +25,10 @@ struct RunSummary {
   uint64_t frames = 0, templates = 0, experiences = 0, links = 0, loop_closures = 0;
   std::optional<double> map_ate_m, trajectory_ate_m, odometry_ate_m;
   size_t ate_points = 0;
+  // Template matches with ground truth at both ends: now, and where the template was stored.
+  size_t evaluated_matches = 0;
+  std::vector<double> match_distances_m;
+  size_t floor_mistakes = 0;
   std::string json;  // the whole summary.json text
 };
 

@@ -134,6 +134,7 @@ std::string Number(double value) {
 }  // namespace
 
 std::string Dataset::ImagePath(const ImageRow& row) const {
+  if (fs::path(row.file).is_absolute()) return row.file;
   return (fs::path(folder) / image_folder / row.file).string();
 }
 

@@ -59,7 +59,9 @@ struct Dataset {
   std::vector<GroundTruthRow> ground_truth;
   std::vector<WifiScan> wifi;
   std::vector<CompassRow> compass;
+  std::vector<double> session_start_times_s;  // more than one for a multi-session run
 
+  // The image's path: `file` itself when absolute, else inside the image folder.
   std::string ImagePath(const ImageRow& row) const;
 };
 

@@ -1,0 +1,273 @@
+#include "fusion/front_end.h"
+
+#include <cmath>
+#include <limits>
+
+#include "ratslam/byte_buffer.h"
+#include "ratslam/circular.h"
+
+namespace ratslam {
+
+std::string ToString(FrontEndKind kind) {
+  switch (kind) {
+    case FrontEndKind::kClassicCamera:
+      return "classic_camera";
+    case FrontEndKind::kFused:
+      return "fused";
+  }
+  return "unknown";
+}
+
+StatusOr<FrontEndKind> FrontEndKindFromString(const std::string& name) {
+  if (name == "classic_camera") return FrontEndKind::kClassicCamera;
+  if (name == "fused") return FrontEndKind::kFused;
+  return Status::Error("unknown front end '" + name + "' (valid: classic_camera, fused)");
+}
+
+std::string ToString(DecisionSource source) {
+  switch (source) {
+    case DecisionSource::kCamera:
+      return "camera";
+    case DecisionSource::kWifi:
+      return "wifi";
+    case DecisionSource::kNew:
+      return "new";
+  }
+  return "unknown";
+}
+
+bool FusedOptions::IsValid(std::string* error) const {
+  auto fail = [error](const std::string& message) {
+    if (error) *error = message;
+    return false;
+  };
+  if (!use_camera && !use_wifi) return fail("use_wifi: at least one of camera and Wi-Fi must be on");
+  if (recency_templates < 0) return fail("recency_templates: must not be negative");
+  if (!(recency_s >= 0.0) || !std::isfinite(recency_s)) {
+    return fail("recency_s: must be a non-negative number");
+  }
+  if (!(max_wifi_age_s >= 0.0)) return fail("max_wifi_age_s: must not be negative");
+  return true;
+}
+
+namespace {
+
+GrayImageView ViewOf(const GrayImage& image) {
+  return {image.width, image.height, image.width, image.pixels.data()};
+}
+
+class ClassicCameraFrontEnd : public FrontEnd {
+ public:
+  explicit ClassicCameraFrontEnd(const ClassicCameraOptions& options) : matcher_(options) {}
+
+  StatusOr<std::optional<FrameDecision>> OnImage(double time_s, const GrayImage& image) override {
+    StatusOr<ViewDecision> view = matcher_.Observe(ViewOf(image), time_s);
+    if (!view.ok()) return view.status();
+    FrameDecision d;
+    d.view = view.value();
+    d.source = d.view.is_new ? DecisionSource::kNew : DecisionSource::kCamera;
+    return std::optional<FrameDecision>(d);
+  }
+  StatusOr<std::optional<FrameDecision>> OnWifi(const WifiScan&) override {
+    return std::optional<FrameDecision>();
+  }
+  void OnCompass(double, double) override {}
+  std::optional<double> CompassHeading() const override { return std::nullopt; }
+  bool WantsImages() const override { return true; }
+  uint32_t size() const override { return matcher_.size(); }
+
+  std::string EncodeState() const override {
+    ByteWriter w;
+    w.Pod(matcher_.state().template_count);
+    w.PodVector(matcher_.state().templates);
+    return std::move(w.bytes());
+  }
+  Status DecodeState(const std::string& bytes) override {
+    ByteReader r(bytes, "classic camera state");
+    ClassicCameraMatcher::State state;
+    if (!(r.Pod(&state.template_count) && r.PodVector(&state.templates) && r.AtEnd())) {
+      return Status::Error(r.error().empty() ? "classic camera state: trailing bytes" : r.error());
+    }
+    return matcher_.SetState(std::move(state));
+  }
+
+ private:
+  ClassicCameraMatcher matcher_;
+};
+
+class FusedFrontEnd : public FrontEnd {
+ public:
+  FusedFrontEnd(const FusedOptions& options, const KernelCameraOptions& camera,
+                const WifiMatcherOptions& wifi)
+      : options_(options), camera_(camera), wifi_(wifi) {}
+
+  StatusOr<std::optional<FrameDecision>> OnImage(double time_s, const GrayImage& image) override {
+    if (!options_.use_camera) return std::optional<FrameDecision>();
+    StatusOr<std::vector<float>> view = camera_.MakeTemplate(ViewOf(image));
+    if (!view.ok()) return view.status();
+    // The newest scan, if fresh enough, is this frame's Wi-Fi observation.
+    const bool fresh = options_.use_wifi && newest_scan_time_s_ &&
+                       time_s - *newest_scan_time_s_ <= options_.max_wifi_age_s;
+    return std::optional<FrameDecision>(Decide(time_s, &view.value(), fresh ? &newest_scan_ : nullptr));
+  }
+
+  StatusOr<std::optional<FrameDecision>> OnWifi(const WifiScan& scan) override {
+    if (!options_.use_wifi) return std::optional<FrameDecision>();
+    std::vector<std::pair<std::string, double>> readings;
+    readings.reserve(scan.readings.size());
+    for (const WifiReading& r : scan.readings) readings.emplace_back(r.bssid, r.rssi_dbm);
+    newest_scan_ = wifi_.MakeFingerprint(readings);
+    newest_scan_time_s_ = scan.time_s;
+    if (options_.use_camera) return std::optional<FrameDecision>();  // images are the frames
+    return std::optional<FrameDecision>(Decide(scan.time_s, nullptr, &newest_scan_));
+  }
+
+  void OnCompass(double, double heading_rad) override { heading_rad_ = heading_rad; }
+  std::optional<double> CompassHeading() const override {
+    return options_.use_compass ? heading_rad_ : std::nullopt;
+  }
+  bool WantsImages() const override { return options_.use_camera; }
+  uint32_t size() const override { return static_cast<uint32_t>(created_time_s_.size()); }
+
+  std::string EncodeState() const override {
+    ByteWriter w;
+    w.Count(camera_.templates().size());
+    for (const auto& t : camera_.templates()) w.PodVector(t);
+    const WifiFingerprintMatcher::State& ws = wifi_.state();
+    w.Count(ws.bssids.size());
+    for (const std::string& b : ws.bssids) w.String(b);
+    w.Count(ws.fingerprints.size());
+    for (const Fingerprint& f : ws.fingerprints) {
+      w.PodVector(f.ap_ids);
+      w.PodVector(f.rssi_dbm);
+    }
+    w.PodVector(created_time_s_);
+    w.Count(headings_.size());
+    for (const auto& h : headings_) w.Optional(h);
+    w.PodVector(newest_scan_.ap_ids);
+    w.PodVector(newest_scan_.rssi_dbm);
+    w.Optional(newest_scan_time_s_);
+    w.Optional(heading_rad_);
+    return std::move(w.bytes());
+  }
+
+  Status DecodeState(const std::string& bytes) override {
+    ByteReader r(bytes, "fused front-end state");
+    size_t n = 0;
+    std::vector<std::vector<float>> camera;
+    if (!r.Count(8, &n)) return Status::Error(r.error());
+    camera.resize(n);
+    for (auto& t : camera) {
+      if (!r.PodVector(&t)) return Status::Error(r.error());
+    }
+    WifiFingerprintMatcher::State ws;
+    if (!r.Count(8, &n)) return Status::Error(r.error());
+    ws.bssids.resize(n);
+    for (std::string& b : ws.bssids) {
+      if (!r.String(&b)) return Status::Error(r.error());
+    }
+    if (!r.Count(16, &n)) return Status::Error(r.error());
+    ws.fingerprints.resize(n);
+    for (Fingerprint& f : ws.fingerprints) {
+      if (!(r.PodVector(&f.ap_ids) && r.PodVector(&f.rssi_dbm))) return Status::Error(r.error());
+    }
+    std::vector<double> created;
+    std::vector<std::optional<double>> headings;
+    Fingerprint newest;
+    std::optional<double> newest_time, heading;
+    if (!(r.PodVector(&created) && r.Count(9, &n))) return Status::Error(r.error());
+    headings.resize(n);
+    for (auto& h : headings) {
+      if (!r.Optional(&h)) return Status::Error(r.error());
+    }
+    if (!(r.PodVector(&newest.ap_ids) && r.PodVector(&newest.rssi_dbm) &&
+          r.Optional(&newest_time) && r.Optional(&heading))) {
+      return Status::Error(r.error());
+    }
+    if (!r.AtEnd()) return Status::Error("fused front-end state: trailing bytes");
+    if (camera.size() != created.size() || ws.fingerprints.size() != created.size() ||
+        headings.size() != created.size()) {
+      return Status::Error("fused front-end state: sensor template counts differ");
+    }
+    RATSLAM_RETURN_IF_ERROR(camera_.SetTemplates(std::move(camera)));
+    RATSLAM_RETURN_IF_ERROR(wifi_.SetState(std::move(ws)));
+    created_time_s_ = std::move(created);
+    headings_ = std::move(headings);
+    newest_scan_ = std::move(newest);
+    newest_scan_time_s_ = newest_time;
+    heading_rad_ = heading;
+    return Status::Ok();
+  }
+
+ private:
+  // Eqs. 10-11: a sensor's best match counts when it reaches the threshold and is not recent.
+  bool Counts(int32_t best, double score, double threshold, double time_s) const {
+    if (best < 0 || score < threshold) return false;
+    const int64_t n = static_cast<int64_t>(created_time_s_.size());
+    return n - best >= options_.recency_templates &&
+           time_s - created_time_s_[best] >= options_.recency_s;
+  }
+
+  FrameDecision Decide(double time_s, const std::vector<float>* view, const Fingerprint* scan) {
+    const uint32_t n = size();
+    std::optional<uint32_t> chosen;
+    FrameDecision d;
+    if (view) {
+      const KernelCameraMatch best = camera_.Best(*view);  // eq. 8
+      if (Counts(best.id, best.similarity, camera_.options().match_threshold, time_s)) {
+        chosen = static_cast<uint32_t>(best.id);
+        d.source = DecisionSource::kCamera;
+      }
+    }
+    if (!chosen && scan && !scan->empty()) {
+      const WifiMatch best = wifi_.Best(*scan);  // eq. 9
+      if (Counts(best.id, best.weight, wifi_.options().match_threshold, time_s)) {
+        chosen = static_cast<uint32_t>(best.id);
+        d.source = DecisionSource::kWifi;
+      }
+    }
+    d.view.time_s = time_s;
+    if (chosen) {  // eq. 12
+      d.view.template_id = *chosen;
+      d.view.is_new = false;
+      const std::optional<double>& stored = headings_[*chosen];
+      if (options_.use_compass && heading_rad_ && stored) {
+        // Eq. 2 gives theta_j - theta_t; the spine wants the change since the template.
+        d.view.heading_change_rad = WrapAngle(*heading_rad_ - *stored);
+      }
+      return d;
+    }
+    // Both sensors say novel: a new joint template.
+    camera_.Add(view ? *view : std::vector<float>());
+    wifi_.Add(scan ? *scan : Fingerprint());
+    created_time_s_.push_back(time_s);
+    headings_.push_back(options_.use_compass ? heading_rad_ : std::nullopt);
+    d.view.template_id = n;
+    d.view.is_new = true;
+    d.source = DecisionSource::kNew;
+    return d;
+  }
+
+  FusedOptions options_;
+  KernelCameraMatcher camera_;
+  WifiFingerprintMatcher wifi_;
+  std::vector<double> created_time_s_;               // by template
+  std::vector<std::optional<double>> headings_;      // by template
+  Fingerprint newest_scan_;
+  std::optional<double> newest_scan_time_s_;
+  std::optional<double> heading_rad_;
+};
+
+}  // namespace
+
+std::unique_ptr<FrontEnd> CreateFrontEnd(const FrontEndSettings& s) {
+  switch (s.front_end.kind) {
+    case FrontEndKind::kClassicCamera:
+      return std::make_unique<ClassicCameraFrontEnd>(s.classic_camera);
+    case FrontEndKind::kFused:
+      return std::make_unique<FusedFrontEnd>(s.fused, s.camera_12x9, s.wifi);
+  }
+  return nullptr;
+}
+
+}  // namespace ratslam

@@ -1,0 +1,104 @@
+// Front ends decide which local view is active. The replay pipeline hands them every event; a
+// front end answers with a frame decision when an event makes a frame (a camera image, or a
+// Wi-Fi scan when no camera is used).
+//
+// kClassicCamera: the OpenRatSLAM camera matcher (sensors/classic_camera_matcher.h).
+// kFused: the Wi-Fi RatSLAM paper's front end (section III): 12x9 camera templates (eq. 7),
+// Wi-Fi fingerprints (eqs. 3-6) and a compass (eq. 2), combined by the b_out rule (eqs. 8-12):
+// the best match per sensor counts only if it reaches the sensor's threshold and is not among
+// the last k templates (k in templates and/or seconds); the camera is preferred when it matches,
+// else Wi-Fi, else a new joint template (camera view + newest Wi-Fi scan + heading) is stored.
+// Wi-Fi is evaluated at the camera rate with the newest scan; scans older than max_wifi_age_s
+// count as absent. Any sensor can be switched off (Wi-Fi only, camera only, fused).
+#ifndef RATSLAM_FUSION_FRONT_END_H_
+#define RATSLAM_FUSION_FRONT_END_H_
+
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "ratslam/local_view_cells.h"
+#include "ratslam/status.h"
+#include "sensors/classic_camera_matcher.h"
+#include "sensors/dataset/dataset.h"
+#include "sensors/dataset/image_loader.h"
+#include "sensors/kernel_camera_matcher.h"
+#include "sensors/wifi_fingerprint_matcher.h"
+
+namespace ratslam {
+
+enum class FrontEndKind { kClassicCamera, kFused };
+std::string ToString(FrontEndKind kind);
+// Fails with the list of valid names.
+StatusOr<FrontEndKind> FrontEndKindFromString(const std::string& name);
+
+struct FrontEndOptions {
+  FrontEndKind kind = FrontEndKind::kClassicCamera;  // which front end decides the local view
+
+  bool IsValid(std::string*) const { return true; }
+  template <typename Visitor>
+  void VisitFields(Visitor&& v) {
+    v("kind", kind, "front end that decides the active local view: classic_camera or fused");
+  }
+};
+
+struct FusedOptions {
+  bool use_camera = false;         // 12x9 camera templates (eq. 7)
+  bool use_wifi = true;            // Wi-Fi fingerprints (eqs. 3-6)
+  bool use_compass = false;        // heading per template; relative orientation of eq. 2
+  int recency_templates = 0;       // k: a match must be at least this many templates old
+  double recency_s = 40.0;         // k: and at least this many seconds old (paper: 40 s)
+  double max_wifi_age_s = 5.0;     // an older newest scan counts as absent
+
+  bool IsValid(std::string* error) const;
+
+  template <typename Visitor>
+  void VisitFields(Visitor&& v) {
+    v("use_camera", use_camera, "use 12x9 camera templates (eq. 7); frames are camera images");
+    v("use_wifi", use_wifi, "use Wi-Fi fingerprints (eqs. 3-6); without a camera, scans are frames");
+    v("use_compass", use_compass,
+      "store a heading with each template; matches give the relative orientation of eq. 2");
+    v("recency_templates", recency_templates, "k of eqs. 10-11 in templates: newer matches do not count");
+    v("recency_s", recency_s, "k of eqs. 10-11 in seconds: matches newer than this do not count");
+    v("max_wifi_age_s", max_wifi_age_s, "a Wi-Fi scan older than this counts as absent at a frame");
+  }
+};
+
+// Which sensor decided a frame.
+enum class DecisionSource : uint8_t { kCamera = 0, kWifi = 1, kNew = 2 };
+std::string ToString(DecisionSource source);
+
+struct FrameDecision {
+  ViewDecision view;
+  DecisionSource source = DecisionSource::kNew;
+};
+
+class FrontEnd {
+ public:
+  virtual ~FrontEnd() = default;
+  // A camera image; a decision when images are frames for this front end.
+  virtual StatusOr<std::optional<FrameDecision>> OnImage(double time_s, const GrayImage& image) = 0;
+  // A Wi-Fi scan; a decision when scans are frames (no camera).
+  virtual StatusOr<std::optional<FrameDecision>> OnWifi(const WifiScan& scan) = 0;
+  virtual void OnCompass(double time_s, double heading_rad) = 0;
+  // The absolute heading the spine should use, if this front end uses a compass.
+  virtual std::optional<double> CompassHeading() const = 0;
+  virtual bool WantsImages() const = 0;
+  virtual uint32_t size() const = 0;  // templates stored
+  virtual std::string EncodeState() const = 0;
+  virtual Status DecodeState(const std::string& bytes) = 0;
+};
+
+struct FrontEndSettings {
+  FrontEndOptions front_end;
+  ClassicCameraOptions classic_camera;
+  FusedOptions fused;
+  KernelCameraOptions camera_12x9;
+  WifiMatcherOptions wifi;
+};
+
+std::unique_ptr<FrontEnd> CreateFrontEnd(const FrontEndSettings& settings);
+
+}  // namespace ratslam
+
+#endif  // RATSLAM_FUSION_FRONT_END_H_

@@ -1,0 +1,107 @@
+#include "sensors/dataset/dataset_loader.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+
+namespace ratslam {
+namespace fs = std::filesystem;
+
+StatusOr<DatasetFormat> DetectDatasetFormat(const std::string& path) {
+  if (fs::is_directory(path)) {
+    if (fs::exists(fs::path(path) / "manifest.toml")) return DatasetFormat::kReplayFolder;
+    return Status::Error(path + ": a folder without manifest.toml is not a replay data set");
+  }
+  std::ifstream in(path);
+  if (!in) return Status::Error(path + ": no such file or folder");
+  std::string line;
+  for (int i = 0; i < 200 && std::getline(in, line); ++i) {
+    if (line.empty() || line[0] == '%') continue;
+    for (const char* type : {"WIFI;", "ACCE;", "GYRO;", "MAGN;", "AHRS;", "POSI;", "PRES;"}) {
+      if (line.rfind(type, 0) == 0) return DatasetFormat::kIpinLog;
+    }
+  }
+  return Status::Error(path + ": unknown data-set format (expected a replay folder or an IPIN log)");
+}
+
+StatusOr<Dataset> LoadDataset(const std::string& path, const PhoneLogOptions& phone_options) {
+  StatusOr<DatasetFormat> format = DetectDatasetFormat(path);
+  if (!format.ok()) return format.status();
+  switch (format.value()) {
+    case DatasetFormat::kReplayFolder:
+      return ReadDataset(path);
+    case DatasetFormat::kIpinLog:
+      return ReadIpinLog(path, phone_options);
+  }
+  return Status::Error(path + ": unsupported format");
+}
+
+StatusOr<Dataset> LoadSessions(const std::vector<std::string>& paths,
+                               const PhoneLogOptions& phone_options, double gap_s) {
+  if (paths.empty()) return Status::Error("no data set given");
+  if (paths.size() == 1) {
+    StatusOr<Dataset> d = LoadDataset(paths[0], phone_options);
+    if (d.ok()) d->session_start_times_s = {d->odometry.empty() ? 0.0 : d->odometry.front().time_s};
+    return d;
+  }
+  Dataset joined;
+  PhoneLogOptions options = phone_options;
+  double end_of_previous = -std::numeric_limits<double>::infinity();
+  for (const std::string& path : paths) {
+    PhoneLogReport report;
+    StatusOr<DatasetFormat> format = DetectDatasetFormat(path);
+    if (!format.ok()) return format.status();
+    StatusOr<Dataset> d = format.value() == DatasetFormat::kIpinLog
+                              ? ReadIpinLog(path, options, &report)
+                              : ReadDataset(path);
+    if (!d.ok()) return d.status();
+    if (format.value() == DatasetFormat::kIpinLog && !options.reference) {
+      options.reference = report.reference;  // later logs share the first log's frame
+    }
+    // The session's time span over every stream.
+    double first = std::numeric_limits<double>::infinity(), last = -first;
+    auto span = [&](double t) {
+      first = std::min(first, t);
+      last = std::max(last, t);
+    };
+    for (const auto& r : d->odometry) span(r.time_s);
+    for (const auto& r : d->images) span(r.time_s);
+    for (const auto& r : d->wifi) span(r.time_s);
+    for (const auto& r : d->compass) span(r.time_s);
+    for (const auto& r : d->ground_truth) span(r.time_s);
+    if (!std::isfinite(first)) return Status::Error(path + ": empty data set");
+    const double shift = std::isfinite(end_of_previous) ? end_of_previous + gap_s - first : 0.0;
+    joined.session_start_times_s.push_back(first + shift);
+    joined.odometry.push_back({first + shift, 0.0, 0.0});
+    for (auto r : d->odometry) {
+      r.time_s += shift;
+      if (r.time_s > joined.odometry.back().time_s || joined.odometry.size() == 1) {
+        joined.odometry.push_back(r);
+      }
+    }
+    for (auto r : d->images) {
+      r.time_s += shift;
+      r.file = fs::absolute(d->ImagePath(r)).string();
+      joined.images.push_back(r);
+    }
+    for (auto r : d->wifi) {
+      r.time_s += shift;
+      joined.wifi.push_back(std::move(r));
+    }
+    for (auto r : d->compass) {
+      r.time_s += shift;
+      joined.compass.push_back(r);
+    }
+    for (auto r : d->ground_truth) {
+      r.time_s += shift;
+      joined.ground_truth.push_back(r);
+    }
+    joined.name += (joined.name.empty() ? "" : "+") + d->name;
+    end_of_previous = last + shift;
+  }
+  return joined;
+}
+
+}  // namespace ratslam

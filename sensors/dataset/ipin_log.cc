@@ -1,0 +1,190 @@
+#include "sensors/dataset/ipin_log.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <numbers>
+
+#include "ratslam/circular.h"
+
+namespace ratslam {
+namespace {
+
+constexpr double kEarthRadiusM = 6371008.8;  // mean Earth radius (IUGG)
+
+std::vector<std::string> Split(const std::string& line) {
+  std::vector<std::string> fields;
+  size_t start = 0;
+  while (true) {
+    const size_t end = line.find(';', start);
+    fields.push_back(line.substr(start, end == std::string::npos ? std::string::npos : end - start));
+    if (end == std::string::npos) break;
+    start = end + 1;
+  }
+  // A trailing ';' (some logs end WIFI lines with one) leaves an empty last field.
+  if (fields.size() > 1 && fields.back().find_first_not_of(" \t\r") == std::string::npos) {
+    fields.pop_back();
+  }
+  return fields;
+}
+
+bool ParseDouble(const std::string& text, double* value) {
+  const auto begin = text.find_first_not_of(" \t");
+  const auto end = text.find_last_not_of(" \t\r");
+  if (begin == std::string::npos) return false;
+  const char* first = text.data() + begin;
+  const char* last = text.data() + end + 1;
+  const auto result = std::from_chars(first, last, *value);
+  return result.ec == std::errc() && result.ptr == last && std::isfinite(*value);
+}
+
+}  // namespace
+
+void GeoToLocal(const GeoReference& reference, double latitude_deg, double longitude_deg,
+                double* x_m, double* y_m) {
+  const double to_rad = std::numbers::pi / 180.0;
+  *x_m = kEarthRadiusM * std::cos(reference.latitude_deg * to_rad) *
+         (longitude_deg - reference.longitude_deg) * to_rad;
+  *y_m = kEarthRadiusM * (latitude_deg - reference.latitude_deg) * to_rad;
+}
+
+std::vector<OdometryRow> StepsToOdometry(const std::vector<Step>& steps, double start_time_s) {
+  std::vector<OdometryRow> rows;
+  rows.push_back({start_time_s, 0.0, 0.0});
+  double previous_time = start_time_s;
+  double previous_heading = steps.empty() ? 0.0 : steps.front().heading_rad;
+  for (const Step& s : steps) {
+    const double dt = s.time_s - previous_time;
+    if (dt <= 0.0) continue;  // a step at the start time carries no usable interval
+    rows.push_back({s.time_s, s.length_m / dt, WrapAngle(s.heading_rad - previous_heading) / dt});
+    previous_time = s.time_s;
+    previous_heading = s.heading_rad;
+  }
+  return rows;
+}
+
+StatusOr<Dataset> ReadIpinLog(const std::string& path, const PhoneLogOptions& options,
+                              PhoneLogReport* report) {
+  std::string pdr_error;
+  if (!options.pdr.IsValid(&pdr_error)) return Status::Error("pdr." + pdr_error);
+  std::ifstream in(path);
+  if (!in) return Status::Error(path + ": cannot open log file");
+  PhoneLogReport local_report;
+  PhoneLogReport& r = report ? *report : local_report;
+  r = PhoneLogReport();
+
+  std::vector<AccelerometerSample> accelerometer;
+  std::vector<HeadingSample> headings;
+  std::map<double, std::vector<WifiReading>> scans;  // by app timestamp
+  struct Posi {
+    double time_s, latitude, longitude;
+    int floor;
+  };
+  std::vector<Posi> posi;
+  std::string line;
+  int number = 0;
+  double first_time = std::numeric_limits<double>::infinity();
+  while (std::getline(in, line)) {
+    ++number;
+    ++r.lines;
+    if (line.empty() || line[0] == '%' || line.find_first_not_of(" \t\r") == std::string::npos) {
+      continue;
+    }
+    const std::vector<std::string> f = Split(line);
+    const std::string& type = f[0];
+    auto fail = [&](const std::string& what) -> Status {
+      return Status::Error(path + ":" + std::to_string(number) + ": " + type + ": " + what);
+    };
+    std::vector<double> v(f.size(), 0.0);
+    auto numbers = [&](std::initializer_list<size_t> indices, std::initializer_list<const char*> names) {
+      auto name = names.begin();
+      for (size_t i : indices) {
+        if (i >= f.size()) return fail(std::string("missing field ") + *name);
+        if (!ParseDouble(f[i], &v[i])) return fail(std::string(*name) + " is not a number: '" + f[i] + "'");
+        ++name;
+      }
+      return Status::Ok();
+    };
+    Status status;
+    if (type == "WIFI") {
+      // WIFI;App;Sensor;SSID;BSSID;[Frequency;]RSS
+      if (f.size() != 6 && f.size() != 7) {
+        status = fail("expected 6 or 7 fields, found " + std::to_string(f.size()));
+      } else {
+        const size_t rss = f.size() - 1;
+        status = numbers({1, rss}, {"AppTimestamp(s)", "RSS(dBm)"});
+        if (status.ok() && f[4].empty()) status = fail("empty BSSID");
+        if (status.ok()) scans[v[1]].push_back({f[4], v[rss]});
+      }
+    } else if (type == "ACCE") {
+      status = numbers({1, 3, 4, 5}, {"AppTimestamp(s)", "Acc_X", "Acc_Y", "Acc_Z"});
+      if (status.ok()) accelerometer.push_back({v[1], v[3], v[4], v[5]});
+    } else if (type == "AHRS") {
+      status = numbers({1, 5}, {"AppTimestamp(s)", "YawZ(deg)"});
+      // The app's yaw is an azimuth: clockwise from north. Ours: counter-clockwise from east.
+      if (status.ok()) {
+        headings.push_back({v[1], WrapAngle(std::numbers::pi / 2 - v[5] * std::numbers::pi / 180)});
+      }
+    } else if (type == "POSI") {
+      status = numbers({1, 3, 4, 5}, {"Timestamp(s)", "Latitude", "Longitude", "floor"});
+      if (status.ok()) posi.push_back({v[1], v[3], v[4], static_cast<int>(std::lround(v[5]))});
+    } else {
+      ++r.skipped_other_types;
+      continue;
+    }
+    if (!status.ok()) {
+      if (!options.lenient) return status;
+      ++r.skipped_malformed;
+      continue;
+    }
+    first_time = std::min(first_time, v[1]);
+  }
+  if (in.bad()) return Status::Error(path + ": read error");
+  if (!std::isfinite(first_time)) return Status::Error(path + ": no sensor lines (not an IPIN log?)");
+
+  auto by_time = [](const auto& a, const auto& b) { return a.time_s < b.time_s; };
+  std::stable_sort(accelerometer.begin(), accelerometer.end(), by_time);
+  std::stable_sort(headings.begin(), headings.end(), by_time);
+  std::stable_sort(posi.begin(), posi.end(), by_time);
+
+  Dataset d;
+  d.name = std::filesystem::path(path).stem().string();
+  d.folder = "";
+  const std::vector<Step> steps = PedestrianDeadReckoning(accelerometer, headings, options.pdr);
+  r.steps = steps.size();
+  d.odometry = StepsToOdometry(steps, first_time);
+  for (auto& [time, readings] : scans) d.wifi.push_back({time, std::move(readings)});
+  double last_compass = -std::numeric_limits<double>::infinity();
+  for (const HeadingSample& h : headings) {
+    if (h.time_s - last_compass >= 1.0 / options.compass_rate_hz) {
+      d.compass.push_back({h.time_s, h.heading_rad});
+      last_compass = h.time_s;
+    }
+  }
+  if (!posi.empty()) {
+    r.reference = options.reference
+                      ? *options.reference
+                      : GeoReference{posi.front().latitude, posi.front().longitude};
+    for (size_t i = 0; i < posi.size(); ++i) {
+      GroundTruthRow row;
+      row.time_s = posi[i].time_s;
+      GeoToLocal(r.reference, posi[i].latitude, posi[i].longitude, &row.x_m, &row.y_m);
+      row.floor = posi[i].floor;
+      d.ground_truth.push_back(row);
+    }
+    // Heading of the ground truth: the direction of travel towards the next point.
+    for (size_t i = 0; i < d.ground_truth.size(); ++i) {
+      const size_t j = i + 1 < d.ground_truth.size() ? i + 1 : i;
+      const size_t k = j == i && i > 0 ? i - 1 : i;
+      const GroundTruthRow& a = d.ground_truth[j == i ? k : i];
+      const GroundTruthRow& b = d.ground_truth[j];
+      d.ground_truth[i].theta_rad = std::atan2(b.y_m - a.y_m, b.x_m - a.x_m);
+    }
+  }
+  return d;
+}
+
+}  // namespace ratslam

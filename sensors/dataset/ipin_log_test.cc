@@ -1,0 +1,108 @@
+#include "sensors/dataset/ipin_log.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "sensors/dataset/dataset_loader.h"
+
+namespace ratslam {
+namespace {
+namespace fs = std::filesystem;
+
+const char kFixture[] =
+    "% LogFile created by the 'GetSensorData' App for Android.\n"
+    "%\n"
+    "ACCE;0.10;100.10;0.1;0.2;9.8;3\n"
+    "AHRS;0.11;100.11;1.0;2.0;90.0;0.1;0.2;0.3;3\n"
+    "WIFI;0.50;100.50;net;aa:bb;2437;-60\n"
+    "WIFI;0.50;100.50;net;cc:dd;5200;-71;\n"
+    "WIFI;4.50;104.50;net;aa:bb;-62\n"  // no Frequency column: accepted
+    "SOUN;0.6;1;2;3\n"
+    "POSI;1.0;1;49.461316433032;11.110964442580;0;100\n"
+    "POSI;3.0;2;49.461275602490;11.110988346746;0;100\n";
+
+fs::path WriteFixture(const std::string& name, const std::string& text) {
+  const fs::path path = fs::temp_directory_path() / name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+TEST(IpinLogTest, ReadsScansCompassAndGroundTruth) {
+  const fs::path path = WriteFixture("ratslam_ipin_fixture.txt", kFixture);
+  PhoneLogReport report;
+  StatusOr<Dataset> d = ReadIpinLog(path.string(), {}, &report);
+  ASSERT_TRUE(d.ok()) << d.status().message();
+  ASSERT_EQ(d->wifi.size(), 2u);
+  ASSERT_EQ(d->wifi[0].readings.size(), 2u);
+  EXPECT_EQ(d->wifi[0].readings[1].bssid, "cc:dd");
+  EXPECT_EQ(d->wifi[1].readings[0].rssi_dbm, -62);
+  ASSERT_EQ(d->compass.size(), 1u);
+  EXPECT_NEAR(d->compass[0].heading_rad, 0.0, 1e-12);  // azimuth 90 deg (east) = 0 rad
+  ASSERT_EQ(d->ground_truth.size(), 2u);
+  EXPECT_EQ(d->ground_truth[0].x_m, 0.0);
+  // Second point: 0.0000408 deg south, 0.0000239 deg east of the first.
+  EXPECT_NEAR(d->ground_truth[1].y_m, -(49.461316433032 - 49.461275602490) * M_PI / 180 * 6371008.8, 1e-6);
+  EXPECT_GT(d->ground_truth[1].x_m, 1.0);
+  EXPECT_EQ(report.skipped_other_types, 1u);
+  EXPECT_EQ(DetectDatasetFormat(path.string()).value(), DatasetFormat::kIpinLog);
+  fs::remove(path);
+}
+
+TEST(IpinLogTest, BrokenLinesNameFileAndLineOrAreCountedWhenLenient) {
+  std::string text = kFixture;
+  text += "WIFI;5.0;105.0;net;aa:bb;2437;strong\n";  // line 11
+  text += "ACCE;5.1;105.1;0.1\n";                      // line 12: truncated
+  const fs::path path = WriteFixture("ratslam_ipin_broken.txt", text);
+  StatusOr<Dataset> strict = ReadIpinLog(path.string(), {});
+  ASSERT_FALSE(strict.ok());
+  EXPECT_NE(strict.status().message().find("ratslam_ipin_broken.txt:11: WIFI: RSS(dBm) is not a number"),
+            std::string::npos)
+      << strict.status().message();
+  PhoneLogOptions lenient;
+  lenient.lenient = true;
+  PhoneLogReport report;
+  StatusOr<Dataset> d = ReadIpinLog(path.string(), lenient, &report);
+  ASSERT_TRUE(d.ok()) << d.status().message();
+  EXPECT_EQ(report.skipped_malformed, 2u);
+  EXPECT_EQ(d->wifi.size(), 2u);
+  fs::remove(path);
+  EXPECT_FALSE(ReadIpinLog("/nonexistent.txt", {}).ok());
+}
+
+TEST(IpinLogTest, StepsBecomeOdometryRows) {
+  const std::vector<Step> steps = {{1.0, 0.7, 0.0}, {1.5, 0.8, 0.5}};
+  const std::vector<OdometryRow> rows = StepsToOdometry(steps, 0.0);
+  ASSERT_EQ(rows.size(), 3u);
+  EXPECT_DOUBLE_EQ(rows[1].forward_speed_m_per_s * 1.0, 0.7);
+  EXPECT_DOUBLE_EQ(rows[2].forward_speed_m_per_s * 0.5, 0.8);
+  EXPECT_DOUBLE_EQ(rows[2].turn_rate_rad_per_s * 0.5, 0.5);
+}
+
+// On a real log: the walk's path length from dead reckoning is close to the ground truth's.
+TEST(IpinLogTest, RealLogDeadReckoningDistanceMatchesGroundTruth) {
+  const fs::path log = fs::path(RATSLAM_SHARED_DATA_DIR) / "ipin2023-t3" /
+                       "IPIN2023_T3_TrainingTrial01_repetition01.txt";
+  if (!fs::exists(log)) GTEST_SKIP() << "missing " << log;
+  PhoneLogReport report;
+  StatusOr<Dataset> d = ReadIpinLog(log.string(), {}, &report);
+  ASSERT_TRUE(d.ok()) << d.status().message();
+  EXPECT_EQ(d->ground_truth.size(), 14u);
+  EXPECT_GT(d->wifi.size(), 40u);
+  double truth = 0.0, walked = 0.0;
+  for (size_t i = 1; i < d->ground_truth.size(); ++i) {
+    truth += std::hypot(d->ground_truth[i].x_m - d->ground_truth[i - 1].x_m,
+                        d->ground_truth[i].y_m - d->ground_truth[i - 1].y_m);
+  }
+  for (size_t i = 1; i < d->odometry.size(); ++i) {
+    const double t = d->odometry[i].time_s;
+    if (t < d->ground_truth.front().time_s || t > d->ground_truth.back().time_s) continue;
+    walked += d->odometry[i].forward_speed_m_per_s * (t - d->odometry[i - 1].time_s);
+  }
+  EXPECT_NEAR(walked / truth, 1.0, 0.25) << "walked " << walked << " m, truth " << truth << " m";
+}
+
+}  // namespace
+}  // namespace ratslam

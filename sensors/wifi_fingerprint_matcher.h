@@ -1,0 +1,112 @@
+// Wi-Fi fingerprint matching of the Wi-Fi RatSLAM paper (section III-B, eqs. 3-6), after Weyn's
+// model. A fingerprint is a set of (BSSID, RSSI dBm). Against a stored fingerprint j:
+//   w_hit   = prod over the H common APs of exp(-(s - s_j)^2 / (2 sigma^2))           (eq. 3)
+//   w_extra = prod over the E APs only in the query of exp(-P(s)^2 / (2 sigma^2))      (eq. 4)
+//   w_miss  = prod over the M APs only in j of exp(-P(s_j)^2 / (2 sigma^2))            (eq. 5)
+//   w       = w_hit^(1/H) * w_extra * w_miss * H / (H + E + M)                         (eq. 6)
+// The paper takes the penalty P from Weyn without stating it; ours grows linearly with how far
+// the AP's RSSI is above a floor, P(s) = penalty_per_dbm * max(0, s - penalty_floor_dbm), so a
+// strong AP that should be there and is not is strong evidence against a match and an AP near
+// the sensitivity floor (often missed by a scan) is almost none.
+//
+// Fingerprints are indexed by BSSID: a query touches only the stored fingerprints that share an
+// AP with it; the per-fingerprint totals of penalties are precomputed, so extra and missing APs
+// cost nothing beyond the shared ones.
+#ifndef RATSLAM_SENSORS_WIFI_FINGERPRINT_MATCHER_H_
+#define RATSLAM_SENSORS_WIFI_FINGERPRINT_MATCHER_H_
+
+#include <cstdint>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "ratslam/status.h"
+
+namespace ratslam {
+
+struct WifiMatcherOptions {
+  double kernel_variance_dbm2 = 20.0;  // sigma^2 of eqs. 3-5 (Chiou et al., the paper's value)
+  double penalty_floor_dbm = -90.0;    // an extra or missing AP at or below this costs nothing
+  double penalty_per_dbm = 0.1;        // P(s) = penalty_per_dbm * max(0, s - penalty_floor_dbm)
+  double match_threshold = 0.25;       // t_wifi: smallest weight w that is a match
+  double min_rssi_dbm = -100.0;        // readings weaker than this are dropped from scans
+
+  bool IsValid(std::string* error) const;
+
+  template <typename Visitor>
+  void VisitFields(Visitor&& v) {
+    v("kernel_variance_dbm2", kernel_variance_dbm2,
+      "sigma^2 of the Gaussian kernels of eqs. 3-5, dBm^2 (paper: 20)");
+    v("penalty_floor_dbm", penalty_floor_dbm,
+      "extra or missing APs at or below this RSSI carry no penalty");
+    v("penalty_per_dbm", penalty_per_dbm,
+      "penalty P(s) = penalty_per_dbm * max(0, s - penalty_floor_dbm) for eqs. 4-5");
+    v("match_threshold", match_threshold, "t_wifi: smallest weight w (eq. 6) that is a match");
+    v("min_rssi_dbm", min_rssi_dbm, "readings weaker than this are ignored");
+  }
+};
+
+// A scan reduced to unique APs (by interned BSSID id), sorted by id.
+struct Fingerprint {
+  std::vector<uint32_t> ap_ids;
+  std::vector<float> rssi_dbm;
+  bool empty() const { return ap_ids.empty(); }
+};
+
+struct WifiMatch {
+  int32_t id = -1;      // -1: nothing stored shares an AP
+  double weight = 0.0;  // eq. 6
+};
+
+class WifiFingerprintMatcher {
+ public:
+  struct State {
+    std::vector<std::string> bssids;  // interned, index = AP id
+    std::vector<Fingerprint> fingerprints;
+  };
+
+  // `options` must be valid; throws std::invalid_argument otherwise.
+  explicit WifiFingerprintMatcher(const WifiMatcherOptions& options);
+
+  // Interns BSSIDs (new ones get new ids) and merges repeated APs by averaging their RSSI.
+  // Readings that are not finite or below min_rssi_dbm are dropped.
+  Fingerprint MakeFingerprint(const std::vector<std::pair<std::string, double>>& readings);
+
+  // The weight of eq. 6 between two fingerprints.
+  double Weight(const Fingerprint& query, const Fingerprint& stored) const;
+  // Weights against every stored fingerprint, by id (0 where no AP is shared).
+  std::vector<double> Weights(const Fingerprint& query) const;
+  // The stored fingerprint with the largest weight (eq. 9).
+  WifiMatch Best(const Fingerprint& query) const;
+
+  // Stores a fingerprint (possibly empty: a template with no Wi-Fi); returns its id.
+  uint32_t Add(const Fingerprint& fingerprint);
+  uint32_t size() const { return static_cast<uint32_t>(state_.fingerprints.size()); }
+  const WifiMatcherOptions& options() const { return options_; }
+  const State& state() const { return state_; }
+  Status SetState(State state);
+
+ private:
+  struct Posting {
+    uint32_t fingerprint;
+    float rssi_dbm;
+  };
+  double Penalty2(double rssi_dbm) const;
+  // Visits every stored fingerprint sharing an AP with the query: visit(id, weight).
+  template <typename Visit>
+  void ForEachCandidate(const Fingerprint& query, Visit&& visit) const;
+  void Index(uint32_t id);
+
+  WifiMatcherOptions options_;
+  State state_;
+  std::unordered_map<std::string, uint32_t> bssid_ids_;
+  std::vector<std::vector<Posting>> postings_;   // by AP id
+  std::vector<double> miss_penalty_total_;       // by fingerprint: sum of P(s)^2 of all its APs
+  mutable std::vector<uint32_t> touched_;        // scratch for queries
+  mutable std::vector<uint32_t> common_;
+  mutable std::vector<double> hit_sum_, extra_common_, miss_common_;
+};
+
+}  // namespace ratslam
+
+#endif  // RATSLAM_SENSORS_WIFI_FINGERPRINT_MATCHER_H_

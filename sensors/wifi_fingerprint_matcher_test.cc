@@ -1,0 +1,104 @@
+#include "sensors/wifi_fingerprint_matcher.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "ratslam/random.h"
+
+namespace ratslam {
+namespace {
+
+using Readings = std::vector<std::pair<std::string, double>>;
+
+TEST(WifiMatcherOptionsTest, DefaultsAreValid) {
+  std::string error;
+  EXPECT_TRUE(WifiMatcherOptions().IsValid(&error)) << error;
+}
+
+TEST(WifiFingerprintMatcherTest, ScanComparedWithItselfScoresOne) {
+  WifiFingerprintMatcher m({});
+  const Fingerprint f = m.MakeFingerprint({{"a", -40}, {"b", -71}, {"c", -88}});
+  EXPECT_DOUBLE_EQ(m.Weight(f, f), 1.0);
+  m.Add(f);
+  EXPECT_DOUBLE_EQ(m.Best(f).weight, 1.0);
+  EXPECT_EQ(m.Best(f).id, 0);
+}
+
+// Worked by hand with sigma^2 = 20 (2 sigma^2 = 40), P(s) = 0.1 * (s + 90):
+// common A (diff 2) and B (diff 4): w_hit^(1/2) = exp(-(4 + 16) / 40 / 2) = exp(-0.25);
+// extra C at -70: P = 2, exp(-4/40) = exp(-0.1); missing D at -80: P = 1, exp(-1/40);
+// H / (H + E + M) = 2 / 4. So w = 0.5 exp(-0.375).
+TEST(WifiFingerprintMatcherTest, Equation6WorkedExample) {
+  WifiFingerprintMatcher m({});
+  const Fingerprint q = m.MakeFingerprint({{"A", -50}, {"B", -60}, {"C", -70}});
+  const Fingerprint j = m.MakeFingerprint({{"A", -52}, {"B", -64}, {"D", -80}});
+  EXPECT_NEAR(m.Weight(q, j), 0.5 * std::exp(-0.375), 1e-12);
+  m.Add(j);
+  EXPECT_NEAR(m.Weights(q)[0], 0.5 * std::exp(-0.375), 1e-12);
+}
+
+TEST(WifiFingerprintMatcherTest, MissingStrongApCostsMoreThanMissingWeakAp) {
+  WifiFingerprintMatcher m({});
+  const Fingerprint stored = m.MakeFingerprint({{"a", -50}, {"b", -60}, {"strong", -40}, {"weak", -88}});
+  const Fingerprint without_strong = m.MakeFingerprint({{"a", -50}, {"b", -60}, {"weak", -88}});
+  const Fingerprint without_weak = m.MakeFingerprint({{"a", -50}, {"b", -60}, {"strong", -40}});
+  EXPECT_LT(m.Weight(without_strong, stored), m.Weight(without_weak, stored));
+  // Likewise for an extra AP in the query.
+  const Fingerprint base = m.MakeFingerprint({{"a", -50}, {"b", -60}});
+  EXPECT_LT(m.Weight(m.MakeFingerprint({{"a", -50}, {"b", -60}, {"x", -45}}), base),
+            m.Weight(m.MakeFingerprint({{"a", -50}, {"b", -60}, {"y", -89}}), base));
+}
+
+TEST(WifiFingerprintMatcherTest, RepeatedApsAndOrderDoNotMatter) {
+  WifiFingerprintMatcher m({});
+  const Fingerprint a = m.MakeFingerprint({{"b", -60}, {"a", -50}, {"b", -62}});
+  const Fingerprint b = m.MakeFingerprint({{"a", -50}, {"b", -61}});
+  EXPECT_EQ(a.ap_ids, b.ap_ids);
+  EXPECT_EQ(a.rssi_dbm, b.rssi_dbm);
+  EXPECT_DOUBLE_EQ(m.Weight(a, b), 1.0);
+  const Fingerprint bad = m.MakeFingerprint({{"a", std::nan("")}, {"b", -150}, {"", -40}});
+  EXPECT_TRUE(bad.empty());
+}
+
+TEST(WifiFingerprintMatcherTest, NoSharedApScoresZero) {
+  WifiFingerprintMatcher m({});
+  m.Add(m.MakeFingerprint({{"a", -50}}));
+  const Fingerprint q = m.MakeFingerprint({{"z", -50}});
+  EXPECT_EQ(m.Best(q).id, -1);
+  EXPECT_EQ(m.Weights(q)[0], 0.0);
+}
+
+// The inverted index computes the same weights as the direct pairwise formula.
+TEST(WifiFingerprintMatcherTest, IndexedWeightsEqualDirectWeights) {
+  WifiFingerprintMatcher m({});
+  Random rng(11);
+  auto random_scan = [&]() {
+    Readings r;
+    const int n = 5 + static_cast<int>(rng.Uniform() * 30);
+    for (int i = 0; i < n; ++i) {
+      r.push_back({"ap" + std::to_string(static_cast<int>(rng.Uniform() * 200)),
+                   rng.Uniform(-95, -30)});
+    }
+    return m.MakeFingerprint(r);
+  };
+  std::vector<Fingerprint> stored;
+  for (int i = 0; i < 300; ++i) {
+    stored.push_back(random_scan());
+    m.Add(stored.back());
+  }
+  for (int k = 0; k < 20; ++k) {
+    const Fingerprint q = random_scan();
+    const std::vector<double> indexed = m.Weights(q);
+    for (size_t i = 0; i < stored.size(); ++i) {
+      ASSERT_NEAR(indexed[i], m.Weight(q, stored[i]), 1e-9 * std::max(1.0, indexed[i]));
+    }
+  }
+  WifiFingerprintMatcher restored({});
+  ASSERT_TRUE(restored.SetState(m.state()).ok());
+  const Fingerprint q = stored[17];
+  EXPECT_EQ(restored.Best(q).id, m.Best(q).id);
+}
+
+}  // namespace
+}  // namespace ratslam
