@@ -21,10 +21,12 @@ inline constexpr int kExitInterrupted = 130;
 
 // Parsed "--flag value" pairs and bare flags.
 struct Arguments {
-  std::map<std::string, std::string> values;
+  std::map<std::string, std::string> values;             // the last value of each flag
+  std::map<std::string, std::vector<std::string>> all;   // every value, for repeatable flags
   std::vector<std::string> positional;
   bool quiet = false;
   bool render = false;
+  bool lenient = false;
 };
 
 inline std::optional<Arguments> ParseArguments(int argc, char** argv, int first,
@@ -36,6 +38,8 @@ inline std::optional<Arguments> ParseArguments(int argc, char** argv, int first,
       args.quiet = true;
     } else if (a == "--render") {
       args.render = true;
+    } else if (a == "--lenient") {
+      args.lenient = true;
     } else if (a.rfind("--", 0) == 0) {
       if (std::find(flags_with_values.begin(), flags_with_values.end(), a) ==
           flags_with_values.end()) {
@@ -47,6 +51,7 @@ inline std::optional<Arguments> ParseArguments(int argc, char** argv, int first,
         return std::nullopt;
       }
       args.values[a] = argv[++i];
+      args.all[a].push_back(args.values[a]);
     } else {
       args.positional.push_back(a);
     }

@@ -25,6 +25,7 @@
 #include "fusion/io/run_outputs.h"
 #include "fusion/replay_pipeline.h"
 #include "sensors/dataset/dataset.h"
+#include "sensors/dataset/dataset_loader.h"
 #include "sensors/dataset/image_loader.h"
 #include "sensors/dataset/synthetic_dataset.h"
 #include "viewer/animation.h"
@@ -43,13 +44,16 @@ extern "C" void OnSignal(int) { g_stop_requested.store(true); }
 
 const char kUsage[] =
     "usage:\n"
-    "  ratslam replay --data D --out O [--config C] [--save-map F] [--load-map F]\n"
-    "                 [--until T] [--render] [--animate N] [--quiet]\n"
-    "      Replays data set D (a replay-format folder) and writes the map, trajectory and\n"
-    "      summary into O. --until T stops after data time T seconds; --save-map F saves the\n"
+    "  ratslam replay --data D [--data D2 ...] --out O [--config C] [--save-map F]\n"
+    "                 [--load-map F] [--until T] [--render] [--animate N] [--lenient] [--quiet]\n"
+    "      Replays data set D (a replay-format folder or an IPIN log; several --data make one\n"
+    "      multi-session run) and writes the map, trajectory and summary into O. --until T stops after data time T seconds; --save-map F saves the\n"
     "      whole state to F; --load-map F resumes from F. Ctrl-C stops cleanly and saves.\n"
     "      --render also writes experience_map.png, template_graph.png and pose_cells.png;\n"
     "      --animate N writes an experience-map frame every N events to O/animation/.\n"
+    "      --lenient skips and counts malformed lines of phone logs instead of failing.\n"
+    "  ratslam import --data D [--data D2 ...] --out F [--config C] [--lenient]\n"
+    "      Converts data sets (IPIN logs, ...) to the replay format in folder F.\n"
     "  ratslam demo --out O [--quiet]\n"
     "      Writes the built-in synthetic data set to O/data, replays it into O and renders\n"
     "      the images.\n"
@@ -69,7 +73,8 @@ const char kUsage[] =
 struct ReplayRequest {
   PipelineOptions options;
   std::string config_path;  // empty: built-in
-  std::string data;
+  std::vector<std::string> data;  // one data set, or several sessions
+  bool lenient = false;           // skip malformed lines of phone logs
   std::string out;
   std::string save_map;
   std::string load_map;
@@ -80,7 +85,10 @@ struct ReplayRequest {
 };
 
 int RunReplay(const ReplayRequest& request) {
-  StatusOr<Dataset> dataset = ReadDataset(request.data);
+  PhoneLogOptions phone;
+  phone.lenient = request.lenient;
+  phone.pdr = request.options.pdr;
+  StatusOr<Dataset> dataset = LoadSessions(request.data, phone);
   if (!dataset.ok()) {
     std::cerr << "ratslam: " << dataset.status().message() << "\n";
     return kExitError;
@@ -250,7 +258,8 @@ int Replay(int argc, char** argv) {
   auto options = LoadOptions(*args, &request.config_path);
   if (!options) return kExitError;
   request.options = *options;
-  request.data = args->values["--data"];
+  request.data = args->all["--data"];
+  request.lenient = args->lenient;
   request.out = args->values["--out"];
   request.save_map = args->values.count("--save-map") ? args->values["--save-map"] : "";
   request.load_map = args->values.count("--load-map") ? args->values["--load-map"] : "";
@@ -295,7 +304,7 @@ int Demo(int argc, char** argv) {
   ReplayRequest request;
   request.options = DemoPipelineOptions();
   request.config_path = "(built-in demo configuration, as configs/demo.toml)";
-  request.data = data;
+  request.data = {data};
   request.out = out;
   request.quiet = args->quiet;
   request.render = true;
@@ -335,6 +344,39 @@ int ImportOpenRatslam(int argc, char** argv) {
   return kExitOk;
 }
 
+int ImportCommand(int argc, char** argv) {
+  auto args = ParseArguments(argc, argv, 2, {"--data", "--out", "--config"});
+  if (!args || !args->positional.empty() || !args->values.count("--data") ||
+      !args->values.count("--out")) {
+    std::cerr << kUsage;
+    return kExitUsage;
+  }
+  std::string config_path;
+  auto options = LoadOptions(*args, &config_path);
+  if (!options) return kExitError;
+  PhoneLogOptions phone;
+  phone.lenient = args->lenient;
+  phone.pdr = options->pdr;
+  StatusOr<Dataset> d = LoadSessions(args->all["--data"], phone);
+  if (!d.ok()) {
+    std::cerr << "ratslam: " << d.status().message() << "\n";
+    return kExitError;
+  }
+  if (!d->images.empty()) {
+    std::cerr << "ratslam: import copies no images; convert image data sets by hand\n";
+    return kExitError;
+  }
+  Status written = WriteDataset(d.value(), args->values["--out"]);
+  if (!written.ok()) {
+    std::cerr << "ratslam: " << written.message() << "\n";
+    return kExitError;
+  }
+  std::cerr << "ratslam: wrote '" << d->name << "' (" << d->odometry.size() << " odometry rows, "
+            << d->wifi.size() << " Wi-Fi scans, " << d->compass.size() << " compass rows, "
+            << d->ground_truth.size() << " ground-truth rows) to " << args->values["--out"] << "\n";
+  return kExitOk;
+}
+
 int SynthesizeCommand(int argc, char** argv) {
   auto args = ParseArguments(argc, argv, 2, {"--out", "--seed", "--laps"});
   if (!args || !args->positional.empty() || !args->values.count("--out")) {
@@ -371,6 +413,7 @@ int main(int argc, char** argv) {
   if (command == "import-openratslam") return ImportOpenRatslam(argc, argv);
   if (command == "synthesize") return SynthesizeCommand(argc, argv);
   if (command == "render") return RenderCommand(argc, argv);
+  if (command == "import") return ImportCommand(argc, argv);
   if (command == "--help" || command == "help" || command == "-h") {
     std::cout << kUsage;
     return kExitOk;

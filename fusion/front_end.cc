@@ -200,36 +200,54 @@ class FusedFrontEnd : public FrontEnd {
   }
 
  private:
+  enum class Verdict { kNovel, kFamiliarRecent, kMatch };
+
   // Eqs. 10-11: a sensor's best match counts when it reaches the threshold and is not recent.
-  bool Counts(int32_t best, double score, double threshold, double time_s) const {
-    if (best < 0 || score < threshold) return false;
+  Verdict Judge(int32_t best, double score, double threshold, double time_s) const {
+    if (best < 0 || score < threshold) return Verdict::kNovel;
     const int64_t n = static_cast<int64_t>(created_time_s_.size());
-    return n - best >= options_.recency_templates &&
-           time_s - created_time_s_[best] >= options_.recency_s;
+    const bool old_enough = n - best >= options_.recency_templates &&
+                            time_s - created_time_s_[best] >= options_.recency_s;
+    return old_enough ? Verdict::kMatch : Verdict::kFamiliarRecent;
   }
 
   FrameDecision Decide(double time_s, const std::vector<float>* view, const Fingerprint* scan) {
     const uint32_t n = size();
-    std::optional<uint32_t> chosen;
-    FrameDecision d;
+    Verdict camera_verdict = Verdict::kNovel, wifi_verdict = Verdict::kNovel;
+    int32_t camera_best = -1, wifi_best = -1;
     if (view) {
       const KernelCameraMatch best = camera_.Best(*view);  // eq. 8
-      if (Counts(best.id, best.similarity, camera_.options().match_threshold, time_s)) {
-        chosen = static_cast<uint32_t>(best.id);
-        d.source = DecisionSource::kCamera;
-      }
+      camera_best = best.id;
+      camera_verdict = Judge(best.id, best.similarity, camera_.options().match_threshold, time_s);
     }
-    if (!chosen && scan && !scan->empty()) {
+    if (scan && !scan->empty()) {
       const WifiMatch best = wifi_.Best(*scan);  // eq. 9
-      if (Counts(best.id, best.weight, wifi_.options().match_threshold, time_s)) {
-        chosen = static_cast<uint32_t>(best.id);
-        d.source = DecisionSource::kWifi;
-      }
+      wifi_best = best.id;
+      wifi_verdict = Judge(best.id, best.weight, wifi_.options().match_threshold, time_s);
     }
+    FrameDecision d;
     d.view.time_s = time_s;
-    if (chosen) {  // eq. 12
+    std::optional<uint32_t> chosen;
+    // Eq. 12: camera first, then Wi-Fi; then a familiar recent template; else new.
+    if (camera_verdict == Verdict::kMatch) {
+      chosen = camera_best;
+      d.source = DecisionSource::kCamera;
+    } else if (wifi_verdict == Verdict::kMatch) {
+      chosen = wifi_best;
+      d.source = DecisionSource::kWifi;
+    } else if (camera_verdict == Verdict::kFamiliarRecent) {
+      chosen = camera_best;
+      d.source = DecisionSource::kCamera;
+      d.recent = true;
+    } else if (wifi_verdict == Verdict::kFamiliarRecent) {
+      chosen = wifi_best;
+      d.source = DecisionSource::kWifi;
+      d.recent = true;
+    }
+    if (chosen) {
       d.view.template_id = *chosen;
       d.view.is_new = false;
+      d.view.allow_injection = !d.recent;
       const std::optional<double>& stored = headings_[*chosen];
       if (options_.use_compass && heading_rad_ && stored) {
         // Eq. 2 gives theta_j - theta_t; the spine wants the change since the template.

@@ -8,6 +8,11 @@
 // the best match per sensor counts only if it reaches the sensor's threshold and is not among
 // the last k templates (k in templates and/or seconds); the camera is preferred when it matches,
 // else Wi-Fi, else a new joint template (camera view + newest Wi-Fi scan + heading) is stored.
+// Our reading of "novel": a best match above threshold that is merely recent is familiar, not
+// novel. Taken literally, eqs. 10-12 would store a new template at every frame while the robot
+// stands still (its best match is always the template just stored). So a recent best above
+// threshold re-uses that template without pose-cell injection (as OpenRatSLAM treats its newest
+// templates); only both sensors below threshold make a new template.
 // Wi-Fi is evaluated at the camera rate with the newest scan; scans older than max_wifi_age_s
 // count as absent. Any sensor can be switched off (Wi-Fi only, camera only, fused).
 #ifndef RATSLAM_FUSION_FRONT_END_H_
@@ -71,6 +76,7 @@ std::string ToString(DecisionSource source);
 struct FrameDecision {
   ViewDecision view;
   DecisionSource source = DecisionSource::kNew;
+  bool recent = false;  // a familiar but recent template: re-used, no injection, not a match
 };
 
 class FrontEnd {

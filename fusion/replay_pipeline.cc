@@ -138,6 +138,7 @@ Status ReplayPipeline::Apply(const FrameDecision& decision) {
   frame.template_id = decision.view.template_id;
   frame.is_new = decision.view.is_new;
   frame.source = decision.source;
+  frame.recent = decision.recent;
   const auto current = slam_->experience_map().current();
   frame.experience_id = current ? static_cast<int64_t>(*current) : -1;
   state_.frames.push_back(frame);

@@ -62,6 +62,7 @@ struct FrameRecord {
   bool is_new = false;
   int64_t experience_id = -1;  // current experience after the frame
   DecisionSource source = DecisionSource::kNew;
+  bool recent = false;  // re-used a recent template (no injection; not counted as a match)
 };
 
 struct ReplayProgress {

@@ -78,7 +78,7 @@ StatusOr<std::optional<Injection>> LocalViewCells::Observe(const ViewDecision& d
   t.decay_frame = frame;
   const bool recent = decision.template_id + static_cast<uint64_t>(options_.skip_recent_templates) >=
                       count;
-  if (recent) return std::optional<Injection>();
+  if (recent || !decision.allow_injection) return std::optional<Injection>();
   const double energy = options_.injection_gain *
                         (options_.energy_limit - std::exp(options_.energy_decay_rate * decay)) /
                         options_.energy_limit;

@@ -48,6 +48,9 @@ struct ViewDecision {
   // Current heading minus the heading the template was stored with (panoramic camera or compass);
   // the injection lands at the stored theta plus this change.
   double heading_change_rad = 0.0;
+  // False for a familiar view that is no evidence of a loop closure (a recent template seen
+  // again): the template becomes current but injects no energy.
+  bool allow_injection = true;
 };
 
 struct ViewTemplate {

@@ -1,6 +1,7 @@
 #include "viewer/run_images.h"
 
 #include <filesystem>
+#include <limits>
 
 #include "fusion/trajectory_metrics.h"
 
@@ -52,11 +53,22 @@ Status WriteRunImages(SceneRenderer& renderer, const ReplayPipeline& pipeline,
   };
   ExperienceMapImageOptions map_options;
   map_options.title = "experience map (" + dataset.name + ")";
+  const std::vector<double>& sessions = dataset.session_start_times_s;
+  if (sessions.size() > 1) {
+    map_options.coloring = MapColoring::kSession;
+    map_options.session_start_times_s = sessions;
+  }
   RATSLAM_RETURN_IF_ERROR(
       write(ExperienceMapScene(ExperienceMapDataOf(pipeline, dataset), map_options),
             "experience_map.png"));
   TemplateGraphImageOptions graph_options;
   graph_options.title = "template graph (" + dataset.name + ")";
+  // Every other session shaded.
+  for (size_t i = 0; sessions.size() > 1 && i < sessions.size(); i += 2) {
+    const double end = i + 1 < sessions.size() ? sessions[i + 1]
+                                               : std::numeric_limits<double>::infinity();
+    graph_options.shaded_spans.push_back({sessions[i], end, "session " + std::to_string(i + 1)});
+  }
   RATSLAM_RETURN_IF_ERROR(
       write(TemplateGraphScene(TemplateGraphOf(pipeline), graph_options), "template_graph.png"));
   return write(PoseCellScene(pipeline.slam().pose_cells(), {}), "pose_cells.png");

@@ -79,7 +79,7 @@ StatusOr<RunFolder> ReadRunFolder(const std::string& folder) {
   }
   StatusOr<CsvTable> fr = CsvTable::Read((fs::path(folder) / "frames.csv").string(),
                                          {"time_s", "template_id", "new_template", "experience_id"},
-                                         {"source"});
+                                         {"source", "recent"});
   if (!fr.ok()) return fr.status();
   for (size_t r = 0; r < fr->rows(); ++r) {
     FrameRecord f;
@@ -104,6 +104,11 @@ StatusOr<RunFolder> ReadRunFolder(const std::string& folder) {
       } else {
         return fr->ErrorAt(r, "source", "must be camera, wifi or new, not '" + *source + "'");
       }
+    }
+    if (fr->has_column("recent")) {
+      int64_t recent = 0;
+      RATSLAM_RETURN_IF_ERROR(ReadId(*fr, r, "recent", 0, &recent));
+      f.recent = recent != 0;
     }
     run.frames.push_back(f);
   }

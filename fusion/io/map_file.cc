@@ -113,6 +113,7 @@ void Encode(ByteWriter& w, const ReplayPipeline::State& s) {
     w.Bool(f.is_new);
     w.Pod(f.experience_id);
     w.Pod(f.source);
+    w.Bool(f.recent);
   }
   w.Pod(s.wifi_scans_seen);
   w.Pod(s.compass_readings_seen);
@@ -183,7 +184,7 @@ bool Decode(ByteReader& r, ReplayPipeline::State* s) {
   s->frames.resize(n);
   for (FrameRecord& f : s->frames) {
     if (!(r.Pod(&f.time_s) && r.Pod(&f.template_id) && r.Bool(&f.is_new) &&
-          r.Pod(&f.experience_id) && r.Pod(&f.source))) {
+          r.Pod(&f.experience_id) && r.Pod(&f.source) && r.Bool(&f.recent))) {
       return false;
     }
     if (static_cast<uint8_t>(f.source) > 2) return r.Fail("invalid decision source");

@@ -81,7 +81,7 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
     // Every template match: how far is the true position now from the true position where the
     // matched template was stored? A match to another floor is a floor mistake.
     for (const FrameRecord& f : state.frames) {
-      if (f.is_new) continue;
+      if (f.is_new || f.recent) continue;  // only matches that can close a loop
       const auto now = InterpolateGroundTruth(dataset.ground_truth, f.time_s);
       const auto then = InterpolateGroundTruth(
           dataset.ground_truth, slam.local_view().at(f.template_id).created_time_s);
@@ -107,8 +107,13 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
   j["compass_readings"] = state.compass_readings_seen;
   j["images_unused"] = state.images_skipped;
   size_t by_source[3] = {0, 0, 0};
-  for (const FrameRecord& f : state.frames) ++by_source[static_cast<int>(f.source)];
-  j["frames_by_source"] = {{"camera", by_source[0]}, {"wifi", by_source[1]}, {"new", by_source[2]}};
+  size_t recent = 0;
+  for (const FrameRecord& f : state.frames) {
+    ++by_source[static_cast<int>(f.source)];
+    recent += f.recent;
+  }
+  j["frames_by_source"] = {{"camera", by_source[0]}, {"wifi", by_source[1]}, {"new", by_source[2]},
+                           {"recent_reuse", recent}};
   if (dataset.session_start_times_s.size() > 1) j["sessions"] = dataset.session_start_times_s.size();
   j["events_done"] = state.next_event;
   j["events_total"] = state.events_total;
@@ -195,10 +200,10 @@ StatusOr<RunSummary> WriteRunOutputs(const std::string& folder, const ReplayPipe
   RATSLAM_RETURN_IF_ERROR(WriteFileAtomically(path("experience_map.g2o"), g2o.str()));
 
   std::ostringstream frames;
-  frames << "time_s,template_id,new_template,experience_id,source\n";
+  frames << "time_s,template_id,new_template,experience_id,source,recent\n";
   for (const FrameRecord& f : state.frames) {
     frames << Num(f.time_s) << ',' << f.template_id << ',' << (f.is_new ? 1 : 0) << ','
-           << f.experience_id << ',' << ToString(f.source) << '\n';
+           << f.experience_id << ',' << ToString(f.source) << ',' << (f.recent ? 1 : 0) << '\n';
   }
   RATSLAM_RETURN_IF_ERROR(WriteFileAtomically(path("frames.csv"), frames.str()));
 

@@ -98,9 +98,10 @@ StatusOr<Dataset> LoadSessions(const std::vector<std::string>& paths,
       r.time_s += shift;
       joined.ground_truth.push_back(r);
     }
-    joined.name += (joined.name.empty() ? "" : "+") + d->name;
+    if (joined.name.empty()) joined.name = d->name;
     end_of_previous = last + shift;
   }
+  joined.name += " +" + std::to_string(paths.size() - 1) + " sessions";
   return joined;
 }
 

@@ -40,7 +40,8 @@ TEST(IpinLogTest, ReadsScansCompassAndGroundTruth) {
   EXPECT_EQ(d->wifi[0].readings[1].bssid, "cc:dd");
   EXPECT_EQ(d->wifi[1].readings[0].rssi_dbm, -62);
   ASSERT_EQ(d->compass.size(), 1u);
-  EXPECT_NEAR(d->compass[0].heading_rad, 0.0, 1e-12);  // azimuth 90 deg (east) = 0 rad
+  // Yaw 90 deg counter-clockwise from north is west: pi from east.
+  EXPECT_NEAR(std::abs(d->compass[0].heading_rad), M_PI, 1e-12);
   ASSERT_EQ(d->ground_truth.size(), 2u);
   EXPECT_EQ(d->ground_truth[0].x_m, 0.0);
   // Second point: 0.0000408 deg south, 0.0000239 deg east of the first.
