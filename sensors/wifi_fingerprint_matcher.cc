@@ -105,7 +105,7 @@ void WifiFingerprintMatcher::ForEachCandidate(const Fingerprint& query, Visit&& 
       const double d = s - p.rssi_dbm;
       hit_sum_[p.fingerprint] += d * d;
       extra_common_[p.fingerprint] += extra;
-      miss_common_[p.fingerprint] += Penalty2(p.rssi_dbm);
+      miss_common_[p.fingerprint] += p.penalty2;
     }
   }
   const double two_sigma2 = 2.0 * options_.kernel_variance_dbm2;
@@ -146,8 +146,9 @@ void WifiFingerprintMatcher::Index(uint32_t id) {
   double miss_total = 0.0;
   for (size_t a = 0; a < f.ap_ids.size(); ++a) {
     if (f.ap_ids[a] >= postings_.size()) postings_.resize(f.ap_ids[a] + 1);
-    postings_[f.ap_ids[a]].push_back({id, f.rssi_dbm[a]});
-    miss_total += Penalty2(f.rssi_dbm[a]);
+    const double penalty2 = Penalty2(f.rssi_dbm[a]);
+    postings_[f.ap_ids[a]].push_back({id, f.rssi_dbm[a], penalty2});
+    miss_total += penalty2;
   }
   miss_penalty_total_.push_back(miss_total);
 }

@@ -90,6 +90,7 @@ class WifiFingerprintMatcher {
   struct Posting {
     uint32_t fingerprint;
     float rssi_dbm;
+    double penalty2;  // P(rssi)^2, precomputed for eq. 5
   };
   double Penalty2(double rssi_dbm) const;
   // Visits every stored fingerprint sharing an AP with the query: visit(id, weight).

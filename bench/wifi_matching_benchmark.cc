@@ -1,0 +1,62 @@
+// Wi-Fi fingerprint matching: one query against 10k stored fingerprints of about 30 APs each.
+// Two AP universes: 230 APs (one building, like the IPIN logs: most fingerprints share APs with
+// the query) and 20,000 APs (a campus: few share any). Baseline: the pairwise formula against
+// every stored fingerprint, without the BSSID index.
+#include <benchmark/benchmark.h>
+
+#include <string>
+#include <vector>
+
+#include "ratslam/random.h"
+#include "sensors/wifi_fingerprint_matcher.h"
+
+namespace ratslam {
+namespace {
+
+struct Setup {
+  WifiFingerprintMatcher matcher{WifiMatcherOptions()};
+  std::vector<Fingerprint> stored;
+  Fingerprint query;
+};
+
+Setup Make(int fingerprints, int universe) {
+  Setup s;
+  Random rng(5);
+  auto scan = [&]() {
+    // A place: 30 APs clustered around a random point of the universe (nearby APs are heard).
+    const int center = static_cast<int>(rng.Uniform() * universe);
+    std::vector<std::pair<std::string, double>> r;
+    for (int i = 0; i < 30; ++i) {
+      const int ap = (center + static_cast<int>(rng.Gaussian(0, 25))) % universe;
+      r.push_back({"ap" + std::to_string((ap + universe) % universe), rng.Uniform(-92, -35)});
+    }
+    return s.matcher.MakeFingerprint(r);
+  };
+  for (int i = 0; i < fingerprints; ++i) {
+    s.stored.push_back(scan());
+    s.matcher.Add(s.stored.back());
+  }
+  s.query = scan();
+  return s;
+}
+
+void BM_WifiBestIndexed(benchmark::State& state) {
+  Setup s = Make(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  for (auto _ : state) benchmark::DoNotOptimize(s.matcher.Best(s.query));
+}
+BENCHMARK(BM_WifiBestIndexed)->Args({10000, 230})->Args({10000, 20000})->Unit(benchmark::kMicrosecond);
+
+void BM_WifiBestPairwiseBaseline(benchmark::State& state) {
+  Setup s = Make(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  for (auto _ : state) {
+    double best = 0.0;
+    for (const Fingerprint& f : s.stored) best = std::max(best, s.matcher.Weight(s.query, f));
+    benchmark::DoNotOptimize(best);
+  }
+}
+BENCHMARK(BM_WifiBestPairwiseBaseline)->Args({10000, 230})->Args({10000, 20000})->Unit(benchmark::kMicrosecond);
+
+}  // namespace
+}  // namespace ratslam
+
+BENCHMARK_MAIN();
