@@ -1,5 +1,7 @@
 #include "sensors/dataset/dataset_loader.h"
 
+#include "sensors/dataset/msft_log.h"
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -19,11 +21,18 @@ StatusOr<DatasetFormat> DetectDatasetFormat(const std::string& path) {
   std::string line;
   for (int i = 0; i < 200 && std::getline(in, line); ++i) {
     if (line.empty() || line[0] == '%') continue;
+    if (line[0] == '#') {
+      if (line.find("SiteID:") != std::string::npos || line.find("startTime:") != std::string::npos) {
+        return DatasetFormat::kMicrosoftLog;
+      }
+      continue;
+    }
+    if (line.find("\tTYPE_") != std::string::npos) return DatasetFormat::kMicrosoftLog;
     for (const char* type : {"WIFI;", "ACCE;", "GYRO;", "MAGN;", "AHRS;", "POSI;", "PRES;"}) {
       if (line.rfind(type, 0) == 0) return DatasetFormat::kIpinLog;
     }
   }
-  return Status::Error(path + ": unknown data-set format (expected a replay folder or an IPIN log)");
+  return Status::Error(path + ": unknown data-set format (expected a replay folder, an IPIN log or a Microsoft walk)");
 }
 
 StatusOr<Dataset> LoadDataset(const std::string& path, const PhoneLogOptions& phone_options) {
@@ -34,6 +43,8 @@ StatusOr<Dataset> LoadDataset(const std::string& path, const PhoneLogOptions& ph
       return ReadDataset(path);
     case DatasetFormat::kIpinLog:
       return ReadIpinLog(path, phone_options);
+    case DatasetFormat::kMicrosoftLog:
+      return ReadMicrosoftLog(path, phone_options);
   }
   return Status::Error(path + ": unsupported format");
 }
@@ -53,8 +64,9 @@ StatusOr<Dataset> LoadSessions(const std::vector<std::string>& paths,
     PhoneLogReport report;
     StatusOr<DatasetFormat> format = DetectDatasetFormat(path);
     if (!format.ok()) return format.status();
-    StatusOr<Dataset> d = format.value() == DatasetFormat::kIpinLog
-                              ? ReadIpinLog(path, options, &report)
+    StatusOr<Dataset> d = format.value() == DatasetFormat::kIpinLog ? ReadIpinLog(path, options, &report)
+                          : format.value() == DatasetFormat::kMicrosoftLog
+                              ? ReadMicrosoftLog(path, options, &report)
                               : ReadDataset(path);
     if (!d.ok()) return d.status();
     if (format.value() == DatasetFormat::kIpinLog && !options.reference) {

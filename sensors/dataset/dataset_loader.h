@@ -11,11 +11,11 @@
 
 namespace ratslam {
 
-enum class DatasetFormat { kReplayFolder, kIpinLog };
+enum class DatasetFormat { kReplayFolder, kIpinLog, kMicrosoftLog };
 
 // A folder with manifest.toml: the replay format; a file whose lines look like
-// `WIFI;...`/`ACCE;...` (after `%` comments): an IPIN log. Anything else is an error naming
-// the path.
+// `WIFI;...`/`ACCE;...` (after `%` comments): an IPIN log; tab-separated `unix_ms TYPE_...`
+// lines: a Microsoft Indoor Location Competition walk. Anything else is an error naming the path.
 StatusOr<DatasetFormat> DetectDatasetFormat(const std::string& path);
 StatusOr<Dataset> LoadDataset(const std::string& path, const PhoneLogOptions& phone_options);
 

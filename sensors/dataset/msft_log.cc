@@ -1,0 +1,175 @@
+#include "sensors/dataset/msft_log.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <sstream>
+
+#include "ratslam/circular.h"
+
+namespace ratslam {
+namespace {
+
+std::vector<std::string> SplitTabs(const std::string& line) {
+  std::vector<std::string> fields;
+  std::string field;
+  std::istringstream in(line);
+  while (std::getline(in, field, '\t')) {
+    if (!field.empty() && field.back() == '\r') field.pop_back();
+    fields.push_back(field);
+  }
+  return fields;
+}
+
+bool ParseNumber(const std::string& text, double* value) {
+  if (text.empty()) return false;
+  const auto result = std::from_chars(text.data(), text.data() + text.size(), *value);
+  return result.ec == std::errc() && result.ptr == text.data() + text.size() && std::isfinite(*value);
+}
+
+}  // namespace
+
+std::optional<int> FloorFromName(const std::string& name) {
+  if (name.size() < 2 || (name[0] != 'B' && name[0] != 'F')) return std::nullopt;
+  int n = 0;
+  const auto result = std::from_chars(name.data() + 1, name.data() + name.size(), n);
+  if (result.ec != std::errc() || result.ptr != name.data() + name.size() || n < 1) {
+    return std::nullopt;
+  }
+  return name[0] == 'B' ? -n : n - 1;
+}
+
+double HeadingFromRotationVector(double x, double y, double z) {
+  const double w = std::sqrt(std::max(0.0, 1.0 - x * x - y * y - z * z));
+  // Device y axis in the world frame: the second column of the rotation matrix.
+  const double east = 2.0 * (x * y - z * w);
+  const double north = 1.0 - 2.0 * (x * x + z * z);
+  return std::atan2(north, east);
+}
+
+StatusOr<Dataset> ReadMicrosoftLog(const std::string& path, const PhoneLogOptions& options,
+                                   PhoneLogReport* report, double max_wifi_staleness_s) {
+  std::string pdr_error;
+  if (!options.pdr.IsValid(&pdr_error)) return Status::Error("pdr." + pdr_error);
+  std::ifstream in(path);
+  if (!in) return Status::Error(path + ": cannot open log file");
+  PhoneLogReport local_report;
+  PhoneLogReport& r = report ? *report : local_report;
+  r = PhoneLogReport();
+
+  std::vector<AccelerometerSample> accelerometer;
+  std::vector<HeadingSample> headings;
+  std::map<double, std::vector<WifiReading>> scans;
+  std::vector<GroundTruthRow> waypoints;
+  int floor = 0;
+  double start_ms = std::numeric_limits<double>::quiet_NaN();
+  std::string line;
+  int number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    ++r.lines;
+    if (line.empty() || line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    const std::vector<std::string> f = SplitTabs(line);
+    if (line[0] == '#') {
+      for (const std::string& field : f) {
+        if (field.rfind("FloorName:", 0) == 0) {
+          if (auto n = FloorFromName(field.substr(10))) floor = *n;
+        }
+        double start = 0.0;
+        if (field.rfind("startTime:", 0) == 0 && ParseNumber(field.substr(10), &start) &&
+            std::isnan(start_ms)) {
+          start_ms = start;  // times count from the recording's start
+        }
+      }
+      continue;
+    }
+    const std::string type = f.size() > 1 ? f[1] : "";
+    auto fail = [&](const std::string& what) {
+      return Status::Error(path + ":" + std::to_string(number) + ": " +
+                           (type.empty() ? std::string("line") : type) + ": " + what);
+    };
+    std::vector<double> v(f.size(), 0.0);
+    auto numbers = [&](std::initializer_list<size_t> indices) {
+      for (size_t i : indices) {
+        if (i >= f.size()) return fail("missing field " + std::to_string(i + 1));
+        if (!ParseNumber(f[i], &v[i])) {
+          return fail("field " + std::to_string(i + 1) + " is not a number: '" + f[i] + "'");
+        }
+      }
+      return Status::Ok();
+    };
+    Status status = numbers({0});
+    if (status.ok() && std::isnan(start_ms)) start_ms = v[0];
+    const double t = status.ok() ? (v[0] - start_ms) / 1000.0 : 0.0;
+    if (!status.ok()) {
+      // the timestamp itself is broken
+    } else if (type == "TYPE_WIFI") {
+      status = f.size() < 6 ? fail("expected ssid, bssid, rssi, frequency and last-seen time")
+                            : numbers({4, 5, 6 < f.size() ? size_t{6} : size_t{5}});
+      if (status.ok() && f[3].empty()) status = fail("empty BSSID");
+      if (status.ok()) {
+        const bool stale = f.size() > 6 && v[0] - v[6] > max_wifi_staleness_s * 1000.0;
+        if (!stale) scans[t].push_back({f[3], v[4]});
+      }
+    } else if (type == "TYPE_ACCELEROMETER") {
+      status = numbers({2, 3, 4});
+      if (status.ok()) accelerometer.push_back({t, v[2], v[3], v[4]});
+    } else if (type == "TYPE_ROTATION_VECTOR") {
+      status = numbers({2, 3, 4});
+      if (status.ok()) headings.push_back({t, HeadingFromRotationVector(v[2], v[3], v[4])});
+    } else if (type == "TYPE_WAYPOINT") {
+      status = numbers({2, 3});
+      if (status.ok()) {
+        GroundTruthRow row;
+        row.time_s = t;
+        row.x_m = v[2];
+        row.y_m = v[3];
+        row.floor = floor;
+        waypoints.push_back(row);
+      }
+    } else {
+      ++r.skipped_other_types;
+      continue;
+    }
+    if (!status.ok()) {
+      if (!options.lenient) return status;
+      ++r.skipped_malformed;
+    }
+  }
+  if (in.bad()) return Status::Error(path + ": read error");
+  if (std::isnan(start_ms)) return Status::Error(path + ": no data lines (not a Microsoft walk?)");
+  auto by_time = [](const auto& a, const auto& b) { return a.time_s < b.time_s; };
+  std::stable_sort(accelerometer.begin(), accelerometer.end(), by_time);
+  std::stable_sort(headings.begin(), headings.end(), by_time);
+  std::stable_sort(waypoints.begin(), waypoints.end(), by_time);
+  for (GroundTruthRow& w : waypoints) w.floor = floor;  // FloorName may follow the first lines
+
+  Dataset d;
+  d.name = std::filesystem::path(path).stem().string();
+  const std::vector<Step> steps = PedestrianDeadReckoning(accelerometer, headings, options.pdr);
+  r.steps = steps.size();
+  d.odometry = StepsToOdometry(steps, 0.0);
+  for (auto& [time, readings] : scans) d.wifi.push_back({time, std::move(readings)});
+  double last_compass = -std::numeric_limits<double>::infinity();
+  for (const HeadingSample& h : headings) {
+    if (h.time_s - last_compass >= 1.0 / options.compass_rate_hz) {
+      d.compass.push_back({h.time_s, h.heading_rad});
+      last_compass = h.time_s;
+    }
+  }
+  d.ground_truth = std::move(waypoints);
+  for (size_t i = 0; i < d.ground_truth.size(); ++i) {
+    const size_t j = std::min(i + 1, d.ground_truth.size() - 1);
+    const size_t k = j == i && i > 0 ? i - 1 : i;
+    const GroundTruthRow& a = d.ground_truth[j == i ? k : i];
+    const GroundTruthRow& b = d.ground_truth[j];
+    d.ground_truth[i].theta_rad = std::atan2(b.y_m - a.y_m, b.x_m - a.x_m);
+  }
+  return d;
+}
+
+}  // namespace ratslam
