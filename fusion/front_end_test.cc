@@ -1,0 +1,131 @@
+#include "fusion/front_end.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace ratslam {
+namespace {
+
+// A 24x18 grey image with a distinct pattern per seed.
+GrayImage Pattern(int seed) {
+  GrayImage image{24, 18, std::vector<uint8_t>(24 * 18)};
+  for (int y = 0; y < 18; ++y)
+    for (int x = 0; x < 24; ++x)
+      image.pixels[y * 24 + x] = static_cast<uint8_t>((x * (7 + seed * 13) + y * (3 + seed * 5)) % 256);
+  return image;
+}
+
+WifiScan Scan(double t, int seed) {
+  WifiScan s{t, {}};
+  for (int i = 0; i < 6; ++i) s.readings.push_back({"ap" + std::to_string(seed * 10 + i), -50.0 - i});
+  return s;
+}
+
+class BOutRuleTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    settings_.front_end.kind = FrontEndKind::kFused;
+    settings_.fused.use_camera = true;
+    settings_.fused.use_wifi = true;
+    settings_.fused.use_compass = true;
+    settings_.fused.recency_s = 40.0;
+    settings_.fused.max_wifi_age_s = 5.0;
+    front_end_ = CreateFrontEnd(settings_);
+  }
+  // A frame: the scan arrives just before the image.
+  FrameDecision Frame(double t, int image, std::optional<int> scan, double heading = 0.0) {
+    front_end_->OnCompass(t, heading);
+    if (scan) {
+      EXPECT_FALSE(front_end_->OnWifi(Scan(t - 0.5, *scan)).value().has_value());
+    }
+    auto d = front_end_->OnImage(t, Pattern(image));
+    EXPECT_TRUE(d.ok());
+    return d.value().value();
+  }
+  FrontEndSettings settings_;
+  std::unique_ptr<FrontEnd> front_end_;
+};
+
+TEST_F(BOutRuleTest, TruthTable) {
+  // Both novel: a new joint template each time.
+  FrameDecision d = Frame(0, 1, 1);
+  EXPECT_TRUE(d.view.is_new);
+  EXPECT_EQ(d.view.template_id, 0u);
+  d = Frame(100, 2, 2);
+  EXPECT_TRUE(d.view.is_new);
+  EXPECT_EQ(d.view.template_id, 1u);
+  // Camera matches template 0 while Wi-Fi matches template 1: the camera is preferred.
+  d = Frame(200, 1, 2);
+  EXPECT_FALSE(d.view.is_new);
+  EXPECT_EQ(d.view.template_id, 0u);
+  EXPECT_EQ(d.source, DecisionSource::kCamera);
+  EXPECT_FALSE(d.recent);
+  // Camera novel, Wi-Fi matches template 0: Wi-Fi decides.
+  d = Frame(300, 3, 1);
+  EXPECT_FALSE(d.view.is_new);
+  EXPECT_EQ(d.view.template_id, 0u);
+  EXPECT_EQ(d.source, DecisionSource::kWifi);
+  // Both novel again: new template 2.
+  d = Frame(400, 4, 4);
+  EXPECT_TRUE(d.view.is_new);
+  EXPECT_EQ(d.view.template_id, 2u);
+  EXPECT_EQ(front_end_->size(), 3u);
+}
+
+TEST_F(BOutRuleTest, RecentMatchIsReusedWithoutInjection) {
+  Frame(0, 1, 1);
+  const FrameDecision d = Frame(10, 1, 1);  // template 0 is only 10 s old (k = 40 s)
+  EXPECT_FALSE(d.view.is_new);
+  EXPECT_EQ(d.view.template_id, 0u);
+  EXPECT_TRUE(d.recent);
+  EXPECT_FALSE(d.view.allow_injection);
+  EXPECT_EQ(front_end_->size(), 1u);
+}
+
+TEST_F(BOutRuleTest, StaleScanCountsAsAbsent) {
+  Frame(0, 1, 1);
+  // Wi-Fi would match template 0, but the newest scan is 20 s old at this frame.
+  EXPECT_FALSE(front_end_->OnWifi(Scan(80, 1)).value().has_value());
+  auto d = front_end_->OnImage(100, Pattern(5));
+  ASSERT_TRUE(d.ok());
+  EXPECT_TRUE(d.value()->view.is_new);
+}
+
+TEST_F(BOutRuleTest, CompassGivesHeadingChange) {
+  Frame(0, 1, 1, /*heading=*/0.3);
+  const FrameDecision d = Frame(100, 6, 1, /*heading=*/0.3 + M_PI / 2);  // Wi-Fi match, turned left
+  EXPECT_EQ(d.source, DecisionSource::kWifi);
+  EXPECT_NEAR(d.view.heading_change_rad, M_PI / 2, 1e-12);  // eq. 2 with the sign of a change
+}
+
+TEST(FrontEndTest, WifiOnlyMakesFramesFromScansAndStateRoundTrips) {
+  FrontEndSettings settings;
+  settings.front_end.kind = FrontEndKind::kFused;
+  settings.fused.use_camera = false;
+  settings.fused.recency_s = 0.0;
+  std::unique_ptr<FrontEnd> a = CreateFrontEnd(settings);
+  EXPECT_FALSE(a->WantsImages());
+  ASSERT_TRUE(a->OnWifi(Scan(0, 1)).value().has_value());
+  ASSERT_TRUE(a->OnWifi(Scan(1, 2)).value().has_value());
+  std::unique_ptr<FrontEnd> b = CreateFrontEnd(settings);
+  ASSERT_TRUE(b->DecodeState(a->EncodeState()).ok());
+  EXPECT_EQ(b->size(), 2u);
+  const auto da = a->OnWifi(Scan(5, 1)).value();
+  const auto db = b->OnWifi(Scan(5, 1)).value();
+  EXPECT_EQ(da->view.template_id, db->view.template_id);
+  EXPECT_EQ(da->source, DecisionSource::kWifi);
+  std::string corrupt = a->EncodeState();
+  corrupt.resize(corrupt.size() / 2);
+  EXPECT_FALSE(b->DecodeState(corrupt).ok());
+}
+
+TEST(FrontEndTest, KindNamesRoundTrip) {
+  for (FrontEndKind k : {FrontEndKind::kClassicCamera, FrontEndKind::kFused}) {
+    EXPECT_EQ(FrontEndKindFromString(ToString(k)).value(), k);
+  }
+  EXPECT_FALSE(FrontEndKindFromString("fabmap").ok());
+}
+
+}  // namespace
+}  // namespace ratslam
