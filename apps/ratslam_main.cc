@@ -27,6 +27,7 @@
 #include "sensors/dataset/dataset.h"
 #include "sensors/dataset/dataset_loader.h"
 #include "sensors/dataset/image_loader.h"
+#include "sensors/dataset/visual_odometry_source.h"
 #include "sensors/dataset/synthetic_dataset.h"
 #include "viewer/animation.h"
 #include "viewer/figures.h"
@@ -93,6 +94,15 @@ int RunReplay(const ReplayRequest& request) {
     std::cerr << "ratslam: " << dataset.status().message() << "\n";
     return kExitError;
   }
+  FileImageLoader images;
+  if (request.options.visual_odometry.enabled) {
+    Status replaced =
+        ReplaceOdometryWithVisual(&dataset.value(), &images, request.options.visual_odometry);
+    if (!replaced.ok()) {
+      std::cerr << "ratslam: visual odometry: " << replaced.message() << "\n";
+      return kExitError;
+    }
+  }
   std::error_code ec;
   fs::create_directories(request.out, ec);
   if (ec) {
@@ -108,7 +118,6 @@ int RunReplay(const ReplayRequest& request) {
     return kExitError;
   }
 
-  FileImageLoader images;
   ReplayPipeline pipeline(request.options, dataset.value(), &images);
   const uint64_t fingerprint = ConfigFingerprint(request.options);
   if (!request.load_map.empty()) {

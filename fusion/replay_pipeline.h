@@ -17,6 +17,7 @@
 #include "ratslam/ratslam.h"
 #include "ratslam/status.h"
 #include "sensors/pedestrian_dead_reckoning.h"
+#include "sensors/visual_odometry.h"
 #include "sensors/dataset/dataset.h"
 #include "sensors/dataset/image_loader.h"
 
@@ -26,6 +27,7 @@ namespace ratslam {
 struct PipelineOptions {
   FrontEndSettings sensors;  // front end choice and every sensor's options
   PdrOptions pdr;            // odometry from phone logs
+  VisualOdometryOptions visual_odometry;  // odometry from a camera alone
   RatslamOptions ratslam;
 
   bool IsValid(std::string* error) const;
@@ -39,6 +41,7 @@ struct PipelineOptions {
     v("camera_12x9", sensors.camera_12x9);
     v("wifi", sensors.wifi);
     v("pdr", pdr);
+    v("visual_odometry", visual_odometry);
     v("pose_cells", ratslam.pose_cells);
     v("local_view", ratslam.local_view);
     v("experience_map", ratslam.experience_map);
