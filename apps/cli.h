@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "fusion/io/config.h"
+
 namespace ratslam {
 
 inline constexpr int kExitOk = 0;
@@ -69,6 +71,21 @@ inline std::optional<double> ParseNumber(const std::string& flag, const std::str
   return value;
 }
 
+
+// The options of --config, or the defaults; prints the error and returns nullopt on a bad file.
+// `path` (optional) receives the file name.
+inline std::optional<PipelineOptions> LoadOptions(const Arguments& args,
+                                                  std::string* path = nullptr) {
+  auto it = args.values.find("--config");
+  if (it == args.values.end()) return PipelineOptions();
+  if (path) *path = it->second;
+  StatusOr<PipelineOptions> options = LoadConfigFile(it->second);
+  if (!options.ok()) {
+    std::cerr << "ratslam: " << options.status().message() << "\n";
+    return std::nullopt;
+  }
+  return options.value();
+}
 
 // `ratslam render ...` (render_command.cc).
 int RenderCommand(int argc, char** argv);

@@ -242,18 +242,6 @@ int RunReplay(const ReplayRequest& request) {
   return kExitOk;
 }
 
-std::optional<PipelineOptions> LoadOptions(const Arguments& args, std::string* path) {
-  auto it = args.values.find("--config");
-  if (it == args.values.end()) return PipelineOptions();
-  *path = it->second;
-  StatusOr<PipelineOptions> options = LoadConfigFile(it->second);
-  if (!options.ok()) {
-    std::cerr << "ratslam: " << options.status().message() << "\n";
-    return std::nullopt;
-  }
-  return options.value();
-}
-
 int Replay(int argc, char** argv) {
   auto args = ParseArguments(argc, argv, 2,
                              {"--config", "--data", "--out", "--save-map", "--load-map", "--until",

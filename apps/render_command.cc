@@ -10,6 +10,7 @@
 #include "sensors/dataset/image_loader.h"
 #include "viewer/figures.h"
 #include "viewer/renderer.h"
+#include "viewer/run_images.h"
 #include "viewer/run_reader.h"
 #include "viewer/similarity.h"
 
@@ -85,17 +86,6 @@ Status Write(const Scene& scene, const std::string& path) {
   return status;
 }
 
-std::optional<PipelineOptions> OptionsFrom(const Arguments& args) {
-  auto it = args.values.find("--config");
-  if (it == args.values.end()) return PipelineOptions();
-  StatusOr<PipelineOptions> options = LoadConfigFile(it->second);
-  if (!options.ok()) {
-    std::cerr << "ratslam: " << options.status().message() << "\n";
-    return std::nullopt;
-  }
-  return options.value();
-}
-
 int RenderExperienceMap(const Arguments& args) {
   if (!args.values.count("--run")) return Fail(std::string("--run is required\n") + kRenderUsage);
   const std::string run_folder = args.values.at("--run");
@@ -130,19 +120,8 @@ int RenderExperienceMap(const Arguments& args) {
   if (!data_folder.empty()) {
     StatusOr<Dataset> dataset = ReadDataset(data_folder);
     if (!dataset.ok()) return Fail(dataset.status().message());
-    std::vector<Point2> map_points, truth_points, truth_path;
-    for (const Experience& e : data.experiences) {
-      if (auto gt = InterpolateGroundTruth(dataset->ground_truth, e.time_s)) {
-        map_points.push_back({e.x_m, e.y_m});
-        truth_points.push_back({gt->x_m, gt->y_m});
-      }
-    }
-    // Only the part of the ground truth the run reached.
-    const double until = run->frames.empty() ? 0.0 : run->frames.back().time_s;
-    for (const GroundTruthRow& row : dataset->ground_truth) {
-      if (row.time_s <= until) truth_path.push_back({row.x_m, row.y_m});
-    }
-    data.ground_truth = AlignGroundTruthToMap(map_points, truth_points, truth_path);
+    data.ground_truth = GroundTruthInMapFrame(
+        data.experiences, dataset.value(), run->frames.empty() ? 0.0 : run->frames.back().time_s);
     options.title = "experience map (" + dataset->name + ")";
   }
   const std::string out = args.values.count("--out")
@@ -180,7 +159,7 @@ int RenderPoseCells(const Arguments& args) {
   if (!args.values.count("--map") || !args.values.count("--out")) {
     return Fail(std::string("--map and --out are required\n") + kRenderUsage);
   }
-  auto options = OptionsFrom(args);
+  auto options = LoadOptions(args);
   if (!options) return kExitError;
   StatusOr<MapFile> map = LoadMapFile(args.values.at("--map"));
   if (!map.ok()) return Fail(map.status().message());
@@ -200,7 +179,7 @@ int RenderSimilarity(const Arguments& args) {
   if (!args.values.count("--data") || !args.values.count("--out")) {
     return Fail(std::string("--data and --out are required\n") + kRenderUsage);
   }
-  auto options = OptionsFrom(args);
+  auto options = LoadOptions(args);
   if (!options) return kExitError;
   int frames = 600;
   if (auto it = args.values.find("--frames"); it != args.values.end()) {

@@ -7,29 +7,31 @@
 
 namespace ratslam {
 
+std::vector<Point2> GroundTruthInMapFrame(const std::vector<Experience>& experiences,
+                                          const Dataset& dataset, double until_time_s) {
+  std::vector<Point2> map_points, truth_points, truth_path;
+  for (const Experience& e : experiences) {
+    if (auto gt = InterpolateGroundTruth(dataset.ground_truth, e.time_s)) {
+      map_points.push_back({e.x_m, e.y_m});
+      truth_points.push_back({gt->x_m, gt->y_m});
+    }
+  }
+  for (const GroundTruthRow& row : dataset.ground_truth) {
+    if (row.time_s <= until_time_s) truth_path.push_back({row.x_m, row.y_m});
+  }
+  return AlignGroundTruthToMap(map_points, truth_points, truth_path);
+}
+
 ExperienceMapImageData ExperienceMapDataOf(const ReplayPipeline& pipeline, const Dataset& dataset) {
   const ExperienceMap& map = pipeline.slam().experience_map();
   ExperienceMapImageData data;
   data.experiences = map.experiences();
   data.links = map.links();
   data.current = map.current();
-  if (!dataset.ground_truth.empty()) {
-    std::vector<Point2> map_points, truth_points, truth_path;
-    for (const Experience& e : map.experiences()) {
-      if (auto gt = InterpolateGroundTruth(dataset.ground_truth, e.time_s)) {
-        map_points.push_back({e.x_m, e.y_m});
-        truth_points.push_back({gt->x_m, gt->y_m});
-      }
-    }
-    // Only the part of the ground truth the run has reached.
-    const double until = pipeline.state().trajectory.empty()
-                             ? -1.0
-                             : pipeline.state().trajectory.back().time_s;
-    for (const GroundTruthRow& row : dataset.ground_truth) {
-      if (row.time_s <= until) truth_path.push_back({row.x_m, row.y_m});
-    }
-    data.ground_truth = AlignGroundTruthToMap(map_points, truth_points, truth_path);
-  }
+  // Only the part of the ground truth the run has reached.
+  const auto& trajectory = pipeline.state().trajectory;
+  data.ground_truth = GroundTruthInMapFrame(data.experiences, dataset,
+                                            trajectory.empty() ? -1.0 : trajectory.back().time_s);
   return data;
 }
 

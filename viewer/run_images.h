@@ -12,6 +12,11 @@
 
 namespace ratslam {
 
+// The ground truth up to `until_time_s`, moved into the map's frame by the rigid fit of the
+// experiences to the ground truth at their creation times; empty without ground truth.
+std::vector<Point2> GroundTruthInMapFrame(const std::vector<Experience>& experiences,
+                                          const Dataset& dataset, double until_time_s);
+
 // The experience-map figure data of a run, with the ground truth (if any) aligned to the map.
 ExperienceMapImageData ExperienceMapDataOf(const ReplayPipeline& pipeline, const Dataset& dataset);
 // One template-graph point per view frame.

@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <fstream>
 #include <map>
 #include <numbers>
@@ -43,6 +44,39 @@ bool ParseDouble(const std::string& text, double* value) {
 
 }  // namespace
 
+Dataset AssemblePhoneDataset(PhoneLogStreams streams, const std::string& name,
+                             const PhoneLogOptions& options, double start_time_s,
+                             PhoneLogReport* report) {
+  auto by_time = [](const auto& a, const auto& b) { return a.time_s < b.time_s; };
+  std::stable_sort(streams.accelerometer.begin(), streams.accelerometer.end(), by_time);
+  std::stable_sort(streams.headings.begin(), streams.headings.end(), by_time);
+  std::stable_sort(streams.ground_truth.begin(), streams.ground_truth.end(), by_time);
+  Dataset d;
+  d.name = name;
+  const std::vector<Step> steps =
+      PedestrianDeadReckoning(streams.accelerometer, streams.headings, options.pdr);
+  if (report) report->steps = steps.size();
+  d.odometry = StepsToOdometry(steps, start_time_s);
+  for (auto& [time, readings] : streams.scans) d.wifi.push_back({time, std::move(readings)});
+  double last_compass = -std::numeric_limits<double>::infinity();
+  for (const HeadingSample& h : streams.headings) {
+    if (h.time_s - last_compass >= 1.0 / options.compass_rate_hz) {
+      d.compass.push_back({h.time_s, h.heading_rad});
+      last_compass = h.time_s;
+    }
+  }
+  d.ground_truth = std::move(streams.ground_truth);
+  // Heading of the ground truth: the direction of travel towards the next point (the last point
+  // keeps the direction from its predecessor).
+  for (size_t i = 0; i < d.ground_truth.size(); ++i) {
+    const size_t from = i + 1 < d.ground_truth.size() ? i : (i > 0 ? i - 1 : i);
+    const size_t to = i + 1 < d.ground_truth.size() ? i + 1 : i;
+    d.ground_truth[i].theta_rad = std::atan2(d.ground_truth[to].y_m - d.ground_truth[from].y_m,
+                                             d.ground_truth[to].x_m - d.ground_truth[from].x_m);
+  }
+  return d;
+}
+
 void GeoToLocal(const GeoReference& reference, double latitude_deg, double longitude_deg,
                 double* x_m, double* y_m) {
   const double to_rad = std::numbers::pi / 180.0;
@@ -76,9 +110,10 @@ StatusOr<Dataset> ReadIpinLog(const std::string& path, const PhoneLogOptions& op
   PhoneLogReport& r = report ? *report : local_report;
   r = PhoneLogReport();
 
-  std::vector<AccelerometerSample> accelerometer;
-  std::vector<HeadingSample> headings;
-  std::map<double, std::vector<WifiReading>> scans;  // by app timestamp
+  PhoneLogStreams streams;
+  std::vector<AccelerometerSample>& accelerometer = streams.accelerometer;
+  std::vector<HeadingSample>& headings = streams.headings;
+  std::map<double, std::vector<WifiReading>>& scans = streams.scans;  // by app timestamp
   struct Posi {
     double time_s, latitude, longitude;
     int floor;
@@ -147,45 +182,22 @@ StatusOr<Dataset> ReadIpinLog(const std::string& path, const PhoneLogOptions& op
   if (in.bad()) return Status::Error(path + ": read error");
   if (!std::isfinite(first_time)) return Status::Error(path + ": no sensor lines (not an IPIN log?)");
 
-  auto by_time = [](const auto& a, const auto& b) { return a.time_s < b.time_s; };
-  std::stable_sort(accelerometer.begin(), accelerometer.end(), by_time);
-  std::stable_sort(headings.begin(), headings.end(), by_time);
-  std::stable_sort(posi.begin(), posi.end(), by_time);
-
-  Dataset d;
-  d.name = std::filesystem::path(path).stem().string();
-  d.folder = "";
-  const std::vector<Step> steps = PedestrianDeadReckoning(accelerometer, headings, options.pdr);
-  r.steps = steps.size();
-  d.odometry = StepsToOdometry(steps, first_time);
-  for (auto& [time, readings] : scans) d.wifi.push_back({time, std::move(readings)});
-  double last_compass = -std::numeric_limits<double>::infinity();
-  for (const HeadingSample& h : headings) {
-    if (h.time_s - last_compass >= 1.0 / options.compass_rate_hz) {
-      d.compass.push_back({h.time_s, h.heading_rad});
-      last_compass = h.time_s;
-    }
-  }
+  std::stable_sort(posi.begin(), posi.end(),
+                   [](const Posi& a, const Posi& b) { return a.time_s < b.time_s; });
   if (!posi.empty()) {
     r.reference = options.reference
                       ? *options.reference
                       : GeoReference{posi.front().latitude, posi.front().longitude};
-    for (size_t i = 0; i < posi.size(); ++i) {
+    for (const Posi& p : posi) {
       GroundTruthRow row;
-      row.time_s = posi[i].time_s;
-      GeoToLocal(r.reference, posi[i].latitude, posi[i].longitude, &row.x_m, &row.y_m);
-      row.floor = posi[i].floor;
-      d.ground_truth.push_back(row);
-    }
-    // Heading of the ground truth: the direction of travel towards the next point.
-    for (size_t i = 0; i < d.ground_truth.size(); ++i) {
-      const size_t j = i + 1 < d.ground_truth.size() ? i + 1 : i;
-      const size_t k = j == i && i > 0 ? i - 1 : i;
-      const GroundTruthRow& a = d.ground_truth[j == i ? k : i];
-      const GroundTruthRow& b = d.ground_truth[j];
-      d.ground_truth[i].theta_rad = std::atan2(b.y_m - a.y_m, b.x_m - a.x_m);
+      row.time_s = p.time_s;
+      GeoToLocal(r.reference, p.latitude, p.longitude, &row.x_m, &row.y_m);
+      row.floor = p.floor;
+      streams.ground_truth.push_back(row);
     }
   }
+  Dataset d = AssemblePhoneDataset(std::move(streams), std::filesystem::path(path).stem().string(),
+                                   options, first_time, &r);
   return d;
 }
 

@@ -8,6 +8,7 @@
 #ifndef RATSLAM_SENSORS_DATASET_IPIN_LOG_H_
 #define RATSLAM_SENSORS_DATASET_IPIN_LOG_H_
 
+#include <map>
 #include <optional>
 #include <string>
 
@@ -45,6 +46,20 @@ struct PhoneLogReport {
 // Reads one log. Errors name the file and line ("log.txt:812: WIFI: RSS(dBm) is not a number").
 StatusOr<Dataset> ReadIpinLog(const std::string& path, const PhoneLogOptions& options,
                               PhoneLogReport* report = nullptr);
+
+// What a phone log reader collects, before it becomes a data set.
+struct PhoneLogStreams {
+  std::vector<AccelerometerSample> accelerometer;
+  std::vector<HeadingSample> headings;
+  std::map<double, std::vector<WifiReading>> scans;  // readings by scan time
+  std::vector<GroundTruthRow> ground_truth;
+};
+
+// Sorts the streams, runs dead reckoning, thins the compass to compass_rate_hz, and gives each
+// ground-truth point the heading towards the next. Shared by the phone log readers.
+Dataset AssemblePhoneDataset(PhoneLogStreams streams, const std::string& name,
+                             const PhoneLogOptions& options, double start_time_s,
+                             PhoneLogReport* report);
 
 // Builds odometry rows from pedestrian dead-reckoning steps: a zero row at `start_time_s`, then
 // one row per step carrying its length and heading change over the time since the previous row.

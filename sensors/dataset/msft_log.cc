@@ -61,10 +61,11 @@ StatusOr<Dataset> ReadMicrosoftLog(const std::string& path, const PhoneLogOption
   PhoneLogReport& r = report ? *report : local_report;
   r = PhoneLogReport();
 
-  std::vector<AccelerometerSample> accelerometer;
-  std::vector<HeadingSample> headings;
-  std::map<double, std::vector<WifiReading>> scans;
-  std::vector<GroundTruthRow> waypoints;
+  PhoneLogStreams streams;
+  std::vector<AccelerometerSample>& accelerometer = streams.accelerometer;
+  std::vector<HeadingSample>& headings = streams.headings;
+  std::map<double, std::vector<WifiReading>>& scans = streams.scans;
+  std::vector<GroundTruthRow>& waypoints = streams.ground_truth;
   int floor = 0;
   double start_ms = std::numeric_limits<double>::quiet_NaN();
   std::string line;
@@ -142,33 +143,9 @@ StatusOr<Dataset> ReadMicrosoftLog(const std::string& path, const PhoneLogOption
   }
   if (in.bad()) return Status::Error(path + ": read error");
   if (std::isnan(start_ms)) return Status::Error(path + ": no data lines (not a Microsoft walk?)");
-  auto by_time = [](const auto& a, const auto& b) { return a.time_s < b.time_s; };
-  std::stable_sort(accelerometer.begin(), accelerometer.end(), by_time);
-  std::stable_sort(headings.begin(), headings.end(), by_time);
-  std::stable_sort(waypoints.begin(), waypoints.end(), by_time);
   for (GroundTruthRow& w : waypoints) w.floor = floor;  // FloorName may follow the first lines
-
-  Dataset d;
-  d.name = std::filesystem::path(path).stem().string();
-  const std::vector<Step> steps = PedestrianDeadReckoning(accelerometer, headings, options.pdr);
-  r.steps = steps.size();
-  d.odometry = StepsToOdometry(steps, 0.0);
-  for (auto& [time, readings] : scans) d.wifi.push_back({time, std::move(readings)});
-  double last_compass = -std::numeric_limits<double>::infinity();
-  for (const HeadingSample& h : headings) {
-    if (h.time_s - last_compass >= 1.0 / options.compass_rate_hz) {
-      d.compass.push_back({h.time_s, h.heading_rad});
-      last_compass = h.time_s;
-    }
-  }
-  d.ground_truth = std::move(waypoints);
-  for (size_t i = 0; i < d.ground_truth.size(); ++i) {
-    const size_t j = std::min(i + 1, d.ground_truth.size() - 1);
-    const size_t k = j == i && i > 0 ? i - 1 : i;
-    const GroundTruthRow& a = d.ground_truth[j == i ? k : i];
-    const GroundTruthRow& b = d.ground_truth[j];
-    d.ground_truth[i].theta_rad = std::atan2(b.y_m - a.y_m, b.x_m - a.x_m);
-  }
+  Dataset d = AssemblePhoneDataset(std::move(streams), std::filesystem::path(path).stem().string(),
+                                   options, 0.0, &r);
   return d;
 }
 
