@@ -20,11 +20,10 @@ inline constexpr int kExitError = 1;
 inline constexpr int kExitUsage = 2;
 inline constexpr int kExitInterrupted = 130;
 
-
 // Parsed "--flag value" pairs and bare flags.
 struct Arguments {
-  std::map<std::string, std::string> values;             // the last value of each flag
-  std::map<std::string, std::vector<std::string>> all;   // every value, for repeatable flags
+  std::map<std::string, std::string> values;            // the last value of each flag
+  std::map<std::string, std::vector<std::string>> all;  // every value, for repeatable flags
   std::vector<std::string> positional;
   bool quiet = false;
   bool render = false;
@@ -32,7 +31,7 @@ struct Arguments {
 };
 
 inline std::optional<Arguments> ParseArguments(int argc, char** argv, int first,
-                                        const std::vector<std::string>& flags_with_values) {
+                                               const std::vector<std::string>& flags_with_values) {
   Arguments args;
   for (int i = first; i < argc; ++i) {
     const std::string a = argv[i];
@@ -70,7 +69,6 @@ inline std::optional<double> ParseNumber(const std::string& flag, const std::str
   }
   return value;
 }
-
 
 // The options of --config, or the defaults; prints the error and returns nullopt on a bad file.
 // `path` (optional) receives the file name.

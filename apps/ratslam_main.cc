@@ -1,7 +1,7 @@
 // The `ratslam` command line: replay a data set, run the demo, print or import configurations,
 // and write the built-in synthetic data set.
-#include <atomic>
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -27,8 +27,8 @@
 #include "sensors/dataset/dataset.h"
 #include "sensors/dataset/dataset_loader.h"
 #include "sensors/dataset/image_loader.h"
-#include "sensors/dataset/visual_odometry_source.h"
 #include "sensors/dataset/synthetic_dataset.h"
+#include "sensors/dataset/visual_odometry_source.h"
 #include "viewer/animation.h"
 #include "viewer/figures.h"
 #include "viewer/renderer.h"
@@ -48,7 +48,8 @@ const char kUsage[] =
     "  ratslam replay --data D [--data D2 ...] --out O [--config C] [--save-map F]\n"
     "                 [--load-map F] [--until T] [--render] [--animate N] [--lenient] [--quiet]\n"
     "      Replays data set D (a replay-format folder or an IPIN log; several --data make one\n"
-    "      multi-session run) and writes the map, trajectory and summary into O. --until T stops after data time T seconds; --save-map F saves the\n"
+    "      multi-session run) and writes the map, trajectory and summary into O. --until T stops "
+    "after data time T seconds; --save-map F saves the\n"
     "      whole state to F; --load-map F resumes from F. Ctrl-C stops cleanly and saves.\n"
     "      --render also writes experience_map.png, template_graph.png and pose_cells.png;\n"
     "      --animate N writes an experience-map frame every N events to O/animation/.\n"
@@ -73,7 +74,7 @@ const char kUsage[] =
 
 struct ReplayRequest {
   PipelineOptions options;
-  std::string config_path;  // empty: built-in
+  std::string config_path;        // empty: built-in
   std::vector<std::string> data;  // one data set, or several sessions
   bool lenient = false;           // skip malformed lines of phone logs
   std::string out;
@@ -81,7 +82,7 @@ struct ReplayRequest {
   std::string load_map;
   double until_s = std::numeric_limits<double>::infinity();
   bool quiet = false;
-  bool render = false;  // write experience_map.png, template_graph.png, pose_cells.png
+  bool render = false;         // write experience_map.png, template_graph.png, pose_cells.png
   uint64_t animate_every = 0;  // events between animation frames; 0: no animation
 };
 
@@ -160,8 +161,8 @@ int RunReplay(const ReplayRequest& request) {
       return kExitError;
     }
     animation_renderer = std::move(renderer.value());
-    animation = std::make_unique<AnimationWriter>(
-        (fs::path(request.out) / "animation").string(), 10.0);
+    animation =
+        std::make_unique<AnimationWriter>((fs::path(request.out) / "animation").string(), 10.0);
     control.checkpoint_every = request.animate_every;
     control.checkpoint = [&](const ReplayPipeline& p) -> Status {
       ExperienceMapImageOptions options;
@@ -171,8 +172,8 @@ int RunReplay(const ReplayRequest& request) {
       std::snprintf(title, sizeof title, "%s  t = %.1f s", dataset->name.c_str(),
                     p.state().trajectory.empty() ? 0.0 : p.state().trajectory.back().time_s);
       options.title = title;
-      StatusOr<RgbaImage> frame =
-          animation_renderer->Render(ExperienceMapScene(ExperienceMapDataOf(p, dataset.value()), options));
+      StatusOr<RgbaImage> frame = animation_renderer->Render(
+          ExperienceMapScene(ExperienceMapDataOf(p, dataset.value()), options));
       if (!frame.ok()) return frame.status();
       return animation->AddFrame(frame.value());
     };
@@ -221,9 +222,9 @@ int RunReplay(const ReplayRequest& request) {
   std::cout << summary->json;
   if (request.render) {
     StatusOr<std::unique_ptr<SceneRenderer>> renderer = CreateOsMesaRenderer();
-    Status rendered = renderer.ok() ? WriteRunImages(*renderer.value(), pipeline, dataset.value(),
-                                                     request.out)
-                                    : renderer.status();
+    Status rendered =
+        renderer.ok() ? WriteRunImages(*renderer.value(), pipeline, dataset.value(), request.out)
+                      : renderer.status();
     if (!rendered.ok()) {
       std::cerr << "ratslam: images not written: " << rendered.message() << "\n";
       return kExitError;
@@ -243,9 +244,9 @@ int RunReplay(const ReplayRequest& request) {
 }
 
 int Replay(int argc, char** argv) {
-  auto args = ParseArguments(argc, argv, 2,
-                             {"--config", "--data", "--out", "--save-map", "--load-map", "--until",
-                              "--animate"});
+  auto args = ParseArguments(
+      argc, argv, 2,
+      {"--config", "--data", "--out", "--save-map", "--load-map", "--until", "--animate"});
   if (!args || !args->positional.empty() || !args->values.count("--data") ||
       !args->values.count("--out")) {
     std::cerr << kUsage;

@@ -71,9 +71,9 @@ std::optional<std::vector<TimeSpan>> ParseSpans(const std::string& text) {
       return std::nullopt;
     }
     auto start = ParseNumber("--spans", item.substr(0, dash));
-    auto end = ParseNumber("--spans", item.substr(dash + 1, colon == std::string::npos
-                                                                ? std::string::npos
-                                                                : colon - dash - 1));
+    auto end = ParseNumber(
+        "--spans",
+        item.substr(dash + 1, colon == std::string::npos ? std::string::npos : colon - dash - 1));
     if (!start || !end) return std::nullopt;
     spans.push_back({*start, *end, colon == std::string::npos ? "" : item.substr(colon + 1)});
   }
@@ -145,8 +145,7 @@ int RenderTemplateGraph(const Arguments& args) {
   }
   std::vector<TemplateGraphPoint> points;
   for (const FrameRecord& f : run->frames) {
-    points.push_back({f.time_s, f.template_id, f.experience_id,
-                      f.source});
+    points.push_back({f.time_s, f.template_id, f.experience_id, f.source});
   }
   const std::string out = args.values.count("--out")
                               ? args.values.at("--out")
@@ -190,13 +189,14 @@ int RenderSimilarity(const Arguments& args) {
   StatusOr<Dataset> dataset = ReadDataset(args.values.at("--data"));
   if (!dataset.ok()) return Fail(dataset.status().message());
   FileImageLoader images;
-  StatusOr<SimilarityMatrix> m = CameraSimilarityMatrix(dataset.value(), &images, options->sensors.classic_camera, frames);
+  StatusOr<SimilarityMatrix> m =
+      CameraSimilarityMatrix(dataset.value(), &images, options->sensors.classic_camera, frames);
   if (!m.ok()) return Fail(m.status().message());
   SimilarityImageOptions image_options;
   image_options.title = "camera template similarity (" + dataset->name + ")";
   image_options.value_label = "similarity";
-  Status status = Write(SimilarityMatrixScene(m->values, m->times_s, image_options),
-                        args.values.at("--out"));
+  Status status =
+      Write(SimilarityMatrixScene(m->values, m->times_s, image_options), args.values.at("--out"));
   return status.ok() ? kExitOk : Fail(status.message());
 }
 

@@ -71,8 +71,8 @@ class DenseBaseline {
     for (int i = 0; i < size; ++i)
       for (int j = 0; j < size; ++j)
         for (int l = 0; l < size; ++l) {
-          k[(i * size + j) * size + l] =
-              std::exp(-((i - r) * (i - r) + (j - r) * (j - r) + (l - r) * (l - r)) / (2 * variance));
+          k[(i * size + j) * size + l] = std::exp(
+              -((i - r) * (i - r) + (j - r) * (j - r) + (l - r) * (l - r)) / (2 * variance));
           sum += k[(i * size + j) * size + l];
         }
     for (double& w : k) w /= sum;
@@ -90,7 +90,8 @@ class DenseBaseline {
           for (int dt = -r; dt <= r; ++dt)
             for (int dy = -r; dy <= r; ++dy)
               for (int dx = -r; dx <= r; ++dx)
-                out[Index(WrapIndex(x + dx, nx_), WrapIndex(y + dy, nx_), WrapIndex(t + dt, nt_))] +=
+                out[Index(WrapIndex(x + dx, nx_), WrapIndex(y + dy, nx_),
+                          WrapIndex(t + dt, nt_))] +=
                     v * k[((dt + r) * size + dy + r) * size + dx + r];
         }
     return out;

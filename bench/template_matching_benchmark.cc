@@ -37,7 +37,11 @@ void BM_ClassicTemplateMatching(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(matcher.Compare(query));
   state.SetItemsProcessed(state.iterations() * templates);  // items/s = templates per second
 }
-BENCHMARK(BM_ClassicTemplateMatching)->Arg(1000)->Arg(10000)->Arg(50000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ClassicTemplateMatching)
+    ->Arg(1000)
+    ->Arg(10000)
+    ->Arg(50000)
+    ->Unit(benchmark::kMillisecond);
 
 void BM_ClassicTemplateMatchingFloatBaseline(benchmark::State& state) {
   Random rng(1);
@@ -65,7 +69,10 @@ void BM_ClassicTemplateMatchingFloatBaseline(benchmark::State& state) {
   }
   state.SetItemsProcessed(state.iterations() * templates);
 }
-BENCHMARK(BM_ClassicTemplateMatchingFloatBaseline)->Arg(1000)->Arg(10000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ClassicTemplateMatchingFloatBaseline)
+    ->Arg(1000)
+    ->Arg(10000)
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace ratslam

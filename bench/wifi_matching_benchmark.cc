@@ -44,7 +44,10 @@ void BM_WifiBestIndexed(benchmark::State& state) {
   Setup s = Make(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
   for (auto _ : state) benchmark::DoNotOptimize(s.matcher.Best(s.query));
 }
-BENCHMARK(BM_WifiBestIndexed)->Args({10000, 230})->Args({10000, 20000})->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_WifiBestIndexed)
+    ->Args({10000, 230})
+    ->Args({10000, 20000})
+    ->Unit(benchmark::kMicrosecond);
 
 void BM_WifiBestPairwiseBaseline(benchmark::State& state) {
   Setup s = Make(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
@@ -54,7 +57,10 @@ void BM_WifiBestPairwiseBaseline(benchmark::State& state) {
     benchmark::DoNotOptimize(best);
   }
 }
-BENCHMARK(BM_WifiBestPairwiseBaseline)->Args({10000, 230})->Args({10000, 20000})->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_WifiBestPairwiseBaseline)
+    ->Args({10000, 230})
+    ->Args({10000, 20000})
+    ->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace ratslam

@@ -41,7 +41,8 @@ bool FusedOptions::IsValid(std::string* error) const {
     if (error) *error = message;
     return false;
   };
-  if (!use_camera && !use_wifi) return fail("use_wifi: at least one of camera and Wi-Fi must be on");
+  if (!use_camera && !use_wifi)
+    return fail("use_wifi: at least one of camera and Wi-Fi must be on");
   if (recency_templates < 0) return fail("recency_templates: must not be negative");
   if (!(recency_s >= 0.0) || !std::isfinite(recency_s)) {
     return fail("recency_s: must be a non-negative number");
@@ -108,7 +109,8 @@ class FusedFrontEnd : public FrontEnd {
     // The newest scan, if fresh enough, is this frame's Wi-Fi observation.
     const bool fresh = options_.use_wifi && newest_scan_time_s_ &&
                        time_s - *newest_scan_time_s_ <= options_.max_wifi_age_s;
-    return std::optional<FrameDecision>(Decide(time_s, &view.value(), fresh ? &newest_scan_ : nullptr));
+    return std::optional<FrameDecision>(
+        Decide(time_s, &view.value(), fresh ? &newest_scan_ : nullptr));
   }
 
   StatusOr<std::optional<FrameDecision>> OnWifi(const WifiScan& scan) override {
@@ -269,8 +271,8 @@ class FusedFrontEnd : public FrontEnd {
   FusedOptions options_;
   KernelCameraMatcher camera_;
   WifiFingerprintMatcher wifi_;
-  std::vector<double> created_time_s_;               // by template
-  std::vector<std::optional<double>> headings_;      // by template
+  std::vector<double> created_time_s_;           // by template
+  std::vector<std::optional<double>> headings_;  // by template
   Fingerprint newest_scan_;
   std::optional<double> newest_scan_time_s_;
   std::optional<double> heading_rad_;

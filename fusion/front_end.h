@@ -48,22 +48,24 @@ struct FrontEndOptions {
 };
 
 struct FusedOptions {
-  bool use_camera = false;         // 12x9 camera templates (eq. 7)
-  bool use_wifi = true;            // Wi-Fi fingerprints (eqs. 3-6)
-  bool use_compass = false;        // heading per template; relative orientation of eq. 2
-  int recency_templates = 0;       // k: a match must be at least this many templates old
-  double recency_s = 40.0;         // k: and at least this many seconds old (paper: 40 s)
-  double max_wifi_age_s = 5.0;     // an older newest scan counts as absent
+  bool use_camera = false;      // 12x9 camera templates (eq. 7)
+  bool use_wifi = true;         // Wi-Fi fingerprints (eqs. 3-6)
+  bool use_compass = false;     // heading per template; relative orientation of eq. 2
+  int recency_templates = 0;    // k: a match must be at least this many templates old
+  double recency_s = 40.0;      // k: and at least this many seconds old (paper: 40 s)
+  double max_wifi_age_s = 5.0;  // an older newest scan counts as absent
 
   bool IsValid(std::string* error) const;
 
   template <typename Visitor>
   void VisitFields(Visitor&& v) {
     v("use_camera", use_camera, "use 12x9 camera templates (eq. 7); frames are camera images");
-    v("use_wifi", use_wifi, "use Wi-Fi fingerprints (eqs. 3-6); without a camera, scans are frames");
+    v("use_wifi", use_wifi,
+      "use Wi-Fi fingerprints (eqs. 3-6); without a camera, scans are frames");
     v("use_compass", use_compass,
       "store a heading with each template; matches give the relative orientation of eq. 2");
-    v("recency_templates", recency_templates, "k of eqs. 10-11 in templates: newer matches do not count");
+    v("recency_templates", recency_templates,
+      "k of eqs. 10-11 in templates: newer matches do not count");
     v("recency_s", recency_s, "k of eqs. 10-11 in seconds: matches newer than this do not count");
     v("max_wifi_age_s", max_wifi_age_s, "a Wi-Fi scan older than this counts as absent at a frame");
   }

@@ -12,13 +12,15 @@ GrayImage Pattern(int seed) {
   GrayImage image{24, 18, std::vector<uint8_t>(24 * 18)};
   for (int y = 0; y < 18; ++y)
     for (int x = 0; x < 24; ++x)
-      image.pixels[y * 24 + x] = static_cast<uint8_t>((x * (7 + seed * 13) + y * (3 + seed * 5)) % 256);
+      image.pixels[y * 24 + x] =
+          static_cast<uint8_t>((x * (7 + seed * 13) + y * (3 + seed * 5)) % 256);
   return image;
 }
 
 WifiScan Scan(double t, int seed) {
   WifiScan s{t, {}};
-  for (int i = 0; i < 6; ++i) s.readings.push_back({"ap" + std::to_string(seed * 10 + i), -50.0 - i});
+  for (int i = 0; i < 6; ++i)
+    s.readings.push_back({"ap" + std::to_string(seed * 10 + i), -50.0 - i});
   return s;
 }
 

@@ -16,17 +16,17 @@
 #include "fusion/front_end.h"
 #include "ratslam/ratslam.h"
 #include "ratslam/status.h"
-#include "sensors/pedestrian_dead_reckoning.h"
-#include "sensors/visual_odometry.h"
 #include "sensors/dataset/dataset.h"
 #include "sensors/dataset/image_loader.h"
+#include "sensors/pedestrian_dead_reckoning.h"
+#include "sensors/visual_odometry.h"
 
 namespace ratslam {
 
 // Everything a replay is configured by; one TOML section per member.
 struct PipelineOptions {
-  FrontEndSettings sensors;  // front end choice and every sensor's options
-  PdrOptions pdr;            // odometry from phone logs
+  FrontEndSettings sensors;               // front end choice and every sensor's options
+  PdrOptions pdr;                         // odometry from phone logs
   VisualOdometryOptions visual_odometry;  // odometry from a camera alone
   RatslamOptions ratslam;
 
@@ -76,7 +76,7 @@ struct ReplayProgress {
 
 struct ReplayControl {
   double until_time_s = std::numeric_limits<double>::infinity();  // stop after this data time
-  const std::atomic<bool>* stop_requested = nullptr;  // checked between events
+  const std::atomic<bool>* stop_requested = nullptr;              // checked between events
   std::function<void(const ReplayProgress&)> progress;  // called every progress_every events
   uint64_t progress_every = 500;
   // Called every checkpoint_every events with the pipeline (read only), e.g. to draw animation

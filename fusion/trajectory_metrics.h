@@ -17,7 +17,7 @@ struct RigidAlignment2D {
   double rotation_rad = 0.0;  // applied to the estimate, then the translation
   double translation_x_m = 0.0;
   double translation_y_m = 0.0;
-  double rmse_m = 0.0;        // after alignment
+  double rmse_m = 0.0;  // after alignment
   size_t points = 0;
 };
 

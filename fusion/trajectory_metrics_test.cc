@@ -14,8 +14,8 @@ TEST(AlignRigid2DTest, RecoversKnownRotationAndTranslation) {
   // estimate = R(-angle) (truth - t): aligning it must give back rotation +angle.
   for (const Point2& p : truth) {
     const double x = p.x - tx, y = p.y - ty;
-    estimate.push_back({std::cos(angle) * x + std::sin(angle) * y,
-                        -std::sin(angle) * x + std::cos(angle) * y});
+    estimate.push_back(
+        {std::cos(angle) * x + std::sin(angle) * y, -std::sin(angle) * x + std::cos(angle) * y});
   }
   auto a = AlignRigid2D(estimate, truth);
   ASSERT_TRUE(a.has_value());

@@ -67,8 +67,7 @@ void ExperienceMap::AddLink(uint32_t from, uint32_t to, double time_s,
 }
 
 uint32_t ExperienceMap::CreateExperience(uint32_t template_id, const PoseCellPosition& pose_cells,
-                                         double time_s,
-                                         std::optional<double> compass_heading_rad) {
+                                         double time_s, std::optional<double> compass_heading_rad) {
   Experience e;
   e.id = static_cast<uint32_t>(state_.experiences.size());
   CurrentPose(&e.x_m, &e.y_m, &e.theta_rad);
@@ -155,16 +154,15 @@ void ExperienceMap::Relax() {
 std::vector<uint32_t> ExperienceMap::ShortestPath(uint32_t from, uint32_t to) const {
   const size_t n = state_.experiences.size();
   if (from >= n || to >= n) return {};
-  using Graph = boost::adjacency_list<boost::vecS, boost::vecS, boost::undirectedS,
-                                      boost::no_property,
-                                      boost::property<boost::edge_weight_t, double>>;
+  using Graph =
+      boost::adjacency_list<boost::vecS, boost::vecS, boost::undirectedS, boost::no_property,
+                            boost::property<boost::edge_weight_t, double>>;
   Graph graph(n);
   for (const Link& l : state_.links) boost::add_edge(l.from, l.to, l.distance_m, graph);
   std::vector<Graph::vertex_descriptor> predecessor(n);
   std::vector<double> distance(n, std::numeric_limits<double>::infinity());
   boost::dijkstra_shortest_paths(
-      graph, from,
-      boost::predecessor_map(predecessor.data()).distance_map(distance.data()));
+      graph, from, boost::predecessor_map(predecessor.data()).distance_map(distance.data()));
   if (!std::isfinite(distance[to])) return {};
   std::vector<uint32_t> path;
   for (auto v = static_cast<Graph::vertex_descriptor>(to);; v = predecessor[v]) {

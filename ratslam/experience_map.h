@@ -14,8 +14,8 @@
 namespace ratslam {
 
 struct ExperienceMapOptions {
-  int relaxation_sweeps = 10;          // relaxation passes over all links after each action
-  double relaxation_correction = 0.5;  // share of a link's error each end absorbs per pass
+  int relaxation_sweeps = 10;            // relaxation passes over all links after each action
+  double relaxation_correction = 0.5;    // share of a link's error each end absorbs per pass
   bool anchor_first_experience = false;  // keep experience 0 fixed during relaxation
 
   bool IsValid(std::string* error) const;
@@ -36,10 +36,10 @@ struct Experience {
   double y_m = 0.0;
   double theta_rad = 0.0;
   uint32_t template_id = 0;
-  PoseCellPosition pose_cells;  // pose-cell position at creation
-  double time_s = 0.0;          // creation time
+  PoseCellPosition pose_cells;                // pose-cell position at creation
+  double time_s = 0.0;                        // creation time
   std::optional<double> compass_heading_rad;  // absolute heading at creation, if known
-  std::vector<uint32_t> link_ids;  // links from or to this experience
+  std::vector<uint32_t> link_ids;             // links from or to this experience
 };
 
 struct Link {
@@ -80,8 +80,8 @@ class ExperienceMap {
   // current experience to it. With a compass heading (here and at the current experience) the
   // link's facing change is the compass difference instead of the odometric one, which removes
   // rotational drift (Wi-Fi RatSLAM paper, section III-A). Returns its id.
-  uint32_t CreateExperience(uint32_t template_id, const PoseCellPosition& pose_cells,
-                            double time_s, std::optional<double> compass_heading_rad = std::nullopt);
+  uint32_t CreateExperience(uint32_t template_id, const PoseCellPosition& pose_cells, double time_s,
+                            std::optional<double> compass_heading_rad = std::nullopt);
   // Links the current experience to the existing experience `id` (unless a link between them
   // exists already) and makes it current. With a compass heading now, at `id` and at the current
   // experience, the link's facing is the compass difference (eq. 2) and dead reckoning continues

@@ -43,8 +43,8 @@ LocalViewCells::LocalViewCells(const LocalViewOptions& options, int dim_theta_ce
 
 double LocalViewCells::DecayAtStartOfFrame(const ViewTemplate& t, uint64_t frame) const {
   // Restores since the stored value are applied lazily, so a frame costs O(1), not O(templates).
-  const double elapsed = frame > t.decay_frame + 1 ? static_cast<double>(frame - t.decay_frame - 1)
-                                                   : 0.0;
+  const double elapsed =
+      frame > t.decay_frame + 1 ? static_cast<double>(frame - t.decay_frame - 1) : 0.0;
   return std::max(options_.decay_floor, t.decay - options_.decay_restore_per_frame * elapsed);
 }
 
@@ -55,8 +55,8 @@ StatusOr<std::optional<Injection>> LocalViewCells::Observe(const ViewDecision& d
   if (decision.is_new) {
     if (decision.template_id != count) {
       return Status::Error("view decision: new template id " +
-                           std::to_string(decision.template_id) + " but " +
-                           std::to_string(count) + " templates exist (ids must be consecutive)");
+                           std::to_string(decision.template_id) + " but " + std::to_string(count) +
+                           " templates exist (ids must be consecutive)");
     }
     ViewTemplate t;
     t.id = decision.template_id;
@@ -76,8 +76,8 @@ StatusOr<std::optional<Injection>> LocalViewCells::Observe(const ViewDecision& d
   const double decay = DecayAtStartOfFrame(t, frame) + options_.decay_per_match;
   t.decay = std::max(options_.decay_floor, decay - options_.decay_restore_per_frame);
   t.decay_frame = frame;
-  const bool recent = decision.template_id + static_cast<uint64_t>(options_.skip_recent_templates) >=
-                      count;
+  const bool recent =
+      decision.template_id + static_cast<uint64_t>(options_.skip_recent_templates) >= count;
   if (recent || !decision.allow_injection) return std::optional<Injection>();
   const double energy = options_.injection_gain *
                         (options_.energy_limit - std::exp(options_.energy_decay_rate * decay)) /
@@ -86,8 +86,8 @@ StatusOr<std::optional<Injection>> LocalViewCells::Observe(const ViewDecision& d
   Injection injection;
   injection.position = t.pose_cells;
   injection.position.theta =
-      WrapCoordinate(t.pose_cells.theta + decision.heading_change_rad /
-                                              (2.0 * std::numbers::pi) * dim_theta_cells_,
+      WrapCoordinate(t.pose_cells.theta +
+                         decision.heading_change_rad / (2.0 * std::numbers::pi) * dim_theta_cells_,
                      dim_theta_cells_);
   injection.energy = energy;
   return std::optional<Injection>(injection);

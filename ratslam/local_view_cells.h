@@ -16,13 +16,13 @@
 namespace ratslam {
 
 struct LocalViewOptions {
-  double injection_gain = 0.15;            // energy injected by a fully rested template
-  double decay_per_match = 1.0;            // added to a template's decay on each match
-  double decay_restore_per_frame = 0.05;   // removed from every template's decay each frame
-  double decay_floor = 1.0;                // decay never falls below this
-  double energy_limit = 30.0;              // "limit" in the energy formula above
-  double energy_decay_rate = 1.2;          // "rate" in the energy formula above
-  int skip_recent_templates = 10;          // the newest templates never inject
+  double injection_gain = 0.15;           // energy injected by a fully rested template
+  double decay_per_match = 1.0;           // added to a template's decay on each match
+  double decay_restore_per_frame = 0.05;  // removed from every template's decay each frame
+  double decay_floor = 1.0;               // decay never falls below this
+  double energy_limit = 30.0;             // "limit" in the energy formula above
+  double energy_decay_rate = 1.2;         // "rate" in the energy formula above
+  int skip_recent_templates = 10;         // the newest templates never inject
 
   bool IsValid(std::string* error) const;
 
@@ -34,7 +34,8 @@ struct LocalViewOptions {
       "removed from every template's decay each view frame");
     v("decay_floor", decay_floor, "lowest value of a template's decay");
     v("energy_limit", energy_limit, "E = gain * (limit - exp(rate * decay)) / limit: limit");
-    v("energy_decay_rate", energy_decay_rate, "E = gain * (limit - exp(rate * decay)) / limit: rate");
+    v("energy_decay_rate", energy_decay_rate,
+      "E = gain * (limit - exp(rate * decay)) / limit: rate");
     v("skip_recent_templates", skip_recent_templates,
       "matches to this many newest templates inject no energy");
   }
@@ -55,9 +56,9 @@ struct ViewDecision {
 
 struct ViewTemplate {
   uint32_t id = 0;
-  PoseCellPosition pose_cells;       // pose-cell position when the template was created
+  PoseCellPosition pose_cells;  // pose-cell position when the template was created
   double created_time_s = 0.0;
-  double decay = 1.0;                // value after the restore of frame decay_frame
+  double decay = 1.0;  // value after the restore of frame decay_frame
   uint64_t decay_frame = 0;
   uint32_t match_count = 0;
   std::vector<uint32_t> experience_ids;  // experiences created or linked with this template

@@ -135,8 +135,7 @@ void PoseCellNetwork::Reset(const PoseCellPosition& position) {
 }
 
 PoseCellNetwork::Box PoseCellNetwork::ConvolveAxis(const std::vector<double>& kernel, int axis,
-                                                   const Box& in_box,
-                                                   const std::vector<double>& in,
+                                                   const Box& in_box, const std::vector<double>& in,
                                                    std::vector<double>& out, bool grow) const {
   const int sizes[3] = {dim_x_, dim_y_, dim_t_};
   const int strides[3] = {1, dim_x_, dim_x_ * dim_y_};
@@ -266,10 +265,9 @@ void PoseCellNetwork::Step(double forward_m, double rotation_rad) {
     // Inhibition removed everything (only possible for a perfectly flat activity): start again
     // from one cell at the centre of the region rather than dividing by zero.
     box_ = inhibited;
-    const PoseCellPosition last = {
-        WrapCoordinate(box_[0].start + box_[0].length / 2, dim_x_),
-        WrapCoordinate(box_[1].start + box_[1].length / 2, dim_y_),
-        WrapCoordinate(box_[2].start + box_[2].length / 2, dim_t_)};
+    const PoseCellPosition last = {WrapCoordinate(box_[0].start + box_[0].length / 2, dim_x_),
+                                   WrapCoordinate(box_[1].start + box_[1].length / 2, dim_y_),
+                                   WrapCoordinate(box_[2].start + box_[2].length / 2, dim_t_)};
     Reset(last);
   }
 

@@ -23,15 +23,15 @@
 namespace ratslam {
 
 struct PoseCellOptions {
-  int dim_xy_cells = 21;                     // cells along x and along y (the grid wraps)
-  int dim_theta_cells = 36;                  // cells around the heading ring
-  double cell_size_m = 1.0;                  // metres of travel per x/y cell
-  int excitation_size_cells = 7;             // width of the excitation kernel, odd
-  double excitation_variance_cells2 = 1.0;   // variance of the excitation Gaussian
-  int inhibition_size_cells = 5;             // width of the local inhibition kernel, odd
-  double inhibition_variance_cells2 = 2.0;   // variance of the inhibition Gaussian
-  double global_inhibition = 2e-5;           // subtracted from every cell per step (floor 0)
-  int decode_radius_cells = 3;               // half-width of the population-vector window
+  int dim_xy_cells = 21;                    // cells along x and along y (the grid wraps)
+  int dim_theta_cells = 36;                 // cells around the heading ring
+  double cell_size_m = 1.0;                 // metres of travel per x/y cell
+  int excitation_size_cells = 7;            // width of the excitation kernel, odd
+  double excitation_variance_cells2 = 1.0;  // variance of the excitation Gaussian
+  int inhibition_size_cells = 5;            // width of the local inhibition kernel, odd
+  double inhibition_variance_cells2 = 2.0;  // variance of the inhibition Gaussian
+  double global_inhibition = 2e-5;          // subtracted from every cell per step (floor 0)
+  int decode_radius_cells = 3;              // half-width of the population-vector window
 
   // Returns true when usable; otherwise writes "field: reason" to *error.
   bool IsValid(std::string* error) const;
@@ -118,8 +118,7 @@ class PoseCellNetwork {
   // into `out` over the returned box: `in_box` grown by the kernel radius, or `in_box` itself
   // (the result clipped to it) when `grow` is false.
   Box ConvolveAxis(const std::vector<double>& kernel, int axis, const Box& in_box,
-                   const std::vector<double>& in, std::vector<double>& out,
-                   bool grow = true) const;
+                   const std::vector<double>& in, std::vector<double>& out, bool grow = true) const;
   void ZeroBox(const Box& box, std::vector<double>& buffer) const;
   // The minimal box holding every non-zero cell of activity_ inside `box`.
   Box SupportOf(const Box& box) const;
@@ -134,7 +133,7 @@ class PoseCellNetwork {
   std::vector<double> activity_;
   std::vector<double> scratch_a_;  // all zero between calls
   std::vector<double> scratch_b_;  // all zero between calls
-  Box box_;  // activity_ is zero outside it
+  Box box_;                        // activity_ is zero outside it
   std::vector<double> residual_x_, residual_y_;
   double residual_theta_ = 0.0;
   std::vector<std::complex<double>> phasors_x_;  // e^{i 2 pi x / dim_x}, also used for y

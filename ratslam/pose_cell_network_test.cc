@@ -56,9 +56,8 @@ std::vector<double> DenseReferenceStep(const std::vector<double>& a, const PoseC
         }
     return out;
   };
-  const std::vector<double> excited =
-      convolve(a, kernel3d(o.excitation_size_cells, o.excitation_variance_cells2),
-               o.excitation_size_cells);
+  const std::vector<double> excited = convolve(
+      a, kernel3d(o.excitation_size_cells, o.excitation_variance_cells2), o.excitation_size_cells);
   const std::vector<double> inhibition =
       convolve(excited, kernel3d(o.inhibition_size_cells, o.inhibition_variance_cells2),
                o.inhibition_size_cells);
@@ -170,11 +169,11 @@ TEST_P(PathIntegrationTest, PacketEndsWhereOdometrySays) {
 INSTANTIATE_TEST_SUITE_P(
     AnySpeedAnyHeading, PathIntegrationTest,
     ::testing::Values(PathCase{0.0, 0.1, 100}, PathCase{0.0, 0.37, 60},
-                      PathCase{9.0, 1.0, 25},      // 90 degrees, one cell per step
-                      PathCase{4.5, 2.6, 10},      // 45 degrees, faster than one cell per step
-                      PathCase{20.0, 7.3, 6},      // 200 degrees, several cells per step
-                      PathCase{31.0, 0.05, 200},   // very slow: residual carries everything
-                      PathCase{13.0, 15.2, 3}));   // crosses the whole grid in one step
+                      PathCase{9.0, 1.0, 25},     // 90 degrees, one cell per step
+                      PathCase{4.5, 2.6, 10},     // 45 degrees, faster than one cell per step
+                      PathCase{20.0, 7.3, 6},     // 200 degrees, several cells per step
+                      PathCase{31.0, 0.05, 200},  // very slow: residual carries everything
+                      PathCase{13.0, 15.2, 3}));  // crosses the whole grid in one step
 
 TEST(PoseCellNetworkTest, RotationMovesPacketAcrossLayersAndWraps) {
   PoseCellNetwork network(SmallOptions());

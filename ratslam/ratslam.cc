@@ -106,8 +106,8 @@ StatusOr<ActionKind> Ratslam::Act(double time_s) {
 }
 
 Ratslam::State Ratslam::GetState() const {
-  return {pose_cells_.GetState(), local_view_.state(), experience_map_.state(), current_template_,
-          counters_, compass_heading_rad_};
+  return {pose_cells_.GetState(), local_view_.state(), experience_map_.state(),
+          current_template_,      counters_,           compass_heading_rad_};
 }
 
 Status Ratslam::SetState(const State& state) {

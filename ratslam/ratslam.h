@@ -16,8 +16,8 @@
 namespace ratslam {
 
 struct ActionOptions {
-  double match_distance_cells = 2.0;  // experiences of the current template closer than this
-                                      // (in pose cells) are candidates for a link
+  double match_distance_cells = 2.0;    // experiences of the current template closer than this
+                                        // (in pose cells) are candidates for a link
   bool refuse_ambiguous_links = false;  // no link when several candidates are in range
   bool match_heading = true;  // compare pose-cell theta too; off with a compass (a place seen
                               // facing the other way is the same place)
@@ -58,7 +58,7 @@ class Ratslam {
     uint64_t odometry_steps = 0;
     uint64_t view_frames = 0;
     uint64_t injections = 0;
-    uint64_t loop_closures = 0;      // links made to an experience that existed already
+    uint64_t loop_closures = 0;  // links made to an experience that existed already
     uint64_t refused_ambiguous = 0;
   };
 

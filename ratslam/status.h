@@ -35,7 +35,7 @@ class [[nodiscard]] Status {
 template <typename T>
 class [[nodiscard]] StatusOr {
  public:
-  StatusOr(T value) : value_(std::move(value)) {}  // NOLINT: implicit by design.
+  StatusOr(T value) : value_(std::move(value)) {}          // NOLINT: implicit by design.
   StatusOr(Status status) : status_(std::move(status)) {}  // NOLINT: implicit by design.
 
   bool ok() const { return status_.ok(); }
@@ -55,9 +55,9 @@ class [[nodiscard]] StatusOr {
 
 }  // namespace ratslam
 
-#define RATSLAM_RETURN_IF_ERROR(expr)        \
-  do {                                       \
-    ::ratslam::Status ratslam_status_ = (expr); \
+#define RATSLAM_RETURN_IF_ERROR(expr)                  \
+  do {                                                 \
+    ::ratslam::Status ratslam_status_ = (expr);        \
     if (!ratslam_status_.ok()) return ratslam_status_; \
   } while (false)
 

@@ -92,9 +92,9 @@ inline uint32_t MaskedSadPortable(const uint8_t* stored, const uint8_t* prepared
 
 #if defined(RATSLAM_HAVE_X86_SIMD)
 __attribute__((target("avx2"))) inline uint32_t MaskedSadAvx2(const uint8_t* stored,
-                                                               const uint8_t* prepared,
-                                                               const uint8_t* mask, int height,
-                                                               int stride) {
+                                                              const uint8_t* prepared,
+                                                              const uint8_t* mask, int height,
+                                                              int stride) {
   __m256i acc = _mm256_setzero_si256();
   for (int r = 0; r < height; ++r) {
     const uint8_t* t = stored + static_cast<size_t>(r) * stride;
@@ -197,8 +197,8 @@ StatusOr<std::vector<uint8_t>> ClassicCameraMatcher::MakeTemplate(
   }
   if (crop_w < w || crop_h < h) {
     return Status::Error("crop of " + std::to_string(crop_w) + "x" + std::to_string(crop_h) +
-                         " px is smaller than the " + std::to_string(w) + "x" +
-                         std::to_string(h) + " template");
+                         " px is smaller than the " + std::to_string(w) + "x" + std::to_string(h) +
+                         " template");
   }
   // Block means over integer block boundaries.
   std::vector<double> values(static_cast<size_t>(w) * h);
@@ -262,8 +262,8 @@ StatusOr<std::vector<uint8_t>> ClassicCameraMatcher::MakeTemplate(
 template <typename Visit>
 void ClassicCameraMatcher::VisitTemplates(const std::vector<uint8_t>& query, Visit&& visit) const {
   const int h = options_.template_height_px;
-  const PreparedQuery prepared = Prepare(query, shifts_, options_.template_width_px, h,
-                                         row_stride_, options_.panoramic);
+  const PreparedQuery prepared =
+      Prepare(query, shifts_, options_.template_width_px, h, row_stride_, options_.panoramic);
   std::vector<double> scale(shifts_.size());
   for (size_t k = 0; k < shifts_.size(); ++k) {
     scale[k] = 1.0 / (255.0 * h * prepared.overlap_columns[k]);
@@ -292,8 +292,8 @@ TemplateComparison ClassicCameraMatcher::Compare(const std::vector<uint8_t>& que
   });
   // The winning shift: recomputed for the winning template only (the first shift attaining it).
   const int h = options_.template_height_px;
-  const PreparedQuery prepared = Prepare(query, shifts_, options_.template_width_px, h,
-                                         row_stride_, options_.panoramic);
+  const PreparedQuery prepared =
+      Prepare(query, shifts_, options_.template_width_px, h, row_stride_, options_.panoramic);
   const uint8_t* t = state_.templates.data() + best.template_id * bytes_per_template_;
   for (size_t k = 0; k < shifts_.size(); ++k) {
     const uint32_t sad = MaskedSadPortable(t, prepared.rows.data() + k * h * row_stride_,
@@ -311,9 +311,8 @@ std::vector<double> ClassicCameraMatcher::Differences(const std::vector<uint8_t>
   std::vector<double> differences;
   if (query.size() != bytes_per_template_) return differences;
   differences.reserve(state_.template_count);
-  VisitTemplates(query, [&differences](uint32_t, double difference) {
-    differences.push_back(difference);
-  });
+  VisitTemplates(
+      query, [&differences](uint32_t, double difference) { differences.push_back(difference); });
   return differences;
 }
 

@@ -28,18 +28,18 @@ struct GrayImageView {
 };
 
 struct ClassicCameraOptions {
-  int crop_left_px = 0;           // first image column used
-  int crop_right_px = -1;         // one past the last column used; -1: image width
-  int crop_top_px = 0;            // first image row used
-  int crop_bottom_px = -1;        // one past the last row used; -1: image height
-  int template_width_px = 60;     // template columns after block-mean down-sampling
-  int template_height_px = 10;    // template rows
-  int shift_px = 5;               // columns compared at offsets -shift_px..+shift_px
-  int shift_step_px = 1;          // step between compared offsets
-  double match_threshold = 0.03;  // mean absolute difference (0..1 scale) for a match
+  int crop_left_px = 0;                    // first image column used
+  int crop_right_px = -1;                  // one past the last column used; -1: image width
+  int crop_top_px = 0;                     // first image row used
+  int crop_bottom_px = -1;                 // one past the last row used; -1: image height
+  int template_width_px = 60;              // template columns after block-mean down-sampling
+  int template_height_px = 10;             // template rows
+  int shift_px = 5;                        // columns compared at offsets -shift_px..+shift_px
+  int shift_step_px = 1;                   // step between compared offsets
+  double match_threshold = 0.03;           // mean absolute difference (0..1 scale) for a match
   double global_normalisation_mean = 0.0;  // >0: scale each template to this mean; 0: off
   int patch_normalisation_radius_px = 0;   // >0: local contrast normalisation; 0: off
-  bool panoramic = false;         // the template spans 360 degrees: shifts wrap around
+  bool panoramic = false;                  // the template spans 360 degrees: shifts wrap around
 
   bool IsValid(std::string* error) const;
 

@@ -94,7 +94,8 @@ TEST(ClassicCameraMatcherTest, ShiftedViewMatchesWithTheShift) {
   ClassicCameraMatcher matcher(options);
   const Image a = RandomImage(60, 10, 5);
   matcher.Add(matcher.MakeTemplate(a.view()).value());
-  const TemplateComparison c = matcher.Compare(matcher.MakeTemplate(RollColumns(a, 3).view()).value());
+  const TemplateComparison c =
+      matcher.Compare(matcher.MakeTemplate(RollColumns(a, 3).view()).value());
   EXPECT_EQ(c.shift_px, 3);
   EXPECT_EQ(c.mean_difference, 0.0);
 }

@@ -30,8 +30,10 @@ struct KernelCameraOptions {
   void VisitFields(Visitor&& v) {
     v("template_width_px", template_width_px, "template columns (paper: 12)");
     v("template_height_px", template_height_px, "template rows (paper: 9)");
-    v("kernel_sigma", kernel_sigma, "sigma_camera of eq. 7 on the 0..1 intensity scale (paper: 2.0)");
-    v("match_threshold", match_threshold, "t_camera: smallest similarity c(j) that is a match (paper: 0.96)");
+    v("kernel_sigma", kernel_sigma,
+      "sigma_camera of eq. 7 on the 0..1 intensity scale (paper: 2.0)");
+    v("match_threshold", match_threshold,
+      "t_camera: smallest similarity c(j) that is a match (paper: 0.96)");
     v("subtract_mean", subtract_mean, "remove each template's mean intensity before comparing");
   }
 };

@@ -15,7 +15,8 @@ TEST(KernelCameraOptionsTest, DefaultsAreValid) {
 std::vector<uint8_t> Gradient(int w, int h, int offset) {
   std::vector<uint8_t> p(static_cast<size_t>(w) * h);
   for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) p[y * w + x] = static_cast<uint8_t>((x * 7 + y * 11 + offset) % 200);
+    for (int x = 0; x < w; ++x)
+      p[y * w + x] = static_cast<uint8_t>((x * 7 + y * 11 + offset) % 200);
   return p;
 }
 

@@ -11,14 +11,14 @@
 namespace ratslam {
 
 struct PdrOptions {
-  double smoothing_s = 0.1;            // time constant of the magnitude low-pass filter
-  double baseline_s = 2.0;             // time constant of the baseline (the phone's gravity)
-  double peak_threshold_m_s2 = 0.6;    // a step peak rises this far above the baseline
-  double min_step_interval_s = 0.3;    // steps closer than this are one step
-  double max_step_interval_s = 2.0;    // a longer gap starts a new walk (no step length carry)
-  double weinberg_k = 0.48;            // K of the Weinberg step-length model
-  double fixed_step_length_m = 0.0;    // > 0: use this length instead of the Weinberg model
-  double heading_offset_rad = 0.0;     // walking direction minus phone heading
+  double smoothing_s = 0.1;          // time constant of the magnitude low-pass filter
+  double baseline_s = 2.0;           // time constant of the baseline (the phone's gravity)
+  double peak_threshold_m_s2 = 0.6;  // a step peak rises this far above the baseline
+  double min_step_interval_s = 0.3;  // steps closer than this are one step
+  double max_step_interval_s = 2.0;  // a longer gap starts a new walk (no step length carry)
+  double weinberg_k = 0.48;          // K of the Weinberg step-length model
+  double fixed_step_length_m = 0.0;  // > 0: use this length instead of the Weinberg model
+  double heading_offset_rad = 0.0;   // walking direction minus phone heading
 
   bool IsValid(std::string* error) const;
 
@@ -26,7 +26,8 @@ struct PdrOptions {
   void VisitFields(Visitor&& v) {
     v("smoothing_s", smoothing_s, "time constant of the accelerometer magnitude low-pass, s");
     v("baseline_s", baseline_s, "time constant of the slow baseline (the phone's gravity), s");
-    v("peak_threshold_m_s2", peak_threshold_m_s2, "a step peak rises this far above the baseline, m/s^2");
+    v("peak_threshold_m_s2", peak_threshold_m_s2,
+      "a step peak rises this far above the baseline, m/s^2");
     v("min_step_interval_s", min_step_interval_s, "steps closer in time than this are one step, s");
     v("max_step_interval_s", max_step_interval_s, "longest gap between steps of one walk, s");
     v("weinberg_k", weinberg_k, "K of the Weinberg step length L = K (a_max - a_min)^(1/4)");
@@ -53,7 +54,8 @@ struct Step {
 
 // Detects steps in time-ordered accelerometer samples.
 std::vector<double> DetectSteps(const std::vector<AccelerometerSample>& samples,
-                                const PdrOptions& options, std::vector<double>* swing_m_s2 = nullptr);
+                                const PdrOptions& options,
+                                std::vector<double>* swing_m_s2 = nullptr);
 
 // Steps with lengths and headings (heading interpolated at each step's time).
 std::vector<Step> PedestrianDeadReckoning(const std::vector<AccelerometerSample>& accelerometer,

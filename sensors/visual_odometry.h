@@ -15,12 +15,12 @@
 namespace ratslam {
 
 struct VisualOdometryOptions {
-  bool enabled = false;               // replace the data set's odometry with visual odometry
-  double speed_m_per_s = 1.0;         // the constant forward speed assumed
-  double field_of_view_rad = 1.8;     // horizontal field of view of the camera
-  int max_shift_px = 10;              // largest profile shift searched between frames
-  int crop_top_px = 0;                // rows used for the profile: [top, bottom)
-  int crop_bottom_px = -1;            // -1: image height
+  bool enabled = false;            // replace the data set's odometry with visual odometry
+  double speed_m_per_s = 1.0;      // the constant forward speed assumed
+  double field_of_view_rad = 1.8;  // horizontal field of view of the camera
+  int max_shift_px = 10;           // largest profile shift searched between frames
+  int crop_top_px = 0;             // rows used for the profile: [top, bottom)
+  int crop_bottom_px = -1;         // -1: image height
 
   bool IsValid(std::string* error) const;
 

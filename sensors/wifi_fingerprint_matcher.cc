@@ -42,8 +42,7 @@ Fingerprint WifiFingerprintMatcher::MakeFingerprint(
   std::map<uint32_t, std::pair<double, int>> merged;  // id -> (sum, count), ordered by id
   for (const auto& [bssid, rssi] : readings) {
     if (!std::isfinite(rssi) || rssi < options_.min_rssi_dbm || bssid.empty()) continue;
-    auto [it, inserted] =
-        bssid_ids_.emplace(bssid, static_cast<uint32_t>(state_.bssids.size()));
+    auto [it, inserted] = bssid_ids_.emplace(bssid, static_cast<uint32_t>(state_.bssids.size()));
     if (inserted) {
       state_.bssids.push_back(bssid);
       postings_.emplace_back();
@@ -80,8 +79,8 @@ double WifiFingerprintMatcher::Weight(const Fingerprint& q, const Fingerprint& j
   const double e = static_cast<double>(q.ap_ids.size()) - common;
   const double m = static_cast<double>(j.ap_ids.size()) - common;
   // w_hit^(1/H): the H-th root of a product of exponentials is the exponential of the mean.
-  return std::exp(-hit / (two_sigma2 * common) - extra / two_sigma2 - miss / two_sigma2) *
-         common / (common + e + m);
+  return std::exp(-hit / (two_sigma2 * common) - extra / two_sigma2 - miss / two_sigma2) * common /
+         (common + e + m);
 }
 
 template <typename Visit>
@@ -133,7 +132,8 @@ WifiMatch WifiFingerprintMatcher::Best(const Fingerprint& query) const {
   WifiMatch best;
   ForEachCandidate(query, [&best](uint32_t id, double w) {
     // Ties go to the older template, independent of the order the index visits them in.
-    if (w > best.weight || (w == best.weight && best.id >= 0 && id < static_cast<uint32_t>(best.id))) {
+    if (w > best.weight ||
+        (w == best.weight && best.id >= 0 && id < static_cast<uint32_t>(best.id))) {
       best.weight = w;
       best.id = static_cast<int32_t>(id);
     }

@@ -101,9 +101,9 @@ class WifiFingerprintMatcher {
   WifiMatcherOptions options_;
   State state_;
   std::unordered_map<std::string, uint32_t> bssid_ids_;
-  std::vector<std::vector<Posting>> postings_;   // by AP id
-  std::vector<double> miss_penalty_total_;       // by fingerprint: sum of P(s)^2 of all its APs
-  mutable std::vector<uint32_t> touched_;        // scratch for queries
+  std::vector<std::vector<Posting>> postings_;  // by AP id
+  std::vector<double> miss_penalty_total_;      // by fingerprint: sum of P(s)^2 of all its APs
+  mutable std::vector<uint32_t> touched_;       // scratch for queries
   mutable std::vector<uint32_t> common_;
   mutable std::vector<double> hit_sum_, extra_common_, miss_common_;
 };

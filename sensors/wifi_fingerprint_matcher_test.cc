@@ -40,7 +40,8 @@ TEST(WifiFingerprintMatcherTest, Equation6WorkedExample) {
 
 TEST(WifiFingerprintMatcherTest, MissingStrongApCostsMoreThanMissingWeakAp) {
   WifiFingerprintMatcher m({});
-  const Fingerprint stored = m.MakeFingerprint({{"a", -50}, {"b", -60}, {"strong", -40}, {"weak", -88}});
+  const Fingerprint stored =
+      m.MakeFingerprint({{"a", -50}, {"b", -60}, {"strong", -40}, {"weak", -88}});
   const Fingerprint without_strong = m.MakeFingerprint({{"a", -50}, {"b", -60}, {"weak", -88}});
   const Fingerprint without_weak = m.MakeFingerprint({{"a", -50}, {"b", -60}, {"strong", -40}});
   EXPECT_LT(m.Weight(without_strong, stored), m.Weight(without_weak, stored));
@@ -77,8 +78,8 @@ TEST(WifiFingerprintMatcherTest, IndexedWeightsEqualDirectWeights) {
     Readings r;
     const int n = 5 + static_cast<int>(rng.Uniform() * 30);
     for (int i = 0; i < n; ++i) {
-      r.push_back({"ap" + std::to_string(static_cast<int>(rng.Uniform() * 200)),
-                   rng.Uniform(-95, -30)});
+      r.push_back(
+          {"ap" + std::to_string(static_cast<int>(rng.Uniform() * 200)), rng.Uniform(-95, -30)});
     }
     return m.MakeFingerprint(r);
   };

@@ -41,8 +41,8 @@ void ExpectMatchesGolden(const Scene& scene, const std::string& name) {
   const fs::path written = fs::temp_directory_path() / ("ratslam_actual_" + name + ".png");
   if (mean > 1.0 || large_fraction > 0.005) (void)WritePng(actual.value(), written.string());
   EXPECT_LE(mean, 1.0) << name << ": mean channel difference; actual image in " << written;
-  EXPECT_LE(large_fraction, 0.005) << name << ": share of very different channels; actual in "
-                                   << written;
+  EXPECT_LE(large_fraction, 0.005)
+      << name << ": share of very different channels; actual in " << written;
 }
 
 Experience At(uint32_t id, double x, double y, double theta, double t) {
@@ -60,7 +60,8 @@ TEST(GoldenImageTest, ExperienceMap) {
   ExperienceMapImageData data;
   for (uint32_t i = 0; i < 12; ++i) {
     const double a = 2 * M_PI * i / 12;
-    data.experiences.push_back(At(i, 10 * std::cos(a) + 0.1 * i, 5 * std::sin(a), a + M_PI / 2, i * 2.0));
+    data.experiences.push_back(
+        At(i, 10 * std::cos(a) + 0.1 * i, 5 * std::sin(a), a + M_PI / 2, i * 2.0));
     data.ground_truth.push_back({10 * std::cos(a), 5 * std::sin(a)});
   }
   data.ground_truth.push_back(data.ground_truth.front());
@@ -106,7 +107,8 @@ TEST(GoldenImageTest, TemplateGraph) {
     p.time_s = i;
     p.template_id = i < 30 ? i : i - 30;
     p.experience_id = i < 30 ? i : i - 28;
-    p.source = i < 30 ? DecisionSource::kNew : (i % 3 ? DecisionSource::kCamera : DecisionSource::kWifi);
+    p.source =
+        i < 30 ? DecisionSource::kNew : (i % 3 ? DecisionSource::kCamera : DecisionSource::kWifi);
     points.push_back(p);
   }
   TemplateGraphImageOptions options;

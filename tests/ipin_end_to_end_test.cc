@@ -27,7 +27,8 @@ TEST(IpinEndToEndTest, WifiRatslamClosesOutAndBackLoops) {
   const fs::path a = data / "IPIN2023_T3_TrainingTrial01_repetition01.txt";
   const fs::path b = data / "IPIN2023_T3_TrainingTrial01_repetition02.txt";
   if (!fs::exists(a) || !fs::exists(b)) GTEST_SKIP() << "missing " << a << " or " << b;
-  const fs::path out = fs::temp_directory_path() / ("ratslam_ipin_e2e_" + std::to_string(::getpid()));
+  const fs::path out =
+      fs::temp_directory_path() / ("ratslam_ipin_e2e_" + std::to_string(::getpid()));
   const std::string command = std::string(RATSLAM_BINARY) + " replay --quiet --config " +
                               RATSLAM_SOURCE_DIR + "/configs/ipin2023-wifi-compass.toml --data " +
                               a.string() + " --data " + b.string() + " --out " + out.string() +
@@ -50,7 +51,8 @@ TEST(IpinEndToEndTest, WifiRatslamClosesOutAndBackLoops) {
     for (size_t j = 0; j < i; ++j) {
       if (at_scans[i].time_s - at_scans[j].time_s < 40.0) continue;
       ++pairs;
-      near += std::hypot(at_scans[i].x_m - at_scans[j].x_m, at_scans[i].y_m - at_scans[j].y_m) <= 10.0;
+      near +=
+          std::hypot(at_scans[i].x_m - at_scans[j].x_m, at_scans[i].y_m - at_scans[j].y_m) <= 10.0;
     }
   }
   ASSERT_GT(pairs, 100u);

@@ -16,7 +16,7 @@ namespace ratslam {
 namespace {
 namespace fs = std::filesystem;
 
-const char* const kOutputs[] = {"experiences.csv", "links.csv", "trajectory_tum.txt",
+const char* const kOutputs[] = {"experiences.csv",  "links.csv",          "trajectory_tum.txt",
                                 "odometry_tum.txt", "experience_map.g2o", "frames.csv",
                                 "config.toml"};
 
@@ -113,10 +113,11 @@ TEST_F(ReplayEndToEndTest, Camera12x9FrontEndClosesLoops) {
 // The paper's campus odometry: constant speed and rotation from the camera alone.
 TEST_F(ReplayEndToEndTest, VisualOdometryWithClassicCameraClosesLoops) {
   const fs::path config = root_ / "visual_odometry.toml";
-  std::ofstream(config) << "[camera]\ncrop_top_px = 8\ncrop_bottom_px = 32\nmatch_threshold = 0.03\n"
-                           "[pose_cells]\ndim_xy_cells = 30\ncell_size_m = 1.5\n"
-                           "[visual_odometry]\nenabled = true\nspeed_m_per_s = 1.0\n"
-                           "field_of_view_rad = 1.8\ncrop_top_px = 8\ncrop_bottom_px = 32\n";
+  std::ofstream(config)
+      << "[camera]\ncrop_top_px = 8\ncrop_bottom_px = 32\nmatch_threshold = 0.03\n"
+         "[pose_cells]\ndim_xy_cells = 30\ncell_size_m = 1.5\n"
+         "[visual_odometry]\nenabled = true\nspeed_m_per_s = 1.0\n"
+         "field_of_view_rad = 1.8\ncrop_top_px = 8\ncrop_bottom_px = 32\n";
   const fs::path out = root_ / "visual_odometry";
   ASSERT_EQ(RunRatslam("replay --quiet --config " + config.string() + " --data " +
                            (root_ / "data").string() + " --out " + out.string(),
@@ -141,7 +142,8 @@ TEST_F(ReplayEndToEndTest, SaveAndResumeEqualsUninterruptedRun) {
   const fs::path whole = root_ / "whole", part = root_ / "part", rest = root_ / "rest";
   const fs::path map = root_ / "half.map";
   ASSERT_EQ(RunRatslam(ReplayArgs(whole), root_).exit_code, 0);
-  ASSERT_EQ(RunRatslam(ReplayArgs(part) + " --until 150 --save-map " + map.string(), root_).exit_code, 0);
+  ASSERT_EQ(
+      RunRatslam(ReplayArgs(part) + " --until 150 --save-map " + map.string(), root_).exit_code, 0);
   EXPECT_EQ(Summary(part)["finished"], false);
   EXPECT_LE(Summary(part)["data_time_s"].get<double>(), 150.0);
   ASSERT_EQ(RunRatslam(ReplayArgs(rest) + " --load-map " + map.string(), root_).exit_code, 0);
@@ -157,10 +159,11 @@ TEST_F(ReplayEndToEndTest, SaveAndResumeEqualsUninterruptedRun) {
 
 TEST_F(ReplayEndToEndTest, ResumeWithAnotherConfigIsRefused) {
   const fs::path part = root_ / "part2", map = root_ / "part2.map";
-  ASSERT_EQ(RunRatslam(ReplayArgs(part) + " --until 20 --save-map " + map.string(), root_).exit_code, 0);
+  ASSERT_EQ(
+      RunRatslam(ReplayArgs(part) + " --until 20 --save-map " + map.string(), root_).exit_code, 0);
   const Result r = RunRatslam("replay --quiet --data " + (root_ / "data").string() + " --out " +
-                           (root_ / "other").string() + " --load-map " + map.string(),
-                       root_);
+                                  (root_ / "other").string() + " --load-map " + map.string(),
+                              root_);
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("different configuration"), std::string::npos) << r.err;
 }
@@ -169,8 +172,8 @@ TEST_F(ReplayEndToEndTest, BadConfigNamesLineAndRunsNothing) {
   const fs::path bad = root_ / "bad.toml";
   std::ofstream(bad) << "[camera]\nmatch_threshold = 0.03\nmatch_treshold = 0.1\n";
   const Result r = RunRatslam("replay --quiet --config " + bad.string() + " --data " +
-                           (root_ / "data").string() + " --out " + (root_ / "bad").string(),
-                       root_);
+                                  (root_ / "data").string() + " --out " + (root_ / "bad").string(),
+                              root_);
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("bad.toml:3: unknown key 'match_treshold' in [camera]"), std::string::npos)
       << r.err;
@@ -185,9 +188,9 @@ TEST_F(ReplayEndToEndTest, MissingImageKeepsOutputsAndStateThenResumes) {
   const fs::path aside = root_ / "001000.png";
   fs::rename(image, aside);
   const fs::path out = root_ / "broken";
-  const Result r = RunRatslam("replay --quiet --config " + config_ + " --data " + data.string() +
-                           " --out " + out.string(),
-                       root_);
+  const Result r = RunRatslam(
+      "replay --quiet --config " + config_ + " --data " + data.string() + " --out " + out.string(),
+      root_);
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("images.csv:1002"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("image file missing"), std::string::npos) << r.err;
@@ -198,11 +201,12 @@ TEST_F(ReplayEndToEndTest, MissingImageKeepsOutputsAndStateThenResumes) {
   // Put the image back and resume from the saved state: same result as an unbroken run.
   fs::rename(aside, image);
   const fs::path resumed = root_ / "resumed";
-  ASSERT_EQ(RunRatslam("replay --quiet --config " + config_ + " --data " + data.string() + " --out " +
-                    resumed.string() + " --load-map " + (out / "interrupted.map").string(),
-                root_)
-                .exit_code,
-            0);
+  ASSERT_EQ(
+      RunRatslam("replay --quiet --config " + config_ + " --data " + data.string() + " --out " +
+                     resumed.string() + " --load-map " + (out / "interrupted.map").string(),
+                 root_)
+          .exit_code,
+      0);
   const fs::path whole = root_ / "whole_for_broken";
   ASSERT_EQ(RunRatslam(ReplayArgs(whole), root_).exit_code, 0);
   EXPECT_EQ(Slurp(whole / "experiences.csv"), Slurp(resumed / "experiences.csv"));
@@ -224,9 +228,9 @@ void ExpectPicture(const fs::path& png, int width, int height) {
 TEST_F(ReplayEndToEndTest, RenderWritesImagesFromRunsAndMaps) {
   if (!CreateOsMesaRenderer().ok()) GTEST_SKIP() << "OSMesa unavailable";
   const fs::path out = root_ / "rendered";
-  ASSERT_EQ(RunRatslam(ReplayArgs(out) + " --render --animate 2000 --save-map " +
-                           (out / "m.map").string(),
-                       root_)
+  ASSERT_EQ(RunRatslam(
+                ReplayArgs(out) + " --render --animate 2000 --save-map " + (out / "m.map").string(),
+                root_)
                 .exit_code,
             0);
   ExpectPicture(out / "experience_map.png", 1600, 1200);

@@ -1,13 +1,13 @@
 #include "viewer/figures.h"
 
-#include "viewer/image.h"
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <functional>
 #include <limits>
 #include <numbers>
+
+#include "viewer/image.h"
 
 namespace ratslam {
 namespace {
@@ -133,7 +133,7 @@ void DrawRow(Scene& scene, const std::vector<LegendItem>& items, const std::vect
 
 Rgba SequentialColor(double t) {
   // Anchors of a dark-blue to yellow ramp with monotonically rising lightness.
-  static const Rgba kAnchors[] = {{48, 18, 90, 255},   {40, 70, 140, 255}, {30, 120, 142, 255},
+  static const Rgba kAnchors[] = {{48, 18, 90, 255},   {40, 70, 140, 255},  {30, 120, 142, 255},
                                   {40, 165, 120, 255}, {130, 200, 70, 255}, {240, 225, 40, 255}};
   constexpr int kSegments = static_cast<int>(std::size(kAnchors)) - 1;
   t = std::clamp(std::isfinite(t) ? t : 0.0, 0.0, 1.0) * kSegments;
@@ -142,9 +142,9 @@ Rgba SequentialColor(double t) {
 }
 
 Rgba CategoryColor(int index) {
-  static const Rgba kColors[] = {{31, 119, 180, 255}, {214, 39, 40, 255},  {44, 160, 44, 255},
+  static const Rgba kColors[] = {{31, 119, 180, 255},  {214, 39, 40, 255},  {44, 160, 44, 255},
                                  {148, 103, 189, 255}, {255, 127, 14, 255}, {23, 190, 207, 255},
-                                 {140, 86, 75, 255},  {227, 119, 194, 255}};
+                                 {140, 86, 75, 255},   {227, 119, 194, 255}};
   const int n = static_cast<int>(std::size(kColors));
   return kColors[((index % n) + n) % n];
 }
@@ -218,14 +218,15 @@ Scene ExperienceMapScene(const ExperienceMapImageData& data,
     t_last = std::max(t_last, e.time_s);
   }
   if (options.coloring == MapColoring::kTime && std::isfinite(t_first)) {
-    items.push_back({kColorBarWidth + 20, [t_first, t_last](Scene& s, float x, float y) {
-                       s.Image(ColorBar(x, y - 7, kColorBarWidth, 14));
-                       s.Text({x, y + 24}, FormatNumber(t_first) + " s", 13, kInk, TextAnchor::kCenter);
-                       s.Text({x + kColorBarWidth, y + 24}, FormatNumber(t_last) + " s", 13, kInk,
-                              TextAnchor::kCenter);
-                       s.Text({x + kColorBarWidth / 2, y - 12}, "experience created at", 13, kInk,
-                              TextAnchor::kCenter);
-                     }});
+    items.push_back(
+        {kColorBarWidth + 20, [t_first, t_last](Scene& s, float x, float y) {
+           s.Image(ColorBar(x, y - 7, kColorBarWidth, 14));
+           s.Text({x, y + 24}, FormatNumber(t_first) + " s", 13, kInk, TextAnchor::kCenter);
+           s.Text({x + kColorBarWidth, y + 24}, FormatNumber(t_last) + " s", 13, kInk,
+                  TextAnchor::kCenter);
+           s.Text({x + kColorBarWidth / 2, y - 12}, "experience created at", 13, kInk,
+                  TextAnchor::kCenter);
+         }});
   } else if (options.coloring == MapColoring::kSession) {
     for (size_t i = 0; i < options.session_start_times_s.size(); ++i) {
       const std::string label = "session " + std::to_string(i + 1);
@@ -239,8 +240,8 @@ Scene ExperienceMapScene(const ExperienceMapImageData& data,
   const std::vector<std::vector<size_t>> rows = FlowRows(items, row_width);
   auto row_length = [&](const std::vector<size_t>& row) { return RowLength(items, row); };
   constexpr float kScaleBarRoom = 160;  // the scale bar and its label
-  const bool first_row_beside_bar = row_length(rows.front()) + kScaleBarRoom < row_width &&
-                                    rows.size() == 1;
+  const bool first_row_beside_bar =
+      row_length(rows.front()) + kScaleBarRoom < row_width && rows.size() == 1;
   const size_t stacked_rows = first_row_beside_bar ? 0 : rows.size();
   bottom_band += 46 * stacked_rows;
   const double plot_w = w - 2 * margin, plot_h = h - top_band - bottom_band;
@@ -263,7 +264,8 @@ Scene ExperienceMapScene(const ExperienceMapImageData& data,
     return static_cast<int>(std::upper_bound(starts.begin(), starts.end(), t) - starts.begin()) - 1;
   };
   auto color_of = [&](const Experience& e) {
-    if (options.coloring == MapColoring::kSession) return CategoryColor(std::max(0, session_of(e.time_s)));
+    if (options.coloring == MapColoring::kSession)
+      return CategoryColor(std::max(0, session_of(e.time_s)));
     return SequentialColor(t_max > t_min ? (e.time_s - t_min) / (t_max - t_min) : 0.0);
   };
 
@@ -273,8 +275,9 @@ Scene ExperienceMapScene(const ExperienceMapImageData& data,
   const float zoom = std::max(1.0f, std::min(w, h) / 1200.0f);
   const float link_width = zoom * (n_links > 20000 ? 1.2f : (n_links > 2000 ? 1.5f : 2.5f));
   const uint8_t link_alpha = n_links > 20000 ? 200 : 230;
-  const float node_radius = data.experiences.size() > 20000 ? 0.0f
-                            : data.experiences.size() > 2000 ? 1.5f : 3.0f;
+  const float node_radius = data.experiences.size() > 20000  ? 0.0f
+                            : data.experiences.size() > 2000 ? 1.5f
+                                                             : 3.0f;
 
   if (data.ground_truth.size() > 1) {
     std::vector<ScenePoint> path;
@@ -308,18 +311,19 @@ Scene ExperienceMapScene(const ExperienceMapImageData& data,
     const Experience& e = data.experiences[*data.current];
     const ScenePoint c = to_image(e.x_m, e.y_m);
     const float size = 16, dx = std::cos(e.theta_rad), dy = -std::sin(e.theta_rad);
-    scene.Triangle({c.x + dx * size, c.y + dy * size},
-                   {c.x - dx * size * 0.6f - dy * size * 0.5f, c.y - dy * size * 0.6f + dx * size * 0.5f},
-                   {c.x - dx * size * 0.6f + dy * size * 0.5f, c.y - dy * size * 0.6f - dx * size * 0.5f},
-                   {0, 0, 0, 255});
+    scene.Triangle(
+        {c.x + dx * size, c.y + dy * size},
+        {c.x - dx * size * 0.6f - dy * size * 0.5f, c.y - dy * size * 0.6f + dx * size * 0.5f},
+        {c.x - dx * size * 0.6f + dy * size * 0.5f, c.y - dy * size * 0.6f - dx * size * 0.5f},
+        {0, 0, 0, 255});
   }
 
   // Title, and the counts on a line of their own.
   scene.Text({margin, 26}, options.title.empty() ? "experience map" : options.title, 18, kInk);
-  scene.Text({margin, 50}, std::to_string(data.experiences.size()) + " experiences, " +
-                               std::to_string(n_links) + " links, " +
-                               std::to_string(loop_closures) +
-                               (loop_closures == 1 ? " loop closure" : " loop closures"),
+  scene.Text({margin, 50},
+             std::to_string(data.experiences.size()) + " experiences, " + std::to_string(n_links) +
+                 " links, " + std::to_string(loop_closures) +
+                 (loop_closures == 1 ? " loop closure" : " loop closures"),
              14, kInk);
 
   // Scale bar, bottom left: a nice length near a fifth of the plot width.
@@ -348,8 +352,8 @@ Scene TemplateGraphScene(const std::vector<TemplateGraphPoint>& points,
   for (const TemplateGraphPoint& p : points) {
     t0 = std::min(t0, p.time_s);
     t1 = std::max(t1, p.time_s);
-    id_max = std::max({id_max, static_cast<double>(p.template_id),
-                       static_cast<double>(p.experience_id)});
+    id_max = std::max(
+        {id_max, static_cast<double>(p.template_id), static_cast<double>(p.experience_id)});
   }
   if (!std::isfinite(t0)) t0 = 0, t1 = 1;
   if (t1 <= t0) t1 = t0 + 1;
@@ -364,14 +368,15 @@ Scene TemplateGraphScene(const std::vector<TemplateGraphPoint>& points,
     if (!present[s]) continue;
     const std::string name = names[s];
     const Rgba color = source_colors[s];
-    items.push_back({12 + TextWidthPx(name, 14), [s, name, color](Scene& sc, float x, float y) {
-                       if (s == 2) {
-                         sc.Disc({x + 3, y}, 2.5f, color, 8);
-                       } else {
-                         sc.Ring({x + 3, y}, 2.2f, 3.8f, 0, 2 * std::numbers::pi_v<float>, color, 10);
-                       }
-                       sc.Text({x + 12, y + 5}, name, 14, kInk);
-                     }});
+    items.push_back(
+        {12 + TextWidthPx(name, 14), [s, name, color](Scene& sc, float x, float y) {
+           if (s == 2) {
+             sc.Disc({x + 3, y}, 2.5f, color, 8);
+           } else {
+             sc.Ring({x + 3, y}, 2.2f, 3.8f, 0, 2 * std::numbers::pi_v<float>, color, 10);
+           }
+           sc.Text({x + 12, y + 5}, name, 14, kInk);
+         }});
   }
   items.push_back({12 + TextWidthPx("experience", 14), [](Scene& sc, float x, float y) {
                      sc.Disc({x + 3, y}, 2.5f, kExperienceColor, 8);
@@ -381,8 +386,14 @@ Scene TemplateGraphScene(const std::vector<TemplateGraphPoint>& points,
   const std::vector<std::vector<size_t>> rows = FlowRows(items, right - 20);
   for (size_t r = 0; r < rows.size(); ++r) DrawRow(scene, items, rows[r], right, 52 + 24.0f * r);
   const float plot_top = 52 + 24.0f * rows.size() + 30;
-  PlotArea plot{80, plot_top, static_cast<float>(options.width_px - 110),
-                static_cast<float>(options.height_px) - plot_top - 70, t0, t1, 0, id_max * 1.02};
+  PlotArea plot{80,
+                plot_top,
+                static_cast<float>(options.width_px - 110),
+                static_cast<float>(options.height_px) - plot_top - 70,
+                t0,
+                t1,
+                0,
+                id_max * 1.02};
   for (const TimeSpan& span : options.shaded_spans) {
     const ScenePoint a = plot.Map(std::max(span.start_s, t0), 0);
     const ScenePoint b = plot.Map(std::min(span.end_s, t1), 0);
@@ -398,7 +409,8 @@ Scene TemplateGraphScene(const std::vector<TemplateGraphPoint>& points,
     if (p.source == DecisionSource::kNew) {
       scene.Disc(at, many ? 1.0f : 1.8f, c, 8);
     } else {
-      scene.Ring(at, many ? 1.2f : 2.2f, many ? 2.2f : 3.6f, 0, 2 * std::numbers::pi_v<float>, c, 10);
+      scene.Ring(at, many ? 1.2f : 2.2f, many ? 2.2f : 3.6f, 0, 2 * std::numbers::pi_v<float>, c,
+                 10);
     }
   }
   for (const TemplateGraphPoint& p : points) {
@@ -461,13 +473,15 @@ Scene PoseCellScene(const PoseCellNetwork& network, const PoseCellImageOptions& 
     scene.Ring(center, radius * 0.75f, radius, (t - 0.5f) * step, (t + 0.5f) * step, c, 4);
   }
   const float best_angle = static_cast<float>(best.theta) * step;
-  scene.Line(center, {center.x + radius * 0.7f * std::cos(best_angle),
-                      center.y - radius * 0.7f * std::sin(best_angle)},
+  scene.Line(center,
+             {center.x + radius * 0.7f * std::cos(best_angle),
+              center.y - radius * 0.7f * std::sin(best_angle)},
              3.0f, kInk);
   for (int deg = 0; deg < 360; deg += 90) {
     const float a = deg * std::numbers::pi_v<float> / 180;
-    const TextAnchor anchor = deg == 0 ? TextAnchor::kLeft
-                              : deg == 180 ? TextAnchor::kRight : TextAnchor::kCenter;
+    const TextAnchor anchor = deg == 0     ? TextAnchor::kLeft
+                              : deg == 180 ? TextAnchor::kRight
+                                           : TextAnchor::kCenter;
     const float offset = deg % 180 == 0 ? 12.0f : 24.0f;
     scene.Text({center.x + (radius + offset) * std::cos(a),
                 center.y - (radius + offset) * std::sin(a) + 5},
@@ -477,9 +491,11 @@ Scene PoseCellScene(const PoseCellNetwork& network, const PoseCellImageOptions& 
   std::snprintf(label, sizeof label, "best pose: x %.2f, y %.2f, theta %.2f cells (%.0f deg)",
                 best.x, best.y, best.theta, best.theta * 360.0 / nt);
   scene.Text({left, static_cast<float>(options.height_px - 16)}, label, 15, kInk);
-  scene.Text({center.x, top - 30}, "heading (activity summed over x, y)", 15, kInk, TextAnchor::kCenter);
-  scene.Text({20, 26}, options.title.empty() ? "pose-cell activity (summed over theta)" : options.title,
-             18, kInk);
+  scene.Text({center.x, top - 30}, "heading (activity summed over x, y)", 15, kInk,
+             TextAnchor::kCenter);
+  scene.Text({20, 26},
+             options.title.empty() ? "pose-cell activity (summed over theta)" : options.title, 18,
+             kInk);
   return scene;
 }
 
@@ -524,7 +540,8 @@ Scene SimilarityMatrixScene(const std::vector<float>& matrix, const std::vector<
   vertical.pixels_high = 256;
   vertical.smooth = true;
   for (int i = 255; i >= 0; --i) {
-    vertical.rgba.insert(vertical.rgba.end(), bar.rgba.begin() + i * 4, bar.rgba.begin() + i * 4 + 4);
+    vertical.rgba.insert(vertical.rgba.end(), bar.rgba.begin() + i * 4,
+                         bar.rgba.begin() + i * 4 + 4);
   }
   scene.Image(std::move(vertical));
   scene.Text({left + size + 55, top + 12}, "1", 14, kInk);

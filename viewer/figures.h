@@ -48,14 +48,15 @@ struct ExperienceMapImageOptions {
 struct ExperienceMapImageData {
   std::vector<Experience> experiences;
   std::vector<Link> links;
-  std::optional<uint32_t> current;    // experience where the robot is
-  std::vector<Point2> ground_truth;   // already in the map's frame (see AlignGroundTruthToMap)
+  std::optional<uint32_t> current;   // experience where the robot is
+  std::vector<Point2> ground_truth;  // already in the map's frame (see AlignGroundTruthToMap)
 };
 
 // The experience map with equal aspect, a scale bar in metres, loop-closure links highlighted,
 // the current pose as an arrow, and a time colour bar or a session legend. `transform` receives
 // the world-to-pixel mapping used.
-Scene ExperienceMapScene(const ExperienceMapImageData& data, const ExperienceMapImageOptions& options,
+Scene ExperienceMapScene(const ExperienceMapImageData& data,
+                         const ExperienceMapImageOptions& options,
                          WorldToImage* transform = nullptr);
 
 // Moves ground-truth points (paired with map points by index) into the map frame with the

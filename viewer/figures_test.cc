@@ -85,15 +85,16 @@ TEST(ExperienceMapSceneTest, RenderedNodesAreWhereTheWorldSays) {
   StatusOr<RgbaImage> image = renderer.value()->Render(scene);
   ASSERT_TRUE(image.ok()) << image.status().message();
   auto is_ink = [&](ScenePoint p) {
-    const Rgba c = image->At(static_cast<int>(std::lround(p.x)), static_cast<int>(std::lround(p.y)));
+    const Rgba c =
+        image->At(static_cast<int>(std::lround(p.x)), static_cast<int>(std::lround(p.y)));
     return c.r + c.g + c.b < 600;
   };
   EXPECT_TRUE(is_ink(t(0, 0)));
   EXPECT_TRUE(is_ink(t(20, 0)));
   EXPECT_TRUE(is_ink(t(20, 10)));
-  EXPECT_TRUE(is_ink(t(10, 0)));    // on the first link
-  EXPECT_FALSE(is_ink(t(5, 8)));    // empty corner of the L
-  EXPECT_FALSE(is_ink(t(0, 10)));   // mirrored position of node 2: would be inked if upside down
+  EXPECT_TRUE(is_ink(t(10, 0)));   // on the first link
+  EXPECT_FALSE(is_ink(t(5, 8)));   // empty corner of the L
+  EXPECT_FALSE(is_ink(t(0, 10)));  // mirrored position of node 2: would be inked if upside down
 }
 
 TEST(TemplateGraphSceneTest, EmptyInputStillGivesAFigure) {

@@ -50,7 +50,8 @@ int FontThickness(float height_px) {
 float TextWidthPx(const std::string& text, float height_px) {
   int baseline = 0;
   return static_cast<float>(
-      cv::getTextSize(text, kFont, FontScale(height_px), FontThickness(height_px), &baseline).width);
+      cv::getTextSize(text, kFont, FontScale(height_px), FontThickness(height_px), &baseline)
+          .width);
 }
 
 void DrawTexts(const Scene& scene, RgbaImage* image) {

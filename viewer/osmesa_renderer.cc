@@ -1,7 +1,7 @@
-#include <dlfcn.h>
-
 #include <GL/osmesa.h>
+// glext.h needs the GL types that osmesa.h (through gl.h) declares first.
 #include <GL/glext.h>
+#include <dlfcn.h>
 
 #include <cstdlib>
 #include <cstring>
@@ -15,59 +15,59 @@ namespace {
 
 // The OpenGL entry points we use, resolved through OSMesaGetProcAddress.
 struct GlFunctions {
-#define RATSLAM_GL_FUNCTIONS(X)                                                          \
-  X(decltype(&::glGetError), GetError, "glGetError")                                           \
-  X(decltype(&::glGetIntegerv), GetIntegerv, "glGetIntegerv")                                  \
-  X(decltype(&::glViewport), Viewport, "glViewport")                                           \
-  X(decltype(&::glClearColor), ClearColor, "glClearColor")                                     \
-  X(decltype(&::glClear), Clear, "glClear")                                                    \
-  X(decltype(&::glEnable), Enable, "glEnable")                                                 \
-  X(PFNGLBLENDFUNCSEPARATEPROC, BlendFuncSeparate, "glBlendFuncSeparate")                \
-  X(decltype(&::glReadPixels), ReadPixels, "glReadPixels")                                     \
-  X(decltype(&::glPixelStorei), PixelStorei, "glPixelStorei")                                  \
-  X(decltype(&::glFinish), Finish, "glFinish")                                                 \
-  X(PFNGLGENBUFFERSPROC, GenBuffers, "glGenBuffers")                                     \
-  X(PFNGLDELETEBUFFERSPROC, DeleteBuffers, "glDeleteBuffers")                            \
-  X(PFNGLBINDBUFFERPROC, BindBuffer, "glBindBuffer")                                     \
-  X(PFNGLBUFFERDATAPROC, BufferData, "glBufferData")                                     \
-  X(PFNGLGENVERTEXARRAYSPROC, GenVertexArrays, "glGenVertexArrays")                      \
-  X(PFNGLDELETEVERTEXARRAYSPROC, DeleteVertexArrays, "glDeleteVertexArrays")             \
-  X(PFNGLBINDVERTEXARRAYPROC, BindVertexArray, "glBindVertexArray")                      \
-  X(PFNGLVERTEXATTRIBPOINTERPROC, VertexAttribPointer, "glVertexAttribPointer")          \
+#define RATSLAM_GL_FUNCTIONS(X)                                                             \
+  X(decltype(&::glGetError), GetError, "glGetError")                                        \
+  X(decltype(&::glGetIntegerv), GetIntegerv, "glGetIntegerv")                               \
+  X(decltype(&::glViewport), Viewport, "glViewport")                                        \
+  X(decltype(&::glClearColor), ClearColor, "glClearColor")                                  \
+  X(decltype(&::glClear), Clear, "glClear")                                                 \
+  X(decltype(&::glEnable), Enable, "glEnable")                                              \
+  X(PFNGLBLENDFUNCSEPARATEPROC, BlendFuncSeparate, "glBlendFuncSeparate")                   \
+  X(decltype(&::glReadPixels), ReadPixels, "glReadPixels")                                  \
+  X(decltype(&::glPixelStorei), PixelStorei, "glPixelStorei")                               \
+  X(decltype(&::glFinish), Finish, "glFinish")                                              \
+  X(PFNGLGENBUFFERSPROC, GenBuffers, "glGenBuffers")                                        \
+  X(PFNGLDELETEBUFFERSPROC, DeleteBuffers, "glDeleteBuffers")                               \
+  X(PFNGLBINDBUFFERPROC, BindBuffer, "glBindBuffer")                                        \
+  X(PFNGLBUFFERDATAPROC, BufferData, "glBufferData")                                        \
+  X(PFNGLGENVERTEXARRAYSPROC, GenVertexArrays, "glGenVertexArrays")                         \
+  X(PFNGLDELETEVERTEXARRAYSPROC, DeleteVertexArrays, "glDeleteVertexArrays")                \
+  X(PFNGLBINDVERTEXARRAYPROC, BindVertexArray, "glBindVertexArray")                         \
+  X(PFNGLVERTEXATTRIBPOINTERPROC, VertexAttribPointer, "glVertexAttribPointer")             \
   X(PFNGLENABLEVERTEXATTRIBARRAYPROC, EnableVertexAttribArray, "glEnableVertexAttribArray") \
-  X(PFNGLCREATESHADERPROC, CreateShader, "glCreateShader")                               \
-  X(PFNGLDELETESHADERPROC, DeleteShader, "glDeleteShader")                               \
-  X(PFNGLSHADERSOURCEPROC, ShaderSource, "glShaderSource")                               \
-  X(PFNGLCOMPILESHADERPROC, CompileShader, "glCompileShader")                            \
-  X(PFNGLGETSHADERIVPROC, GetShaderiv, "glGetShaderiv")                                  \
-  X(PFNGLGETSHADERINFOLOGPROC, GetShaderInfoLog, "glGetShaderInfoLog")                   \
-  X(PFNGLCREATEPROGRAMPROC, CreateProgram, "glCreateProgram")                            \
-  X(PFNGLDELETEPROGRAMPROC, DeleteProgram, "glDeleteProgram")                            \
-  X(PFNGLATTACHSHADERPROC, AttachShader, "glAttachShader")                               \
-  X(PFNGLLINKPROGRAMPROC, LinkProgram, "glLinkProgram")                                  \
-  X(PFNGLGETPROGRAMIVPROC, GetProgramiv, "glGetProgramiv")                               \
-  X(PFNGLGETPROGRAMINFOLOGPROC, GetProgramInfoLog, "glGetProgramInfoLog")                \
-  X(PFNGLUSEPROGRAMPROC, UseProgram, "glUseProgram")                                     \
-  X(PFNGLGETUNIFORMLOCATIONPROC, GetUniformLocation, "glGetUniformLocation")             \
-  X(PFNGLUNIFORM2FPROC, Uniform2f, "glUniform2f")                                        \
-  X(PFNGLUNIFORM1IPROC, Uniform1i, "glUniform1i")                                        \
-  X(decltype(&::glDrawArrays), DrawArrays, "glDrawArrays")                                     \
-  X(decltype(&::glGenTextures), GenTextures, "glGenTextures")                                  \
-  X(decltype(&::glDeleteTextures), DeleteTextures, "glDeleteTextures")                         \
-  X(decltype(&::glBindTexture), BindTexture, "glBindTexture")                                  \
-  X(decltype(&::glTexImage2D), TexImage2D, "glTexImage2D")                                     \
-  X(decltype(&::glTexParameteri), TexParameteri, "glTexParameteri")                            \
-  X(PFNGLACTIVETEXTUREPROC, ActiveTexture, "glActiveTexture")                            \
-  X(PFNGLGENFRAMEBUFFERSPROC, GenFramebuffers, "glGenFramebuffers")                      \
-  X(PFNGLDELETEFRAMEBUFFERSPROC, DeleteFramebuffers, "glDeleteFramebuffers")             \
-  X(PFNGLBINDFRAMEBUFFERPROC, BindFramebuffer, "glBindFramebuffer")                      \
-  X(PFNGLCHECKFRAMEBUFFERSTATUSPROC, CheckFramebufferStatus, "glCheckFramebufferStatus") \
-  X(PFNGLGENRENDERBUFFERSPROC, GenRenderbuffers, "glGenRenderbuffers")                   \
-  X(PFNGLDELETERENDERBUFFERSPROC, DeleteRenderbuffers, "glDeleteRenderbuffers")          \
-  X(PFNGLBINDRENDERBUFFERPROC, BindRenderbuffer, "glBindRenderbuffer")                   \
-  X(PFNGLRENDERBUFFERSTORAGEMULTISAMPLEPROC, RenderbufferStorageMultisample,             \
-    "glRenderbufferStorageMultisample")                                                  \
-  X(PFNGLRENDERBUFFERSTORAGEPROC, RenderbufferStorage, "glRenderbufferStorage")          \
+  X(PFNGLCREATESHADERPROC, CreateShader, "glCreateShader")                                  \
+  X(PFNGLDELETESHADERPROC, DeleteShader, "glDeleteShader")                                  \
+  X(PFNGLSHADERSOURCEPROC, ShaderSource, "glShaderSource")                                  \
+  X(PFNGLCOMPILESHADERPROC, CompileShader, "glCompileShader")                               \
+  X(PFNGLGETSHADERIVPROC, GetShaderiv, "glGetShaderiv")                                     \
+  X(PFNGLGETSHADERINFOLOGPROC, GetShaderInfoLog, "glGetShaderInfoLog")                      \
+  X(PFNGLCREATEPROGRAMPROC, CreateProgram, "glCreateProgram")                               \
+  X(PFNGLDELETEPROGRAMPROC, DeleteProgram, "glDeleteProgram")                               \
+  X(PFNGLATTACHSHADERPROC, AttachShader, "glAttachShader")                                  \
+  X(PFNGLLINKPROGRAMPROC, LinkProgram, "glLinkProgram")                                     \
+  X(PFNGLGETPROGRAMIVPROC, GetProgramiv, "glGetProgramiv")                                  \
+  X(PFNGLGETPROGRAMINFOLOGPROC, GetProgramInfoLog, "glGetProgramInfoLog")                   \
+  X(PFNGLUSEPROGRAMPROC, UseProgram, "glUseProgram")                                        \
+  X(PFNGLGETUNIFORMLOCATIONPROC, GetUniformLocation, "glGetUniformLocation")                \
+  X(PFNGLUNIFORM2FPROC, Uniform2f, "glUniform2f")                                           \
+  X(PFNGLUNIFORM1IPROC, Uniform1i, "glUniform1i")                                           \
+  X(decltype(&::glDrawArrays), DrawArrays, "glDrawArrays")                                  \
+  X(decltype(&::glGenTextures), GenTextures, "glGenTextures")                               \
+  X(decltype(&::glDeleteTextures), DeleteTextures, "glDeleteTextures")                      \
+  X(decltype(&::glBindTexture), BindTexture, "glBindTexture")                               \
+  X(decltype(&::glTexImage2D), TexImage2D, "glTexImage2D")                                  \
+  X(decltype(&::glTexParameteri), TexParameteri, "glTexParameteri")                         \
+  X(PFNGLACTIVETEXTUREPROC, ActiveTexture, "glActiveTexture")                               \
+  X(PFNGLGENFRAMEBUFFERSPROC, GenFramebuffers, "glGenFramebuffers")                         \
+  X(PFNGLDELETEFRAMEBUFFERSPROC, DeleteFramebuffers, "glDeleteFramebuffers")                \
+  X(PFNGLBINDFRAMEBUFFERPROC, BindFramebuffer, "glBindFramebuffer")                         \
+  X(PFNGLCHECKFRAMEBUFFERSTATUSPROC, CheckFramebufferStatus, "glCheckFramebufferStatus")    \
+  X(PFNGLGENRENDERBUFFERSPROC, GenRenderbuffers, "glGenRenderbuffers")                      \
+  X(PFNGLDELETERENDERBUFFERSPROC, DeleteRenderbuffers, "glDeleteRenderbuffers")             \
+  X(PFNGLBINDRENDERBUFFERPROC, BindRenderbuffer, "glBindRenderbuffer")                      \
+  X(PFNGLRENDERBUFFERSTORAGEMULTISAMPLEPROC, RenderbufferStorageMultisample,                \
+    "glRenderbufferStorageMultisample")                                                     \
+  X(PFNGLRENDERBUFFERSTORAGEPROC, RenderbufferStorage, "glRenderbufferStorage")             \
   X(PFNGLFRAMEBUFFERRENDERBUFFERPROC, FramebufferRenderbuffer, "glFramebufferRenderbuffer") \
   X(PFNGLBLITFRAMEBUFFERPROC, BlitFramebuffer, "glBlitFramebuffer")
 #define RATSLAM_DECLARE(type, name, symbol) type name = nullptr;
@@ -118,7 +118,8 @@ void main() { fragment_color = texture(image, uv); }
 class OsMesaRenderer : public SceneRenderer {
  public:
   ~OsMesaRenderer() override {
-    if (gl_.DeleteProgram && context_ && make_current_(context_, dummy_.data(), GL_UNSIGNED_BYTE, 4, 4)) {
+    if (gl_.DeleteProgram && context_ &&
+        make_current_(context_, dummy_.data(), GL_UNSIGNED_BYTE, 4, 4)) {
       gl_.DeleteProgram(color_program_);
       gl_.DeleteProgram(texture_program_);
     }
@@ -133,8 +134,8 @@ class OsMesaRenderer : public SceneRenderer {
     if (const char* override_path = std::getenv("RATSLAM_OSMESA_LIBRARY")) {
       library_ = dlopen(override_path, RTLD_NOW | RTLD_LOCAL);
       if (!library_) {
-        return Status::Error(std::string("OSMesa is not available: cannot load ") +
-                             override_path + " (RATSLAM_OSMESA_LIBRARY): " + dlerror());
+        return Status::Error(std::string("OSMesa is not available: cannot load ") + override_path +
+                             " (RATSLAM_OSMESA_LIBRARY): " + dlerror());
       }
     } else {
       for (const char* name : {"libOSMesa.so.8", "libOSMesa.so.6", "libOSMesa.so"}) {
@@ -147,16 +148,24 @@ class OsMesaRenderer : public SceneRenderer {
           "OSMesa is not available (cannot load libOSMesa.so.8; install the Debian package "
           "libosmesa6): images cannot be rendered");
     }
-    auto create = reinterpret_cast<CreateContextAttribsFn>(dlsym(library_, "OSMesaCreateContextAttribs"));
+    auto create =
+        reinterpret_cast<CreateContextAttribsFn>(dlsym(library_, "OSMesaCreateContextAttribs"));
     make_current_ = reinterpret_cast<MakeCurrentFn>(dlsym(library_, "OSMesaMakeCurrent"));
     destroy_context_ = reinterpret_cast<DestroyContextFn>(dlsym(library_, "OSMesaDestroyContext"));
     auto get_proc = reinterpret_cast<GetProcAddressFn>(dlsym(library_, "OSMesaGetProcAddress"));
     if (!create || !make_current_ || !destroy_context_ || !get_proc) {
       return Status::Error("OSMesa library lacks OSMesaCreateContextAttribs (Mesa too old?)");
     }
-    const int attributes[] = {OSMESA_FORMAT, OSMESA_RGBA, OSMESA_DEPTH_BITS, 0,
-                              OSMESA_PROFILE, OSMESA_CORE_PROFILE,
-                              OSMESA_CONTEXT_MAJOR_VERSION, 3, OSMESA_CONTEXT_MINOR_VERSION, 3,
+    const int attributes[] = {OSMESA_FORMAT,
+                              OSMESA_RGBA,
+                              OSMESA_DEPTH_BITS,
+                              0,
+                              OSMESA_PROFILE,
+                              OSMESA_CORE_PROFILE,
+                              OSMESA_CONTEXT_MAJOR_VERSION,
+                              3,
+                              OSMESA_CONTEXT_MINOR_VERSION,
+                              3,
                               0};
     context_ = create(attributes, nullptr);
     if (!context_) return Status::Error("OSMesa: cannot create an OpenGL 3.3 core context");
@@ -164,8 +173,8 @@ class OsMesaRenderer : public SceneRenderer {
     if (!make_current_(context_, dummy_.data(), GL_UNSIGNED_BYTE, 4, 4)) {
       return Status::Error("OSMesa: cannot make the context current");
     }
-#define RATSLAM_LOAD(type, name, symbol)                                    \
-  gl_.name = reinterpret_cast<type>(get_proc(symbol));                      \
+#define RATSLAM_LOAD(type, name, symbol)               \
+  gl_.name = reinterpret_cast<type>(get_proc(symbol)); \
   if (!gl_.name) return Status::Error(std::string("OSMesa: missing ") + symbol);
     RATSLAM_GL_FUNCTIONS(RATSLAM_LOAD)
 #undef RATSLAM_LOAD
@@ -197,11 +206,13 @@ class OsMesaRenderer : public SceneRenderer {
     gl_.BindRenderbuffer(GL_RENDERBUFFER, renderbuffers[0]);
     gl_.RenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_RGBA8, w, h);
     gl_.BindFramebuffer(GL_FRAMEBUFFER, framebuffers[0]);
-    gl_.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, renderbuffers[0]);
+    gl_.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER,
+                                renderbuffers[0]);
     gl_.BindRenderbuffer(GL_RENDERBUFFER, renderbuffers[1]);
     gl_.RenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, w, h);
     gl_.BindFramebuffer(GL_FRAMEBUFFER, framebuffers[1]);
-    gl_.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, renderbuffers[1]);
+    gl_.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER,
+                                renderbuffers[1]);
     const bool complete = gl_.CheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
     gl_.BindFramebuffer(GL_FRAMEBUFFER, framebuffers[0]);
     const bool ms_complete = gl_.CheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;

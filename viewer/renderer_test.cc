@@ -16,8 +16,8 @@ std::unique_ptr<SceneRenderer> MakeRenderer() {
   return std::move(renderer.value());
 }
 
-#define REQUIRE_RENDERER(r)                                                          \
-  auto r = MakeRenderer();                                                           \
+#define REQUIRE_RENDERER(r) \
+  auto r = MakeRenderer();  \
   if (!r) GTEST_SKIP() << "OSMesa unavailable: " << CreateOsMesaRenderer().status().message()
 
 TEST(OsMesaRendererTest, ImageIsTheRightWayUpAndColoursAreExact) {
@@ -35,7 +35,8 @@ TEST(OsMesaRendererTest, ImageIsTheRightWayUpAndColoursAreExact) {
   EXPECT_EQ((std::array<int, 3>{top.r, top.g, top.b}), (std::array<int, 3>{255, 0, 0}));
   EXPECT_EQ((std::array<int, 3>{bottom.r, bottom.g, bottom.b}), (std::array<int, 3>{0, 0, 255}));
   EXPECT_EQ((std::array<int, 3>{left.r, left.g, left.b}), (std::array<int, 3>{0, 255, 0}));
-  EXPECT_EQ((std::array<int, 3>{middle.r, middle.g, middle.b}), (std::array<int, 3>{255, 255, 255}));
+  EXPECT_EQ((std::array<int, 3>{middle.r, middle.g, middle.b}),
+            (std::array<int, 3>{255, 255, 255}));
 }
 
 TEST(OsMesaRendererTest, DiagonalLinesAreAntialiased) {
@@ -105,8 +106,8 @@ TEST(OsMesaRendererTest, MissingLibraryIsAClearError) {
 }
 
 TEST(PngTest, WriteReadRoundTrip) {
-  RgbaImage image{3, 2, {1, 2, 3, 255, 4, 5, 6, 255, 7, 8, 9, 255, 10, 11, 12, 255, 13, 14, 15,
-                         255, 16, 17, 18, 128}};
+  RgbaImage image{3, 2, {1,  2,  3,  255, 4,  5,  6,  255, 7,  8,  9,  255,
+                         10, 11, 12, 255, 13, 14, 15, 255, 16, 17, 18, 128}};
   const auto path = std::filesystem::temp_directory_path() / "ratslam_png_test.png";
   ASSERT_TRUE(WritePng(image, path.string()).ok());
   StatusOr<RgbaImage> back = ReadPng(path.string());

@@ -39,8 +39,7 @@ std::vector<TemplateGraphPoint> TemplateGraphOf(const ReplayPipeline& pipeline) 
   std::vector<TemplateGraphPoint> points;
   points.reserve(pipeline.state().frames.size());
   for (const FrameRecord& f : pipeline.state().frames) {
-    points.push_back({f.time_s, f.template_id, f.experience_id,
-                      f.source});
+    points.push_back({f.time_s, f.template_id, f.experience_id, f.source});
   }
   return points;
 }
@@ -67,8 +66,8 @@ Status WriteRunImages(SceneRenderer& renderer, const ReplayPipeline& pipeline,
   graph_options.title = "template graph (" + dataset.name + ")";
   // Every other session shaded.
   for (size_t i = 0; sessions.size() > 1 && i < sessions.size(); i += 2) {
-    const double end = i + 1 < sessions.size() ? sessions[i + 1]
-                                               : std::numeric_limits<double>::infinity();
+    const double end =
+        i + 1 < sessions.size() ? sessions[i + 1] : std::numeric_limits<double>::infinity();
     graph_options.shaded_spans.push_back({sessions[i], end, "session " + std::to_string(i + 1)});
   }
   RATSLAM_RETURN_IF_ERROR(

@@ -11,15 +11,14 @@ namespace ratslam {
 namespace {
 namespace fs = std::filesystem;
 
-#define READ_NUMBER(lhs, table, row, column)                 \
-  do {                                                       \
-    StatusOr<double> value_ = (table).Number(row, column);   \
-    if (!value_.ok()) return value_.status();                \
-    lhs = value_.value();                                    \
+#define READ_NUMBER(lhs, table, row, column)               \
+  do {                                                     \
+    StatusOr<double> value_ = (table).Number(row, column); \
+    if (!value_.ok()) return value_.status();              \
+    lhs = value_.value();                                  \
   } while (false)
 
-Status ReadId(const CsvTable& t, size_t row, const std::string& column, int64_t min,
-              int64_t* out) {
+Status ReadId(const CsvTable& t, size_t row, const std::string& column, int64_t min, int64_t* out) {
   double v = 0;
   READ_NUMBER(v, t, row, column);
   if (v != std::floor(v) || v < static_cast<double>(min) || v > 4e9) {
@@ -33,10 +32,9 @@ Status ReadId(const CsvTable& t, size_t row, const std::string& column, int64_t 
 
 StatusOr<RunFolder> ReadRunFolder(const std::string& folder) {
   RunFolder run;
-  StatusOr<CsvTable> ex = CsvTable::Read(
-      (fs::path(folder) / "experiences.csv").string(),
-      {"id", "x_m", "y_m", "theta_rad", "template_id", "time_s"},
-      {"pose_cell_x", "pose_cell_y", "pose_cell_theta"});
+  StatusOr<CsvTable> ex = CsvTable::Read((fs::path(folder) / "experiences.csv").string(),
+                                         {"id", "x_m", "y_m", "theta_rad", "template_id", "time_s"},
+                                         {"pose_cell_x", "pose_cell_y", "pose_cell_theta"});
   if (!ex.ok()) return ex.status();
   for (size_t r = 0; r < ex->rows(); ++r) {
     Experience e;
@@ -52,10 +50,9 @@ StatusOr<RunFolder> ReadRunFolder(const std::string& folder) {
     READ_NUMBER(e.time_s, *ex, r, "time_s");
     run.experiences.push_back(e);
   }
-  StatusOr<CsvTable> li = CsvTable::Read(
-      (fs::path(folder) / "links.csv").string(),
-      {"id", "from_id", "to_id", "distance_m", "heading_rad", "facing_rad", "duration_s",
-       "loop_closure"});
+  StatusOr<CsvTable> li = CsvTable::Read((fs::path(folder) / "links.csv").string(),
+                                         {"id", "from_id", "to_id", "distance_m", "heading_rad",
+                                          "facing_rad", "duration_s", "loop_closure"});
   if (!li.ok()) return li.status();
   const int64_t n = static_cast<int64_t>(run.experiences.size());
   for (size_t r = 0; r < li->rows(); ++r) {

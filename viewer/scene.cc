@@ -29,7 +29,8 @@ void Scene::Polyline(const std::vector<ScenePoint>& points, float width_px, Rgba
 void Scene::Disc(ScenePoint center, float radius_px, Rgba color, int segments) {
   const float step = 2.0f * static_cast<float>(M_PI) / segments;
   for (int i = 0; i < segments; ++i) {
-    Triangle(center, {center.x + radius_px * std::cos(i * step), center.y + radius_px * std::sin(i * step)},
+    Triangle(center,
+             {center.x + radius_px * std::cos(i * step), center.y + radius_px * std::sin(i * step)},
              {center.x + radius_px * std::cos((i + 1) * step),
               center.y + radius_px * std::sin((i + 1) * step)},
              color);
@@ -42,10 +43,14 @@ void Scene::Ring(ScenePoint center, float inner_radius_px, float outer_radius_px
   for (int i = 0; i < segments; ++i) {
     const float a0 = start_rad + i * step, a1 = a0 + step;
     // Angles are counter-clockwise on screen (y points down, so negate the sine).
-    const ScenePoint i0{center.x + inner_radius_px * std::cos(a0), center.y - inner_radius_px * std::sin(a0)};
-    const ScenePoint i1{center.x + inner_radius_px * std::cos(a1), center.y - inner_radius_px * std::sin(a1)};
-    const ScenePoint o0{center.x + outer_radius_px * std::cos(a0), center.y - outer_radius_px * std::sin(a0)};
-    const ScenePoint o1{center.x + outer_radius_px * std::cos(a1), center.y - outer_radius_px * std::sin(a1)};
+    const ScenePoint i0{center.x + inner_radius_px * std::cos(a0),
+                        center.y - inner_radius_px * std::sin(a0)};
+    const ScenePoint i1{center.x + inner_radius_px * std::cos(a1),
+                        center.y - inner_radius_px * std::sin(a1)};
+    const ScenePoint o0{center.x + outer_radius_px * std::cos(a0),
+                        center.y - outer_radius_px * std::sin(a0)};
+    const ScenePoint o1{center.x + outer_radius_px * std::cos(a1),
+                        center.y - outer_radius_px * std::sin(a1)};
     Triangle(i0, o0, o1, color);
     Triangle(i0, o1, i1, color);
   }

@@ -1,5 +1,7 @@
 #include "fusion/io/config.h"
 
+#include <toml++/toml.h>
+
 #include <charconv>
 #include <cmath>
 #include <fstream>
@@ -8,7 +10,6 @@
 #include <map>
 #include <set>
 #include <sstream>
-#include <toml++/toml.h>
 
 namespace ratslam {
 namespace {
@@ -40,8 +41,8 @@ class SectionReader {
     if (!status_.ok()) return status_;
     for (const auto& [key, node] : table_) {
       if (!used_.count(std::string(key.str()))) {
-        return Status::Error(Location(source_, &node) + ": unknown key '" +
-                             std::string(key.str()) + "' in [" + section_ + "]");
+        return Status::Error(Location(source_, &node) + ": unknown key '" + std::string(key.str()) +
+                             "' in [" + section_ + "]");
       }
     }
     return Status::Ok();

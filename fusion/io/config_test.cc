@@ -45,7 +45,8 @@ TEST(ConfigTest, UnknownSectionNamesLine) {
 TEST(ConfigTest, WrongTypeNamesLineAndKey) {
   EXPECT_EQ(ErrorOf("[experience_map]\n\nrelaxation_sweeps = 2.5\n"),
             "c.toml:3: [experience_map] relaxation_sweeps: expected an integer");
-  EXPECT_EQ(ErrorOf("[camera]\npanoramic = 1\n"), "c.toml:2: [camera] panoramic: expected true or false");
+  EXPECT_EQ(ErrorOf("[camera]\npanoramic = 1\n"),
+            "c.toml:2: [camera] panoramic: expected true or false");
 }
 
 TEST(ConfigTest, OutOfRangeValueNamesLine) {

@@ -21,7 +21,9 @@ void Field(ByteWriter& w, const PoseCellPosition& p) {
   w.Pod(p.y);
   w.Pod(p.theta);
 }
-bool Field(ByteReader& r, PoseCellPosition* p) { return r.Pod(&p->x) && r.Pod(&p->y) && r.Pod(&p->theta); }
+bool Field(ByteReader& r, PoseCellPosition* p) {
+  return r.Pod(&p->x) && r.Pod(&p->y) && r.Pod(&p->theta);
+}
 
 void Field(ByteWriter& w, const LocalOffset& o) {
   w.Pod(o.forward_m);
@@ -132,9 +134,8 @@ bool Decode(ByteReader& r, ReplayPipeline::State* s) {
   if (!(r.Pod(&lv.frame) && r.Count(8, &n))) return false;
   lv.templates.resize(n);
   for (ViewTemplate& t : lv.templates) {
-    if (!(r.Pod(&t.id) && Field(r, &t.pose_cells) && r.Pod(&t.created_time_s) &&
-          r.Pod(&t.decay) && r.Pod(&t.decay_frame) && r.Pod(&t.match_count) &&
-          r.PodVector(&t.experience_ids))) {
+    if (!(r.Pod(&t.id) && Field(r, &t.pose_cells) && r.Pod(&t.created_time_s) && r.Pod(&t.decay) &&
+          r.Pod(&t.decay_frame) && r.Pod(&t.match_count) && r.PodVector(&t.experience_ids))) {
       return false;
     }
   }

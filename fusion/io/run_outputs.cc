@@ -26,8 +26,8 @@ std::string TumLine(double t, double x, double y, double theta) {
 
 }  // namespace
 
-void RecordPose(const ExperienceMap& map, const TrajectoryRecord& record, double* x_m,
-                double* y_m, double* theta_rad) {
+void RecordPose(const ExperienceMap& map, const TrajectoryRecord& record, double* x_m, double* y_m,
+                double* theta_rad) {
   double x = 0, y = 0, theta = 0;
   if (record.experience_id >= 0) {
     const Experience& e = map.experience(static_cast<uint32_t>(record.experience_id));
@@ -83,8 +83,8 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
     for (const FrameRecord& f : state.frames) {
       if (f.is_new || f.recent) continue;  // only matches that can close a loop
       const auto now = InterpolateGroundTruth(dataset.ground_truth, f.time_s);
-      const auto then = InterpolateGroundTruth(
-          dataset.ground_truth, slam.local_view().at(f.template_id).created_time_s);
+      const auto then = InterpolateGroundTruth(dataset.ground_truth,
+                                               slam.local_view().at(f.template_id).created_time_s);
       if (!now || !then) continue;
       ++s.evaluated_matches;
       s.match_distances_m.push_back(std::hypot(now->x_m - then->x_m, now->y_m - then->y_m));
@@ -112,9 +112,12 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
     ++by_source[static_cast<int>(f.source)];
     recent += f.recent;
   }
-  j["frames_by_source"] = {{"camera", by_source[0]}, {"wifi", by_source[1]}, {"new", by_source[2]},
+  j["frames_by_source"] = {{"camera", by_source[0]},
+                           {"wifi", by_source[1]},
+                           {"new", by_source[2]},
                            {"recent_reuse", recent}};
-  if (dataset.session_start_times_s.size() > 1) j["sessions"] = dataset.session_start_times_s.size();
+  if (dataset.session_start_times_s.size() > 1)
+    j["sessions"] = dataset.session_start_times_s.size();
   j["events_done"] = state.next_event;
   j["events_total"] = state.events_total;
   j["finished"] = pipeline.finished();
@@ -157,7 +160,8 @@ StatusOr<RunSummary> WriteRunOutputs(const std::string& folder, const ReplayPipe
   const ReplayPipeline::State& state = pipeline.state();
 
   std::ostringstream experiences;
-  experiences << "id,x_m,y_m,theta_rad,template_id,time_s,pose_cell_x,pose_cell_y,pose_cell_theta\n";
+  experiences
+      << "id,x_m,y_m,theta_rad,template_id,time_s,pose_cell_x,pose_cell_y,pose_cell_theta\n";
   for (const Experience& e : map.experiences()) {
     experiences << e.id << ',' << Num(e.x_m) << ',' << Num(e.y_m) << ',' << Num(e.theta_rad) << ','
                 << e.template_id << ',' << Num(e.time_s) << ',' << Num(e.pose_cells.x) << ','
@@ -193,8 +197,9 @@ StatusOr<RunSummary> WriteRunOutputs(const std::string& folder, const ReplayPipe
         << Num(e.theta_rad) << '\n';
   }
   for (const Link& l : map.links()) {
-    g2o << "EDGE_SE2 " << l.from << ' ' << l.to << ' ' << Num(l.distance_m * std::cos(l.heading_rad))
-        << ' ' << Num(l.distance_m * std::sin(l.heading_rad)) << ' ' << Num(l.facing_rad)
+    g2o << "EDGE_SE2 " << l.from << ' ' << l.to << ' '
+        << Num(l.distance_m * std::cos(l.heading_rad)) << ' '
+        << Num(l.distance_m * std::sin(l.heading_rad)) << ' ' << Num(l.facing_rad)
         << " 1 0 0 1 0 1\n";
   }
   RATSLAM_RETURN_IF_ERROR(WriteFileAtomically(path("experience_map.g2o"), g2o.str()));

@@ -13,12 +13,12 @@
 namespace ratslam {
 
 struct RunInfo {
-  double wall_seconds = 0.0;        // of this process's replay (not of earlier resumed parts)
-  uint64_t frames_this_run = 0;     // view frames processed by this process
-  bool interrupted = false;         // stopped by a signal
-  std::string config_path;          // as given, or empty for built-in defaults
+  double wall_seconds = 0.0;     // of this process's replay (not of earlier resumed parts)
+  uint64_t frames_this_run = 0;  // view frames processed by this process
+  bool interrupted = false;      // stopped by a signal
+  std::string config_path;       // as given, or empty for built-in defaults
   uint64_t config_fingerprint = 0;
-  std::string resumed_from;         // map file, or empty
+  std::string resumed_from;  // map file, or empty
 };
 
 struct RunSummary {
@@ -33,8 +33,8 @@ struct RunSummary {
 };
 
 // The corrected pose of a trajectory record in the final map.
-void RecordPose(const ExperienceMap& map, const TrajectoryRecord& record, double* x_m,
-                double* y_m, double* theta_rad);
+void RecordPose(const ExperienceMap& map, const TrajectoryRecord& record, double* x_m, double* y_m,
+                double* theta_rad);
 
 RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, const RunInfo& info);
 

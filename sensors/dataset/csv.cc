@@ -37,7 +37,7 @@ StatusOr<CsvTable> CsvTable::Read(const std::string& path, const std::vector<std
   while (std::getline(in, line)) {
     ++line_number;
     if (line.find_first_not_of(" \t\r") == std::string::npos) continue;  // blank line
-    if (line[line.find_first_not_of(" \t")] == '#') continue;              // comment
+    if (line[line.find_first_not_of(" \t")] == '#') continue;            // comment
     std::vector<std::string> fields = SplitFields(line);
     if (!have_header) {
       for (size_t i = 0; i < fields.size(); ++i) {

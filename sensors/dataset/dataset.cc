@@ -1,12 +1,13 @@
 #include "sensors/dataset/dataset.h"
 
+#include <toml++/toml.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <toml++/toml.h>
 
 #include "ratslam/circular.h"
 #include "sensors/dataset/csv.h"
@@ -20,17 +21,18 @@ constexpr int kFormatVersion = 1;
 // Fails when time goes backwards between consecutive rows.
 Status CheckTimeOrder(const CsvTable& table, size_t row, double previous, double current) {
   if (row > 0 && current < previous) {
-    return table.ErrorAt(row, "time_s", "time goes backwards (" + std::to_string(current) +
-                                            " after " + std::to_string(previous) + ")");
+    return table.ErrorAt(row, "time_s",
+                         "time goes backwards (" + std::to_string(current) + " after " +
+                             std::to_string(previous) + ")");
   }
   return Status::Ok();
 }
 
-#define ASSIGN_OR_RETURN_NUMBER(lhs, table, row, column)  \
-  do {                                                    \
+#define ASSIGN_OR_RETURN_NUMBER(lhs, table, row, column)   \
+  do {                                                     \
     StatusOr<double> value_ = (table).Number(row, column); \
-    if (!value_.ok()) return value_.status();             \
-    lhs = value_.value();                                 \
+    if (!value_.ok()) return value_.status();              \
+    lhs = value_.value();                                  \
   } while (false)
 
 Status ReadOdometry(const std::string& path, Dataset* d) {
@@ -42,8 +44,7 @@ Status ReadOdometry(const std::string& path, Dataset* d) {
     ASSIGN_OR_RETURN_NUMBER(row.time_s, *t, r, "time_s");
     ASSIGN_OR_RETURN_NUMBER(row.forward_speed_m_per_s, *t, r, "forward_speed_m_per_s");
     ASSIGN_OR_RETURN_NUMBER(row.turn_rate_rad_per_s, *t, r, "turn_rate_rad_per_s");
-    RATSLAM_RETURN_IF_ERROR(
-        CheckTimeOrder(*t, r, r ? d->odometry.back().time_s : 0.0, row.time_s));
+    RATSLAM_RETURN_IF_ERROR(CheckTimeOrder(*t, r, r ? d->odometry.back().time_s : 0.0, row.time_s));
     d->odometry.push_back(row);
   }
   return Status::Ok();
@@ -156,8 +157,8 @@ StatusOr<Dataset> ReadDataset(const std::string& folder) {
   Dataset d;
   d.folder = folder;
   static const std::vector<std::string> kTopKeys = {"format", "format_version", "name", "streams"};
-  static const std::vector<std::string> kStreams = {"odometry", "images",  "image_folder",
-                                                    "ground_truth", "wifi", "compass"};
+  static const std::vector<std::string> kStreams = {"odometry",     "images", "image_folder",
+                                                    "ground_truth", "wifi",   "compass"};
   for (const auto& [key, node] : manifest) {
     if (std::find(kTopKeys.begin(), kTopKeys.end(), key.str()) == kTopKeys.end()) {
       return error_at(&node, "unknown key '" + std::string(key.str()) + "'");
@@ -167,9 +168,9 @@ StatusOr<Dataset> ReadDataset(const std::string& folder) {
     return error_at(manifest.get("format"), "format must be \"ratslam-replay\"");
   }
   if (manifest["format_version"].value_or(0) != kFormatVersion) {
-    return error_at(manifest.get("format_version"),
-                    "unsupported format_version (this program reads " +
-                        std::to_string(kFormatVersion) + ")");
+    return error_at(
+        manifest.get("format_version"),
+        "unsupported format_version (this program reads " + std::to_string(kFormatVersion) + ")");
   }
   d.name = manifest["name"].value_or(fs::path(folder).filename().string());
   const toml::table* streams = manifest["streams"].as_table();
@@ -203,7 +204,8 @@ Status WriteDataset(const Dataset& d, const std::string& folder) {
   if (ec) return Status::Error(folder + ": cannot create folder: " + ec.message());
   auto open = [&](const std::string& name, std::ofstream& out) {
     out.open(fs::path(folder) / name);
-    return out ? Status::Ok() : Status::Error((fs::path(folder) / name).string() + ": cannot write");
+    return out ? Status::Ok()
+               : Status::Error((fs::path(folder) / name).string() + ": cannot write");
   };
   std::ofstream manifest;
   RATSLAM_RETURN_IF_ERROR(open("manifest.toml", manifest));

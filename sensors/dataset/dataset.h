@@ -52,7 +52,7 @@ struct CompassRow {
 
 struct Dataset {
   std::string name;
-  std::string folder;       // where it was read from (empty for one made in memory)
+  std::string folder;                   // where it was read from (empty for one made in memory)
   std::string image_folder = "images";  // relative to `folder`
   std::vector<OdometryRow> odometry;
   std::vector<ImageRow> images;

@@ -1,12 +1,12 @@
 #include "sensors/dataset/dataset_loader.h"
 
-#include "sensors/dataset/msft_log.h"
-
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
+
+#include "sensors/dataset/msft_log.h"
 
 namespace ratslam {
 namespace fs = std::filesystem;
@@ -22,7 +22,8 @@ StatusOr<DatasetFormat> DetectDatasetFormat(const std::string& path) {
   for (int i = 0; i < 200 && std::getline(in, line); ++i) {
     if (line.empty() || line[0] == '%') continue;
     if (line[0] == '#') {
-      if (line.find("SiteID:") != std::string::npos || line.find("startTime:") != std::string::npos) {
+      if (line.find("SiteID:") != std::string::npos ||
+          line.find("startTime:") != std::string::npos) {
         return DatasetFormat::kMicrosoftLog;
       }
       continue;
@@ -32,7 +33,9 @@ StatusOr<DatasetFormat> DetectDatasetFormat(const std::string& path) {
       if (line.rfind(type, 0) == 0) return DatasetFormat::kIpinLog;
     }
   }
-  return Status::Error(path + ": unknown data-set format (expected a replay folder, an IPIN log or a Microsoft walk)");
+  return Status::Error(
+      path +
+      ": unknown data-set format (expected a replay folder, an IPIN log or a Microsoft walk)");
 }
 
 StatusOr<Dataset> LoadDataset(const std::string& path, const PhoneLogOptions& phone_options) {
@@ -64,10 +67,10 @@ StatusOr<Dataset> LoadSessions(const std::vector<std::string>& paths,
     PhoneLogReport report;
     StatusOr<DatasetFormat> format = DetectDatasetFormat(path);
     if (!format.ok()) return format.status();
-    StatusOr<Dataset> d = format.value() == DatasetFormat::kIpinLog ? ReadIpinLog(path, options, &report)
-                          : format.value() == DatasetFormat::kMicrosoftLog
-                              ? ReadMicrosoftLog(path, options, &report)
-                              : ReadDataset(path);
+    StatusOr<Dataset> d =
+        format.value() == DatasetFormat::kIpinLog        ? ReadIpinLog(path, options, &report)
+        : format.value() == DatasetFormat::kMicrosoftLog ? ReadMicrosoftLog(path, options, &report)
+                                                         : ReadDataset(path);
     if (!d.ok()) return d.status();
     if (format.value() == DatasetFormat::kIpinLog && !options.reference) {
       options.reference = report.reference;  // later logs share the first log's frame

@@ -81,16 +81,14 @@ TEST_F(DatasetTest, NanNamesColumn) {
 TEST_F(DatasetTest, NotANumberNamesColumn) {
   Write("ground_truth.csv", "time_s,x_m,y_m\n0,0,0\n1,ten,0\n");
   const std::string error = ReadError();
-  EXPECT_NE(error.find("ground_truth.csv:3: column 'x_m': not a number: 'ten'"),
-            std::string::npos)
+  EXPECT_NE(error.find("ground_truth.csv:3: column 'x_m': not a number: 'ten'"), std::string::npos)
       << error;
 }
 
 TEST_F(DatasetTest, TimeGoingBackwardsIsAnError) {
   Write("odometry.csv", "time_s,forward_speed_m_per_s,turn_rate_rad_per_s\n1,0,0\n0.5,0,0\n");
   const std::string error = ReadError();
-  EXPECT_NE(error.find("odometry.csv:3: column 'time_s': time goes backwards"),
-            std::string::npos)
+  EXPECT_NE(error.find("odometry.csv:3: column 'time_s': time goes backwards"), std::string::npos)
       << error;
 }
 
@@ -174,7 +172,8 @@ TEST(ImageLoaderTest, MissingAndCorruptFilesAreErrors) {
   FileImageLoader loader;
   EXPECT_NE(loader.Load("/nonexistent/x.png").status().message().find("image file missing"),
             std::string::npos);
-  const fs::path bad = fs::temp_directory_path() / ("ratslam_bad_" + std::to_string(::getpid()) + ".png");
+  const fs::path bad =
+      fs::temp_directory_path() / ("ratslam_bad_" + std::to_string(::getpid()) + ".png");
   std::ofstream(bad) << "not a png";
   EXPECT_FALSE(loader.Load(bad.string()).ok());
   fs::remove(bad);

@@ -4,8 +4,8 @@
 #include <charconv>
 #include <cmath>
 #include <filesystem>
-#include <limits>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <numbers>
 
@@ -21,7 +21,8 @@ std::vector<std::string> Split(const std::string& line) {
   size_t start = 0;
   while (true) {
     const size_t end = line.find(';', start);
-    fields.push_back(line.substr(start, end == std::string::npos ? std::string::npos : end - start));
+    fields.push_back(
+        line.substr(start, end == std::string::npos ? std::string::npos : end - start));
     if (end == std::string::npos) break;
     start = end + 1;
   }
@@ -134,11 +135,13 @@ StatusOr<Dataset> ReadIpinLog(const std::string& path, const PhoneLogOptions& op
       return Status::Error(path + ":" + std::to_string(number) + ": " + type + ": " + what);
     };
     std::vector<double> v(f.size(), 0.0);
-    auto numbers = [&](std::initializer_list<size_t> indices, std::initializer_list<const char*> names) {
+    auto numbers = [&](std::initializer_list<size_t> indices,
+                       std::initializer_list<const char*> names) {
       auto name = names.begin();
       for (size_t i : indices) {
         if (i >= f.size()) return fail(std::string("missing field ") + *name);
-        if (!ParseDouble(f[i], &v[i])) return fail(std::string(*name) + " is not a number: '" + f[i] + "'");
+        if (!ParseDouble(f[i], &v[i]))
+          return fail(std::string(*name) + " is not a number: '" + f[i] + "'");
         ++name;
       }
       return Status::Ok();
@@ -180,14 +183,14 @@ StatusOr<Dataset> ReadIpinLog(const std::string& path, const PhoneLogOptions& op
     first_time = std::min(first_time, v[1]);
   }
   if (in.bad()) return Status::Error(path + ": read error");
-  if (!std::isfinite(first_time)) return Status::Error(path + ": no sensor lines (not an IPIN log?)");
+  if (!std::isfinite(first_time))
+    return Status::Error(path + ": no sensor lines (not an IPIN log?)");
 
   std::stable_sort(posi.begin(), posi.end(),
                    [](const Posi& a, const Posi& b) { return a.time_s < b.time_s; });
   if (!posi.empty()) {
-    r.reference = options.reference
-                      ? *options.reference
-                      : GeoReference{posi.front().latitude, posi.front().longitude};
+    r.reference = options.reference ? *options.reference
+                                    : GeoReference{posi.front().latitude, posi.front().longitude};
     for (const Posi& p : posi) {
       GroundTruthRow row;
       row.time_s = p.time_s;

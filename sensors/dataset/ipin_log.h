@@ -29,18 +29,18 @@ void GeoToLocal(const GeoReference& reference, double latitude_deg, double longi
                 double* x_m, double* y_m);
 
 struct PhoneLogOptions {
-  bool lenient = false;             // skip (and count) malformed lines instead of failing
-  PdrOptions pdr;                   // step detection and length
-  double compass_rate_hz = 10.0;    // compass events kept per second (AHRS arrives at ~100 Hz)
+  bool lenient = false;           // skip (and count) malformed lines instead of failing
+  PdrOptions pdr;                 // step detection and length
+  double compass_rate_hz = 10.0;  // compass events kept per second (AHRS arrives at ~100 Hz)
   std::optional<GeoReference> reference;  // default: the log's first POSI point
 };
 
 struct PhoneLogReport {
   size_t lines = 0;
-  size_t skipped_malformed = 0;   // only in lenient mode
+  size_t skipped_malformed = 0;  // only in lenient mode
   size_t skipped_other_types = 0;
   size_t steps = 0;
-  GeoReference reference;         // the reference actually used
+  GeoReference reference;  // the reference actually used
 };
 
 // Reads one log. Errors name the file and line ("log.txt:812: WIFI: RSS(dBm) is not a number").

@@ -45,7 +45,8 @@ TEST(IpinLogTest, ReadsScansCompassAndGroundTruth) {
   ASSERT_EQ(d->ground_truth.size(), 2u);
   EXPECT_EQ(d->ground_truth[0].x_m, 0.0);
   // Second point: 0.0000408 deg south, 0.0000239 deg east of the first.
-  EXPECT_NEAR(d->ground_truth[1].y_m, -(49.461316433032 - 49.461275602490) * M_PI / 180 * 6371008.8, 1e-6);
+  EXPECT_NEAR(d->ground_truth[1].y_m, -(49.461316433032 - 49.461275602490) * M_PI / 180 * 6371008.8,
+              1e-6);
   EXPECT_GT(d->ground_truth[1].x_m, 1.0);
   EXPECT_EQ(report.skipped_other_types, 1u);
   EXPECT_EQ(DetectDatasetFormat(path.string()).value(), DatasetFormat::kIpinLog);
@@ -55,12 +56,13 @@ TEST(IpinLogTest, ReadsScansCompassAndGroundTruth) {
 TEST(IpinLogTest, BrokenLinesNameFileAndLineOrAreCountedWhenLenient) {
   std::string text = kFixture;
   text += "WIFI;5.0;105.0;net;aa:bb;2437;strong\n";  // line 11
-  text += "ACCE;5.1;105.1;0.1\n";                      // line 12: truncated
+  text += "ACCE;5.1;105.1;0.1\n";                    // line 12: truncated
   const fs::path path = WriteFixture("ratslam_ipin_broken.txt", text);
   StatusOr<Dataset> strict = ReadIpinLog(path.string(), {});
   ASSERT_FALSE(strict.ok());
-  EXPECT_NE(strict.status().message().find("ratslam_ipin_broken.txt:11: WIFI: RSS(dBm) is not a number"),
-            std::string::npos)
+  EXPECT_NE(
+      strict.status().message().find("ratslam_ipin_broken.txt:11: WIFI: RSS(dBm) is not a number"),
+      std::string::npos)
       << strict.status().message();
   PhoneLogOptions lenient;
   lenient.lenient = true;

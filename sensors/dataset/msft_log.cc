@@ -28,7 +28,8 @@ std::vector<std::string> SplitTabs(const std::string& line) {
 bool ParseNumber(const std::string& text, double* value) {
   if (text.empty()) return false;
   const auto result = std::from_chars(text.data(), text.data() + text.size(), *value);
-  return result.ec == std::errc() && result.ptr == text.data() + text.size() && std::isfinite(*value);
+  return result.ec == std::errc() && result.ptr == text.data() + text.size() &&
+         std::isfinite(*value);
 }
 
 }  // namespace

@@ -34,11 +34,12 @@ class LoopPath {
     const double arc = kPi / 2 * radius_;
     // Segments: bottom edge (east), corner, right edge (north), corner, top (west), corner,
     // left edge (south), corner.
-    const double lengths[8] = {straight_x_, arc, straight_y_, arc, straight_x_, arc, straight_y_, arc};
+    const double lengths[8] = {straight_x_, arc, straight_y_, arc,
+                               straight_x_, arc, straight_y_, arc};
     const double start_headings[4] = {0, kPi / 2, kPi, 3 * kPi / 2};
     const double corners[4][2] = {{hx, -hy}, {hx, hy}, {-hx, hy}, {-hx, -hy}};
-    const double starts[4][2] = {{-hx, -hy - radius_}, {hx + radius_, -hy}, {hx, hy + radius_},
-                                 {-hx - radius_, hy}};
+    const double starts[4][2] = {
+        {-hx, -hy - radius_}, {hx + radius_, -hy}, {hx, hy + radius_}, {-hx - radius_, hy}};
     Pose p{};
     for (int i = 0; i < 8; ++i) {
       if (s <= lengths[i] || i == 7) {
@@ -107,8 +108,8 @@ void Render(const SyntheticOptions& o, const std::vector<Pillar>& pillars, const
   const double camera_height_m = 0.5;
   for (int c = 0; c < w; ++c) {
     // Columns run clockwise: the left edge looks furthest to the left.
-    const double bearing = pose.theta + 0.5 * o.field_of_view_rad -
-                           (c + 0.5) / w * o.field_of_view_rad;
+    const double bearing =
+        pose.theta + 0.5 * o.field_of_view_rad - (c + 0.5) / w * o.field_of_view_rad;
     const double dx = std::cos(bearing), dy = std::sin(bearing);
     double nearest = 1e9;
     const Pillar* hit = nullptr;

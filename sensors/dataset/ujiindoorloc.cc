@@ -41,8 +41,8 @@ StatusOr<std::vector<LabelledScan>> ReadUjiIndoorLoc(const std::string& path, bo
   if (!std::getline(in, line)) return Status::Error(path + ": empty file");
   const std::vector<std::string> header = SplitCommas(line);
   std::vector<size_t> waps;
-  const char* labels[] = {"LONGITUDE", "LATITUDE", "FLOOR", "BUILDINGID", "SPACEID",
-                          "RELATIVEPOSITION", "USERID", "PHONEID", "TIMESTAMP"};
+  const char* labels[] = {"LONGITUDE",        "LATITUDE", "FLOOR",   "BUILDINGID", "SPACEID",
+                          "RELATIVEPOSITION", "USERID",   "PHONEID", "TIMESTAMP"};
   std::vector<int> label_column(std::size(labels), -1);
   for (size_t i = 0; i < header.size(); ++i) {
     if (header[i].rfind("WAP", 0) == 0) {
@@ -73,7 +73,8 @@ StatusOr<std::vector<LabelledScan>> ReadUjiIndoorLoc(const std::string& path, bo
     ++r.rows;
     const std::vector<std::string> f = SplitCommas(line);
     auto error = [&](const std::string& column, const std::string& what) {
-      return Status::Error(path + ":" + std::to_string(number) + ": column '" + column + "': " + what);
+      return Status::Error(path + ":" + std::to_string(number) + ": column '" + column +
+                           "': " + what);
     };
     Status status;
     LabelledScan s;

@@ -9,8 +9,9 @@ namespace ratslam {
 namespace {
 namespace fs = std::filesystem;
 
-const char kHeader[] = "WAP001,WAP002,WAP003,LONGITUDE,LATITUDE,FLOOR,BUILDINGID,SPACEID,"
-                       "RELATIVEPOSITION,USERID,PHONEID,TIMESTAMP\n";
+const char kHeader[] =
+    "WAP001,WAP002,WAP003,LONGITUDE,LATITUDE,FLOOR,BUILDINGID,SPACEID,"
+    "RELATIVEPOSITION,USERID,PHONEID,TIMESTAMP\n";
 
 fs::path Write(const std::string& name, const std::string& text) {
   const fs::path p = fs::temp_directory_path() / name;
@@ -19,8 +20,9 @@ fs::path Write(const std::string& name, const std::string& text) {
 }
 
 TEST(UjiIndoorLocTest, NotDetectedIsDropped) {
-  const fs::path p = Write("ratslam_uji.csv", std::string(kHeader) +
-                                                  "100,-71,100,-7541.26,4864920.77,2,1,106,2,2,23,1371713733\n");
+  const fs::path p =
+      Write("ratslam_uji.csv",
+            std::string(kHeader) + "100,-71,100,-7541.26,4864920.77,2,1,106,2,2,23,1371713733\n");
   StatusOr<std::vector<LabelledScan>> scans = ReadUjiIndoorLoc(p.string());
   ASSERT_TRUE(scans.ok()) << scans.status().message();
   ASSERT_EQ(scans->size(), 1u);
@@ -34,9 +36,10 @@ TEST(UjiIndoorLocTest, NotDetectedIsDropped) {
 }
 
 TEST(UjiIndoorLocTest, BrokenRowsNameLineAndColumn) {
-  const fs::path p = Write("ratslam_uji_bad.csv",
-                           std::string(kHeader) + "100,-71,100,-7541.26,4864920.77,2,1,106,2,2,23,1\n" +
-                               "100,abc,100,-7541.26,4864920.77,2,1,106,2,2,23,1\n" + "100,-71\n");
+  const fs::path p =
+      Write("ratslam_uji_bad.csv",
+            std::string(kHeader) + "100,-71,100,-7541.26,4864920.77,2,1,106,2,2,23,1\n" +
+                "100,abc,100,-7541.26,4864920.77,2,1,106,2,2,23,1\n" + "100,-71\n");
   StatusOr<std::vector<LabelledScan>> strict = ReadUjiIndoorLoc(p.string());
   ASSERT_FALSE(strict.ok());
   EXPECT_NE(strict.status().message().find("ratslam_uji_bad.csv:3: column 'WAP002': not a number"),
