@@ -69,7 +69,8 @@ const char kUsage[] =
     "                 [--color time|session] [--sessions T1,T2,...]\n"
     "  ratslam render template-graph --run O [--out F] [--size WxH] [--spans A-B:label,...]\n"
     "  ratslam render pose-cells --map F [--config C] --out F\n"
-    "  ratslam render similarity --data D [--config C] --out F [--frames N]\n"
+    "  ratslam render similarity --data D [--data D2 ...] [--config C] --out F [--frames N]\n"
+    "                 [--sensor camera|wifi]\n"
     "      Images from a run folder, a saved map, or a data set (PNG).\n";
 
 struct ReplayRequest {

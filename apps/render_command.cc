@@ -7,6 +7,7 @@
 #include "fusion/io/config.h"
 #include "fusion/io/map_file.h"
 #include "sensors/dataset/dataset.h"
+#include "sensors/dataset/dataset_loader.h"
 #include "sensors/dataset/image_loader.h"
 #include "viewer/figures.h"
 #include "viewer/renderer.h"
@@ -25,7 +26,8 @@ const char kRenderUsage[] =
     "                 [--color time|session] [--sessions T1,T2,...]\n"
     "  ratslam render template-graph --run O [--out F] [--size WxH] [--spans A-B:label,...]\n"
     "  ratslam render pose-cells --map F [--config C] --out F\n"
-    "  ratslam render similarity --data D [--config C] --out F [--frames N]\n";
+    "  ratslam render similarity --data D [--data D2 ...] [--config C] --out F [--frames N]\n"
+    "                 [--sensor camera|wifi]\n";
 
 int Fail(const std::string& message) {
   std::cerr << "ratslam: " << message << "\n";
@@ -186,15 +188,24 @@ int RenderSimilarity(const Arguments& args) {
     if (!n || *n < 2 || *n > 5000) return Fail("--frames must be in 2..5000");
     frames = static_cast<int>(*n);
   }
-  StatusOr<Dataset> dataset = ReadDataset(args.values.at("--data"));
+  PhoneLogOptions phone;
+  phone.pdr = options->pdr;
+  StatusOr<Dataset> dataset = LoadSessions(args.all.at("--data"), phone);
   if (!dataset.ok()) return Fail(dataset.status().message());
-  FileImageLoader images;
-  StatusOr<SimilarityMatrix> m =
-      CameraSimilarityMatrix(dataset.value(), &images, options->sensors.classic_camera, frames);
-  if (!m.ok()) return Fail(m.status().message());
+  const std::string sensor = args.values.count("--sensor") ? args.values.at("--sensor") : "camera";
   SimilarityImageOptions image_options;
-  image_options.title = "camera template similarity (" + dataset->name + ")";
-  image_options.value_label = "similarity";
+  StatusOr<SimilarityMatrix> m =
+      Status::Error("--sensor must be camera or wifi, not '" + sensor + "'");
+  if (sensor == "camera") {
+    FileImageLoader images;
+    m = CameraSimilarityMatrix(dataset.value(), &images, options->sensors.classic_camera, frames);
+    image_options.title = "camera template similarity (" + dataset->name + ")";
+  } else if (sensor == "wifi") {
+    m = WifiSimilarityMatrix(dataset.value(), options->sensors.wifi, frames);
+    image_options.title = "Wi-Fi similarity, eq. 6 (" + dataset->name + ")";
+    image_options.value_label = "weight w";
+  }
+  if (!m.ok()) return Fail(m.status().message());
   Status status =
       Write(SimilarityMatrixScene(m->values, m->times_s, image_options), args.values.at("--out"));
   return status.ok() ? kExitOk : Fail(status.message());
@@ -210,7 +221,7 @@ int RenderCommand(int argc, char** argv) {
   const std::string what = argv[2];
   auto args = ParseArguments(argc, argv, 3,
                              {"--run", "--data", "--out", "--size", "--color", "--sessions",
-                              "--spans", "--map", "--config", "--frames"});
+                              "--spans", "--map", "--config", "--frames", "--sensor"});
   if (!args || !args->positional.empty()) {
     std::cerr << kRenderUsage;
     return kExitUsage;

@@ -65,6 +65,16 @@ TEST(IpinEndToEndTest, WifiRatslamClosesOutAndBackLoops) {
   EXPECT_GE(within_10, chance + 0.3) << "chance " << chance;
   EXPECT_EQ(s["floor_mistakes"], 0);
   EXPECT_LT(s["map_ate_m"].get<double>(), 0.7 * s["odometry_ate_m"].get<double>());
+  // The Wi-Fi similarity matrix of the same walks (the Wi-Fi loop-closure paper's figure 9).
+  const fs::path png = out / "wifi_similarity.png";
+  const std::string render = std::string(RATSLAM_BINARY) +
+                             " render similarity --sensor wifi --data " + a.string() + " --data " +
+                             b.string() + " --out " + png.string() + " 2> /dev/null";
+  const int status = std::system(render.c_str());
+  const bool have_osmesa = WEXITSTATUS(status) == 0;
+  if (have_osmesa) {
+    EXPECT_GT(fs::file_size(png), 10000u);
+  }
   fs::remove_all(out);
 }
 

@@ -42,4 +42,29 @@ StatusOr<SimilarityMatrix> CameraSimilarityMatrix(const Dataset& dataset, ImageL
   return m;
 }
 
+StatusOr<SimilarityMatrix> WifiSimilarityMatrix(const Dataset& dataset,
+                                                const WifiMatcherOptions& options, int max_scans) {
+  if (dataset.wifi.empty())
+    return Status::Error(dataset.name + ": the data set has no Wi-Fi scans");
+  if (max_scans < 2) return Status::Error("max_scans must be at least 2");
+  const size_t total = dataset.wifi.size();
+  const size_t n = std::min(total, static_cast<size_t>(max_scans));
+  WifiFingerprintMatcher matcher(options);
+  std::vector<Fingerprint> fingerprints;
+  SimilarityMatrix m;
+  for (size_t i = 0; i < n; ++i) {
+    const WifiScan& scan = dataset.wifi[i * (total - 1) / std::max<size_t>(n - 1, 1)];
+    std::vector<std::pair<std::string, double>> readings;
+    for (const WifiReading& r : scan.readings) readings.emplace_back(r.bssid, r.rssi_dbm);
+    fingerprints.push_back(matcher.MakeFingerprint(readings));
+    matcher.Add(fingerprints.back());
+    m.times_s.push_back(scan.time_s);
+  }
+  for (const Fingerprint& f : fingerprints) {
+    for (double w : matcher.Weights(f)) m.values.push_back(static_cast<float>(w));
+  }
+  m.reference_difference = 0.0;
+  return m;
+}
+
 }  // namespace ratslam

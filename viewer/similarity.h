@@ -8,6 +8,7 @@
 #include "sensors/classic_camera_matcher.h"
 #include "sensors/dataset/dataset.h"
 #include "sensors/dataset/image_loader.h"
+#include "sensors/wifi_fingerprint_matcher.h"
 
 namespace ratslam {
 
@@ -23,6 +24,11 @@ struct SimilarityMatrix {
 StatusOr<SimilarityMatrix> CameraSimilarityMatrix(const Dataset& dataset, ImageLoader* images,
                                                   const ClassicCameraOptions& options,
                                                   int max_frames);
+
+// Pairwise Wi-Fi similarity between at most `max_scans` evenly spaced scans: the weight of eq. 6
+// (already in [0, 1]; 1 for identical scans).
+StatusOr<SimilarityMatrix> WifiSimilarityMatrix(const Dataset& dataset,
+                                                const WifiMatcherOptions& options, int max_scans);
 
 }  // namespace ratslam
 

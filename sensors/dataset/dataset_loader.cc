@@ -116,7 +116,8 @@ StatusOr<Dataset> LoadSessions(const std::vector<std::string>& paths,
     if (joined.name.empty()) joined.name = d->name;
     end_of_previous = last + shift;
   }
-  joined.name += " +" + std::to_string(paths.size() - 1) + " sessions";
+  joined.name +=
+      " +" + std::to_string(paths.size() - 1) + (paths.size() == 2 ? " session" : " sessions");
   return joined;
 }
 
