@@ -192,8 +192,13 @@ Scene ExperienceMapScene(const ExperienceMapImageData& data,
     min_y = std::min(min_y, y);
     max_y = std::max(max_y, y);
   };
-  for (const Experience& e : data.experiences) include(e.x_m, e.y_m);
-  for (const Point2& p : data.ground_truth) include(p.x, p.y);
+  if (options.bounds) {
+    include(options.bounds->min_x_m, options.bounds->min_y_m);
+    include(options.bounds->max_x_m, options.bounds->max_y_m);
+  } else {
+    for (const Experience& e : data.experiences) include(e.x_m, e.y_m);
+    for (const Point2& p : data.ground_truth) include(p.x, p.y);
+  }
   if (!std::isfinite(min_x)) {
     min_x = min_y = -1;
     max_x = max_y = 1;

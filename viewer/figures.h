@@ -37,9 +37,15 @@ struct WorldToImage {
 
 enum class MapColoring { kTime, kSession };
 
+// A world-space view window, metres.
+struct WorldBounds {
+  double min_x_m = 0, min_y_m = 0, max_x_m = 0, max_y_m = 0;
+};
+
 struct ExperienceMapImageOptions {
   int width_px = 1600;
   int height_px = 1200;
+  std::optional<WorldBounds> bounds;  // fixed view (e.g. shared by per-floor panels); default: fit
   MapColoring coloring = MapColoring::kTime;
   std::vector<double> session_start_times_s;  // ascending; sessions for kSession colouring
   std::string title;

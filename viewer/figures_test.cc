@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "viewer/renderer.h"
+#include "viewer/run_images.h"
 
 namespace ratslam {
 namespace {
@@ -95,6 +96,34 @@ TEST(ExperienceMapSceneTest, RenderedNodesAreWhereTheWorldSays) {
   EXPECT_TRUE(is_ink(t(10, 0)));   // on the first link
   EXPECT_FALSE(is_ink(t(5, 8)));   // empty corner of the L
   EXPECT_FALSE(is_ink(t(0, 10)));  // mirrored position of node 2: would be inked if upside down
+}
+
+// Two floors: two panels at one scale; each shows only its own floor's experiences.
+TEST(ExperienceMapByFloorTest, OnePanelPerFloor) {
+  StatusOr<std::unique_ptr<SceneRenderer>> renderer = CreateOsMesaRenderer();
+  if (!renderer.ok()) GTEST_SKIP() << "OSMesa unavailable: " << renderer.status().message();
+  ExperienceMapImageData data = LMap();  // (0,0) and (20,0) on floor 0, (20,10) on floor 1
+  ExperienceMapImageOptions options;
+  options.width_px = 400;
+  options.height_px = 300;
+  StatusOr<RgbaImage> image =
+      RenderExperienceMapByFloor(*renderer.value(), data, {0, 0, 1}, {}, options);
+  ASSERT_TRUE(image.ok()) << image.status().message();
+  ASSERT_EQ(image->width, 800);
+  ASSERT_EQ(image->height, 300);
+  // Both panels share the full map's view, so a world point maps to the same offset in each.
+  options.bounds = WorldBounds{0, 0, 20, 10};
+  WorldToImage t;
+  ExperienceMapScene(data, options, &t);
+  auto ink = [&](ScenePoint p, int panel) {
+    const Rgba c = image->At(static_cast<int>(std::lround(p.x)) + 400 * panel,
+                             static_cast<int>(std::lround(p.y)));
+    return c.r + c.g + c.b < 600;
+  };
+  EXPECT_TRUE(ink(t(0, 0), 0));
+  EXPECT_FALSE(ink(t(0, 0), 1));
+  EXPECT_TRUE(ink(t(20, 10), 1));
+  EXPECT_FALSE(ink(t(20, 10), 0));
 }
 
 TEST(TemplateGraphSceneTest, EmptyInputStillGivesAFigure) {

@@ -1,14 +1,17 @@
 #include "viewer/run_images.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <limits>
+#include <set>
 
 #include "fusion/trajectory_metrics.h"
 
 namespace ratslam {
 
 std::vector<Point2> GroundTruthInMapFrame(const std::vector<Experience>& experiences,
-                                          const Dataset& dataset, double until_time_s) {
+                                          const Dataset& dataset, double until_time_s,
+                                          std::vector<int>* floors) {
   std::vector<Point2> map_points, truth_points, truth_path;
   for (const Experience& e : experiences) {
     if (auto gt = InterpolateGroundTruth(dataset.ground_truth, e.time_s)) {
@@ -16,10 +19,15 @@ std::vector<Point2> GroundTruthInMapFrame(const std::vector<Experience>& experie
       truth_points.push_back({gt->x_m, gt->y_m});
     }
   }
+  if (floors) floors->clear();
   for (const GroundTruthRow& row : dataset.ground_truth) {
-    if (row.time_s <= until_time_s) truth_path.push_back({row.x_m, row.y_m});
+    if (row.time_s > until_time_s) continue;
+    truth_path.push_back({row.x_m, row.y_m});
+    if (floors) floors->push_back(row.floor);
   }
-  return AlignGroundTruthToMap(map_points, truth_points, truth_path);
+  std::vector<Point2> aligned = AlignGroundTruthToMap(map_points, truth_points, truth_path);
+  if (floors && aligned.empty()) floors->clear();
+  return aligned;
 }
 
 ExperienceMapImageData ExperienceMapDataOf(const ReplayPipeline& pipeline, const Dataset& dataset) {
@@ -33,6 +41,82 @@ ExperienceMapImageData ExperienceMapDataOf(const ReplayPipeline& pipeline, const
   data.ground_truth = GroundTruthInMapFrame(data.experiences, dataset,
                                             trajectory.empty() ? -1.0 : trajectory.back().time_s);
   return data;
+}
+
+std::vector<int> ExperienceFloors(const std::vector<Experience>& experiences,
+                                  const Dataset& dataset) {
+  std::vector<int> floors;
+  floors.reserve(experiences.size());
+  for (const Experience& e : experiences) {
+    const auto gt = InterpolateGroundTruth(dataset.ground_truth, e.time_s);
+    floors.push_back(gt ? gt->floor : 0);
+  }
+  return floors;
+}
+
+StatusOr<RgbaImage> RenderExperienceMapByFloor(SceneRenderer& renderer,
+                                               const ExperienceMapImageData& data,
+                                               const std::vector<int>& experience_floors,
+                                               const std::vector<int>& ground_truth_floors,
+                                               const ExperienceMapImageOptions& panel) {
+  std::set<int> distinct(experience_floors.begin(), experience_floors.end());
+  if (distinct.size() <= 1 || experience_floors.size() != data.experiences.size()) {
+    return renderer.Render(ExperienceMapScene(data, panel));
+  }
+  // One view for all panels: the bounds of everything.
+  WorldBounds bounds{1e300, 1e300, -1e300, -1e300};
+  auto include = [&bounds](double x, double y) {
+    bounds.min_x_m = std::min(bounds.min_x_m, x);
+    bounds.min_y_m = std::min(bounds.min_y_m, y);
+    bounds.max_x_m = std::max(bounds.max_x_m, x);
+    bounds.max_y_m = std::max(bounds.max_y_m, y);
+  };
+  for (const Experience& e : data.experiences) include(e.x_m, e.y_m);
+  for (const Point2& p : data.ground_truth) include(p.x, p.y);
+  std::vector<RgbaImage> panels;
+  for (int floor : distinct) {
+    ExperienceMapImageData subset;
+    std::vector<int64_t> new_id(data.experiences.size(), -1);
+    for (size_t i = 0; i < data.experiences.size(); ++i) {
+      if (experience_floors[i] != floor) continue;
+      new_id[i] = static_cast<int64_t>(subset.experiences.size());
+      Experience e = data.experiences[i];
+      e.id = static_cast<uint32_t>(new_id[i]);
+      subset.experiences.push_back(e);
+    }
+    for (const Link& l : data.links) {
+      if (new_id[l.from] < 0 || new_id[l.to] < 0) continue;  // links between floors are left out
+      Link k = l;
+      k.from = static_cast<uint32_t>(new_id[l.from]);
+      k.to = static_cast<uint32_t>(new_id[l.to]);
+      subset.links.push_back(k);
+    }
+    if (data.current && new_id[*data.current] >= 0) {
+      subset.current = static_cast<uint32_t>(new_id[*data.current]);
+    }
+    for (size_t i = 0; i < data.ground_truth.size() && i < ground_truth_floors.size(); ++i) {
+      if (ground_truth_floors[i] == floor) subset.ground_truth.push_back(data.ground_truth[i]);
+    }
+    ExperienceMapImageOptions options = panel;
+    options.bounds = bounds;
+    options.title = panel.title + ", floor " + std::to_string(floor);
+    StatusOr<RgbaImage> image = renderer.Render(ExperienceMapScene(subset, options));
+    if (!image.ok()) return image.status();
+    panels.push_back(std::move(image.value()));
+  }
+  // Side by side.
+  RgbaImage out;
+  out.height = panel.height_px;
+  out.width = panel.width_px * static_cast<int>(panels.size());
+  out.pixels.resize(static_cast<size_t>(out.width) * out.height * 4);
+  for (size_t k = 0; k < panels.size(); ++k) {
+    for (int y = 0; y < out.height; ++y) {
+      std::copy_n(&panels[k].pixels[static_cast<size_t>(y) * panel.width_px * 4],
+                  static_cast<size_t>(panel.width_px) * 4,
+                  &out.pixels[(static_cast<size_t>(y) * out.width + k * panel.width_px) * 4]);
+    }
+  }
+  return out;
 }
 
 std::vector<TemplateGraphPoint> TemplateGraphOf(const ReplayPipeline& pipeline) {
@@ -59,9 +143,21 @@ Status WriteRunImages(SceneRenderer& renderer, const ReplayPipeline& pipeline,
     map_options.coloring = MapColoring::kSession;
     map_options.session_start_times_s = sessions;
   }
-  RATSLAM_RETURN_IF_ERROR(
-      write(ExperienceMapScene(ExperienceMapDataOf(pipeline, dataset), map_options),
-            "experience_map.png"));
+  {
+    // One panel per floor when the ground truth knows several.
+    ExperienceMapImageData map_data = ExperienceMapDataOf(pipeline, dataset);
+    std::vector<int> truth_floors;
+    const auto& trajectory = pipeline.state().trajectory;
+    map_data.ground_truth =
+        GroundTruthInMapFrame(map_data.experiences, dataset,
+                              trajectory.empty() ? -1.0 : trajectory.back().time_s, &truth_floors);
+    StatusOr<RgbaImage> image = RenderExperienceMapByFloor(
+        renderer, map_data, ExperienceFloors(map_data.experiences, dataset), truth_floors,
+        map_options);
+    if (!image.ok()) return image.status().WithContext("experience_map.png");
+    RATSLAM_RETURN_IF_ERROR(
+        WritePng(image.value(), (fs::path(folder) / "experience_map.png").string()));
+  }
   TemplateGraphImageOptions graph_options;
   graph_options.title = "template graph (" + dataset.name + ")";
   // Every other session shaded.

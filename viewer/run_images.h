@@ -14,8 +14,23 @@ namespace ratslam {
 
 // The ground truth up to `until_time_s`, moved into the map's frame by the rigid fit of the
 // experiences to the ground truth at their creation times; empty without ground truth.
+// `floors`, if given, receives the floor of each returned point.
 std::vector<Point2> GroundTruthInMapFrame(const std::vector<Experience>& experiences,
-                                          const Dataset& dataset, double until_time_s);
+                                          const Dataset& dataset, double until_time_s,
+                                          std::vector<int>* floors = nullptr);
+
+// The floor of each experience: the ground truth's floor at its creation (0 without one).
+std::vector<int> ExperienceFloors(const std::vector<Experience>& experiences,
+                                  const Dataset& dataset);
+
+// One experience-map panel per floor, side by side at one scale, each showing that floor's
+// experiences, the links between them and that floor's ground truth. A single floor gives the
+// ordinary image. `panel` sets each panel's size.
+StatusOr<RgbaImage> RenderExperienceMapByFloor(SceneRenderer& renderer,
+                                               const ExperienceMapImageData& data,
+                                               const std::vector<int>& experience_floors,
+                                               const std::vector<int>& ground_truth_floors,
+                                               const ExperienceMapImageOptions& panel);
 
 // The experience-map figure data of a run, with the ground truth (if any) aligned to the map.
 ExperienceMapImageData ExperienceMapDataOf(const ReplayPipeline& pipeline, const Dataset& dataset);
