@@ -1,0 +1,113 @@
+// Untrusted input never crashes: random mutations of valid inputs (byte flips, truncations,
+// insertions) must give either a clean error or a valid result. Run under the sanitizer build
+// this also catches out-of-bounds reads. Seeded, so failures reproduce.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "fusion/io/config.h"
+#include "fusion/io/map_file.h"
+#include "ratslam/random.h"
+#include "sensors/dataset/dataset.h"
+#include "sensors/dataset/ipin_log.h"
+#include "sensors/dataset/msft_log.h"
+
+namespace ratslam {
+namespace {
+namespace fs = std::filesystem;
+
+std::string Mutate(const std::string& input, Random& rng) {
+  std::string s = input;
+  const int edits = 1 + static_cast<int>(rng.Uniform() * 4);
+  for (int e = 0; e < edits && !s.empty(); ++e) {
+    const size_t at = static_cast<size_t>(rng.Uniform() * s.size());
+    switch (static_cast<int>(rng.Uniform() * 4)) {
+      case 0:
+        s[at] = static_cast<char>(rng.NextU64() & 0xFF);
+        break;
+      case 1:
+        s.resize(at);
+        break;
+      case 2:
+        s.insert(at, 1, ",;\t\n-9e999nan"[rng.NextU64() % 14]);
+        break;
+      default:
+        s.erase(at, 1 + static_cast<size_t>(rng.Uniform() * 8));
+        break;
+    }
+  }
+  return s;
+}
+
+fs::path Scratch(const std::string& name) {
+  return fs::temp_directory_path() / ("ratslam_malformed_" + std::to_string(::getpid()) + name);
+}
+
+TEST(MalformedInputTest, MapFilesNeverCrash) {
+  Ratslam slam({});
+  for (uint32_t i = 0; i < 40; ++i) {
+    ASSERT_TRUE(slam.OnView({i * 0.1, i % 25, i < 25, 0.0}).ok());
+    ASSERT_TRUE(slam.OnOdometry({i * 0.1, 0.5, 0.05}).ok());
+  }
+  MapFile map;
+  map.state.ratslam = slam.GetState();
+  map.state.front_end = "front end bytes";
+  const std::string bytes = EncodeMapFile(map);
+  Random rng(1);
+  int errors = 0;
+  for (int k = 0; k < 2000; ++k) {
+    StatusOr<MapFile> decoded = DecodeMapFile(Mutate(bytes, rng), "fuzz");
+    if (!decoded.ok()) {
+      ++errors;
+      continue;
+    }
+    // A decodable mutation must still be refused or accepted cleanly by the spine.
+    Ratslam other({});
+    (void)other.SetState(decoded->state.ratslam);
+  }
+  EXPECT_GT(errors, 1000);
+}
+
+TEST(MalformedInputTest, ConfigsNeverCrash) {
+  const std::string text = PrintConfig(PipelineOptions());
+  Random rng(2);
+  for (int k = 0; k < 500; ++k) {
+    StatusOr<PipelineOptions> o = ParseConfig(Mutate(text, rng), "fuzz.toml");
+    if (!o.ok()) {
+      EXPECT_EQ(o.status().message().rfind("fuzz.toml", 0), 0u) << o.status().message();
+    }
+  }
+}
+
+TEST(MalformedInputTest, DataSetsAndLogsNeverCrash) {
+  const fs::path folder = Scratch("_dataset");
+  fs::create_directories(folder);
+  const std::string odometry =
+      "time_s,forward_speed_m_per_s,turn_rate_rad_per_s\n0,0,0\n0.1,1,0.5\n0.2,1,0.1\n";
+  const std::string manifest =
+      "format = \"ratslam-replay\"\nformat_version = 1\n[streams]\nodometry = \"odometry.csv\"\n";
+  const std::string ipin =
+      "% header\nACCE;0.10;100.10;0.1;0.2;9.8;3\nAHRS;0.11;100.11;1.0;2.0;90.0;0.1;0.2;0.3;3\n"
+      "WIFI;0.50;100.50;net;aa:bb;2437;-60\nPOSI;1.0;1;49.46;11.11;0;100\n"
+      "POSI;3.0;2;49.47;11.12;0;100\n";
+  const std::string msft =
+      "#\tstartTime:1000\tFloorName:F1\n2000\tTYPE_WAYPOINT\t1.0\t2.0\n"
+      "2100\tTYPE_WIFI\tx\taa:bb\t-50\t2412\t2000\n2200\tTYPE_ACCELEROMETER\t0\t0\t9.8\t3\n";
+  Random rng(3);
+  for (int k = 0; k < 300; ++k) {
+    std::ofstream(folder / "manifest.toml") << Mutate(manifest, rng);
+    std::ofstream(folder / "odometry.csv") << Mutate(odometry, rng);
+    (void)ReadDataset(folder.string());
+    const fs::path log = Scratch("_log.txt");
+    std::ofstream(log) << Mutate(ipin, rng);
+    (void)ReadIpinLog(log.string(), {});
+    std::ofstream(log) << Mutate(msft, rng);
+    (void)ReadMicrosoftLog(log.string(), {});
+    fs::remove(log);
+  }
+  fs::remove_all(folder);
+}
+
+}  // namespace
+}  // namespace ratslam
