@@ -217,10 +217,15 @@ Scene ExperienceMapScene(const ExperienceMapImageData& data,
                      s.Line({x, y}, {x + 30, y}, 3.0f, kLoopClosure);
                      s.Text({x + 38, y + 5}, "loop closure", 14, kInk);
                    }});
+  // The time range of the colours (shared between panels when the options fix it).
   double t_first = std::numeric_limits<double>::infinity(), t_last = -t_first;
   for (const Experience& e : data.experiences) {
     t_first = std::min(t_first, e.time_s);
     t_last = std::max(t_last, e.time_s);
+  }
+  if (options.time_range_s) {
+    t_first = options.time_range_s->first;
+    t_last = options.time_range_s->second;
   }
   if (options.coloring == MapColoring::kTime && std::isfinite(t_first)) {
     items.push_back(
@@ -259,11 +264,6 @@ Scene ExperienceMapScene(const ExperienceMapImageData& data,
   if (transform) *transform = to_image;
 
   // Time or session of each experience, for colouring.
-  double t_min = std::numeric_limits<double>::infinity(), t_max = -t_min;
-  for (const Experience& e : data.experiences) {
-    t_min = std::min(t_min, e.time_s);
-    t_max = std::max(t_max, e.time_s);
-  }
   auto session_of = [&](double t) {
     const auto& starts = options.session_start_times_s;
     return static_cast<int>(std::upper_bound(starts.begin(), starts.end(), t) - starts.begin()) - 1;
@@ -271,7 +271,7 @@ Scene ExperienceMapScene(const ExperienceMapImageData& data,
   auto color_of = [&](const Experience& e) {
     if (options.coloring == MapColoring::kSession)
       return CategoryColor(std::max(0, session_of(e.time_s)));
-    return SequentialColor(t_max > t_min ? (e.time_s - t_min) / (t_max - t_min) : 0.0);
+    return SequentialColor(t_last > t_first ? (e.time_s - t_first) / (t_last - t_first) : 0.0);
   };
 
   // Stay legible from a few links to 100k: thinner, more transparent strokes for larger maps.

@@ -6,6 +6,7 @@
 
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "fusion/front_end.h"
@@ -46,6 +47,7 @@ struct ExperienceMapImageOptions {
   int width_px = 1600;
   int height_px = 1200;
   std::optional<WorldBounds> bounds;  // fixed view (e.g. shared by per-floor panels); default: fit
+  std::optional<std::pair<double, double>> time_range_s;  // fixed colour range; default: the data
   MapColoring coloring = MapColoring::kTime;
   std::vector<double> session_start_times_s;  // ascending; sessions for kSession colouring
   std::string title;

@@ -71,7 +71,11 @@ StatusOr<RgbaImage> RenderExperienceMapByFloor(SceneRenderer& renderer,
     bounds.max_x_m = std::max(bounds.max_x_m, x);
     bounds.max_y_m = std::max(bounds.max_y_m, y);
   };
-  for (const Experience& e : data.experiences) include(e.x_m, e.y_m);
+  std::pair<double, double> times{1e300, -1e300};
+  for (const Experience& e : data.experiences) {
+    include(e.x_m, e.y_m);
+    times = {std::min(times.first, e.time_s), std::max(times.second, e.time_s)};
+  }
   for (const Point2& p : data.ground_truth) include(p.x, p.y);
   std::vector<RgbaImage> panels;
   for (int floor : distinct) {
@@ -99,6 +103,7 @@ StatusOr<RgbaImage> RenderExperienceMapByFloor(SceneRenderer& renderer,
     }
     ExperienceMapImageOptions options = panel;
     options.bounds = bounds;
+    options.time_range_s = times;
     options.title = panel.title + ", floor " + std::to_string(floor);
     StatusOr<RgbaImage> image = renderer.Render(ExperienceMapScene(subset, options));
     if (!image.ok()) return image.status();
