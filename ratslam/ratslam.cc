@@ -111,9 +111,6 @@ Ratslam::State Ratslam::GetState() const {
 }
 
 Status Ratslam::SetState(const State& state) {
-  RATSLAM_RETURN_IF_ERROR(pose_cells_.SetState(state.pose_cells));
-  RATSLAM_RETURN_IF_ERROR(local_view_.SetState(state.local_view));
-  RATSLAM_RETURN_IF_ERROR(experience_map_.SetState(state.experience_map));
   for (const Experience& e : state.experience_map.experiences) {
     if (e.template_id >= state.local_view.templates.size()) {
       return Status::Error("state: experience " + std::to_string(e.id) +
@@ -123,6 +120,16 @@ Status Ratslam::SetState(const State& state) {
   if (state.current_template && *state.current_template >= state.local_view.templates.size()) {
     return Status::Error("state: current template does not exist");
   }
+  // All or nothing: restore into fresh components, then swap them in.
+  PoseCellNetwork pose_cells(options_.pose_cells);
+  LocalViewCells local_view(options_.local_view, options_.pose_cells.dim_theta_cells);
+  ExperienceMap experience_map(options_.experience_map);
+  RATSLAM_RETURN_IF_ERROR(pose_cells.SetState(state.pose_cells));
+  RATSLAM_RETURN_IF_ERROR(local_view.SetState(state.local_view));
+  RATSLAM_RETURN_IF_ERROR(experience_map.SetState(state.experience_map));
+  pose_cells_ = std::move(pose_cells);
+  local_view_ = std::move(local_view);
+  experience_map_ = std::move(experience_map);
   current_template_ = state.current_template;
   counters_ = state.counters;
   compass_heading_rad_ = state.compass_heading_rad;

@@ -89,8 +89,8 @@ class Ratslam {
     std::optional<double> compass_heading_rad;
   };
   State GetState() const;
-  // Fails, leaving this object unusable for further steps only if partially applied state is
-  // inconsistent; callers load into a fresh object.
+  // Restores a state from GetState (of a spine with the same options). All or nothing: on an
+  // error (ids out of range, sizes that do not fit the options) nothing changes.
   Status SetState(const State& state);
 
  private:

@@ -80,5 +80,22 @@ TEST(RatslamTest, StateRoundTripContinuesIdentically) {
   }
 }
 
+TEST(RatslamTest, FailedSetStateChangesNothing) {
+  Ratslam a({});
+  for (uint32_t i = 0; i < 5; ++i) {
+    ASSERT_TRUE(a.OnView({i * 1.0, i, true, 0.0}).ok());
+    ASSERT_TRUE(a.OnOdometry({i * 1.0, 1.0, 0.0}).ok());
+  }
+  Ratslam::State bad = a.GetState();
+  bad.experience_map.links.push_back(
+      {99, 0, 1234, 1.0, 0.0, 0.0, 1.0, false});  // no such experience
+  Ratslam b({});
+  const auto before = b.pose_cells().BestPosition();
+  EXPECT_FALSE(b.SetState(bad).ok());
+  EXPECT_EQ(b.local_view().size(), 0u);  // the valid parts were not applied either
+  EXPECT_EQ(b.experience_map().num_experiences(), 0u);
+  EXPECT_EQ(b.pose_cells().BestPosition().x, before.x);
+}
+
 }  // namespace
 }  // namespace ratslam
