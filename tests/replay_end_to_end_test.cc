@@ -55,6 +55,17 @@ class ReplayEndToEndTest : public ::testing::Test {
     config_ = (fs::path(RATSLAM_SOURCE_DIR) / "configs" / "demo.toml").string();
   }
   static void TearDownTestSuite() { fs::remove_all(root_); }
+  // Replays the demo data with a config given as TOML text; returns the summary.
+  static nlohmann::json ReplayWithConfig(const std::string& name, const std::string& toml) {
+    const fs::path config = root_ / (name + ".toml");
+    std::ofstream(config) << toml;
+    const fs::path out = root_ / name;
+    const Result r = RunRatslam("replay --quiet --config " + config.string() + " --data " +
+                                    (root_ / "data").string() + " --out " + out.string(),
+                                root_);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return r.exit_code == 0 ? Summary(out) : nlohmann::json::object();
+  }
   static std::string ReplayArgs(const fs::path& out) {
     return "replay --quiet --config " + config_ + " --data " + (root_ / "data").string() +
            " --out " + out.string();
@@ -92,18 +103,12 @@ TEST_F(ReplayEndToEndTest, DemoDataClosesLoopsAndBeatsOdometry) {
 // only. The paper's t_camera = 0.96 suits its camera; the synthetic views are low-contrast at
 // 12x9 and need 0.99 (measured: 0.96 gives 15 % of matches more than 20 m off).
 TEST_F(ReplayEndToEndTest, Camera12x9FrontEndClosesLoops) {
-  const fs::path config = root_ / "camera12x9.toml";
-  std::ofstream(config) << "[front_end]\nkind = \"fused\"\n[fused]\nuse_camera = true\n"
-                           "use_wifi = false\nrecency_s = 10.0\n[camera_12x9]\n"
-                           "match_threshold = 0.99\n[pose_cells]\ndim_xy_cells = 30\n"
-                           "cell_size_m = 1.5\n";
-  const fs::path out = root_ / "camera12x9";
-  ASSERT_EQ(RunRatslam("replay --quiet --config " + config.string() + " --data " +
-                           (root_ / "data").string() + " --out " + out.string(),
-                       root_)
-                .exit_code,
-            0);
-  const nlohmann::json s = Summary(out);
+  const nlohmann::json s = ReplayWithConfig(
+      "camera12x9",
+      "[front_end]\nkind = \"fused\"\n[fused]\nuse_camera = true\nuse_wifi = false\n"
+      "recency_s = 10.0\n[camera_12x9]\nmatch_threshold = 0.99\n[pose_cells]\n"
+      "dim_xy_cells = 30\ncell_size_m = 1.5\n");
+  ASSERT_FALSE(s.empty());
   EXPECT_GT(s["matches"].get<int>(), 1000);
   EXPECT_GE(s["match_rate_within_m"]["2"].get<double>(), 0.95);
   EXPECT_LT(s["map_ate_m"].get<double>(), 0.2 * s["odometry_ate_m"].get<double>());
@@ -112,19 +117,13 @@ TEST_F(ReplayEndToEndTest, Camera12x9FrontEndClosesLoops) {
 
 // The paper's campus odometry: constant speed and rotation from the camera alone.
 TEST_F(ReplayEndToEndTest, VisualOdometryWithClassicCameraClosesLoops) {
-  const fs::path config = root_ / "visual_odometry.toml";
-  std::ofstream(config)
-      << "[camera]\ncrop_top_px = 8\ncrop_bottom_px = 32\nmatch_threshold = 0.03\n"
-         "[pose_cells]\ndim_xy_cells = 30\ncell_size_m = 1.5\n"
-         "[visual_odometry]\nenabled = true\nspeed_m_per_s = 1.0\n"
-         "field_of_view_rad = 1.8\ncrop_top_px = 8\ncrop_bottom_px = 32\n";
-  const fs::path out = root_ / "visual_odometry";
-  ASSERT_EQ(RunRatslam("replay --quiet --config " + config.string() + " --data " +
-                           (root_ / "data").string() + " --out " + out.string(),
-                       root_)
-                .exit_code,
-            0);
-  const nlohmann::json s = Summary(out);
+  const nlohmann::json s =
+      ReplayWithConfig("visual_odometry",
+                       "[camera]\ncrop_top_px = 8\ncrop_bottom_px = 32\nmatch_threshold = 0.03\n"
+                       "[pose_cells]\ndim_xy_cells = 30\ncell_size_m = 1.5\n"
+                       "[visual_odometry]\nenabled = true\nspeed_m_per_s = 1.0\n"
+                       "field_of_view_rad = 1.8\ncrop_top_px = 8\ncrop_bottom_px = 32\n");
+  ASSERT_FALSE(s.empty());
   // Measured: visual odometry alone drifts to ~15 m; the map stays near 1 m.
   EXPECT_LT(s["odometry_ate_m"].get<double>(), 40.0);
   EXPECT_GT(s["loop_closures"].get<int>(), 10);
