@@ -45,6 +45,14 @@ bool ParseDouble(const std::string& text, double* value) {
 
 }  // namespace
 
+Status OpenPhoneLog(const std::string& path, const PhoneLogOptions& options, std::ifstream* in) {
+  std::string pdr_error;
+  if (!options.pdr.IsValid(&pdr_error)) return Status::Error("pdr." + pdr_error);
+  in->open(path);
+  if (!*in) return Status::Error(path + ": cannot open log file");
+  return Status::Ok();
+}
+
 Dataset AssemblePhoneDataset(PhoneLogStreams streams, const std::string& name,
                              const PhoneLogOptions& options, double start_time_s,
                              PhoneLogReport* report) {
@@ -103,10 +111,8 @@ std::vector<OdometryRow> StepsToOdometry(const std::vector<Step>& steps, double 
 
 StatusOr<Dataset> ReadIpinLog(const std::string& path, const PhoneLogOptions& options,
                               PhoneLogReport* report) {
-  std::string pdr_error;
-  if (!options.pdr.IsValid(&pdr_error)) return Status::Error("pdr." + pdr_error);
-  std::ifstream in(path);
-  if (!in) return Status::Error(path + ": cannot open log file");
+  std::ifstream in;
+  RATSLAM_RETURN_IF_ERROR(OpenPhoneLog(path, options, &in));
   PhoneLogReport local_report;
   PhoneLogReport& r = report ? *report : local_report;
   r = PhoneLogReport();

@@ -8,6 +8,7 @@
 #ifndef RATSLAM_SENSORS_DATASET_IPIN_LOG_H_
 #define RATSLAM_SENSORS_DATASET_IPIN_LOG_H_
 
+#include <fstream>
 #include <map>
 #include <optional>
 #include <string>
@@ -46,6 +47,9 @@ struct PhoneLogReport {
 // Reads one log. Errors name the file and line ("log.txt:812: WIFI: RSS(dBm) is not a number").
 StatusOr<Dataset> ReadIpinLog(const std::string& path, const PhoneLogOptions& options,
                               PhoneLogReport* report = nullptr);
+
+// Checks the options and opens a phone log for reading (shared by the phone log readers).
+Status OpenPhoneLog(const std::string& path, const PhoneLogOptions& options, std::ifstream* in);
 
 // What a phone log reader collects, before it becomes a data set.
 struct PhoneLogStreams {

@@ -54,10 +54,8 @@ double HeadingFromRotationVector(double x, double y, double z) {
 
 StatusOr<Dataset> ReadMicrosoftLog(const std::string& path, const PhoneLogOptions& options,
                                    PhoneLogReport* report, double max_wifi_staleness_s) {
-  std::string pdr_error;
-  if (!options.pdr.IsValid(&pdr_error)) return Status::Error("pdr." + pdr_error);
-  std::ifstream in(path);
-  if (!in) return Status::Error(path + ": cannot open log file");
+  std::ifstream in;
+  RATSLAM_RETURN_IF_ERROR(OpenPhoneLog(path, options, &in));
   PhoneLogReport local_report;
   PhoneLogReport& r = report ? *report : local_report;
   r = PhoneLogReport();
