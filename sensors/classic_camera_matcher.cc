@@ -14,6 +14,14 @@
 #include "ratslam/circular.h"
 
 namespace ratslam {
+
+// Shifted, masked copies of the query, one per compared offset, in the stored-template layout.
+struct ClassicCameraMatcher::PreparedQuery {
+  std::vector<uint8_t> rows;   // shifts * height * stride
+  std::vector<uint8_t> masks;  // shifts * stride: 0xFF where the offset overlaps
+  std::vector<int> overlap_columns;
+};
+
 namespace {
 
 // Local contrast normalisation maps z-scores to intensities as 0.5 + z / kPatchZSpan, so that
@@ -24,16 +32,10 @@ uint8_t Quantise(double value) {
   return static_cast<uint8_t>(std::lround(std::clamp(value, 0.0, 1.0) * 255.0));
 }
 
-// Shifted, masked copies of the query, one per compared offset, in the stored-template layout.
-struct PreparedQuery {
-  std::vector<uint8_t> rows;   // shifts * height * stride
-  std::vector<uint8_t> masks;  // shifts * stride: 0xFF where the offset overlaps
-  std::vector<int> overlap_columns;
-};
-
-PreparedQuery Prepare(const std::vector<uint8_t>& query, const std::vector<int>& shifts, int width,
-                      int height, int stride, bool panoramic) {
-  PreparedQuery p;
+ClassicCameraMatcher::PreparedQuery Prepare(const std::vector<uint8_t>& query,
+                                            const std::vector<int>& shifts, int width, int height,
+                                            int stride, bool panoramic) {
+  ClassicCameraMatcher::PreparedQuery p;
   const size_t per_shift = static_cast<size_t>(height) * stride;
   p.rows.assign(shifts.size() * per_shift, 0);
   p.masks.assign(shifts.size() * stride, 0);
@@ -120,7 +122,7 @@ template <uint32_t (*Sad)(const uint8_t*, const uint8_t*, const uint8_t*, int, i
 __attribute__((target("avx2")))
 #endif
 void ForEachTemplate(const uint8_t* base, uint32_t count, size_t bytes_per_template,
-                     const PreparedQuery& prepared, const std::vector<double>& scale,
+                     const ClassicCameraMatcher::PreparedQuery& prepared, const std::vector<double>& scale,
                      const std::vector<int>& shifts, int height, int stride, Visit&& visit) {
   const size_t per_shift = static_cast<size_t>(height) * stride;
   for (uint32_t id = 0; id < count; ++id) {
@@ -259,11 +261,15 @@ StatusOr<std::vector<uint8_t>> ClassicCameraMatcher::MakeTemplate(
   return result;
 }
 
+ClassicCameraMatcher::PreparedQuery ClassicCameraMatcher::PrepareQuery(
+    const std::vector<uint8_t>& query) const {
+  return Prepare(query, shifts_, options_.template_width_px, options_.template_height_px,
+                 row_stride_, options_.panoramic);
+}
+
 template <typename Visit>
-void ClassicCameraMatcher::VisitTemplates(const std::vector<uint8_t>& query, Visit&& visit) const {
+void ClassicCameraMatcher::VisitTemplates(const PreparedQuery& prepared, Visit&& visit) const {
   const int h = options_.template_height_px;
-  const PreparedQuery prepared =
-      Prepare(query, shifts_, options_.template_width_px, h, row_stride_, options_.panoramic);
   std::vector<double> scale(shifts_.size());
   for (size_t k = 0; k < shifts_.size(); ++k) {
     scale[k] = 1.0 / (255.0 * h * prepared.overlap_columns[k]);
@@ -284,7 +290,8 @@ void ClassicCameraMatcher::VisitTemplates(const std::vector<uint8_t>& query, Vis
 TemplateComparison ClassicCameraMatcher::Compare(const std::vector<uint8_t>& query) const {
   TemplateComparison best;
   if (state_.template_count == 0 || query.size() != bytes_per_template_) return best;
-  VisitTemplates(query, [&best](uint32_t id, double difference) {
+  const PreparedQuery prepared = PrepareQuery(query);
+  VisitTemplates(prepared, [&best](uint32_t id, double difference) {
     if (difference < best.mean_difference) {
       best.mean_difference = difference;
       best.template_id = static_cast<int32_t>(id);
@@ -292,8 +299,6 @@ TemplateComparison ClassicCameraMatcher::Compare(const std::vector<uint8_t>& que
   });
   // The winning shift: recomputed for the winning template only (the first shift attaining it).
   const int h = options_.template_height_px;
-  const PreparedQuery prepared =
-      Prepare(query, shifts_, options_.template_width_px, h, row_stride_, options_.panoramic);
   const uint8_t* t = state_.templates.data() + best.template_id * bytes_per_template_;
   for (size_t k = 0; k < shifts_.size(); ++k) {
     const uint32_t sad = MaskedSadPortable(t, prepared.rows.data() + k * h * row_stride_,
@@ -311,8 +316,9 @@ std::vector<double> ClassicCameraMatcher::Differences(const std::vector<uint8_t>
   std::vector<double> differences;
   if (query.size() != bytes_per_template_) return differences;
   differences.reserve(state_.template_count);
-  VisitTemplates(
-      query, [&differences](uint32_t, double difference) { differences.push_back(difference); });
+  VisitTemplates(PrepareQuery(query), [&differences](uint32_t, double difference) {
+    differences.push_back(difference);
+  });
   return differences;
 }
 

@@ -99,9 +99,13 @@ class ClassicCameraMatcher {
   const State& state() const { return state_; }
   Status SetState(State state);
 
+  // Shifted, masked copies of a query for the SIMD scan; opaque outside the implementation.
+  struct PreparedQuery;
+
  private:
+  PreparedQuery PrepareQuery(const std::vector<uint8_t>& query) const;
   template <typename Visit>
-  void VisitTemplates(const std::vector<uint8_t>& query, Visit&& visit) const;
+  void VisitTemplates(const PreparedQuery& prepared, Visit&& visit) const;
 
   ClassicCameraOptions options_;
   int row_stride_;  // template width rounded up to a multiple of 32 bytes
