@@ -1,0 +1,304 @@
+#include "fusion/fabmap/fabmap.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+namespace ratslam::fabmap {
+
+bool DetectorModel::IsValid(std::string* error) const {
+  if (!(p_observed_given_exists > 0.0 && p_observed_given_exists < 1.0)) {
+    *error = "p_observed_given_exists must be in (0, 1)";
+    return false;
+  }
+  if (!(p_observed_given_absent >= 0.0 && p_observed_given_absent < p_observed_given_exists)) {
+    *error = "p_observed_given_absent must be in [0, p_observed_given_exists)";
+    return false;
+  }
+  return true;
+}
+
+std::string ToString(UnknownWorld unknown_world) {
+  return unknown_world == UnknownWorld::kSampled ? "sampled" : "mean_field";
+}
+
+StatusOr<UnknownWorld> UnknownWorldFromString(const std::string& name) {
+  if (name == "mean_field") return UnknownWorld::kMeanField;
+  if (name == "sampled") return UnknownWorld::kSampled;
+  return Status::Error("unknown unknown-world estimate '" + name +
+                       "' (expected mean_field or sampled)");
+}
+
+bool FabmapOptions::IsValid(std::string* error) const {
+  if (!(p_new_place > 0.0 && p_new_place < 1.0)) {
+    *error = "p_new_place must be in (0, 1)";
+    return false;
+  }
+  if (!(sample_pseudo_count > 0.0) || !std::isfinite(sample_pseudo_count)) {
+    *error = "sample_pseudo_count must be positive and finite";
+    return false;
+  }
+  return true;
+}
+
+namespace {
+
+constexpr double kMinExistence = 1e-6;
+
+// p(e_q = 1) consistent with the marginal p(z_q = 1) under the detector model.
+double ExistencePrior(double marginal, const DetectorModel& d) {
+  const double e = (marginal - d.p_observed_given_absent) /
+                   (d.p_observed_given_exists - d.p_observed_given_absent);
+  return std::clamp(e, kMinExistence, 1.0 - kMinExistence);
+}
+
+// p(e = 1 | z) for one observation of the word.
+double ExistencePosterior(bool observed, double prior, const DetectorModel& d) {
+  const double on = observed ? d.p_observed_given_exists : 1.0 - d.p_observed_given_exists;
+  const double off = observed ? d.p_observed_given_absent : 1.0 - d.p_observed_given_absent;
+  return on * prior / (on * prior + off * (1.0 - prior));
+}
+
+// p(z_q = a | e_q = s, z_p = c) of Cummins and Newman (2008), for word probabilities `marginal`
+// (p(z_q=1)) and `given_parent` (p(z_q=1 | z_p=c)).
+double ObservationGivenExistence(bool a, bool s, double marginal, double given_parent,
+                                 const DetectorModel& d) {
+  const double p_on_given_e = s ? d.p_observed_given_exists : d.p_observed_given_absent;
+  const double p_a = a ? marginal : 1.0 - marginal;
+  const double p_a_given_e = a ? p_on_given_e : 1.0 - p_on_given_e;
+  const double p_a_given_parent = a ? given_parent : 1.0 - given_parent;
+  const double alpha = p_a * (1.0 - p_a_given_e) * (1.0 - p_a_given_parent);
+  const double beta = (1.0 - p_a) * p_a_given_e * p_a_given_parent;
+  return alpha + beta > 0.0 ? beta / (alpha + beta) : 0.0;
+}
+
+double LogMeanExp(const std::vector<double>& values) {
+  if (values.empty()) return -std::numeric_limits<double>::infinity();
+  const double top = *std::max_element(values.begin(), values.end());
+  double sum = 0.0;
+  for (double v : values) sum += std::exp(v - top);
+  return top + std::log(sum / static_cast<double>(values.size()));
+}
+
+}  // namespace
+
+StatusOr<FabmapModel> FabmapModel::Create(ChowLiuTree tree, std::vector<DetectorBlock> blocks,
+                                          std::vector<Observation> unknown_world_samples,
+                                          const FabmapOptions& options) {
+  std::string error;
+  if (!options.IsValid(&error)) return Status::Error("FABMAP options: " + error);
+  const uint32_t v = tree.size();
+  if (v == 0) return Status::Error("FABMAP: the vocabulary is empty");
+  if (tree.marginal.size() != v || tree.on_given_parent_on.size() != v ||
+      tree.on_given_parent_off.size() != v) {
+    return Status::Error("FABMAP: the Chow-Liu tree's tables do not match its size");
+  }
+  std::vector<const DetectorModel*> detector(v, nullptr);
+  WordId next = 0;
+  for (const DetectorBlock& b : blocks) {
+    if (!b.detector.IsValid(&error)) return Status::Error("FABMAP detector model: " + error);
+    if (b.first_word != next || b.count > v - next) {
+      return Status::Error("FABMAP: detector blocks must cover the vocabulary in order");
+    }
+    for (uint32_t k = 0; k < b.count; ++k) detector[next + k] = &b.detector;
+    next += b.count;
+  }
+  if (next != v) return Status::Error("FABMAP: detector blocks do not cover every word");
+  if (unknown_world_samples.empty()) {
+    return Status::Error("FABMAP: the unknown world needs at least one sample observation");
+  }
+  for (size_t i = 0; i < unknown_world_samples.size(); ++i) {
+    RATSLAM_RETURN_IF_ERROR(NormaliseObservation(&unknown_world_samples[i], v,
+                                                 "unknown-world sample " + std::to_string(i)));
+  }
+
+  FabmapModel model;
+  model.options_ = options;
+  model.tree_ = std::move(tree);
+  model.tree_.ChildLists(&model.child_begin_, &model.children_);
+  std::vector<uint32_t> sample_count(v, 0);
+  for (const Observation& o : unknown_world_samples) {
+    for (WordId q : o) ++sample_count[q];
+  }
+  const double n_s = static_cast<double>(unknown_world_samples.size());
+  model.seen_.resize(v);
+  model.unseen_.resize(v);
+  model.average_.resize(v);
+  for (WordId q = 0; q < v; ++q) {
+    const DetectorModel& d = *detector[q];
+    const ChowLiuTree& t = model.tree_;
+    const double prior = ExistencePrior(t.marginal[q], d);
+    const double sample_marginal =
+        (sample_count[q] + options.sample_pseudo_count) / (n_s + 2.0 * options.sample_pseudo_count);
+    const double existence[3] = {ExistencePosterior(true, prior, d),
+                                 ExistencePosterior(false, prior, d),
+                                 ExistencePrior(sample_marginal, d)};
+    Table* tables[3] = {&model.seen_[q], &model.unseen_[q], &model.average_[q]};
+    for (int zq = 0; zq < 2; ++zq) {
+      for (int zp = 0; zp < 2; ++zp) {
+        const double given_parent = zp ? t.on_given_parent_on[q] : t.on_given_parent_off[q];
+        const double if_exists = ObservationGivenExistence(zq, true, t.marginal[q], given_parent, d);
+        const double if_absent =
+            ObservationGivenExistence(zq, false, t.marginal[q], given_parent, d);
+        for (int k = 0; k < 3; ++k) {
+          (*tables[k])[zq][zp] =
+              std::log(if_exists * existence[k] + if_absent * (1.0 - existence[k]));
+        }
+      }
+    }
+    model.unseen_all_zero_ += model.unseen_[q][0][0];
+    model.average_all_zero_ += model.average_[q][0][0];
+  }
+  model.mapped_.postings.resize(v);
+  model.samples_.postings.resize(v);
+  if (options.unknown_world == UnknownWorld::kSampled) {
+    for (Observation& o : unknown_world_samples) model.Index(&model.samples_, std::move(o));
+  }
+  return model;
+}
+
+void FabmapModel::Index(PlaceIndex* index, Observation observation) const {
+  const uint32_t place = static_cast<uint32_t>(index->observations.size());
+  double offset = 0.0;
+  for (WordId q : observation) {
+    index->postings[q].push_back(place);
+    offset += seen_[q][0][0] - unseen_[q][0][0];
+  }
+  index->seen_offset.push_back(offset);
+  index->observations.push_back(std::move(observation));
+}
+
+StatusOr<uint32_t> FabmapModel::AddPlace(Observation observation) {
+  RATSLAM_RETURN_IF_ERROR(NormaliseObservation(&observation, vocabulary_size(), "FABMAP place"));
+  Index(&mapped_, std::move(observation));
+  return places() - 1;
+}
+
+FabmapModel::Active FabmapModel::ActiveWords(const Observation& z) const {
+  Active active;
+  active.words.reserve(z.size() * 3);
+  for (WordId q : z) {
+    active.words.push_back(q);
+    for (uint32_t c = child_begin_[q]; c < child_begin_[q + 1]; ++c) {
+      active.words.push_back(children_[c]);
+    }
+  }
+  std::sort(active.words.begin(), active.words.end());
+  active.words.erase(std::unique(active.words.begin(), active.words.end()), active.words.end());
+  active.z.resize(active.words.size());
+  active.z_parent.resize(active.words.size());
+  for (size_t i = 0; i < active.words.size(); ++i) {
+    const WordId q = active.words[i];
+    const WordId p = tree_.parent[q];
+    active.z[i] = std::binary_search(z.begin(), z.end(), q);
+    active.z_parent[i] = p != ChowLiuTree::kNoParent && std::binary_search(z.begin(), z.end(), p);
+  }
+  return active;
+}
+
+double FabmapModel::UnseenLogLikelihood(const Active& active) const {
+  double sum = unseen_all_zero_;
+  for (size_t i = 0; i < active.words.size(); ++i) {
+    const Table& t = unseen_[active.words[i]];
+    sum += t[active.z[i]][active.z_parent[i]] - t[0][0];
+  }
+  return sum;
+}
+
+void FabmapModel::IndexLogLikelihoods(const PlaceIndex& index, const Active& active,
+                                      std::vector<double>* out) const {
+  const double unseen = UnseenLogLikelihood(active);
+  out->resize(index.observations.size());
+  for (size_t i = 0; i < out->size(); ++i) (*out)[i] = unseen + index.seen_offset[i];
+  for (size_t i = 0; i < active.words.size(); ++i) {
+    const WordId q = active.words[i];
+    const int zq = active.z[i], zp = active.z_parent[i];
+    const double delta =
+        (seen_[q][zq][zp] - unseen_[q][zq][zp]) - (seen_[q][0][0] - unseen_[q][0][0]);
+    for (uint32_t place : index.postings[q]) (*out)[place] += delta;
+  }
+}
+
+void FabmapModel::LogLikelihoods(const Observation& z, std::vector<double>* log_likelihood) const {
+  IndexLogLikelihoods(mapped_, ActiveWords(z), log_likelihood);
+}
+
+double FabmapModel::DenseLogLikelihood(const Observation& z, uint32_t place) const {
+  const Observation& seen_words = mapped_.observations[place];
+  double sum = 0.0;
+  for (WordId q = 0; q < vocabulary_size(); ++q) {
+    const WordId p = tree_.parent[q];
+    const bool zq = std::binary_search(z.begin(), z.end(), q);
+    const bool zp = p != ChowLiuTree::kNoParent && std::binary_search(z.begin(), z.end(), p);
+    const bool saw = std::binary_search(seen_words.begin(), seen_words.end(), q);
+    sum += (saw ? seen_ : unseen_)[q][zq][zp];
+  }
+  return sum;
+}
+
+double FabmapModel::UnknownWorldLogLikelihood(const Observation& z) const {
+  return UnknownLogLikelihood(ActiveWords(z));
+}
+
+double FabmapModel::UnknownLogLikelihood(const Active& active) const {
+  if (options_.unknown_world == UnknownWorld::kSampled) {
+    std::vector<double> sample_log_likelihood;
+    IndexLogLikelihoods(samples_, active, &sample_log_likelihood);
+    return LogMeanExp(sample_log_likelihood);
+  }
+  double sum = average_all_zero_;
+  for (size_t i = 0; i < active.words.size(); ++i) {
+    const Table& t = average_[active.words[i]];
+    sum += t[active.z[i]][active.z_parent[i]] - t[0][0];
+  }
+  return sum;
+}
+
+LocalisationResult FabmapModel::Normalise(const std::vector<double>& log_likelihood,
+                                          double unknown_log_likelihood) const {
+  LocalisationResult result;
+  const double n = static_cast<double>(log_likelihood.size());
+  const double log_new = std::log(options_.p_new_place) + unknown_log_likelihood;
+  const double log_place_prior = n > 0 ? std::log((1.0 - options_.p_new_place) / n) : 0.0;
+  double top = log_new;
+  for (double l : log_likelihood) top = std::max(top, l + log_place_prior);
+  double total = std::exp(log_new - top);
+  result.place_probability.resize(log_likelihood.size());
+  for (size_t i = 0; i < log_likelihood.size(); ++i) {
+    result.place_probability[i] = std::exp(log_likelihood[i] + log_place_prior - top);
+    total += result.place_probability[i];
+  }
+  result.new_place_probability = std::exp(log_new - top) / total;
+  result.best_probability = result.new_place_probability;
+  for (size_t i = 0; i < log_likelihood.size(); ++i) {
+    result.place_probability[i] /= total;
+    if (result.place_probability[i] > result.best_probability) {
+      result.best_probability = result.place_probability[i];
+      result.best_place = static_cast<int64_t>(i);
+    }
+  }
+  return result;
+}
+
+LocalisationResult FabmapModel::Localise(const Observation& z) const {
+  const Active active = ActiveWords(z);
+  std::vector<double> log_likelihood;
+  IndexLogLikelihoods(mapped_, active, &log_likelihood);
+  return Normalise(log_likelihood, UnknownLogLikelihood(active));
+}
+
+LocalisationResult FabmapModel::LocaliseAmong(const Observation& z,
+                                              const std::vector<uint32_t>& candidates) const {
+  const Active active = ActiveWords(z);
+  std::vector<double> all;
+  IndexLogLikelihoods(mapped_, active, &all);
+  std::vector<double> subset;
+  subset.reserve(candidates.size());
+  for (uint32_t c : candidates) subset.push_back(all.at(c));
+  LocalisationResult result = Normalise(subset, UnknownLogLikelihood(active));
+  if (result.best_place >= 0) result.best_place = candidates[result.best_place];
+  return result;
+}
+
+}  // namespace ratslam::fabmap

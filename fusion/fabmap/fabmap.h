@@ -1,0 +1,144 @@
+// FABMAP place recognition (Cummins and Newman 2008, 2011; the fusion paper's section 2).
+//
+// Observation likelihood: each place keeps whether it saw each word; a word's existence e_q at a
+// place is inferred through the detector model p(z|e), and observations follow the Chow-Liu tree.
+// Per word, p(z_q | e_q, z_parent) combines the two as in Cummins and Newman (2008):
+//   p(z_q=a | e_q=s, z_p=c) = beta / (alpha + beta),
+//   alpha = p(z_q=a) p(z_q=!a | e_q=s) p(z_q=!a | z_p=c),
+//   beta  = p(z_q=!a) p(z_q=a | e_q=s) p(z_q=a | z_p=c).
+// The existence prior p(e_q) is the one consistent with the word's training marginal under the
+// detector model: p(z_q) = PzGe p(e_q) + PzGNe (1 - p(e_q)).
+//
+// The likelihood of all V words is computed FABMAP 2.0 style, and exactly: a place's per-word
+// term depends only on whether the place saw the word and on the query bits (z_q, z_parent), so
+// only the "active" words (query words and their children) differ from a precomputed all-zero
+// query. An inverted index over words visits only places that saw an active word. The dense
+// FABMAP 1.0 sum over all words is kept as DenseLogLikelihood, the test oracle.
+//
+// Normalisation (eq. 3): p(L_i|Z) = p(Z|L_i) p(L_i) / (sum_m p(Z|L_m) p(L_m) + p_new p(Z|L_u)),
+// p(L_m) = (1 - p_new) / n_M. The unknown-world likelihood p(Z|L_u) comes from
+//   - kSampled: the mean of p(Z|L_u) over unknown-world sample observations (the paper's eq. 3);
+//   - kMeanField: one "average place" whose existence probabilities are the samples' marginals.
+// The mean-field place is the expectation of the place likelihood over places drawn like the
+// samples (exact without the tree, since the likelihood is linear in each p(e_q|L)). A sample
+// mean of a heavy-tailed likelihood from a fixed n_s samples is biased low, while the mapped sum
+// grows better estimated as the map grows; with kSampled a truly new place is therefore called
+// mapped more and more often as places are added. kMeanField stays calibrated (tested at 10k).
+#ifndef RATSLAM_FUSION_FABMAP_FABMAP_H_
+#define RATSLAM_FUSION_FABMAP_FABMAP_H_
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "fusion/fabmap/chow_liu.h"
+#include "ratslam/status.h"
+
+namespace ratslam::fabmap {
+
+struct DetectorModel {
+  double p_observed_given_exists = 0.39;  // PzGe (openFABMAP default)
+  double p_observed_given_absent = 0.0;   // PzGNe (openFABMAP default)
+
+  bool IsValid(std::string* error) const;
+};
+
+// Words [first_word, first_word + count) use `detector`.
+struct DetectorBlock {
+  WordId first_word = 0;
+  uint32_t count = 0;
+  DetectorModel detector;
+};
+
+enum class UnknownWorld { kMeanField, kSampled };
+std::string ToString(UnknownWorld unknown_world);
+StatusOr<UnknownWorld> UnknownWorldFromString(const std::string& name);
+
+struct FabmapOptions {
+  double p_new_place = 0.9;  // prior of the unknown world (eq. 3; 0.9 in Cummins and Newman 2008)
+  UnknownWorld unknown_world = UnknownWorld::kMeanField;  // how p(Z|L_u) is estimated
+  double sample_pseudo_count = 0.5;  // smoothing of the samples' marginals (mean field)
+
+  bool IsValid(std::string* error) const;
+};
+
+struct LocalisationResult {
+  int64_t best_place = -1;          // -1: the new (unknown) place is the arg-max (eq. 5)
+  double best_probability = 0.0;    // posterior of the arg-max hypothesis
+  double new_place_probability = 0.0;
+  std::vector<double> place_probability;  // per mapped place (or per candidate, in order)
+};
+
+class FabmapModel {
+ public:
+  // `blocks` must cover words 0..tree.size()-1 in order; `unknown_world_samples` are
+  // observations over the same words (at least one).
+  static StatusOr<FabmapModel> Create(ChowLiuTree tree, std::vector<DetectorBlock> blocks,
+                                      std::vector<Observation> unknown_world_samples,
+                                      const FabmapOptions& options);
+
+  uint32_t vocabulary_size() const { return tree_.size(); }
+  uint32_t places() const { return static_cast<uint32_t>(mapped_.observations.size()); }
+  const Observation& place_observation(uint32_t place) const {
+    return mapped_.observations[place];
+  }
+  const FabmapOptions& options() const { return options_; }
+
+  // Adds a place seen as `observation` (normalised; an out-of-vocabulary word is an error).
+  StatusOr<uint32_t> AddPlace(Observation observation);
+
+  // log p(Z | L_i) for every mapped place, via the inverted index. `z` must be normalised.
+  void LogLikelihoods(const Observation& z, std::vector<double>* log_likelihood) const;
+  // The same for one place, summing every word of the vocabulary (FABMAP 1.0; test oracle).
+  double DenseLogLikelihood(const Observation& z, uint32_t place) const;
+  // log p(Z | L_u), by the configured unknown-world estimate.
+  double UnknownWorldLogLikelihood(const Observation& z) const;
+
+  // The posterior over mapped places and the new place (eq. 3, uniform priors, eq. 5 arg-max).
+  LocalisationResult Localise(const Observation& z) const;
+  // The same over a subset of places (normalised over them plus the new place); the result's
+  // place_probability follows `candidates`' order, best_place is a place id.
+  LocalisationResult LocaliseAmong(const Observation& z,
+                                   const std::vector<uint32_t>& candidates) const;
+
+ private:
+  // Per word, indexed [z_q][z_parent].
+  using Table = std::array<std::array<double, 2>, 2>;
+  struct PlaceIndex {
+    std::vector<Observation> observations;
+    std::vector<std::vector<uint32_t>> postings;  // word -> places that saw it
+    std::vector<double> seen_offset;  // per place: sum over its words of the all-zero delta
+  };
+
+  FabmapModel() = default;
+  void Index(PlaceIndex* index, Observation observation) const;
+  // Query bits of the active words: the query's words and their children.
+  struct Active {
+    std::vector<WordId> words;
+    std::vector<uint8_t> z, z_parent;
+  };
+  Active ActiveWords(const Observation& z) const;
+  double UnseenLogLikelihood(const Active& active) const;
+  double UnknownLogLikelihood(const Active& active) const;
+  void IndexLogLikelihoods(const PlaceIndex& index, const Active& active,
+                           std::vector<double>* out) const;
+  LocalisationResult Normalise(const std::vector<double>& log_likelihood,
+                               double unknown_log_likelihood) const;
+
+  ChowLiuTree tree_;
+  FabmapOptions options_;
+  std::vector<uint32_t> child_begin_;
+  std::vector<WordId> children_;
+  std::vector<Table> seen_;      // log p(z_q | z_p, place saw q)
+  std::vector<Table> unseen_;    // log p(z_q | z_p, place did not see q)
+  std::vector<Table> average_;   // log p(z_q | z_p, mean-field unknown place)
+  double unseen_all_zero_ = 0.0;   // sum over words of unseen_[q][0][0]
+  double average_all_zero_ = 0.0;  // sum over words of average_[q][0][0]
+  PlaceIndex mapped_;
+  PlaceIndex samples_;
+};
+
+}  // namespace ratslam::fabmap
+
+#endif  // RATSLAM_FUSION_FABMAP_FABMAP_H_

@@ -1,0 +1,205 @@
+#include "fusion/fabmap/fabmap.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "fusion/fabmap/synthetic_words.h"
+#include "ratslam/random.h"
+
+namespace ratslam::fabmap {
+namespace {
+
+struct World {
+  SyntheticWordWorld words;
+  ChowLiuTree tree;
+  std::vector<Observation> samples;
+};
+
+World MakeWorld(uint32_t vocabulary, double mean_words, uint64_t seed) {
+  World w;
+  w.words.vocabulary_size = vocabulary;
+  w.words.mean_words_per_observation = mean_words;
+  Random random(seed);
+  std::vector<Observation> training;
+  for (int i = 0; i < 500; ++i) {
+    training.push_back(w.words.Observe(w.words.SamplePlace(&random), &random));
+  }
+  w.tree = *LearnChowLiuTree(training, vocabulary);
+  for (int i = 0; i < 300; ++i) {
+    w.samples.push_back(w.words.Observe(w.words.SamplePlace(&random), &random));
+  }
+  return w;
+}
+
+FabmapModel MakeModel(const World& w, UnknownWorld unknown = UnknownWorld::kMeanField,
+                      double p_detect = 0.8) {
+  FabmapOptions options;
+  options.unknown_world = unknown;
+  DetectorBlock block;
+  block.count = w.tree.size();
+  block.detector.p_observed_given_exists = p_detect;
+  auto model = FabmapModel::Create(w.tree, {block}, w.samples, options);
+  EXPECT_TRUE(model.ok()) << model.status().message();
+  return *std::move(model);
+}
+
+TEST(FabmapTest, SparseLikelihoodEqualsDenseOracle) {
+  const World w = MakeWorld(300, 30, 1);
+  for (double p_absent : {0.0, 0.05}) {
+    FabmapOptions options;
+    DetectorBlock block;
+    block.count = w.tree.size();
+    block.detector.p_observed_given_exists = 0.39;  // openFABMAP defaults
+    block.detector.p_observed_given_absent = p_absent;
+    auto model = *FabmapModel::Create(w.tree, {block}, w.samples, options);
+    Random random(11);
+    for (int i = 0; i < 40; ++i) {
+      // Random places, including empty ones and ones of random words (not from the world).
+      Observation o;
+      if (i % 2 == 0) {
+        o = w.words.Observe(w.words.SamplePlace(&random), &random);
+      } else {
+        for (int k = 0; k < i; ++k) o.push_back(static_cast<WordId>(random.NextU64() % 300));
+      }
+      ASSERT_TRUE(model.AddPlace(o).ok());
+    }
+    for (int trial = 0; trial < 20; ++trial) {
+      Observation z;
+      for (int k = 0; k < trial * 3; ++k) z.push_back(static_cast<WordId>(random.NextU64() % 300));
+      ASSERT_TRUE(NormaliseObservation(&z, 300, "query").ok());
+      std::vector<double> sparse;
+      model.LogLikelihoods(z, &sparse);
+      ASSERT_EQ(sparse.size(), model.places());
+      for (uint32_t place = 0; place < model.places(); ++place) {
+        const double dense = model.DenseLogLikelihood(z, place);
+        EXPECT_NEAR(sparse[place], dense, 1e-9 * std::abs(dense) + 1e-9);
+      }
+    }
+  }
+}
+
+TEST(FabmapTest, LikelihoodIsANormalisedDistributionOverObservations) {
+  // Summing p(Z | L) over all 2^V observations of a tiny vocabulary gives 1.
+  const ChowLiuTree tree = *LearnChowLiuTree({{0, 1}, {1, 2}, {0, 1, 3}, {2}, {0, 3}}, 4);
+  DetectorBlock block;
+  block.count = 4;
+  block.detector.p_observed_given_absent = 0.02;
+  auto model = *FabmapModel::Create(tree, {block}, {{0}, {1, 2}}, FabmapOptions{});
+  ASSERT_TRUE(model.AddPlace({0, 2}).ok());
+  double total = 0.0;
+  for (int bits = 0; bits < 16; ++bits) {
+    Observation z;
+    for (WordId q = 0; q < 4; ++q) {
+      if (bits & (1 << q)) z.push_back(q);
+    }
+    total += std::exp(model.DenseLogLikelihood(z, 0));
+  }
+  EXPECT_NEAR(total, 1.0, 1e-9);
+}
+
+TEST(FabmapTest, IdenticalObservationMatchesItsPlace) {
+  const World w = MakeWorld(1000, 50, 2);
+  FabmapModel model = MakeModel(w);
+  Random random(5);
+  std::vector<Observation> places;
+  for (int i = 0; i < 300; ++i) {
+    places.push_back(w.words.Observe(w.words.SamplePlace(&random), &random));
+    ASSERT_TRUE(model.AddPlace(places.back()).ok());
+  }
+  for (uint32_t i : {0u, 17u, 299u}) {
+    const LocalisationResult r = model.Localise(places[i]);
+    EXPECT_EQ(r.best_place, i);
+    EXPECT_GT(r.best_probability, 0.99);
+    EXPECT_LT(r.new_place_probability, 0.01);
+  }
+}
+
+TEST(FabmapTest, AllNewObservationIsRejected) {
+  const World w = MakeWorld(1000, 50, 3);
+  FabmapModel model = MakeModel(w);
+  Random random(6);
+  for (int i = 0; i < 300; ++i) {
+    ASSERT_TRUE(model.AddPlace(w.words.Observe(w.words.SamplePlace(&random), &random)).ok());
+  }
+  int rejected = 0;
+  for (int i = 0; i < 100; ++i) {
+    const LocalisationResult r =
+        model.Localise(w.words.Observe(w.words.SamplePlace(&random), &random));
+    rejected += r.best_place < 0;
+  }
+  EXPECT_GE(rejected, 95);
+}
+
+// Revisits (a second observation of a mapped place) are recognised and truly new places are
+// still called new with 10,000 places in the map: p(new) stays calibrated as the map grows.
+TEST(FabmapTest, NewPlaceStaysCalibratedAtTenThousandPlaces) {
+  const World w = MakeWorld(1000, 50, 4);
+  FabmapModel model = MakeModel(w);
+  FabmapModel sampled = MakeModel(w, UnknownWorld::kSampled);
+  Random random(8);
+  std::vector<Observation> places;
+  for (int i = 0; i < 10000; ++i) {
+    places.push_back(w.words.SamplePlace(&random));
+    const Observation seen = w.words.Observe(places.back(), &random);
+    ASSERT_TRUE(model.AddPlace(seen).ok());
+    ASSERT_TRUE(sampled.AddPlace(seen).ok());
+  }
+  int new_called_new = 0, sampled_new_called_new = 0, revisits_found = 0;
+  const int queries = 200;
+  for (int i = 0; i < queries; ++i) {
+    const Observation fresh = w.words.Observe(w.words.SamplePlace(&random), &random);
+    new_called_new += model.Localise(fresh).best_place < 0;
+    sampled_new_called_new += sampled.Localise(fresh).best_place < 0;
+    const uint32_t target = static_cast<uint32_t>(random.NextU64() % places.size());
+    revisits_found += model.Localise(w.words.Observe(places[target], &random)).best_place ==
+                      static_cast<int64_t>(target);
+  }
+  EXPECT_GE(new_called_new, queries * 95 / 100);
+  EXPECT_GE(revisits_found, queries * 90 / 100);
+  RecordProperty("mean_field_new_called_new", new_called_new);
+  RecordProperty("sampled_new_called_new", sampled_new_called_new);
+}
+
+TEST(FabmapTest, LocaliseAmongCandidates) {
+  const World w = MakeWorld(500, 40, 9);
+  FabmapModel model = MakeModel(w);
+  Random random(10);
+  std::vector<Observation> places;
+  for (int i = 0; i < 50; ++i) {
+    places.push_back(w.words.Observe(w.words.SamplePlace(&random), &random));
+    ASSERT_TRUE(model.AddPlace(places.back()).ok());
+  }
+  const LocalisationResult in = model.LocaliseAmong(places[7], {3, 7, 9});
+  EXPECT_EQ(in.best_place, 7);
+  ASSERT_EQ(in.place_probability.size(), 3u);
+  EXPECT_GT(in.place_probability[1], 0.99);
+  const LocalisationResult out = model.LocaliseAmong(places[7], {3, 9});
+  EXPECT_EQ(out.best_place, -1);  // the true place is not a candidate: new
+}
+
+TEST(FabmapTest, RejectsBadConfiguration) {
+  const World w = MakeWorld(100, 10, 12);
+  DetectorBlock block;
+  block.count = 100;
+  FabmapOptions bad;
+  bad.p_new_place = 1.0;
+  EXPECT_FALSE(FabmapModel::Create(w.tree, {block}, w.samples, bad).ok());
+  EXPECT_FALSE(FabmapModel::Create(w.tree, {block}, {}, FabmapOptions{}).ok());
+  DetectorBlock short_block = block;
+  short_block.count = 99;
+  EXPECT_FALSE(FabmapModel::Create(w.tree, {short_block}, w.samples, FabmapOptions{}).ok());
+  DetectorBlock bad_detector = block;
+  bad_detector.detector.p_observed_given_absent = 0.5;
+  EXPECT_FALSE(FabmapModel::Create(w.tree, {bad_detector}, w.samples, FabmapOptions{}).ok());
+  auto model = *FabmapModel::Create(w.tree, {block}, w.samples, FabmapOptions{});
+  EXPECT_FALSE(model.AddPlace({100}).ok());
+  EXPECT_EQ(UnknownWorldFromString("sampled").value(), UnknownWorld::kSampled);
+  EXPECT_FALSE(UnknownWorldFromString("bogus").ok());
+  std::string error;
+  EXPECT_TRUE(FabmapOptions{}.IsValid(&error));
+  EXPECT_TRUE(DetectorModel{}.IsValid(&error));
+}
+
+}  // namespace
+}  // namespace ratslam::fabmap
