@@ -125,9 +125,8 @@ StatusOr<ChowLiuTree> LearnChowLiuTree(const std::vector<Observation>& observati
       }
     }
     for (WordId v : remaining) {
-      const double mi = together[v] != 0
-                            ? MutualInformation(n, count[u], count[v], together[v])
-                            : mi_never_together(u, v);
+      const double mi = together[v] != 0 ? MutualInformation(n, count[u], count[v], together[v])
+                                         : mi_never_together(u, v);
       if (mi > key[v]) {
         key[v] = mi;
         tree.parent[v] = u;

@@ -33,7 +33,7 @@ struct ChowLiuTree {
   static constexpr WordId kNoParent = std::numeric_limits<WordId>::max();
 
   std::vector<WordId> parent;
-  std::vector<double> marginal;          // p(z_q = 1)
+  std::vector<double> marginal;             // p(z_q = 1)
   std::vector<double> on_given_parent_on;   // p(z_q = 1 | z_parent = 1); marginal for a root
   std::vector<double> on_given_parent_off;  // p(z_q = 1 | z_parent = 0); marginal for a root
 

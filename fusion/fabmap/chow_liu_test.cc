@@ -13,13 +13,13 @@ namespace ratslam::fabmap {
 namespace {
 
 TEST(MutualInformationTest, KnownValues) {
-  EXPECT_NEAR(MutualInformation(100, 50, 50, 25), 0.0, 1e-12);         // independent
+  EXPECT_NEAR(MutualInformation(100, 50, 50, 25), 0.0, 1e-12);            // independent
   EXPECT_NEAR(MutualInformation(100, 50, 50, 50), std::log(2.0), 1e-12);  // identical
   EXPECT_NEAR(MutualInformation(100, 50, 50, 0), std::log(2.0), 1e-12);   // complementary
   // One hand-computed asymmetric case: n=4, a on in 2, b on in 1, together 1.
   // p11=1/4 (pa pb = 1/8), p10=1/4 (pa (1-pb) = 3/8), p01=0, p00=1/2 (3/8).
-  const double expected = 0.25 * std::log(2.0) + 0.25 * std::log(2.0 / 3.0) +
-                          0.5 * std::log(4.0 / 3.0);
+  const double expected =
+      0.25 * std::log(2.0) + 0.25 * std::log(2.0 / 3.0) + 0.5 * std::log(4.0 / 3.0);
   EXPECT_NEAR(MutualInformation(4, 2, 1, 1), expected, 1e-12);
 }
 

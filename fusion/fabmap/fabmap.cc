@@ -138,7 +138,8 @@ StatusOr<FabmapModel> FabmapModel::Create(ChowLiuTree tree, std::vector<Detector
     for (int zq = 0; zq < 2; ++zq) {
       for (int zp = 0; zp < 2; ++zp) {
         const double given_parent = zp ? t.on_given_parent_on[q] : t.on_given_parent_off[q];
-        const double if_exists = ObservationGivenExistence(zq, true, t.marginal[q], given_parent, d);
+        const double if_exists =
+            ObservationGivenExistence(zq, true, t.marginal[q], given_parent, d);
         const double if_absent =
             ObservationGivenExistence(zq, false, t.marginal[q], given_parent, d);
         for (int k = 0; k < 3; ++k) {

@@ -42,6 +42,13 @@ struct DetectorModel {
   double p_observed_given_absent = 0.0;   // PzGNe (openFABMAP default)
 
   bool IsValid(std::string* error) const;
+  template <typename Visitor>
+  void VisitFields(Visitor&& v) {
+    v("p_observed_given_exists", p_observed_given_exists,
+      "detector model PzGe: p(word seen | word exists at the place)");
+    v("p_observed_given_absent", p_observed_given_absent,
+      "detector model PzGNe: p(word seen | word absent at the place)");
+  }
 };
 
 // Words [first_word, first_word + count) use `detector`.
@@ -61,11 +68,19 @@ struct FabmapOptions {
   double sample_pseudo_count = 0.5;  // smoothing of the samples' marginals (mean field)
 
   bool IsValid(std::string* error) const;
+  template <typename Visitor>
+  void VisitFields(Visitor&& v) {
+    v("p_new_place", p_new_place, "prior of the unknown world (eq. 3)");
+    v("unknown_world", unknown_world,
+      "p(Z|unknown place): mean_field (stays calibrated) or sampled (the paper's eq. 3)");
+    v("sample_pseudo_count", sample_pseudo_count,
+      "pseudo-count smoothing the unknown-world samples' word marginals");
+  }
 };
 
 struct LocalisationResult {
-  int64_t best_place = -1;          // -1: the new (unknown) place is the arg-max (eq. 5)
-  double best_probability = 0.0;    // posterior of the arg-max hypothesis
+  int64_t best_place = -1;        // -1: the new (unknown) place is the arg-max (eq. 5)
+  double best_probability = 0.0;  // posterior of the arg-max hypothesis
   double new_place_probability = 0.0;
   std::vector<double> place_probability;  // per mapped place (or per candidate, in order)
 };
@@ -80,9 +95,7 @@ class FabmapModel {
 
   uint32_t vocabulary_size() const { return tree_.size(); }
   uint32_t places() const { return static_cast<uint32_t>(mapped_.observations.size()); }
-  const Observation& place_observation(uint32_t place) const {
-    return mapped_.observations[place];
-  }
+  const Observation& place_observation(uint32_t place) const { return mapped_.observations[place]; }
   const FabmapOptions& options() const { return options_; }
 
   // Adds a place seen as `observation` (normalised; an out-of-vocabulary word is an error).
@@ -130,9 +143,9 @@ class FabmapModel {
   FabmapOptions options_;
   std::vector<uint32_t> child_begin_;
   std::vector<WordId> children_;
-  std::vector<Table> seen_;      // log p(z_q | z_p, place saw q)
-  std::vector<Table> unseen_;    // log p(z_q | z_p, place did not see q)
-  std::vector<Table> average_;   // log p(z_q | z_p, mean-field unknown place)
+  std::vector<Table> seen_;        // log p(z_q | z_p, place saw q)
+  std::vector<Table> unseen_;      // log p(z_q | z_p, place did not see q)
+  std::vector<Table> average_;     // log p(z_q | z_p, mean-field unknown place)
   double unseen_all_zero_ = 0.0;   // sum over words of unseen_[q][0][0]
   double average_all_zero_ = 0.0;  // sum over words of average_[q][0][0]
   PlaceIndex mapped_;

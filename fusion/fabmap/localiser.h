@@ -1,0 +1,119 @@
+// Global localisation with FABMAP over vision, Wi-Fi, or both (the fusion paper's section 4).
+//
+// The map is a list of nodes, each a visual observation and/or a Wi-Fi scan. Wi-Fi words are
+// learnt from the map's scans (section 3.1), the Wi-Fi Chow-Liu tree from map scans that are far
+// enough apart (section 3.2), the Wi-Fi unknown world from virtual samples (section 3.3). The
+// visual vocabulary, tree and unknown-world samples come from offline training (section 2).
+// Modes:
+//   vision, wifi   one modality alone;
+//   early          one FABMAP over concatenated visual and Wi-Fi words, the two trees used as one
+//                  forest and the unknown-world samples concatenated (sections 4.2-4.3);
+//   late           eq. 4: p(L_i) proportional to p_vision(L_i) p_wifi(L_i) / p(L_i), with
+//                  p(L_i) = 1 / (n_M + 1) for the n_M places and the new place;
+//   wifi_guided    visual FABMAP over the Wi-Fi candidates only (section 4.1);
+//   wifi_check     the visual result stands only if Wi-Fi lists it as a candidate, else it is a
+//                  rejection (section 4.1).
+// Sequential fusion needs several Wi-Fi candidates, not FABMAP's single arg-max (the paper uses
+// Stumm et al. 2013). Our normalisation: the candidates are the places whose Wi-Fi likelihood is
+// within `candidate_log_margin` nats of the best one, at most `max_candidates` of them, best
+// first; i.e. places with likelihood ratio to the best of at least exp(-margin).
+#ifndef RATSLAM_FUSION_FABMAP_LOCALISER_H_
+#define RATSLAM_FUSION_FABMAP_LOCALISER_H_
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "fusion/fabmap/chow_liu.h"
+#include "fusion/fabmap/fabmap.h"
+#include "fusion/fabmap/wifi_words.h"
+#include "ratslam/status.h"
+#include "sensors/dataset/dataset.h"
+
+namespace ratslam::fabmap {
+
+enum class FabmapMode { kVision, kWifi, kEarly, kLate, kWifiGuided, kWifiCheck };
+std::string ToString(FabmapMode mode);
+StatusOr<FabmapMode> FabmapModeFromString(const std::string& name);
+bool UsesVision(FabmapMode mode);
+bool UsesWifi(FabmapMode mode);
+
+struct LocaliserOptions {
+  FabmapMode mode = FabmapMode::kWifi;    // which sensors, and how they are fused
+  int max_candidates = 20;                // Wi-Fi candidates for sequential fusion
+  double candidate_log_margin = 20.0;     // nats below the best Wi-Fi likelihood still a candidate
+  double wifi_tree_min_distance_m = 1.0;  // spacing of the scans that learn the Wi-Fi tree
+  double wifi_tree_min_interval_s = 0.0;  // (section 3.2): travel and time since the last one
+
+  bool IsValid(std::string* error) const;
+  template <typename Visitor>
+  void VisitFields(Visitor&& v) {
+    v("mode", mode, "vision, wifi, early, late, wifi_guided or wifi_check (paper section 4)");
+    v("max_candidates", max_candidates, "Wi-Fi candidates at most, for sequential fusion");
+    v("candidate_log_margin", candidate_log_margin,
+      "a place within this many nats of the best Wi-Fi likelihood is a candidate");
+    v("wifi_tree_min_distance_m", wifi_tree_min_distance_m,
+      "Wi-Fi tree: a scan is used only this far (travel) from the previously used one");
+    v("wifi_tree_min_interval_s", wifi_tree_min_interval_s,
+      "Wi-Fi tree: and only this long after it");
+  }
+};
+
+// Everything the localiser is configured with.
+struct LocaliserSettings {
+  LocaliserOptions localiser;
+  FabmapOptions fabmap;
+  DetectorModel visual_detector;
+  DetectorModel wifi_detector;
+  WifiWordOptions wifi_words;
+  VirtualSampleOptions virtual_wifi;
+  ChowLiuOptions chow_liu;
+};
+
+// The offline visual model: its Chow-Liu tree and unknown-world sample observations.
+struct VisualModel {
+  ChowLiuTree tree;
+  std::vector<Observation> samples;
+};
+
+struct MapNode {
+  Observation visual;                            // visual words (vision modes)
+  std::optional<std::vector<WifiReading>> wifi;  // the node's scan, if any
+  double travelled_m = 0.0;                      // along the exploration, for tree spacing
+  double time_s = 0.0;
+};
+
+struct Query {
+  Observation visual;
+  std::optional<std::vector<WifiReading>> wifi;
+};
+
+class Localiser {
+ public:
+  // `visual` is needed by the modes that use vision.
+  static StatusOr<std::unique_ptr<Localiser>> Build(const LocaliserSettings& settings,
+                                                    const VisualModel* visual,
+                                                    const std::vector<MapNode>& map);
+  uint32_t places() const { return places_; }
+  uint32_t wifi_words() const { return wifi_vocabulary_.size(); }
+  // best_place indexes the map nodes; -1 is the new place (a rejection).
+  LocalisationResult Localise(const Query& query) const;
+  // Wi-Fi candidates for sequential fusion, best first.
+  std::vector<uint32_t> WifiCandidates(const Observation& wifi_words) const;
+
+ private:
+  explicit Localiser(const LocaliserSettings& settings)
+      : settings_(settings), wifi_vocabulary_(settings.wifi_words) {}
+  Observation WifiWords(const Query& query) const;
+
+  LocaliserSettings settings_;
+  uint32_t places_ = 0;
+  uint32_t visual_words_ = 0;
+  WifiVocabulary wifi_vocabulary_;
+  std::optional<FabmapModel> vision_, wifi_, early_;
+};
+
+}  // namespace ratslam::fabmap
+
+#endif  // RATSLAM_FUSION_FABMAP_LOCALISER_H_
