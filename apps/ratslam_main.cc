@@ -71,7 +71,11 @@ const char kUsage[] =
     "  ratslam render pose-cells --map F [--config C] --out F\n"
     "  ratslam render similarity --data D [--data D2 ...] [--config C] --out F [--frames N]\n"
     "                 [--sensor camera|wifi]\n"
-    "      Images from a run folder, a saved map, or a data set (PNG).\n";
+    "      Images from a run folder, a saved map, or a data set (PNG).\n"
+    "  ratslam evaluate [--config C] --map M --query Q --out O [--quiet]\n"
+    "      FABMAP localisation benchmark: maps M, localises every node of Q, writes\n"
+    "      evaluation.json, queries.csv and localisation.png to O. M and Q may be the same\n"
+    "      data set: [evaluation] split and map_fraction then divide it.\n";
 
 struct ReplayRequest {
   PipelineOptions options;
@@ -412,6 +416,7 @@ int main(int argc, char** argv) {
   if (command == "import-openratslam") return ImportOpenRatslam(argc, argv);
   if (command == "synthesize") return SynthesizeCommand(argc, argv);
   if (command == "render") return RenderCommand(argc, argv);
+  if (command == "evaluate") return EvaluateCommand(argc, argv);
   if (command == "import") return ImportCommand(argc, argv);
   if (command == "--help" || command == "help" || command == "-h") {
     std::cout << kUsage;

@@ -17,7 +17,26 @@ bool PipelineOptions::IsValid(std::string* error) const {
          check(sensors.fused.IsValid(&inner), "fused") &&
          check(sensors.camera_12x9.IsValid(&inner), "camera_12x9") &&
          check(sensors.wifi.IsValid(&inner), "wifi") && check(pdr.IsValid(&inner), "pdr") &&
-         check(visual_odometry.IsValid(&inner), "visual_odometry") && ratslam.IsValid(error);
+         check(visual_odometry.IsValid(&inner), "visual_odometry") && ratslam.IsValid(error) &&
+         fabmap.IsValid(error);
+}
+
+bool FabmapSettings::IsValid(std::string* error) const {
+  std::string inner;
+  auto check = [&](bool ok, const char* section) {
+    if (!ok && error) *error = std::string(section) + "." + inner;
+    return ok;
+  };
+  return check(localiser.localiser.IsValid(&inner), "fabmap") &&
+         check(localiser.fabmap.IsValid(&inner), "fabmap_model") &&
+         check(localiser.visual_detector.IsValid(&inner), "visual_detector") &&
+         check(localiser.wifi_detector.IsValid(&inner), "wifi_detector") &&
+         check(features.IsValid(&inner), "visual_words") &&
+         check(vocabulary.IsValid(&inner), "vocabulary") &&
+         check(visual_model.IsValid(&inner), "visual_model") &&
+         check(localiser.wifi_words.IsValid(&inner), "wifi_words") &&
+         check(localiser.virtual_wifi.IsValid(&inner), "virtual_wifi") &&
+         check(evaluation.IsValid(&inner), "evaluation");
 }
 
 namespace {

@@ -13,6 +13,10 @@
 #include <string>
 #include <vector>
 
+#include "fusion/fabmap/evaluation.h"
+#include "fusion/fabmap/localiser.h"
+#include "fusion/fabmap/visual_model.h"
+#include "fusion/fabmap/vocabulary.h"
 #include "fusion/front_end.h"
 #include "ratslam/ratslam.h"
 #include "ratslam/status.h"
@@ -23,12 +27,24 @@
 
 namespace ratslam {
 
-// Everything a replay is configured by; one TOML section per member.
+// FABMAP localisation (fusion/fabmap): modes, models, words and the benchmark's split.
+struct FabmapSettings {
+  fabmap::LocaliserSettings localiser;
+  fabmap::FeatureOptions features;
+  fabmap::VocabularyOptions vocabulary;
+  fabmap::VisualModelOptions visual_model;
+  fabmap::EvaluationOptions evaluation;
+
+  bool IsValid(std::string* error) const;
+};
+
+// Everything a replay or an evaluation is configured by; one TOML section per member.
 struct PipelineOptions {
   FrontEndSettings sensors;               // front end choice and every sensor's options
   PdrOptions pdr;                         // odometry from phone logs
   VisualOdometryOptions visual_odometry;  // odometry from a camera alone
   RatslamOptions ratslam;
+  FabmapSettings fabmap;  // `ratslam evaluate`
 
   bool IsValid(std::string* error) const;
 
@@ -46,6 +62,16 @@ struct PipelineOptions {
     v("local_view", ratslam.local_view);
     v("experience_map", ratslam.experience_map);
     v("action", ratslam.action);
+    v("fabmap", fabmap.localiser.localiser);
+    v("fabmap_model", fabmap.localiser.fabmap);
+    v("visual_detector", fabmap.localiser.visual_detector);
+    v("wifi_detector", fabmap.localiser.wifi_detector);
+    v("visual_words", fabmap.features);
+    v("vocabulary", fabmap.vocabulary);
+    v("visual_model", fabmap.visual_model);
+    v("wifi_words", fabmap.localiser.wifi_words);
+    v("virtual_wifi", fabmap.localiser.virtual_wifi);
+    v("evaluation", fabmap.evaluation);
   }
 };
 

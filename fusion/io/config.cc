@@ -10,6 +10,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <type_traits>
 
 namespace ratslam {
 namespace {
@@ -76,6 +77,43 @@ class SectionReader {
     field = b->get();
     return Status::Ok();
   }
+  static Status Assign(const toml::node& node, uint64_t& field) {
+    const auto* v = node.as_integer();
+    if (!v) return Status::Error("expected an integer");
+    if (v->get() < 0) return Status::Error("must not be negative");
+    field = static_cast<uint64_t>(v->get());
+    return Status::Ok();
+  }
+  static Status Assign(const toml::node& node, std::string& field) {
+    const auto* s = node.as_string();
+    if (!s) return Status::Error("expected a string");
+    field = s->get();
+    return Status::Ok();
+  }
+  template <typename Enum, typename Parse>
+  static Status AssignEnum(const toml::node& node, Enum& field, Parse parse) {
+    const auto* s = node.as_string();
+    if (!s) return Status::Error("expected a string");
+    auto value = parse(s->get());
+    if (!value.ok()) return value.status();
+    field = value.value();
+    return Status::Ok();
+  }
+  static Status Assign(const toml::node& node, fabmap::FabmapMode& field) {
+    return AssignEnum(node, field, fabmap::FabmapModeFromString);
+  }
+  static Status Assign(const toml::node& node, fabmap::UnknownWorld& field) {
+    return AssignEnum(node, field, fabmap::UnknownWorldFromString);
+  }
+  static Status Assign(const toml::node& node, fabmap::DescriptorKind& field) {
+    return AssignEnum(node, field, fabmap::DescriptorKindFromString);
+  }
+  static Status Assign(const toml::node& node, fabmap::WifiEncoding& field) {
+    return AssignEnum(node, field, fabmap::WifiEncodingFromString);
+  }
+  static Status Assign(const toml::node& node, fabmap::SplitUnit& field) {
+    return AssignEnum(node, field, fabmap::SplitUnitFromString);
+  }
   static Status Assign(const toml::node& node, FrontEndKind& field) {
     const auto* s = node.as_string();
     if (!s) return Status::Error("expected a string");
@@ -113,11 +151,19 @@ class SectionPrinter {
   static std::string Format(int v) { return std::to_string(v); }
   static std::string Format(double v) { return FormatDouble(v); }
   static std::string Format(bool v) { return v ? "true" : "false"; }
-  static std::string Format(FrontEndKind v) {
+  static std::string Format(uint64_t v) { return std::to_string(v); }
+  static std::string Format(const std::string& v) {
     std::string quoted(1, '"');  // appended piecewise: GCC 12 warns falsely on "\"" + s
-    quoted += ToString(v);
+    for (char c : v) {
+      if (c == '"' || c == '\\') quoted += '\\';
+      quoted += c;
+    }
     quoted += '"';
     return quoted;
+  }
+  template <typename Enum>
+  static std::string Format(Enum v) requires std::is_enum_v<Enum> {
+    return Format(ToString(v));
   }
   std::ostringstream& out_;
   bool comments_;

@@ -1,0 +1,83 @@
+// The localisation benchmark of the fusion paper (sections 5.2-5.3): map with part of the data,
+// query with the rest, take the arg-max place (eq. 5). The error of a query is the distance
+// between its position and the matched place's, infinite when the floor differs; a new-place
+// answer is a rejection. Reported: the rate of correct localisations within d and of misplaced
+// ones beyond d (fractions of all queries), the rejection rate and the floor-mistake rate.
+#ifndef RATSLAM_FUSION_FABMAP_EVALUATION_H_
+#define RATSLAM_FUSION_FABMAP_EVALUATION_H_
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "ratslam/status.h"
+#include "sensors/dataset/dataset.h"
+
+namespace ratslam::fabmap {
+
+// A place of the benchmark: where it is and what was sensed there.
+struct EvaluationNode {
+  double x_m = 0.0, y_m = 0.0;
+  int floor = 0;
+  double time_s = 0.0;
+  double travelled_m = 0.0;  // along its session (for the Wi-Fi tree's spacing)
+  int session = 0;
+  std::string image;                             // image path, if any
+  std::optional<std::vector<WifiReading>> wifi;  // scan, if any
+};
+
+enum class SplitUnit { kNode, kSession };
+std::string ToString(SplitUnit unit);
+StatusOr<SplitUnit> SplitUnitFromString(const std::string& name);
+
+struct EvaluationOptions {
+  SplitUnit split =
+      SplitUnit::kNode;          // when map and query are one data set: split by node or session
+  double map_fraction = 0.4;     // share of nodes (or sessions) that make the map (paper: 40%)
+  double frame_spacing_m = 0.5;  // image folders without positions: metres per frame
+  double image_wifi_max_gap_s = 10.0;  // an image takes a scan at most this far in time
+
+  bool IsValid(std::string* error) const;
+  template <typename Visitor>
+  void VisitFields(Visitor&& v) {
+    v("split", split, "one data set for map and queries: split by node or by session");
+    v("map_fraction", map_fraction, "share of nodes (or sessions) in the map; the rest query");
+    v("frame_spacing_m", frame_spacing_m,
+      "image folders have no positions: frame i is at i * this along its floor");
+    v("image_wifi_max_gap_s", image_wifi_max_gap_s,
+      "an image is paired with a Wi-Fi scan at most this far in time");
+  }
+};
+
+// Interleaved split: item i goes to the map when floor((i+1) f) > floor(i f), so that every
+// stretch of 1/f items has one in the map. Returns true for map items.
+std::vector<bool> InterleavedSplit(size_t count, double map_fraction);
+
+// Nodes of a data set (replay folder, IPIN or Microsoft log, UJIIndoorLoc CSV, image folder,
+// or a folder of logs). `as_map` picks how images get scans: the temporally closest scan for
+// the map, the last scan before the image for queries (the paper's section 5.2). Nodes of
+// data without camera images are the Wi-Fi scans. Nodes without ground truth are skipped.
+StatusOr<std::vector<EvaluationNode>> LoadEvaluationNodes(const std::string& path, bool as_map,
+                                                          bool want_images,
+                                                          const EvaluationOptions& options);
+
+struct EvaluationMetrics {
+  size_t queries = 0;
+  std::vector<double> distances_m;       // the d of the rates below
+  std::vector<double> correct_within;    // error <= d
+  std::vector<double> misplaced_beyond;  // error > d (floor mistakes count as infinite)
+  double rejection_rate = 0.0;
+  double floor_mistake_rate = 0.0;
+  std::vector<double> errors_m;  // per query; infinity: other floor; NaN: rejected
+};
+
+// `matches[i]` is the map index matched by query i, or -1 for a rejection.
+EvaluationMetrics ComputeMetrics(const std::vector<EvaluationNode>& map,
+                                 const std::vector<EvaluationNode>& queries,
+                                 const std::vector<int64_t>& matches,
+                                 const std::vector<double>& distances_m);
+
+}  // namespace ratslam::fabmap
+
+#endif  // RATSLAM_FUSION_FABMAP_EVALUATION_H_

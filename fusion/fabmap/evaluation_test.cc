@@ -1,0 +1,83 @@
+#include "fusion/fabmap/evaluation.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+
+namespace ratslam::fabmap {
+namespace {
+
+EvaluationNode At(double x, double y, int floor) {
+  EvaluationNode n;
+  n.x_m = x;
+  n.y_m = y;
+  n.floor = floor;
+  return n;
+}
+
+TEST(EvaluationTest, MetricsOnAHandBuiltCase) {
+  const std::vector<EvaluationNode> map = {At(0, 0, 0), At(10, 0, 0), At(0, 0, 1)};
+  const std::vector<EvaluationNode> queries = {At(1, 0, 0), At(4, 0, 0), At(0, 3, 0), At(50, 0, 0),
+                                               At(0, 0, 0)};
+  // errors: |(0,0)-(1,0)| = 1; |(10,0)-(4,0)| = 6; map 2 is floor 1: infinite; rejected;
+  // |(0,0)-(0,0)| = 0.
+  const std::vector<int64_t> matches = {0, 1, 2, -1, 0};
+  const EvaluationMetrics m = ComputeMetrics(map, queries, matches, {2, 5, 10, 20});
+  EXPECT_EQ(m.queries, 5u);
+  EXPECT_DOUBLE_EQ(m.correct_within[0], 2.0 / 5);  // errors 1 and 0
+  EXPECT_DOUBLE_EQ(m.correct_within[1], 2.0 / 5);
+  EXPECT_DOUBLE_EQ(m.correct_within[2], 3.0 / 5);  // plus 6
+  EXPECT_DOUBLE_EQ(m.correct_within[3], 3.0 / 5);
+  EXPECT_DOUBLE_EQ(m.misplaced_beyond[0], 2.0 / 5);  // 6 and the floor mistake
+  EXPECT_DOUBLE_EQ(m.misplaced_beyond[2], 1.0 / 5);  // the floor mistake only
+  EXPECT_DOUBLE_EQ(m.misplaced_beyond[3], 1.0 / 5);
+  EXPECT_DOUBLE_EQ(m.rejection_rate, 1.0 / 5);
+  EXPECT_DOUBLE_EQ(m.floor_mistake_rate, 1.0 / 5);
+  // Correct + misplaced + rejected = 1 at every d.
+  for (size_t k = 0; k < 4; ++k) {
+    EXPECT_DOUBLE_EQ(m.correct_within[k] + m.misplaced_beyond[k] + m.rejection_rate, 1.0);
+  }
+  EXPECT_TRUE(std::isinf(m.errors_m[2]));
+  EXPECT_TRUE(std::isnan(m.errors_m[3]));
+}
+
+TEST(EvaluationTest, InterleavedSplitKeepsTheFraction) {
+  const auto split = InterleavedSplit(10, 0.4);
+  int in_map = 0;
+  for (bool b : split) in_map += b;
+  EXPECT_EQ(in_map, 4);
+  // No run of more than 2 queries between map items (1 / 0.4 = 2.5).
+  int run = 0;
+  for (bool b : split) {
+    run = b ? 0 : run + 1;
+    EXPECT_LE(run, 2);
+  }
+}
+
+TEST(EvaluationTest, LoadsAnImageFolderWithFloors) {
+  const std::string path = std::string(RATSLAM_SHARED_DATA_DIR) + "/multifloor-corridors";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "missing " << path;
+  EvaluationOptions options;
+  options.frame_spacing_m = 0.5;
+  const auto nodes = LoadEvaluationNodes(path, true, true, options);
+  ASSERT_TRUE(nodes.ok()) << nodes.status().message();
+  ASSERT_EQ(nodes->size(), 1500u);
+  EXPECT_EQ(nodes->front().floor, 1);
+  EXPECT_EQ(nodes->back().floor, 3);
+  EXPECT_DOUBLE_EQ((*nodes)[1].x_m, 0.5);
+  EXPECT_FALSE(nodes->front().wifi.has_value());
+}
+
+TEST(EvaluationTest, BadPathsAndOptionsAreErrors) {
+  EvaluationOptions options;
+  const auto missing = LoadEvaluationNodes("/no/such/place", true, false, options);
+  ASSERT_FALSE(missing.ok());
+  EXPECT_NE(missing.status().message().find("/no/such/place"), std::string::npos);
+  options.map_fraction = 1.5;
+  EXPECT_FALSE(LoadEvaluationNodes(RATSLAM_SOURCE_DIR, true, false, options).ok());
+  EXPECT_FALSE(SplitUnitFromString("nodes").ok());
+}
+
+}  // namespace
+}  // namespace ratslam::fabmap
