@@ -45,9 +45,9 @@ struct DetectorModel {
   template <typename Visitor>
   void VisitFields(Visitor&& v) {
     v("p_observed_given_exists", p_observed_given_exists,
-      "detector model PzGe: p(word seen | word exists at the place)");
+      "detector model PzGe: p(word seen given it exists at the place)");
     v("p_observed_given_absent", p_observed_given_absent,
-      "detector model PzGNe: p(word seen | word absent at the place)");
+      "detector model PzGNe: p(word seen given it is absent at the place)");
   }
 };
 

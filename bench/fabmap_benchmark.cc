@@ -1,0 +1,90 @@
+// FABMAP query time against map size and vocabulary size (about 200 words per observation), and
+// Chow-Liu learning time. The dense FABMAP 1.0 sum is the baseline, measured in the same run.
+#include <benchmark/benchmark.h>
+
+#include <map>
+#include <memory>
+#include <utility>
+
+#include "fusion/fabmap/fabmap.h"
+#include "fusion/fabmap/synthetic_words.h"
+#include "ratslam/random.h"
+
+namespace ratslam::fabmap {
+namespace {
+
+SyntheticWordWorld World(uint32_t vocabulary) {
+  SyntheticWordWorld w;
+  w.vocabulary_size = vocabulary;
+  w.mean_words_per_observation = 200;
+  return w;
+}
+
+std::vector<Observation> Observations(const SyntheticWordWorld& w, int n, uint64_t seed) {
+  Random random(seed);
+  std::vector<Observation> out;
+  for (int i = 0; i < n; ++i) out.push_back(w.Observe(w.SamplePlace(&random), &random));
+  return out;
+}
+
+// One model per (places, words), built once.
+FabmapModel& Model(uint32_t places, uint32_t vocabulary) {
+  static std::map<std::pair<uint32_t, uint32_t>, std::unique_ptr<FabmapModel>> cache;
+  auto& slot = cache[{places, vocabulary}];
+  if (!slot) {
+    const SyntheticWordWorld w = World(vocabulary);
+    const auto training = Observations(w, 500, 1);
+    DetectorBlock block;
+    block.count = vocabulary;
+    slot = std::make_unique<FabmapModel>(
+        *FabmapModel::Create(*LearnChowLiuTree(training, vocabulary), {block}, training, {}));
+    Random random(2);
+    for (uint32_t i = 0; i < places; ++i) {
+      (void)slot->AddPlace(w.Observe(w.SamplePlace(&random), &random));
+    }
+  }
+  return *slot;
+}
+
+void BM_FabmapQuery(benchmark::State& state) {
+  const uint32_t places = static_cast<uint32_t>(state.range(0));
+  const uint32_t vocabulary = static_cast<uint32_t>(state.range(1));
+  FabmapModel& model = Model(places, vocabulary);
+  const auto queries = Observations(World(vocabulary), 64, 3);
+  size_t i = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(model.Localise(queries[i++ % queries.size()]));
+  }
+  state.counters["places"] = places;
+  state.counters["words"] = vocabulary;
+}
+BENCHMARK(BM_FabmapQuery)
+    ->ArgsProduct({{1000, 10000, 100000}, {1000, 10000}})
+    ->Unit(benchmark::kMicrosecond);
+
+// Baseline: the dense FABMAP 1.0 sum over every word for every place (1k places only).
+void BM_DenseFabmap1Query(benchmark::State& state) {
+  const uint32_t vocabulary = static_cast<uint32_t>(state.range(0));
+  FabmapModel& model = Model(1000, vocabulary);
+  const auto queries = Observations(World(vocabulary), 4, 3);
+  size_t i = 0;
+  for (auto _ : state) {
+    const Observation& z = queries[i++ % queries.size()];
+    double sum = 0.0;
+    for (uint32_t p = 0; p < model.places(); ++p) sum += model.DenseLogLikelihood(z, p);
+    benchmark::DoNotOptimize(sum);
+  }
+}
+BENCHMARK(BM_DenseFabmap1Query)->Arg(1000)->Arg(10000)->Unit(benchmark::kMillisecond);
+
+void BM_ChowLiuLearning(benchmark::State& state) {
+  const uint32_t vocabulary = static_cast<uint32_t>(state.range(0));
+  const auto training = Observations(World(vocabulary), 500, 4);
+  for (auto _ : state) benchmark::DoNotOptimize(LearnChowLiuTree(training, vocabulary));
+}
+BENCHMARK(BM_ChowLiuLearning)->Arg(4000)->Arg(10000)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace ratslam::fabmap
+
+BENCHMARK_MAIN();

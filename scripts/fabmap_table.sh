@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# The fusion paper's table 5 layout on real data: Wi-Fi-only FABMAP for b in {1,4,8,12,16,20}
+# words per access point, exclusive and incremental, on UJIIndoorLoc and the Microsoft walks.
+# Prints a markdown table per data set. Usage: scripts/fabmap_table.sh [build dir] [out dir]
+set -euo pipefail
+build=${1:-build}
+out=${2:-out/fabmap-table}
+data=../shared/data
+mkdir -p "$out"
+run_set() {  # name base-config data-path
+  local name=$1 base=$2 path=$3
+  echo "### $name"
+  echo
+  echo "| b | encoding | correct 2 m | 5 m | 10 m | 20 m | misplaced 2 m | 5 m | 10 m | 20 m | rejected | floor mistakes |"
+  echo "|---|---|---|---|---|---|---|---|---|---|---|---|"
+  for b in 1 4 8 12 16 20; do
+    for enc in exclusive incremental; do
+      if [[ $b == 1 && $enc == incremental ]]; then continue; fi  # b = 1: the same words
+      local dir="$out/$name-b$b-$enc"
+      mkdir -p "$dir"
+      sed -e "s/^bins = .*/bins = $b/" -e "s/^encoding = .*/encoding = \"$enc\"/" "$base" > "$dir/input.toml"
+      "$build/apps/ratslam" evaluate --config "$dir/input.toml" --map "$path" --query "$path" \
+        --out "$dir" --quiet > /dev/null
+      python3 - "$dir/evaluation.json" "$b" "$enc" <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+pct = lambda x: f"{100 * x:.1f}"
+c = [pct(j["correct_within_m"][d]) for d in ("2", "5", "10", "20")]
+m = [pct(j["misplaced_beyond_m"][d]) for d in ("2", "5", "10", "20")]
+print(f"| {sys.argv[2]} | {sys.argv[3]} | " + " | ".join(c + m) +
+      f" | {pct(j['rejection_rate'])} | {pct(j['floor_mistake_rate'])} |")
+PY
+    done
+  done
+  echo
+}
+run_set "UJIIndoorLoc" configs/ujiindoorloc-wifi-b8.toml "$data/ujiindoorloc/trainingData.csv"
+run_set "Microsoft ILC 2.0 site 1" configs/msft-ilc20-wifi-b8.toml "$data/msft-ilc20-site1"
