@@ -177,23 +177,28 @@ StatusOr<uint32_t> FabmapModel::AddPlace(Observation observation) {
 }
 
 FabmapModel::Active FabmapModel::ActiveWords(const Observation& z) const {
+  // Bit sets over the vocabulary (V/8 bytes): the query's words, and words already active.
+  const size_t blocks = (vocabulary_size() + 63) / 64;
+  std::vector<uint64_t> in_query(blocks, 0), seen(blocks, 0);
+  auto test = [](const std::vector<uint64_t>& bits, WordId q) {
+    return (bits[q >> 6] >> (q & 63)) & 1;
+  };
+  auto set = [](std::vector<uint64_t>& bits, WordId q) { bits[q >> 6] |= uint64_t{1} << (q & 63); };
+  for (WordId q : z) set(in_query, q);
   Active active;
-  active.words.reserve(z.size() * 3);
-  for (WordId q : z) {
-    active.words.push_back(q);
-    for (uint32_t c = child_begin_[q]; c < child_begin_[q + 1]; ++c) {
-      active.words.push_back(children_[c]);
-    }
-  }
-  std::sort(active.words.begin(), active.words.end());
-  active.words.erase(std::unique(active.words.begin(), active.words.end()), active.words.end());
-  active.z.resize(active.words.size());
-  active.z_parent.resize(active.words.size());
-  for (size_t i = 0; i < active.words.size(); ++i) {
-    const WordId q = active.words[i];
+  active.words.reserve(z.size() * 2);
+  auto add = [&](WordId q) {
+    if (test(seen, q)) return;
+    set(seen, q);
     const WordId p = tree_.parent[q];
-    active.z[i] = std::binary_search(z.begin(), z.end(), q);
-    active.z_parent[i] = p != ChowLiuTree::kNoParent && std::binary_search(z.begin(), z.end(), p);
+    active.words.push_back(q);
+    active.z.push_back(static_cast<uint8_t>(test(in_query, q)));
+    active.z_parent.push_back(
+        static_cast<uint8_t>(p != ChowLiuTree::kNoParent && test(in_query, p)));
+  };
+  for (WordId q : z) {
+    add(q);
+    for (uint32_t c = child_begin_[q]; c < child_begin_[q + 1]; ++c) add(children_[c]);
   }
   return active;
 }
@@ -210,14 +215,20 @@ double FabmapModel::UnseenLogLikelihood(const Active& active) const {
 void FabmapModel::IndexLogLikelihoods(const PlaceIndex& index, const Active& active,
                                       std::vector<double>* out) const {
   const double unseen = UnseenLogLikelihood(active);
-  out->resize(index.observations.size());
-  for (size_t i = 0; i < out->size(); ++i) (*out)[i] = unseen + index.seen_offset[i];
+  const size_t n = index.observations.size();
+  out->resize(n);
+  double* score = out->data();
+  const double* offset = index.seen_offset.data();
+  for (size_t i = 0; i < n; ++i) score[i] = unseen + offset[i];
   for (size_t i = 0; i < active.words.size(); ++i) {
     const WordId q = active.words[i];
     const int zq = active.z[i], zp = active.z_parent[i];
     const double delta =
         (seen_[q][zq][zp] - unseen_[q][zq][zp]) - (seen_[q][0][0] - unseen_[q][0][0]);
-    for (uint32_t place : index.postings[q]) (*out)[place] += delta;
+    const std::vector<uint32_t>& places = index.postings[q];
+    const uint32_t* place = places.data();
+#pragma GCC unroll 4
+    for (size_t k = 0, m = places.size(); k < m; ++k) score[place[k]] += delta;
   }
 }
 
@@ -259,25 +270,34 @@ double FabmapModel::UnknownLogLikelihood(const Active& active) const {
 LocalisationResult FabmapModel::Normalise(const std::vector<double>& log_likelihood,
                                           double unknown_log_likelihood) const {
   LocalisationResult result;
-  const double n = static_cast<double>(log_likelihood.size());
+  const size_t n = log_likelihood.size();
   const double log_new = std::log(options_.p_new_place) + unknown_log_likelihood;
-  const double log_place_prior = n > 0 ? std::log((1.0 - options_.p_new_place) / n) : 0.0;
-  double top = log_new;
-  for (double l : log_likelihood) top = std::max(top, l + log_place_prior);
-  double total = std::exp(log_new - top);
-  result.place_probability.resize(log_likelihood.size());
-  for (size_t i = 0; i < log_likelihood.size(); ++i) {
-    result.place_probability[i] = std::exp(log_likelihood[i] + log_place_prior - top);
-    total += result.place_probability[i];
+  const double log_place_prior =
+      n > 0 ? std::log((1.0 - options_.p_new_place) / static_cast<double>(n)) : 0.0;
+  size_t best = 0;
+  for (size_t i = 1; i < n; ++i) {
+    if (log_likelihood[i] > log_likelihood[best]) best = i;
   }
-  result.new_place_probability = std::exp(log_new - top) / total;
+  const double top = n > 0 ? std::max(log_new, log_likelihood[best] + log_place_prior) : log_new;
+  const double new_weight = std::exp(log_new - top);
+  double total = new_weight;
+  result.place_probability.resize(n);
+  double* p = result.place_probability.data();
+  // A place e^-40 (4e-18) below the best changes no sum in double precision: it costs no exp
+  // and its probability is reported as 0.
+  constexpr double kUnderflow = -40.0;
+  for (size_t i = 0; i < n; ++i) {
+    const double relative = log_likelihood[i] + log_place_prior - top;
+    p[i] = relative < kUnderflow ? 0.0 : std::exp(relative);
+    total += p[i];
+  }
+  const double inverse = 1.0 / total;
+  for (size_t i = 0; i < n; ++i) p[i] *= inverse;
+  result.new_place_probability = new_weight * inverse;
   result.best_probability = result.new_place_probability;
-  for (size_t i = 0; i < log_likelihood.size(); ++i) {
-    result.place_probability[i] /= total;
-    if (result.place_probability[i] > result.best_probability) {
-      result.best_probability = result.place_probability[i];
-      result.best_place = static_cast<int64_t>(i);
-    }
+  if (n > 0 && p[best] > result.best_probability) {  // a tie goes to the new place
+    result.best_probability = p[best];
+    result.best_place = static_cast<int64_t>(best);
   }
   return result;
 }

@@ -6,10 +6,9 @@ namespace ratslam::fabmap {
 
 Observation SyntheticWordWorld::SamplePlace(Random* random) const {
   // Even words exist independently with probability p; an odd word follows its even neighbour
-  // with p_follow, else exists with p. Expected existing words: V/2 p + V/2 (p p_follow +
-  // (1-p) p) ~ V p (1 + p_follow) / 2 for small p.
+  // with p_follow, else exists with p. Per pair: p + p p_follow + (1 - p) p ~ p (2 + p_follow).
   const double existing = mean_words_per_observation / p_detect;
-  const double p = std::min(0.5, 2.0 * existing / (vocabulary_size * (1.0 + p_follow)));
+  const double p = std::min(0.5, 2.0 * existing / (vocabulary_size * (2.0 + p_follow)));
   Observation place;
   bool previous = false;
   for (WordId q = 0; q < vocabulary_size; ++q) {
