@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include "fusion/fabmap/fabmap.h"
+#include "fusion/fabmap/visual_model.h"
 #include "fusion/io/config.h"
 #include "fusion/io/map_file.h"
 #include "ratslam/random.h"
@@ -65,6 +67,50 @@ TEST(MalformedInputTest, MapFilesNeverCrash) {
     // A decodable mutation must still be refused or accepted cleanly by the spine.
     Ratslam other({});
     (void)other.SetState(decoded->state.ratslam);
+  }
+  EXPECT_GT(errors, 1000);
+}
+
+TEST(MalformedInputTest, VisualModelFilesNeverCrash) {
+  // A small model: 16 ORB words from random descriptors, a tree and samples over them.
+  Random data(9);
+  fabmap::DescriptorSet descriptors;
+  descriptors.kind = fabmap::DescriptorKind::kOrb;
+  descriptors.length = 32;
+  descriptors.count = 64;
+  for (int i = 0; i < 64 * 32; ++i) descriptors.binary.push_back(data.NextU64() & 0xFF);
+  fabmap::VocabularyOptions vocabulary_options;
+  vocabulary_options.words = 16;
+  fabmap::TrainedVisualModel model;
+  model.vocabulary = *fabmap::Vocabulary::Train(descriptors, vocabulary_options);
+  for (int i = 0; i < 20; ++i) {
+    fabmap::Observation o;
+    for (fabmap::WordId q = 0; q < 16; ++q) {
+      if (data.Uniform() < 0.3) o.push_back(q);
+    }
+    model.model.samples.push_back(o);
+  }
+  model.model.tree = *fabmap::LearnChowLiuTree(model.model.samples, 16);
+  const std::string bytes = fabmap::EncodeVisualModel(model);
+  ASSERT_TRUE(fabmap::DecodeVisualModel(bytes, "model.bin").ok());
+  Random rng(5);
+  int errors = 0;
+  for (int k = 0; k < 2000; ++k) {
+    auto decoded = fabmap::DecodeVisualModel(Mutate(bytes, rng), "model.bin");
+    if (!decoded.ok()) {
+      ++errors;
+      EXPECT_EQ(decoded.status().message().rfind("model.bin", 0), 0u) << decoded.status().message();
+      continue;
+    }
+    // A decodable mutation must give a model that FABMAP accepts or refuses cleanly.
+    fabmap::DetectorBlock block;
+    block.count = decoded->vocabulary.size();
+    auto fabmap_model = fabmap::FabmapModel::Create(decoded->model.tree, {block},
+                                                    decoded->model.samples, {});
+    if (fabmap_model.ok()) {
+      (void)fabmap_model->AddPlace({0, 3});
+      (void)fabmap_model->Localise({0, 1, 5});
+    }
   }
   EXPECT_GT(errors, 1000);
 }
