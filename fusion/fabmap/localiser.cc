@@ -55,9 +55,9 @@ Observation Localiser::WifiWords(const Query& query) const {
   return query.wifi ? wifi_vocabulary_.Encode(*query.wifi) : Observation{};
 }
 
-StatusOr<std::unique_ptr<Localiser>> Localiser::Build(const LocaliserSettings& settings,
-                                                      const VisualModel* visual,
-                                                      const std::vector<MapNode>& map) {
+StatusOr<std::unique_ptr<Localiser>> Localiser::Create(const LocaliserSettings& settings,
+                                                       const VisualModel* visual,
+                                                       const WifiExploration& exploration) {
   std::string error;
   const auto check = [&](bool ok, const char* what) {
     return ok ? Status::Ok() : Status::Error(std::string(what) + ": " + error);
@@ -71,57 +71,34 @@ StatusOr<std::unique_ptr<Localiser>> Localiser::Build(const LocaliserSettings& s
     return Status::Error("FABMAP mode " + ToString(mode) + " needs a visual vocabulary");
   }
   std::unique_ptr<Localiser> l(new Localiser(settings));
-  l->places_ = static_cast<uint32_t>(map.size());
-  std::vector<Observation> visual_places;
-  if (UsesVision(mode)) {
-    l->visual_words_ = visual->tree.size();
-    for (size_t i = 0; i < map.size(); ++i) {
-      Observation o = map[i].visual;
-      RATSLAM_RETURN_IF_ERROR(
-          NormaliseObservation(&o, l->visual_words_, "map node " + std::to_string(i)));
-      visual_places.push_back(std::move(o));
-    }
+  if (UsesVision(mode)) l->visual_words_ = visual->tree.size();
+  if (UsesVision(mode) && mode != FabmapMode::kEarly) {
     const DetectorBlock block{0, l->visual_words_, settings.visual_detector};
     auto model = FabmapModel::Create(visual->tree, {block}, visual->samples, settings.fabmap);
     if (!model.ok()) return model.status().WithContext("visual FABMAP");
     l->vision_ = *std::move(model);
-    for (const Observation& o : visual_places)
-      RATSLAM_RETURN_IF_ERROR(l->vision_->AddPlace(o).status());
   }
   if (!UsesWifi(mode)) return l;
 
-  // Wi-Fi vocabulary, tree and virtual unknown world from the map's scans.
-  std::vector<std::vector<WifiReading>> scans;
-  std::vector<double> travelled, times;
-  std::vector<size_t> scan_node;
-  for (size_t i = 0; i < map.size(); ++i) {
-    if (!map[i].wifi) continue;
-    l->wifi_vocabulary_.AddAccessPoints(*map[i].wifi);
-    scans.push_back(*map[i].wifi);
-    travelled.push_back(map[i].travelled_m);
-    times.push_back(map[i].time_s);
-    scan_node.push_back(i);
-  }
+  // Wi-Fi vocabulary, tree and virtual unknown world from the exploration scans.
+  for (const auto& scan : exploration.scans) l->wifi_vocabulary_.AddAccessPoints(scan);
   if (l->wifi_vocabulary_.size() == 0) {
     return Status::Error("FABMAP mode " + ToString(mode) +
-                         " needs Wi-Fi scans in the map, and the map has no usable access point");
+                         " needs Wi-Fi scans to explore, and there is no usable access point");
   }
   std::vector<Observation> tree_observations;
-  for (size_t k : SpacedIndices(travelled, times, settings.localiser.wifi_tree_min_distance_m,
+  for (size_t k : SpacedIndices(exploration.travelled_m, exploration.time_s,
+                                settings.localiser.wifi_tree_min_distance_m,
                                 settings.localiser.wifi_tree_min_interval_s)) {
-    tree_observations.push_back(l->wifi_vocabulary_.Encode(scans[k]));
+    tree_observations.push_back(l->wifi_vocabulary_.Encode(exploration.scans[k]));
   }
   auto wifi_tree =
       LearnChowLiuTree(tree_observations, l->wifi_vocabulary_.size(), settings.chow_liu);
   if (!wifi_tree.ok()) return wifi_tree.status().WithContext("Wi-Fi Chow-Liu tree");
   double mean_aps = 0.0, sigma_aps = 0.0;
-  CountStatistics(scans, &mean_aps, &sigma_aps);
+  CountStatistics(exploration.scans, &mean_aps, &sigma_aps);
   std::vector<Observation> virtual_samples =
       VirtualWifiSamples(l->wifi_vocabulary_, mean_aps, sigma_aps, settings.virtual_wifi);
-  std::vector<Observation> wifi_places(map.size());
-  for (size_t i = 0; i < map.size(); ++i) {
-    if (map[i].wifi) wifi_places[i] = l->wifi_vocabulary_.Encode(*map[i].wifi);
-  }
 
   const uint32_t wifi_size = l->wifi_vocabulary_.size();
   if (mode != FabmapMode::kEarly) {
@@ -129,34 +106,72 @@ StatusOr<std::unique_ptr<Localiser>> Localiser::Build(const LocaliserSettings& s
     auto model = FabmapModel::Create(*wifi_tree, {block}, virtual_samples, settings.fabmap);
     if (!model.ok()) return model.status().WithContext("Wi-Fi FABMAP");
     l->wifi_ = *std::move(model);
-    for (const Observation& o : wifi_places)
-      RATSLAM_RETURN_IF_ERROR(l->wifi_->AddPlace(o).status());
     return l;
   }
   // Early fusion: visual words first, Wi-Fi words after them; sample i of the joint unknown
   // world is visual sample i and Wi-Fi sample i (the shorter list repeats).
-  const uint32_t v = l->visual_words_;
-  auto join = [v](const Observation& visual_words, const Observation& wifi_words) {
-    Observation joined = visual_words;
-    for (WordId w : wifi_words) joined.push_back(w + v);
-    return joined;
-  };
   std::vector<Observation> joint_samples;
   const size_t n = std::max(visual->samples.size(), virtual_samples.size());
   for (size_t i = 0; i < n; ++i) {
     Observation vs = visual->samples[i % visual->samples.size()];
     std::sort(vs.begin(), vs.end());
     vs.erase(std::unique(vs.begin(), vs.end()), vs.end());
-    joint_samples.push_back(join(vs, virtual_samples[i % virtual_samples.size()]));
+    joint_samples.push_back(l->Joined(vs, virtual_samples[i % virtual_samples.size()]));
   }
-  const DetectorBlock blocks[2] = {{0, v, settings.visual_detector},
-                                   {v, wifi_size, settings.wifi_detector}};
+  const DetectorBlock blocks[2] = {{0, l->visual_words_, settings.visual_detector},
+                                   {l->visual_words_, wifi_size, settings.wifi_detector}};
   auto model = FabmapModel::Create(JoinForest(visual->tree, *wifi_tree), {blocks[0], blocks[1]},
                                    std::move(joint_samples), settings.fabmap);
   if (!model.ok()) return model.status().WithContext("early-fusion FABMAP");
   l->early_ = *std::move(model);
+  return l;
+}
+
+Observation Localiser::Joined(const Observation& visual_words,
+                              const Observation& wifi_words) const {
+  Observation joined = visual_words;
+  for (WordId w : wifi_words) joined.push_back(w + visual_words_);
+  return joined;
+}
+
+Observation Localiser::VisualWords(const Query& query) const {
+  Observation visual = query.visual;
+  std::sort(visual.begin(), visual.end());
+  visual.erase(std::unique(visual.begin(), visual.end()), visual.end());
+  while (!visual.empty() && visual.back() >= visual_words_) visual.pop_back();
+  return visual;
+}
+
+Status Localiser::AddPlace(const Query& place) {
+  const Observation visual = vision_ || early_ ? VisualWords(place) : Observation{};
+  if (vision_) RATSLAM_RETURN_IF_ERROR(vision_->AddPlace(visual).status());
+  if (wifi_) RATSLAM_RETURN_IF_ERROR(wifi_->AddPlace(WifiWords(place)).status());
+  if (early_) RATSLAM_RETURN_IF_ERROR(early_->AddPlace(Joined(visual, WifiWords(place))).status());
+  ++places_;
+  return Status::Ok();
+}
+
+StatusOr<std::unique_ptr<Localiser>> Localiser::Build(const LocaliserSettings& settings,
+                                                      const VisualModel* visual,
+                                                      const std::vector<MapNode>& map) {
+  WifiExploration exploration;
+  for (const MapNode& node : map) {
+    if (!node.wifi) continue;
+    exploration.scans.push_back(*node.wifi);
+    exploration.travelled_m.push_back(node.travelled_m);
+    exploration.time_s.push_back(node.time_s);
+  }
+  auto l = Create(settings, visual, exploration);
+  if (!l.ok()) return l.status();
   for (size_t i = 0; i < map.size(); ++i) {
-    RATSLAM_RETURN_IF_ERROR(l->early_->AddPlace(join(visual_places[i], wifi_places[i])).status());
+    if (UsesVision(settings.localiser.mode) && !map[i].visual.empty()) {
+      const WordId top = *std::max_element(map[i].visual.begin(), map[i].visual.end());
+      if (top >= (*l)->visual_words_) {
+        return Status::Error("map node " + std::to_string(i) + ": word " + std::to_string(top) +
+                             " is outside the vocabulary");
+      }
+    }
+    RATSLAM_RETURN_IF_ERROR((*l)->AddPlace({map[i].visual, map[i].wifi}));
   }
   return l;
 }
@@ -181,22 +196,14 @@ std::vector<uint32_t> Localiser::WifiCandidates(const Observation& wifi_words) c
 }
 
 LocalisationResult Localiser::Localise(const Query& query) const {
-  Observation visual = query.visual;
-  if (vision_) {
-    std::sort(visual.begin(), visual.end());
-    visual.erase(std::unique(visual.begin(), visual.end()), visual.end());
-    while (!visual.empty() && visual.back() >= visual_words_) visual.pop_back();
-  }
+  const Observation visual = vision_ || early_ ? VisualWords(query) : Observation{};
   switch (settings_.localiser.mode) {
     case FabmapMode::kVision:
       return vision_->Localise(visual);
     case FabmapMode::kWifi:
       return wifi_->Localise(WifiWords(query));
-    case FabmapMode::kEarly: {
-      Observation joined = visual;
-      for (WordId w : WifiWords(query)) joined.push_back(w + visual_words_);
-      return early_->Localise(joined);
-    }
+    case FabmapMode::kEarly:
+      return early_->Localise(Joined(visual, WifiWords(query)));
     case FabmapMode::kLate: {
       // eq. 4 over the n_M places and the new place; p(L_i) is uniform, so it cancels in alpha.
       const LocalisationResult a = vision_->Localise(visual);

@@ -91,12 +91,27 @@ struct Query {
   std::optional<std::vector<WifiReading>> wifi;
 };
 
+// Scans of an exploration: they define the Wi-Fi words, tree (spaced by travel and time) and
+// virtual unknown world.
+struct WifiExploration {
+  std::vector<std::vector<WifiReading>> scans;
+  std::vector<double> travelled_m;
+  std::vector<double> time_s;
+};
+
 class Localiser {
  public:
-  // `visual` is needed by the modes that use vision.
+  // An empty map; `visual` is needed by the modes that use vision, `exploration` by those that
+  // use Wi-Fi.
+  static StatusOr<std::unique_ptr<Localiser>> Create(const LocaliserSettings& settings,
+                                                     const VisualModel* visual,
+                                                     const WifiExploration& exploration);
+  // Create with the map's own scans as exploration, then AddPlace for every node.
   static StatusOr<std::unique_ptr<Localiser>> Build(const LocaliserSettings& settings,
                                                     const VisualModel* visual,
                                                     const std::vector<MapNode>& map);
+  // Appends a place (the next index).
+  Status AddPlace(const Query& place);
   uint32_t places() const { return places_; }
   uint32_t wifi_words() const { return wifi_vocabulary_.size(); }
   // best_place indexes the map nodes; -1 is the new place (a rejection).
@@ -108,6 +123,8 @@ class Localiser {
   explicit Localiser(const LocaliserSettings& settings)
       : settings_(settings), wifi_vocabulary_(settings.wifi_words) {}
   Observation WifiWords(const Query& query) const;
+  Observation VisualWords(const Query& query) const;  // sorted, in the vocabulary
+  Observation Joined(const Observation& visual_words, const Observation& wifi_words) const;
 
   LocaliserSettings settings_;
   uint32_t places_ = 0;
