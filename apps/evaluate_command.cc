@@ -110,7 +110,7 @@ int EvaluateCommand(int argc, char** argv) {
   std::string config_path;
   const auto options = LoadOptions(*args, &config_path);
   if (!options) return kExitError;
-  const FabmapSettings& settings = options->fabmap;
+  const FabmapSettings& settings = options->sensors.fabmap;
   const std::string map_path = args->values.at("--map");
   const std::string query_path = args->values.at("--query");
   const std::string out = args->values.at("--out");

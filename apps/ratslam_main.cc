@@ -124,7 +124,16 @@ int RunReplay(const ReplayRequest& request) {
     return kExitError;
   }
 
-  ReplayPipeline pipeline(request.options, dataset.value(), &images);
+  std::shared_ptr<const FabmapResources> fabmap;
+  if (request.options.sensors.front_end.kind == FrontEndKind::kFabmap) {
+    auto prepared = PrepareFabmapResources(request.options.sensors, dataset.value(), images);
+    if (!prepared.ok()) {
+      std::cerr << "ratslam: FABMAP front end: " << prepared.status().message() << "\n";
+      return kExitError;
+    }
+    fabmap = *prepared;
+  }
+  ReplayPipeline pipeline(request.options, dataset.value(), &images, fabmap);
   const uint64_t fingerprint = ConfigFingerprint(request.options);
   if (!request.load_map.empty()) {
     StatusOr<MapFile> map = LoadMapFile(request.load_map);

@@ -1,7 +1,10 @@
 #include "fusion/front_end.h"
 
 #include <cmath>
+#include <fstream>
 #include <limits>
+#include <sstream>
+#include <stdexcept>
 
 #include "ratslam/byte_buffer.h"
 #include "ratslam/circular.h"
@@ -14,6 +17,8 @@ std::string ToString(FrontEndKind kind) {
       return "classic_camera";
     case FrontEndKind::kFused:
       return "fused";
+    case FrontEndKind::kFabmap:
+      return "fabmap";
   }
   return "unknown";
 }
@@ -21,7 +26,39 @@ std::string ToString(FrontEndKind kind) {
 StatusOr<FrontEndKind> FrontEndKindFromString(const std::string& name) {
   if (name == "classic_camera") return FrontEndKind::kClassicCamera;
   if (name == "fused") return FrontEndKind::kFused;
-  return Status::Error("unknown front end '" + name + "' (valid: classic_camera, fused)");
+  if (name == "fabmap") return FrontEndKind::kFabmap;
+  return Status::Error("unknown front end '" + name + "' (valid: classic_camera, fused, fabmap)");
+}
+
+bool FabmapSettings::IsValid(std::string* error) const {
+  std::string inner;
+  auto check = [&](bool ok, const char* section) {
+    if (!ok && error) *error = std::string(section) + "." + inner;
+    return ok;
+  };
+  return check(localiser.localiser.IsValid(&inner), "fabmap") &&
+         check(localiser.fabmap.IsValid(&inner), "fabmap_model") &&
+         check(localiser.visual_detector.IsValid(&inner), "visual_detector") &&
+         check(localiser.wifi_detector.IsValid(&inner), "wifi_detector") &&
+         check(features.IsValid(&inner), "visual_words") &&
+         check(vocabulary.IsValid(&inner), "vocabulary") &&
+         check(visual_model.IsValid(&inner), "visual_model") &&
+         check(localiser.wifi_words.IsValid(&inner), "wifi_words") &&
+         check(localiser.virtual_wifi.IsValid(&inner), "virtual_wifi") &&
+         check(evaluation.IsValid(&inner), "evaluation") &&
+         check(front_end.IsValid(&inner), "fabmap_front_end");
+}
+
+bool FabmapFrontEndOptions::IsValid(std::string* error) const {
+  if (!(match_probability > 0.0 && match_probability <= 1.0)) {
+    *error = "match_probability must be in (0, 1]";
+    return false;
+  }
+  if (recency_templates < 0 || !(recency_s >= 0.0) || !(max_wifi_age_s >= 0.0)) {
+    *error = "recency_templates, recency_s and max_wifi_age_s must not be negative";
+    return false;
+  }
+  return true;
 }
 
 std::string ToString(DecisionSource source) {
@@ -278,14 +315,220 @@ class FusedFrontEnd : public FrontEnd {
   std::optional<double> heading_rad_;
 };
 
+class FabmapFrontEnd : public FrontEnd {
+ public:
+  FabmapFrontEnd(const FabmapSettings& settings, std::shared_ptr<const FabmapResources> resources)
+      : settings_(settings), resources_(std::move(resources)) {
+    if (!resources_) {
+      throw std::invalid_argument("the FABMAP front end needs PrepareFabmapResources' models");
+    }
+    Reset();
+  }
+
+  StatusOr<std::optional<FrameDecision>> OnImage(double time_s, const GrayImage& image) override {
+    if (!fabmap::UsesVision(mode())) return std::optional<FrameDecision>();
+    auto words = fabmap::ImageWords(*resources_->visual, image);
+    if (!words.ok()) return words.status();
+    fabmap::Query q;
+    q.visual = *std::move(words);
+    if (fabmap::UsesWifi(mode()) && newest_scan_time_s_ &&
+        time_s - *newest_scan_time_s_ <= settings_.front_end.max_wifi_age_s) {
+      q.wifi = newest_scan_;
+    }
+    return Decide(time_s, std::move(q));
+  }
+
+  StatusOr<std::optional<FrameDecision>> OnWifi(const WifiScan& scan) override {
+    if (!fabmap::UsesWifi(mode())) return std::optional<FrameDecision>();
+    newest_scan_ = scan.readings;
+    newest_scan_time_s_ = scan.time_s;
+    if (fabmap::UsesVision(mode())) return std::optional<FrameDecision>();  // images are frames
+    fabmap::Query q;
+    q.wifi = scan.readings;
+    return Decide(scan.time_s, std::move(q));
+  }
+
+  void OnCompass(double, double) override {}
+  std::optional<double> CompassHeading() const override { return std::nullopt; }
+  bool WantsImages() const override { return fabmap::UsesVision(mode()); }
+  uint32_t size() const override { return static_cast<uint32_t>(places_.size()); }
+
+  std::string EncodeState() const override {
+    ByteWriter w;
+    w.Count(places_.size());
+    for (size_t i = 0; i < places_.size(); ++i) {
+      w.Pod(created_time_s_[i]);
+      w.PodVector(places_[i].visual);
+      w.Bool(places_[i].wifi.has_value());
+      const auto& readings = places_[i].wifi ? *places_[i].wifi : std::vector<WifiReading>();
+      w.Count(readings.size());
+      for (const WifiReading& r : readings) {
+        w.String(r.bssid);
+        w.Pod(r.rssi_dbm);
+      }
+    }
+    w.Optional(newest_scan_time_s_);
+    w.Count(newest_scan_.size());
+    for (const WifiReading& r : newest_scan_) {
+      w.String(r.bssid);
+      w.Pod(r.rssi_dbm);
+    }
+    return std::move(w.bytes());
+  }
+
+  Status DecodeState(const std::string& bytes) override {
+    ByteReader r(bytes, "FABMAP front-end state");
+    auto readings = [&r](std::vector<WifiReading>* out) {
+      size_t n = 0;
+      if (!r.Count(9, &n)) return false;
+      out->resize(n);
+      for (WifiReading& x : *out) {
+        if (!(r.String(&x.bssid) && r.Pod(&x.rssi_dbm))) return false;
+      }
+      return true;
+    };
+    size_t count = 0;
+    std::vector<double> times;
+    std::vector<fabmap::Query> places;
+    bool ok = r.Count(8 + 8 + 1 + 8, &count);
+    for (size_t i = 0; ok && i < count; ++i) {
+      double t = 0.0;
+      fabmap::Query q;
+      bool has_wifi = false;
+      std::vector<WifiReading> scan;
+      ok = r.Pod(&t) && r.PodVector(&q.visual) && r.Bool(&has_wifi) && readings(&scan);
+      if (has_wifi) q.wifi = std::move(scan);
+      times.push_back(t);
+      places.push_back(std::move(q));
+    }
+    std::optional<double> newest_time;
+    std::vector<WifiReading> newest;
+    ok = ok && r.Optional(&newest_time) && readings(&newest) &&
+         (r.AtEnd() || r.Fail("trailing bytes"));
+    if (!ok) return Status::Error(r.error());
+    Reset();
+    for (size_t i = 0; i < places.size(); ++i) {
+      RATSLAM_RETURN_IF_ERROR(localiser_->AddPlace(places[i]));
+    }
+    places_ = std::move(places);
+    created_time_s_ = std::move(times);
+    newest_scan_time_s_ = newest_time;
+    newest_scan_ = std::move(newest);
+    return Status::Ok();
+  }
+
+ private:
+  fabmap::FabmapMode mode() const { return settings_.localiser.localiser.mode; }
+
+  void Reset() {
+    auto l = fabmap::Localiser::Create(settings_.localiser,
+                                       resources_->visual ? &resources_->visual->model : nullptr,
+                                       resources_->exploration);
+    if (!l.ok()) throw std::invalid_argument("FABMAP front end: " + l.status().message());
+    localiser_ = std::move(l).value();
+    places_.clear();
+    created_time_s_.clear();
+  }
+
+  StatusOr<std::optional<FrameDecision>> Decide(double time_s, fabmap::Query q) {
+    const fabmap::LocalisationResult r = localiser_->Localise(q);
+    FrameDecision d;
+    d.view.time_s = time_s;
+    d.source = fabmap::UsesVision(mode()) ? DecisionSource::kCamera : DecisionSource::kWifi;
+    const int64_t n = static_cast<int64_t>(places_.size());
+    if (r.best_place >= 0 && r.best_probability >= settings_.front_end.match_probability) {
+      const bool old_enough =
+          n - r.best_place >= settings_.front_end.recency_templates &&
+          time_s - created_time_s_[r.best_place] >= settings_.front_end.recency_s;
+      d.view.template_id = static_cast<uint32_t>(r.best_place);
+      d.view.is_new = false;
+      d.recent = !old_enough;
+      d.view.allow_injection = old_enough;
+      return std::optional<FrameDecision>(d);
+    }
+    RATSLAM_RETURN_IF_ERROR(localiser_->AddPlace(q));
+    places_.push_back(std::move(q));
+    created_time_s_.push_back(time_s);
+    d.view.template_id = static_cast<uint32_t>(n);
+    d.view.is_new = true;
+    d.source = DecisionSource::kNew;
+    return std::optional<FrameDecision>(d);
+  }
+
+  FabmapSettings settings_;
+  std::shared_ptr<const FabmapResources> resources_;
+  std::unique_ptr<fabmap::Localiser> localiser_;
+  std::vector<fabmap::Query> places_;
+  std::vector<double> created_time_s_;
+  std::vector<WifiReading> newest_scan_;
+  std::optional<double> newest_scan_time_s_;
+};
+
 }  // namespace
 
-std::unique_ptr<FrontEnd> CreateFrontEnd(const FrontEndSettings& s) {
+StatusOr<std::shared_ptr<const FabmapResources>> PrepareFabmapResources(
+    const FrontEndSettings& settings, const Dataset& dataset, ImageLoader& images) {
+  const FabmapSettings& f = settings.fabmap;
+  std::string error;
+  if (!f.IsValid(&error)) return Status::Error("FABMAP settings: " + error);
+  auto resources = std::make_shared<FabmapResources>();
+  const fabmap::FabmapMode mode = f.localiser.localiser.mode;
+  if (fabmap::UsesVision(mode)) {
+    if (!f.visual_model.file.empty()) {
+      std::ifstream in(f.visual_model.file, std::ios::binary);
+      if (!in) return Status::Error(f.visual_model.file + ": cannot open visual model");
+      std::stringstream bytes;
+      bytes << in.rdbuf();
+      auto model = fabmap::DecodeVisualModel(bytes.str(), f.visual_model.file);
+      if (!model.ok()) return model.status();
+      resources->visual = *std::move(model);
+    } else if (!f.visual_model.training_images.empty()) {
+      auto all = fabmap::ListImages(f.visual_model.training_images);
+      if (!all.ok()) return all.status();
+      std::vector<std::string> chosen;
+      for (size_t i = 0; i < all->size(); i += f.visual_model.training_image_step) {
+        chosen.push_back((*all)[i]);
+      }
+      auto model = fabmap::TrainVisualModel(chosen, f.features, f.vocabulary, f.localiser.chow_liu,
+                                            images, nullptr);
+      if (!model.ok()) return model.status();
+      resources->visual = *std::move(model);
+    } else {
+      return Status::Error("FABMAP mode " + fabmap::ToString(mode) +
+                           " needs [visual_model] file or training_images");
+    }
+  }
+  if (fabmap::UsesWifi(mode)) {
+    // Travel at each scan from the odometry (speed held from one row's time to the next's).
+    double travelled = 0.0, last_time = 0.0;
+    size_t k = 0;
+    for (const WifiScan& scan : dataset.wifi) {
+      while (k < dataset.odometry.size() && dataset.odometry[k].time_s <= scan.time_s) {
+        travelled += std::abs(dataset.odometry[k].forward_speed_m_per_s) *
+                     std::max(0.0, dataset.odometry[k].time_s - last_time);
+        last_time = dataset.odometry[k].time_s;
+        ++k;
+      }
+      resources->exploration.scans.push_back(scan.readings);
+      resources->exploration.travelled_m.push_back(travelled);
+      resources->exploration.time_s.push_back(scan.time_s);
+    }
+  }
+  auto check = fabmap::Localiser::Create(
+      f.localiser, resources->visual ? &resources->visual->model : nullptr, resources->exploration);
+  if (!check.ok()) return check.status();
+  return std::shared_ptr<const FabmapResources>(std::move(resources));
+}
+
+std::unique_ptr<FrontEnd> CreateFrontEnd(const FrontEndSettings& s,
+                                         std::shared_ptr<const FabmapResources> fabmap) {
   switch (s.front_end.kind) {
     case FrontEndKind::kClassicCamera:
       return std::make_unique<ClassicCameraFrontEnd>(s.classic_camera);
     case FrontEndKind::kFused:
       return std::make_unique<FusedFrontEnd>(s.fused, s.camera_12x9, s.wifi);
+    case FrontEndKind::kFabmap:
+      return std::make_unique<FabmapFrontEnd>(s.fabmap, std::move(fabmap));
   }
   return nullptr;
 }

@@ -5,6 +5,12 @@
 // kClassicCamera: the OpenRatSLAM camera matcher (sensors/classic_camera_matcher.h).
 // kFused: the Wi-Fi RatSLAM paper's front end (section III): 12x9 camera templates (eq. 7),
 // Wi-Fi fingerprints (eqs. 3-6) and a compass (eq. 2), combined by the b_out rule (eqs. 8-12):
+// kFabmap: FABMAP (fusion/fabmap) decides: a place it recognises with at least
+// match_probability is the active view; otherwise (the new place wins) the observation becomes a
+// new place and template. Any FABMAP mode works (vision, wifi, early, late, sequential). The
+// Wi-Fi words, tree and virtual samples come from an exploration of the data set's own scans
+// (the fusion paper's section 3: Wi-Fi vocabularies exist only after exploring), spaced by
+// odometry travel and time; the visual model is loaded from [visual_model] file or trained.
 // the best match per sensor counts only if it reaches the sensor's threshold and is not among
 // the last k templates (k in templates and/or seconds); the camera is preferred when it matches,
 // else Wi-Fi, else a new joint template (camera view + newest Wi-Fi scan + heading) is stored.
@@ -22,6 +28,10 @@
 #include <optional>
 #include <string>
 
+#include "fusion/fabmap/evaluation.h"
+#include "fusion/fabmap/localiser.h"
+#include "fusion/fabmap/visual_model.h"
+#include "fusion/fabmap/vocabulary.h"
 #include "ratslam/local_view_cells.h"
 #include "ratslam/status.h"
 #include "sensors/classic_camera_matcher.h"
@@ -32,7 +42,7 @@
 
 namespace ratslam {
 
-enum class FrontEndKind { kClassicCamera, kFused };
+enum class FrontEndKind { kClassicCamera, kFused, kFabmap };
 std::string ToString(FrontEndKind kind);
 // Fails with the list of valid names.
 StatusOr<FrontEndKind> FrontEndKindFromString(const std::string& name);
@@ -43,7 +53,8 @@ struct FrontEndOptions {
   bool IsValid(std::string*) const { return true; }
   template <typename Visitor>
   void VisitFields(Visitor&& v) {
-    v("kind", kind, "front end that decides the active local view: classic_camera or fused");
+    v("kind", kind,
+      "front end that decides the active local view: classic_camera, fused or fabmap");
   }
 };
 
@@ -69,6 +80,42 @@ struct FusedOptions {
     v("recency_s", recency_s, "k of eqs. 10-11 in seconds: matches newer than this do not count");
     v("max_wifi_age_s", max_wifi_age_s, "a Wi-Fi scan older than this counts as absent at a frame");
   }
+};
+
+struct FabmapFrontEndOptions {
+  double match_probability = 0.5;  // least posterior of the best place to re-use its template
+  int recency_templates = 0;       // a match this many templates old or newer: no injection
+  double recency_s = 10.0;         // nor one made less than this long ago
+  double max_wifi_age_s = 5.0;     // an older newest scan counts as absent at an image frame
+
+  bool IsValid(std::string* error) const;
+  template <typename Visitor>
+  void VisitFields(Visitor&& v) {
+    v("match_probability", match_probability,
+      "least FABMAP posterior of the best place for its template to become active");
+    v("recency_templates", recency_templates,
+      "matches to one of the newest this-many templates re-use it without injection");
+    v("recency_s", recency_s, "so do matches to a template made less than this long ago");
+    v("max_wifi_age_s", max_wifi_age_s, "a Wi-Fi scan older than this counts as absent at a frame");
+  }
+};
+
+// FABMAP localisation (fusion/fabmap): modes, models, words and the benchmark's split.
+struct FabmapSettings {
+  fabmap::LocaliserSettings localiser;
+  fabmap::FeatureOptions features;
+  fabmap::VocabularyOptions vocabulary;
+  fabmap::VisualModelOptions visual_model;
+  fabmap::EvaluationOptions evaluation;
+  FabmapFrontEndOptions front_end;
+
+  bool IsValid(std::string* error) const;
+};
+
+// What the FABMAP front end is built from, prepared once per run (PrepareFabmapResources).
+struct FabmapResources {
+  std::optional<fabmap::TrainedVisualModel> visual;
+  fabmap::WifiExploration exploration;
 };
 
 // Which sensor decided a frame.
@@ -103,9 +150,19 @@ struct FrontEndSettings {
   FusedOptions fused;
   KernelCameraOptions camera_12x9;
   WifiMatcherOptions wifi;
+  FabmapSettings fabmap;
 };
 
-std::unique_ptr<FrontEnd> CreateFrontEnd(const FrontEndSettings& settings);
+// The FABMAP front end's models for `dataset`: the visual model (loaded, or trained from
+// [visual_model] training_images) when the mode uses vision, and the Wi-Fi exploration (every
+// scan, with odometry travel) when it uses Wi-Fi. Fails on a bad file or an unusable mode.
+StatusOr<std::shared_ptr<const FabmapResources>> PrepareFabmapResources(
+    const FrontEndSettings& settings, const Dataset& dataset, ImageLoader& images);
+
+// `fabmap` is required by the kFabmap front end (it throws std::invalid_argument without it,
+// like the pipeline does for invalid options).
+std::unique_ptr<FrontEnd> CreateFrontEnd(const FrontEndSettings& settings,
+                                         std::shared_ptr<const FabmapResources> fabmap = nullptr);
 
 }  // namespace ratslam
 

@@ -123,10 +123,90 @@ TEST(FrontEndTest, WifiOnlyMakesFramesFromScansAndStateRoundTrips) {
 }
 
 TEST(FrontEndTest, KindNamesRoundTrip) {
-  for (FrontEndKind k : {FrontEndKind::kClassicCamera, FrontEndKind::kFused}) {
+  for (FrontEndKind k :
+       {FrontEndKind::kClassicCamera, FrontEndKind::kFused, FrontEndKind::kFabmap}) {
     EXPECT_EQ(FrontEndKindFromString(ToString(k)).value(), k);
   }
-  EXPECT_FALSE(FrontEndKindFromString("fabmap").ok());
+  EXPECT_FALSE(FrontEndKindFromString("fab_map").ok());
+}
+
+// A corridor of 40 places 2 m apart with 10 access points, walked twice; scans every 2 m.
+WifiScan CorridorScan(double t, double x, double noise_db) {
+  WifiScan s{t, {}};
+  for (int k = 0; k < 10; ++k) {
+    const double d = std::abs(x - 8.0 * k) + 1.0;
+    const double rssi = -30.0 - 25.0 * std::log10(d) + noise_db * std::sin(7.0 * t + k);
+    std::string bssid = "ap";
+    bssid += std::to_string(k);
+    if (rssi > -90.0) s.readings.push_back({bssid, rssi});
+  }
+  return s;
+}
+
+TEST(FabmapFrontEndTest, SecondLapRecognisesTheFirstLapsPlaces) {
+  FrontEndSettings settings;
+  settings.front_end.kind = FrontEndKind::kFabmap;
+  settings.fabmap.localiser.localiser.mode = fabmap::FabmapMode::kWifi;
+  settings.fabmap.localiser.wifi_words.bins = 8;
+  settings.fabmap.localiser.wifi_words.encoding = fabmap::WifiEncoding::kIncremental;
+  settings.fabmap.localiser.virtual_wifi.use_exploration_scans = true;
+  settings.fabmap.front_end.recency_s = 30.0;
+  Dataset data;
+  std::vector<double> x_of_scan;
+  for (int lap = 0; lap < 2; ++lap) {
+    for (int i = 0; i < 40; ++i) {
+      const double t = lap * 100.0 + i * 2.0;
+      data.wifi.push_back(CorridorScan(t, 2.0 * i, lap == 0 ? 1.0 : 2.0));
+      data.odometry.push_back({t, 1.0, 0.0});
+      x_of_scan.push_back(2.0 * i);
+    }
+  }
+  FileImageLoader images;
+  const auto resources = PrepareFabmapResources(settings, data, images);
+  ASSERT_TRUE(resources.ok()) << resources.status().message();
+  std::unique_ptr<FrontEnd> a = CreateFrontEnd(settings, *resources);
+  EXPECT_FALSE(a->WantsImages());
+  std::vector<double> x_of_template;
+  int second_lap_matches = 0, close_matches = 0;
+  for (size_t i = 0; i < data.wifi.size(); ++i) {
+    const auto d = a->OnWifi(data.wifi[i]);
+    ASSERT_TRUE(d.ok() && d->has_value());
+    const FrameDecision& f = **d;
+    if (f.view.is_new) {
+      EXPECT_EQ(f.view.template_id, x_of_template.size());
+      x_of_template.push_back(x_of_scan[i]);
+    } else if (i >= 40 && !f.recent) {
+      ++second_lap_matches;
+      close_matches += std::abs(x_of_template[f.view.template_id] - x_of_scan[i]) <= 4.0;
+      EXPECT_TRUE(f.view.allow_injection);
+    }
+  }
+  EXPECT_GE(x_of_template.size(), 5u);  // the first lap made places
+  EXPECT_GE(second_lap_matches, 20);    // the second lap mostly recognises them
+  EXPECT_GE(close_matches, second_lap_matches * 9 / 10);
+
+  // The state round-trips: a restored front end decides the same.
+  std::unique_ptr<FrontEnd> b = CreateFrontEnd(settings, *resources);
+  ASSERT_TRUE(b->DecodeState(a->EncodeState()).ok());
+  EXPECT_EQ(b->size(), a->size());
+  const WifiScan probe = CorridorScan(300.0, 31.0, 1.5);
+  const auto da = a->OnWifi(probe).value();
+  const auto db = b->OnWifi(probe).value();
+  EXPECT_EQ(da->view.template_id, db->view.template_id);
+  std::string corrupt = a->EncodeState();
+  corrupt.resize(corrupt.size() - 3);
+  EXPECT_FALSE(b->DecodeState(corrupt).ok());
+  EXPECT_THROW(CreateFrontEnd(settings, nullptr), std::invalid_argument);
+}
+
+TEST(FabmapFrontEndTest, VisionWithoutAModelIsAClearError) {
+  FrontEndSettings settings;
+  settings.front_end.kind = FrontEndKind::kFabmap;
+  settings.fabmap.localiser.localiser.mode = fabmap::FabmapMode::kVision;
+  FileImageLoader images;
+  const auto resources = PrepareFabmapResources(settings, Dataset{}, images);
+  ASSERT_FALSE(resources.ok());
+  EXPECT_NE(resources.status().message().find("visual_model"), std::string::npos);
 }
 
 }  // namespace

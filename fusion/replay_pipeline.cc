@@ -18,25 +18,7 @@ bool PipelineOptions::IsValid(std::string* error) const {
          check(sensors.camera_12x9.IsValid(&inner), "camera_12x9") &&
          check(sensors.wifi.IsValid(&inner), "wifi") && check(pdr.IsValid(&inner), "pdr") &&
          check(visual_odometry.IsValid(&inner), "visual_odometry") && ratslam.IsValid(error) &&
-         fabmap.IsValid(error);
-}
-
-bool FabmapSettings::IsValid(std::string* error) const {
-  std::string inner;
-  auto check = [&](bool ok, const char* section) {
-    if (!ok && error) *error = std::string(section) + "." + inner;
-    return ok;
-  };
-  return check(localiser.localiser.IsValid(&inner), "fabmap") &&
-         check(localiser.fabmap.IsValid(&inner), "fabmap_model") &&
-         check(localiser.visual_detector.IsValid(&inner), "visual_detector") &&
-         check(localiser.wifi_detector.IsValid(&inner), "wifi_detector") &&
-         check(features.IsValid(&inner), "visual_words") &&
-         check(vocabulary.IsValid(&inner), "vocabulary") &&
-         check(visual_model.IsValid(&inner), "visual_model") &&
-         check(localiser.wifi_words.IsValid(&inner), "wifi_words") &&
-         check(localiser.virtual_wifi.IsValid(&inner), "virtual_wifi") &&
-         check(evaluation.IsValid(&inner), "evaluation");
+         sensors.fabmap.IsValid(error);
 }
 
 namespace {
@@ -48,13 +30,14 @@ const PipelineOptions& Validated(const PipelineOptions& options) {
 }  // namespace
 
 ReplayPipeline::ReplayPipeline(const PipelineOptions& options, const Dataset& dataset,
-                               ImageLoader* images)
+                               ImageLoader* images, std::shared_ptr<const FabmapResources> fabmap)
     : options_(Validated(options)),
       dataset_(dataset),
       images_(images),
       events_(MergeEvents(dataset)),
       slam_(std::make_unique<Ratslam>(options.ratslam)),
-      front_end_(CreateFrontEnd(options.sensors)) {
+      fabmap_(std::move(fabmap)),
+      front_end_(CreateFrontEnd(options.sensors, fabmap_)) {
   state_.events_total = events_.size();
 }
 
@@ -180,7 +163,7 @@ Status ReplayPipeline::Restore(const State& state) {
   if (state.next_event > events_.size()) return Status::Error("saved map is past the data set");
   auto slam = std::make_unique<Ratslam>(options_.ratslam);
   RATSLAM_RETURN_IF_ERROR(slam->SetState(state.ratslam));
-  std::unique_ptr<FrontEnd> front_end = CreateFrontEnd(options_.sensors);
+  std::unique_ptr<FrontEnd> front_end = CreateFrontEnd(options_.sensors, fabmap_);
   RATSLAM_RETURN_IF_ERROR(front_end->DecodeState(state.front_end));
   if (front_end->size() != slam->local_view().size()) {
     return Status::Error("saved map: front-end templates and local view cells differ in number");

@@ -13,10 +13,6 @@
 #include <string>
 #include <vector>
 
-#include "fusion/fabmap/evaluation.h"
-#include "fusion/fabmap/localiser.h"
-#include "fusion/fabmap/visual_model.h"
-#include "fusion/fabmap/vocabulary.h"
 #include "fusion/front_end.h"
 #include "ratslam/ratslam.h"
 #include "ratslam/status.h"
@@ -26,17 +22,6 @@
 #include "sensors/visual_odometry.h"
 
 namespace ratslam {
-
-// FABMAP localisation (fusion/fabmap): modes, models, words and the benchmark's split.
-struct FabmapSettings {
-  fabmap::LocaliserSettings localiser;
-  fabmap::FeatureOptions features;
-  fabmap::VocabularyOptions vocabulary;
-  fabmap::VisualModelOptions visual_model;
-  fabmap::EvaluationOptions evaluation;
-
-  bool IsValid(std::string* error) const;
-};
 
 // Everything a replay or an evaluation is configured by; one TOML section per member.
 struct PipelineOptions {
@@ -62,16 +47,17 @@ struct PipelineOptions {
     v("local_view", ratslam.local_view);
     v("experience_map", ratslam.experience_map);
     v("action", ratslam.action);
-    v("fabmap", fabmap.localiser.localiser);
-    v("fabmap_model", fabmap.localiser.fabmap);
-    v("visual_detector", fabmap.localiser.visual_detector);
-    v("wifi_detector", fabmap.localiser.wifi_detector);
-    v("visual_words", fabmap.features);
-    v("vocabulary", fabmap.vocabulary);
-    v("visual_model", fabmap.visual_model);
-    v("wifi_words", fabmap.localiser.wifi_words);
-    v("virtual_wifi", fabmap.localiser.virtual_wifi);
-    v("evaluation", fabmap.evaluation);
+    v("fabmap", sensors.fabmap.localiser.localiser);
+    v("fabmap_front_end", sensors.fabmap.front_end);
+    v("fabmap_model", sensors.fabmap.localiser.fabmap);
+    v("visual_detector", sensors.fabmap.localiser.visual_detector);
+    v("wifi_detector", sensors.fabmap.localiser.wifi_detector);
+    v("visual_words", sensors.fabmap.features);
+    v("vocabulary", sensors.fabmap.vocabulary);
+    v("visual_model", sensors.fabmap.visual_model);
+    v("wifi_words", sensors.fabmap.localiser.wifi_words);
+    v("virtual_wifi", sensors.fabmap.localiser.virtual_wifi);
+    v("evaluation", sensors.fabmap.evaluation);
   }
 };
 
@@ -130,7 +116,9 @@ class ReplayPipeline {
 
   // `options` must be valid; throws std::invalid_argument otherwise. `dataset` and `images`
   // must outlive the pipeline.
-  ReplayPipeline(const PipelineOptions& options, const Dataset& dataset, ImageLoader* images);
+  // The FABMAP front end also needs `fabmap` (see PrepareFabmapResources).
+  ReplayPipeline(const PipelineOptions& options, const Dataset& dataset, ImageLoader* images,
+                 std::shared_ptr<const FabmapResources> fabmap = nullptr);
 
   // Replays events from the current position until the data set ends, `until_time_s` passes, or
   // a stop is requested. On an error the state stays valid up to the last complete event.
@@ -156,6 +144,7 @@ class ReplayPipeline {
   ImageLoader* images_;
   std::vector<Event> events_;
   std::unique_ptr<Ratslam> slam_;
+  std::shared_ptr<const FabmapResources> fabmap_;
   std::unique_ptr<FrontEnd> front_end_;
   State state_;  // the parts not held by slam_ and camera_
 };

@@ -97,8 +97,15 @@ StatusOr<std::unique_ptr<Localiser>> Localiser::Create(const LocaliserSettings& 
   if (!wifi_tree.ok()) return wifi_tree.status().WithContext("Wi-Fi Chow-Liu tree");
   double mean_aps = 0.0, sigma_aps = 0.0;
   CountStatistics(exploration.scans, &mean_aps, &sigma_aps);
-  std::vector<Observation> virtual_samples =
-      VirtualWifiSamples(l->wifi_vocabulary_, mean_aps, sigma_aps, settings.virtual_wifi);
+  std::vector<Observation> virtual_samples;
+  if (settings.virtual_wifi.use_exploration_scans) {
+    for (const auto& scan : exploration.scans) {
+      virtual_samples.push_back(l->wifi_vocabulary_.Encode(scan));
+    }
+  } else {
+    virtual_samples =
+        VirtualWifiSamples(l->wifi_vocabulary_, mean_aps, sigma_aps, settings.virtual_wifi);
+  }
 
   const uint32_t wifi_size = l->wifi_vocabulary_.size();
   if (mode != FabmapMode::kEarly) {

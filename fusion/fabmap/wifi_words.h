@@ -74,6 +74,10 @@ struct VirtualSampleOptions {
   int samples = 500;     // n_s
   double p_known = 0.5;  // chance that a simulated AP is a known one
   uint64_t seed = 1;
+  // Use the exploration scans themselves as the unknown world instead of virtual samples. In a
+  // building whose scans all share one core of access points, virtual samples (random AP
+  // subsets) make any mapped place explain a new scan better than the unknown world does.
+  bool use_exploration_scans = false;
 
   bool IsValid(std::string* error) const;
   template <typename Visitor>
@@ -81,6 +85,8 @@ struct VirtualSampleOptions {
     v("samples", samples, "n_s: virtual Wi-Fi samples for the unknown world (section 3.3)");
     v("p_known", p_known, "chance that a simulated access point is a known one");
     v("seed", seed, "seed of the virtual samples");
+    v("use_exploration_scans", use_exploration_scans,
+      "the unknown world is the exploration scans themselves, not virtual samples");
   }
 };
 
