@@ -88,6 +88,7 @@ inline std::optional<PipelineOptions> LoadOptions(const Arguments& args,
 // `ratslam render ...` (render_command.cc).
 int RenderCommand(int argc, char** argv);
 int EvaluateCommand(int argc, char** argv);
+int SimulateCommand(int argc, char** argv);
 
 }  // namespace ratslam
 

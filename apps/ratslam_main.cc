@@ -75,7 +75,11 @@ const char kUsage[] =
     "  ratslam evaluate [--config C] --map M --query Q --out O [--quiet]\n"
     "      FABMAP localisation benchmark: maps M, localises every node of Q, writes\n"
     "      evaluation.json, queries.csv and localisation.png to O. M and Q may be the same\n"
-    "      data set: [evaluation] split and map_fraction then divide it.\n";
+    "      data set: [evaluation] split and map_fraction then divide it.\n"
+    "  ratslam simulate --world NAME|FILE --out D [--seed S] [--quiet]\n"
+    "      Simulates a world (built in: office, circular, day_night, aliased_floors,\n"
+    "      apartment; or a world TOML file) into the replay data set D, with world.toml,\n"
+    "      simulation.json and ground_truth.png.\n";
 
 struct ReplayRequest {
   PipelineOptions options;
@@ -426,6 +430,7 @@ int main(int argc, char** argv) {
   if (command == "synthesize") return SynthesizeCommand(argc, argv);
   if (command == "render") return RenderCommand(argc, argv);
   if (command == "evaluate") return EvaluateCommand(argc, argv);
+  if (command == "simulate") return SimulateCommand(argc, argv);
   if (command == "import") return ImportCommand(argc, argv);
   if (command == "--help" || command == "help" || command == "-h") {
     std::cout << kUsage;

@@ -1,0 +1,88 @@
+// `ratslam simulate`: a simulated world written as a replay data set.
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "apps/cli.h"
+#include "fusion/io/file_util.h"
+#include "sim/simulator.h"
+#include "sim/world_figure.h"
+#include "viewer/renderer.h"
+
+namespace ratslam {
+
+namespace fs = std::filesystem;
+
+StatusOr<sim::World> LoadWorld(const std::string& name_or_path) {
+  std::error_code ec;
+  if (fs::exists(name_or_path, ec)) return sim::LoadWorldFile(name_or_path);
+  return sim::BuiltInWorld(name_or_path);
+}
+
+Status SimulateWorld(const sim::World& world, uint64_t seed, const std::string& out, bool quiet,
+                     Dataset* dataset) {
+  const auto started = std::chrono::steady_clock::now();
+  auto renderer = CreateOsMesaViewRenderer();
+  if (!renderer.ok()) return renderer.status();
+  sim::SimulationReport report;
+  RATSLAM_RETURN_IF_ERROR(sim::Simulate(
+      world, seed, renderer->get(), (fs::path(out) / "images").string(), dataset, &report,
+      [&](double fraction) {
+        if (!quiet)
+          std::fprintf(stderr, "simulate: %s %3.0f%%\n", world.name.c_str(), 100 * fraction);
+      }));
+  RATSLAM_RETURN_IF_ERROR(WriteDataset(*dataset, out));
+  RATSLAM_RETURN_IF_ERROR(
+      WriteFileAtomically((fs::path(out) / "world.toml").string(),
+                          "# The simulated world (ratslam simulate).\n" + sim::PrintWorld(world)));
+  RATSLAM_RETURN_IF_ERROR(RenderToPng(sim::WorldMapScene(world, *dataset),
+                                      (fs::path(out) / "ground_truth.png").string()));
+  nlohmann::ordered_json j;
+  j["world"] = world.name;
+  j["seed"] = seed;
+  j["images"] = report.images;
+  j["wifi_scans"] = report.scans;
+  j["odometry_rows"] = report.odometry_rows;
+  j["compass_rows"] = report.compass_rows;
+  j["sessions"] = dataset->session_start_times_s.size();
+  j["duration_s"] = report.duration_s;
+  j["wall_seconds"] =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return WriteFileAtomically((fs::path(out) / "simulation.json").string(), j.dump(2) + "\n");
+}
+
+int SimulateCommand(int argc, char** argv) {
+  const auto args = ParseArguments(argc, argv, 2, {"--world", "--out", "--seed"});
+  if (!args || !args->values.count("--world") || !args->values.count("--out")) {
+    std::cerr << "usage: ratslam simulate --world NAME|FILE --out D [--seed S] [--quiet]\n";
+    return kExitUsage;
+  }
+  uint64_t seed = 1;
+  if (args->values.count("--seed")) {
+    const auto s = ParseNumber("--seed", args->values.at("--seed"));
+    if (!s || *s < 0 || *s != std::floor(*s)) return kExitUsage;
+    seed = static_cast<uint64_t>(*s);
+  }
+  auto world = LoadWorld(args->values.at("--world"));
+  if (!world.ok()) {
+    std::cerr << "ratslam simulate: " << world.status().message() << "\n";
+    return kExitError;
+  }
+  Dataset dataset;
+  Status s = SimulateWorld(*world, seed, args->values.at("--out"), args->quiet, &dataset);
+  if (!s.ok()) {
+    std::cerr << "ratslam simulate: " << s.message() << "\n";
+    return kExitError;
+  }
+  if (!args->quiet) {
+    std::printf("simulated '%s' into %s: %zu images, %zu Wi-Fi scans, %.0f s\n",
+                world->name.c_str(), args->values.at("--out").c_str(), dataset.images.size(),
+                dataset.wifi.size(),
+                dataset.ground_truth.back().time_s - dataset.ground_truth.front().time_s);
+  }
+  return kExitOk;
+}
+
+}  // namespace ratslam

@@ -1,0 +1,500 @@
+#include "sim/world.h"
+
+#include <toml++/toml.h>
+
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "sim/textures.h"
+
+namespace ratslam::sim {
+
+namespace {
+
+std::string Where(const std::string& source, const toml::node* node) {
+  return source + ":" + (node ? std::to_string(node->source().begin.line) : std::string("?"));
+}
+
+// Reads one TOML table's keys into fields; remembers the first error and unknown keys.
+class TableReader {
+ public:
+  TableReader(const toml::table& table, std::string where, std::string source, Status* status)
+      : table_(table), where_(std::move(where)), source_(std::move(source)), status_(status) {}
+
+  void Number(const char* key, double* field) {
+    const toml::node* n = Find(key);
+    if (!n) return;
+    if (const auto* f = n->as_floating_point()) {
+      if (!std::isfinite(f->get())) return Fail(n, key, "must be a finite number");
+      *field = f->get();
+    } else if (const auto* i = n->as_integer()) {
+      *field = static_cast<double>(i->get());
+    } else {
+      Fail(n, key, "expected a number");
+    }
+  }
+  void Integer(const char* key, int* field) {
+    const toml::node* n = Find(key);
+    if (!n) return;
+    const auto* i = n->as_integer();
+    if (!i || i->get() < -1000000 || i->get() > 1000000) return Fail(n, key, "expected an integer");
+    *field = static_cast<int>(i->get());
+  }
+  void Bool(const char* key, bool* field) {
+    const toml::node* n = Find(key);
+    if (!n) return;
+    const auto* b = n->as_boolean();
+    if (!b) return Fail(n, key, "expected true or false");
+    *field = b->get();
+  }
+  void String(const char* key, std::string* field) {
+    const toml::node* n = Find(key);
+    if (!n) return;
+    const auto* s = n->as_string();
+    if (!s) return Fail(n, key, "expected a string");
+    *field = s->get();
+  }
+  void Point(const char* key, Point2* field) {
+    const toml::node* n = Find(key);
+    if (!n) return;
+    std::vector<double> v;
+    if (!Numbers(*n, &v) || v.size() != 2) return Fail(n, key, "expected [x, y] in metres");
+    *field = {v[0], v[1]};
+  }
+  void Integers(const char* key, std::vector<int>* field) {
+    const toml::node* n = Find(key);
+    if (!n) return;
+    const auto* a = n->as_array();
+    if (!a) return Fail(n, key, "expected a list of integers");
+    field->clear();
+    for (const auto& e : *a) {
+      const auto* i = e.as_integer();
+      if (!i) return Fail(n, key, "expected a list of integers");
+      field->push_back(static_cast<int>(i->get()));
+    }
+  }
+  void RoutePoints(const char* key, std::vector<RoutePoint>* field) {
+    const toml::node* n = Find(key);
+    if (!n) return;
+    const auto* a = n->as_array();
+    if (!a) return Fail(n, key, "expected a list of [x, y, floor]");
+    field->clear();
+    for (const auto& e : *a) {
+      std::vector<double> v;
+      if (!Numbers(e, &v) || v.size() != 3 || v[2] != std::floor(v[2])) {
+        return Fail(&e, key, "expected [x, y, floor] with an integer floor");
+      }
+      field->push_back({{v[0], v[1]}, static_cast<int>(v[2])});
+    }
+  }
+  // The sub-table `key`, or nullptr.
+  const toml::table* Table(const char* key) {
+    const toml::node* n = Find(key);
+    if (!n) return nullptr;
+    const auto* t = n->as_table();
+    if (!t) Fail(n, key, "expected a table");
+    return t;
+  }
+  // The array of tables `key` (empty when absent).
+  std::vector<const toml::table*> Tables(const char* key) {
+    std::vector<const toml::table*> out;
+    const toml::node* n = Find(key);
+    if (!n) return out;
+    const auto* a = n->as_array();
+    if (!a) {
+      Fail(n, key, "expected [[" + std::string(key) + "]] tables");
+      return out;
+    }
+    for (const auto& e : *a) {
+      if (const auto* t = e.as_table()) {
+        out.push_back(t);
+      } else {
+        Fail(&e, key, "expected [[" + std::string(key) + "]] tables");
+      }
+    }
+    return out;
+  }
+  void Finish() {
+    for (const auto& [key, node] : table_) {
+      if (!used_.count(std::string(key.str())) && status_->ok()) {
+        *status_ = Status::Error(Where(source_, &node) + ": unknown key '" +
+                                 std::string(key.str()) + "' in " + where_);
+      }
+    }
+  }
+  const toml::table& table() const { return table_; }
+
+ private:
+  const toml::node* Find(const char* key) {
+    used_.insert(key);
+    return table_.get(key);
+  }
+  static bool Numbers(const toml::node& n, std::vector<double>* out) {
+    const auto* a = n.as_array();
+    if (!a) return false;
+    for (const auto& e : *a) {
+      if (const auto* f = e.as_floating_point()) {
+        if (!std::isfinite(f->get())) return false;
+        out->push_back(f->get());
+      } else if (const auto* i = e.as_integer()) {
+        out->push_back(static_cast<double>(i->get()));
+      } else {
+        return false;
+      }
+    }
+    return true;
+  }
+  void Fail(const toml::node* n, const std::string& key, const std::string& message) {
+    if (status_->ok()) {
+      *status_ = Status::Error(Where(source_, n) + ": " + where_ + " " + key + ": " + message);
+    }
+  }
+
+  const toml::table& table_;
+  std::string where_, source_;
+  Status* status_;
+  std::set<std::string> used_;
+};
+
+}  // namespace
+
+Status World::Validate() const {
+  auto bad = [](const std::string& what) { return Status::Error("world: " + what); };
+  if (walls.empty()) return bad("no walls");
+  for (size_t i = 0; i < walls.size(); ++i) {
+    const Wall& w = walls[i];
+    const std::string which = "wall " + std::to_string(i) + ": ";
+    if (!materials_db.count(w.material))
+      return bad(which + "unknown material '" + w.material + "'");
+    if (!IsTextureName(w.texture)) return bad(which + "unknown texture '" + w.texture + "'");
+    if (!(w.height_m > 0.0)) return bad(which + "height_m must be positive");
+    if (std::hypot(w.to.x_m - w.from.x_m, w.to.y_m - w.from.y_m) < 1e-6) {
+      return bad(which + "has zero length");
+    }
+  }
+  std::map<int, std::set<std::string>> textures_per_floor;
+  for (const Wall& w : walls) textures_per_floor[w.floor].insert(w.texture);
+  for (const auto& [floor, names] : textures_per_floor) {
+    if (names.size() > 250) {
+      return bad("floor " + std::to_string(floor) + " uses more than 250 textures");
+    }
+  }
+  for (const auto& [name, db] : materials_db) {
+    if (!(db >= 0.0)) return bad("material '" + name + "' has a negative attenuation");
+  }
+  std::set<std::string> ap_names;
+  for (const AccessPoint& ap : access_points) {
+    if (ap.name.empty() || !ap_names.insert(ap.name).second) {
+      return bad("access point names must be unique and not empty ('" + ap.name + "')");
+    }
+    if (!((ap.channel >= 1 && ap.channel <= 14) || (ap.channel >= 32 && ap.channel <= 177))) {
+      return bad("access point '" + ap.name + "': channel must be 1-14 or 32-177");
+    }
+  }
+  for (const Person& p : people) {
+    if (!IsTextureName(p.texture)) return bad("person: unknown texture '" + p.texture + "'");
+    if (!(p.speed_m_per_s > 0.0)) return bad("person: speed_m_per_s must be positive");
+  }
+  std::set<std::string> route_names;
+  for (const Route& r : routes) {
+    if (!route_names.insert(r.name).second) return bad("two routes named '" + r.name + "'");
+    if (r.points.size() < 2) return bad("route '" + r.name + "' needs at least two points");
+  }
+  if (sessions.empty()) return bad("no sessions");
+  for (size_t i = 0; i < sessions.size(); ++i) {
+    const Session& s = sessions[i];
+    if (!route_names.count(s.route))
+      return bad("session " + std::to_string(i) + ": unknown route '" + s.route + "'");
+    if (!(s.laps > 0.0 && s.laps <= 1000.0))
+      return bad("session " + std::to_string(i) + ": laps must be in (0, 1000]");
+    if (s.lighting != "day" && s.lighting != "night") {
+      return bad("session " + std::to_string(i) + ": lighting must be day or night");
+    }
+  }
+  const CameraSettings& c = camera;
+  if (c.width_px < 8 || c.height_px < 8 || c.width_px > 1024 || c.height_px > 1024) {
+    return bad("camera: width_px and height_px must be in 8..1024");
+  }
+  if (!(c.horizontal_fov_deg > 10.0 && c.horizontal_fov_deg < 170.0))
+    return bad("camera: horizontal_fov_deg must be in (10, 170)");
+  if (!(c.rate_hz > 0.0) || !(c.noise_sigma >= 0.0) || !(c.height_m > 0.0)) {
+    return bad("camera: rate_hz and height_m must be positive, noise_sigma not negative");
+  }
+  const WifiSettings& w = wifi;
+  if (!(w.path_loss_exponent > 0.0) || !(w.reference_distance_m > 0.0) ||
+      !(w.scan_period_s > 0.0) || !(w.shadowing_correlation_m > 0.0) ||
+      !(w.shadowing_sigma_db >= 0.0) || !(w.fading_sigma_db >= 0.0) ||
+      !(w.floor_attenuation_db >= 0.0) ||
+      !(w.miss_probability >= 0.0 && w.miss_probability < 1.0)) {
+    return bad("wifi: a setting is out of range");
+  }
+  if (!(compass.rate_hz > 0.0) || !(compass.noise_sigma_deg >= 0.0))
+    return bad("compass: a setting is out of range");
+  if (!(odometry.rate_hz > 0.0) || !(odometry.speed_noise_m_per_s >= 0.0) ||
+      !(odometry.turn_noise_rad_per_s >= 0.0) || !(odometry.speed_scale_error > -1.0)) {
+    return bad("odometry: a setting is out of range");
+  }
+  if (!(motion.speed_m_per_s > 0.0) || !(motion.turn_rate_rad_per_s > 0.0) ||
+      !(motion.lift_time_s >= 0.0) || !(motion.session_gap_s >= 0.0)) {
+    return bad("motion: a setting is out of range");
+  }
+  return Status::Ok();
+}
+
+StatusOr<World> ParseWorld(const std::string& text, const std::string& source) {
+  toml::table root;
+  try {
+    root = toml::parse(text, source);
+  } catch (const toml::parse_error& e) {
+    return Status::Error(source + ":" + std::to_string(e.source().begin.line) + ": " +
+                         std::string(e.description()));
+  }
+  World world;
+  Status status;
+  TableReader top(root, "the world", source, &status);
+  top.String("name", &world.name);
+  if (const toml::table* m = top.Table("materials")) {
+    for (const auto& [key, node] : *m) {
+      double db = 0.0;
+      if (const auto* f = node.as_floating_point()) {
+        db = f->get();
+      } else if (const auto* i = node.as_integer()) {
+        db = static_cast<double>(i->get());
+      } else if (status.ok()) {
+        status = Status::Error(Where(source, &node) + ": [materials] " + std::string(key.str()) +
+                               ": expected an attenuation in dB");
+      }
+      world.materials_db[std::string(key.str())] = db;
+    }
+  }
+  for (const toml::table* t : top.Tables("walls")) {
+    Wall w;
+    TableReader r(*t, "[[walls]]", source, &status);
+    r.Integer("floor", &w.floor);
+    r.Point("from", &w.from);
+    r.Point("to", &w.to);
+    r.String("material", &w.material);
+    r.String("texture", &w.texture);
+    r.Number("height_m", &w.height_m);
+    r.Finish();
+    world.walls.push_back(w);
+  }
+  for (const toml::table* t : top.Tables("access_points")) {
+    AccessPoint a;
+    TableReader r(*t, "[[access_points]]", source, &status);
+    r.String("name", &a.name);
+    r.Point("position", &a.position);
+    r.Integer("floor", &a.floor);
+    r.Number("tx_power_dbm", &a.tx_power_dbm);
+    r.Integer("channel", &a.channel);
+    r.Integers("off_in_sessions", &a.off_in_sessions);
+    r.Integers("moved_in_sessions", &a.moved_in_sessions);
+    r.Point("moved_to", &a.moved_to);
+    r.Finish();
+    world.access_points.push_back(a);
+  }
+  for (const toml::table* t : top.Tables("disturbances")) {
+    Disturbance d;
+    TableReader r(*t, "[[disturbances]]", source, &status);
+    r.Point("position", &d.position);
+    r.Integer("floor", &d.floor);
+    r.Number("radius_m", &d.radius_m);
+    r.Number("strength_deg", &d.strength_deg);
+    r.Finish();
+    world.disturbances.push_back(d);
+  }
+  for (const toml::table* t : top.Tables("people")) {
+    Person p;
+    TableReader r(*t, "[[people]]", source, &status);
+    r.Integer("floor", &p.floor);
+    r.Point("from", &p.from);
+    r.Point("to", &p.to);
+    r.Number("speed_m_per_s", &p.speed_m_per_s);
+    r.String("texture", &p.texture);
+    r.Finish();
+    world.people.push_back(p);
+  }
+  for (const toml::table* t : top.Tables("routes")) {
+    Route route;
+    TableReader r(*t, "[[routes]]", source, &status);
+    r.String("name", &route.name);
+    r.RoutePoints("points", &route.points);
+    r.Bool("closed", &route.closed);
+    r.Finish();
+    world.routes.push_back(route);
+  }
+  for (const toml::table* t : top.Tables("sessions")) {
+    Session s;
+    TableReader r(*t, "[[sessions]]", source, &status);
+    r.String("route", &s.route);
+    r.Number("laps", &s.laps);
+    r.Bool("reverse", &s.reverse);
+    r.String("lighting", &s.lighting);
+    r.Finish();
+    world.sessions.push_back(s);
+  }
+  if (const toml::table* t = top.Table("camera")) {
+    CameraSettings& c = world.camera;
+    TableReader r(*t, "[camera]", source, &status);
+    r.Integer("width_px", &c.width_px);
+    r.Integer("height_px", &c.height_px);
+    r.Number("horizontal_fov_deg", &c.horizontal_fov_deg);
+    r.Number("height_m", &c.height_m);
+    r.Number("pitch_deg", &c.pitch_deg);
+    r.Number("rate_hz", &c.rate_hz);
+    r.Number("noise_sigma", &c.noise_sigma);
+    r.Bool("motion_blur", &c.motion_blur);
+    r.Finish();
+  }
+  if (const toml::table* t = top.Table("wifi")) {
+    WifiSettings& w = world.wifi;
+    TableReader r(*t, "[wifi]", source, &status);
+    r.Number("path_loss_exponent", &w.path_loss_exponent);
+    r.Number("reference_distance_m", &w.reference_distance_m);
+    r.Number("floor_attenuation_db", &w.floor_attenuation_db);
+    r.Number("shadowing_sigma_db", &w.shadowing_sigma_db);
+    r.Number("shadowing_correlation_m", &w.shadowing_correlation_m);
+    r.Number("fading_sigma_db", &w.fading_sigma_db);
+    r.Number("sensitivity_dbm", &w.sensitivity_dbm);
+    r.Number("scan_period_s", &w.scan_period_s);
+    r.Number("miss_probability", &w.miss_probability);
+    r.Finish();
+  }
+  if (const toml::table* t = top.Table("compass")) {
+    TableReader r(*t, "[compass]", source, &status);
+    r.Number("rate_hz", &world.compass.rate_hz);
+    r.Number("noise_sigma_deg", &world.compass.noise_sigma_deg);
+    r.Finish();
+  }
+  if (const toml::table* t = top.Table("odometry")) {
+    OdometrySettings& o = world.odometry;
+    TableReader r(*t, "[odometry]", source, &status);
+    r.Number("rate_hz", &o.rate_hz);
+    r.Number("speed_scale_error", &o.speed_scale_error);
+    r.Number("turn_bias_rad_per_s", &o.turn_bias_rad_per_s);
+    r.Number("speed_noise_m_per_s", &o.speed_noise_m_per_s);
+    r.Number("turn_noise_rad_per_s", &o.turn_noise_rad_per_s);
+    r.Finish();
+  }
+  if (const toml::table* t = top.Table("motion")) {
+    MotionSettings& m = world.motion;
+    TableReader r(*t, "[motion]", source, &status);
+    r.Number("speed_m_per_s", &m.speed_m_per_s);
+    r.Number("turn_rate_rad_per_s", &m.turn_rate_rad_per_s);
+    r.Number("lift_time_s", &m.lift_time_s);
+    r.Number("session_gap_s", &m.session_gap_s);
+    r.Finish();
+  }
+  top.Finish();
+  if (!status.ok()) return status;
+  Status valid = world.Validate();
+  if (!valid.ok()) return Status::Error(source + ": " + valid.message());
+  return world;
+}
+
+StatusOr<World> LoadWorldFile(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return Status::Error(path + ": cannot open world file");
+  std::stringstream text;
+  text << in.rdbuf();
+  return ParseWorld(text.str(), path);
+}
+
+namespace {
+std::string Num(double v) {
+  std::ostringstream o;
+  o.precision(17);
+  o << v;
+  std::string s = o.str();
+  if (s.find_first_of(".eEn") == std::string::npos) s += ".0";
+  return s;
+}
+std::string Pt(const Point2& p) { return "[" + Num(p.x_m) + ", " + Num(p.y_m) + "]"; }
+std::string Quote(const std::string& s) {
+  std::string q = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') q += '\\';
+    q += c;
+  }
+  return q + "\"";
+}
+std::string Ints(const std::vector<int>& v) {
+  std::string s = "[";
+  for (size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + std::to_string(v[i]);
+  return s + "]";
+}
+}  // namespace
+
+std::string PrintWorld(const World& w) {
+  std::ostringstream o;
+  o << "name = " << Quote(w.name) << "\n\n[materials]\n";
+  for (const auto& [name, db] : w.materials_db) o << Quote(name) << " = " << Num(db) << "\n";
+  const CameraSettings& c = w.camera;
+  o << "\n[camera]\nwidth_px = " << c.width_px << "\nheight_px = " << c.height_px
+    << "\nhorizontal_fov_deg = " << Num(c.horizontal_fov_deg) << "\nheight_m = " << Num(c.height_m)
+    << "\npitch_deg = " << Num(c.pitch_deg) << "\nrate_hz = " << Num(c.rate_hz)
+    << "\nnoise_sigma = " << Num(c.noise_sigma)
+    << "\nmotion_blur = " << (c.motion_blur ? "true" : "false") << "\n";
+  const WifiSettings& f = w.wifi;
+  o << "\n[wifi]\npath_loss_exponent = " << Num(f.path_loss_exponent)
+    << "\nreference_distance_m = " << Num(f.reference_distance_m)
+    << "\nfloor_attenuation_db = " << Num(f.floor_attenuation_db)
+    << "\nshadowing_sigma_db = " << Num(f.shadowing_sigma_db)
+    << "\nshadowing_correlation_m = " << Num(f.shadowing_correlation_m)
+    << "\nfading_sigma_db = " << Num(f.fading_sigma_db)
+    << "\nsensitivity_dbm = " << Num(f.sensitivity_dbm)
+    << "\nscan_period_s = " << Num(f.scan_period_s)
+    << "\nmiss_probability = " << Num(f.miss_probability) << "\n";
+  o << "\n[compass]\nrate_hz = " << Num(w.compass.rate_hz)
+    << "\nnoise_sigma_deg = " << Num(w.compass.noise_sigma_deg) << "\n";
+  const OdometrySettings& d = w.odometry;
+  o << "\n[odometry]\nrate_hz = " << Num(d.rate_hz)
+    << "\nspeed_scale_error = " << Num(d.speed_scale_error)
+    << "\nturn_bias_rad_per_s = " << Num(d.turn_bias_rad_per_s)
+    << "\nspeed_noise_m_per_s = " << Num(d.speed_noise_m_per_s)
+    << "\nturn_noise_rad_per_s = " << Num(d.turn_noise_rad_per_s) << "\n";
+  const MotionSettings& m = w.motion;
+  o << "\n[motion]\nspeed_m_per_s = " << Num(m.speed_m_per_s)
+    << "\nturn_rate_rad_per_s = " << Num(m.turn_rate_rad_per_s)
+    << "\nlift_time_s = " << Num(m.lift_time_s) << "\nsession_gap_s = " << Num(m.session_gap_s)
+    << "\n";
+  for (const Wall& x : w.walls) {
+    o << "\n[[walls]]\nfloor = " << x.floor << "\nfrom = " << Pt(x.from) << "\nto = " << Pt(x.to)
+      << "\nmaterial = " << Quote(x.material) << "\ntexture = " << Quote(x.texture)
+      << "\nheight_m = " << Num(x.height_m) << "\n";
+  }
+  for (const AccessPoint& a : w.access_points) {
+    o << "\n[[access_points]]\nname = " << Quote(a.name) << "\nposition = " << Pt(a.position)
+      << "\nfloor = " << a.floor << "\ntx_power_dbm = " << Num(a.tx_power_dbm)
+      << "\nchannel = " << a.channel << "\noff_in_sessions = " << Ints(a.off_in_sessions)
+      << "\nmoved_in_sessions = " << Ints(a.moved_in_sessions) << "\nmoved_to = " << Pt(a.moved_to)
+      << "\n";
+  }
+  for (const Disturbance& x : w.disturbances) {
+    o << "\n[[disturbances]]\nposition = " << Pt(x.position) << "\nfloor = " << x.floor
+      << "\nradius_m = " << Num(x.radius_m) << "\nstrength_deg = " << Num(x.strength_deg) << "\n";
+  }
+  for (const Person& p : w.people) {
+    o << "\n[[people]]\nfloor = " << p.floor << "\nfrom = " << Pt(p.from) << "\nto = " << Pt(p.to)
+      << "\nspeed_m_per_s = " << Num(p.speed_m_per_s) << "\ntexture = " << Quote(p.texture) << "\n";
+  }
+  for (const Route& r : w.routes) {
+    o << "\n[[routes]]\nname = " << Quote(r.name) << "\nclosed = " << (r.closed ? "true" : "false")
+      << "\npoints = [";
+    for (size_t i = 0; i < r.points.size(); ++i) {
+      o << (i ? ", " : "") << "[" << Num(r.points[i].position.x_m) << ", "
+        << Num(r.points[i].position.y_m) << ", " << r.points[i].floor << "]";
+    }
+    o << "]\n";
+  }
+  for (const Session& s : w.sessions) {
+    o << "\n[[sessions]]\nroute = " << Quote(s.route) << "\nlaps = " << Num(s.laps)
+      << "\nreverse = " << (s.reverse ? "true" : "false") << "\nlighting = " << Quote(s.lighting)
+      << "\n";
+  }
+  return o.str();
+}
+
+}  // namespace ratslam::sim

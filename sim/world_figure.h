@@ -1,0 +1,16 @@
+// The ground-truth map of a simulated world: walls (by material), access points, disturbances
+// and the true trajectory, one panel per floor.
+#ifndef RATSLAM_SIM_WORLD_FIGURE_H_
+#define RATSLAM_SIM_WORLD_FIGURE_H_
+
+#include "sensors/dataset/dataset.h"
+#include "sim/world.h"
+#include "viewer/scene.h"
+
+namespace ratslam::sim {
+
+Scene WorldMapScene(const World& world, const Dataset& dataset, int panel_px = 700);
+
+}  // namespace ratslam::sim
+
+#endif  // RATSLAM_SIM_WORLD_FIGURE_H_
