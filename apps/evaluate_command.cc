@@ -140,13 +140,17 @@ int EvaluateCommand(int argc, char** argv) {
     for (const auto& n : nodes) {
       if (sessions.empty() || sessions.back() != n.session) sessions.push_back(n.session);
     }
-    const bool by_session = settings.evaluation.split == fabmap::SplitUnit::kSession;
+    const fabmap::SplitUnit unit = settings.evaluation.split;
+    const bool by_session = unit == fabmap::SplitUnit::kSession;
     const auto split = fabmap::InterleavedSplit(by_session ? sessions.size() : nodes.size(),
                                                 settings.evaluation.map_fraction);
     size_t session_index = 0;
     for (size_t i = 0; i < nodes.size(); ++i) {
       if (i > 0 && nodes[i].session != nodes[i - 1].session) ++session_index;
-      (split[by_session ? session_index : i] ? map : queries).push_back(nodes[i]);
+      const bool in_map = unit == fabmap::SplitUnit::kFirstSession ? session_index == 0
+                          : by_session                             ? split[session_index]
+                                                                   : split[i];
+      (in_map ? map : queries).push_back(nodes[i]);
     }
   } else {
     map = *std::move(map_nodes);

@@ -169,14 +169,16 @@ World AliasedFloors() {
   Route r;
   r.name = "both-floors";
   const Point2 corners[4] = {{1.5, 1.5}, {28.5, 1.5}, {28.5, 14.5}, {1.5, 14.5}};
-  for (int floor : {0, 1, 0, 1}) {
+  // Floor 0 round, lift up, floor 1 round, lift down; two sessions (map and query).
+  for (int floor : {0, 1}) {
     for (int c = 0; c < 4; ++c) r.points.push_back({corners[c], floor});
     r.points.push_back({corners[0], floor});
   }
+  r.points.push_back({corners[0], 0});
   w.routes.push_back(r);
   Session s;
   s.route = r.name;
-  w.sessions.push_back(s);
+  w.sessions = {s, s};
   return w;
 }
 
@@ -214,10 +216,9 @@ World Apartment() {
                        {{7.5, 1.5}, 0}},
                       true});
   w.wifi.path_loss_exponent = 2.5;
-  Session s;
+  Session s;  // three visits: one to map, two to query (FABMAP evaluation by session)
   s.route = "rooms";
-  s.laps = 3;
-  w.sessions.push_back(s);
+  w.sessions = {s, s, s};
   return w;
 }
 

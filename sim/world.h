@@ -69,7 +69,7 @@ struct Session {
 };
 
 struct CameraSettings {
-  int width_px = 64, height_px = 48;
+  int width_px = 128, height_px = 96;  // enough for ORB features (FABMAP), cheap to render
   double horizontal_fov_deg = 90.0;
   double height_m = 1.2;
   double pitch_deg = 0.0;

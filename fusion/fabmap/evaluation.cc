@@ -13,12 +13,23 @@
 
 namespace ratslam::fabmap {
 
-std::string ToString(SplitUnit unit) { return unit == SplitUnit::kSession ? "session" : "node"; }
+std::string ToString(SplitUnit unit) {
+  switch (unit) {
+    case SplitUnit::kNode:
+      return "node";
+    case SplitUnit::kSession:
+      return "session";
+    case SplitUnit::kFirstSession:
+      return "first_session";
+  }
+  return "?";
+}
 
 StatusOr<SplitUnit> SplitUnitFromString(const std::string& name) {
   if (name == "node") return SplitUnit::kNode;
   if (name == "session") return SplitUnit::kSession;
-  return Status::Error("unknown split '" + name + "' (expected node or session)");
+  if (name == "first_session") return SplitUnit::kFirstSession;
+  return Status::Error("unknown split '" + name + "' (expected node, session or first_session)");
 }
 
 bool EvaluationOptions::IsValid(std::string* error) const {

@@ -27,7 +27,8 @@ struct EvaluationNode {
   std::optional<std::vector<WifiReading>> wifi;  // scan, if any
 };
 
-enum class SplitUnit { kNode, kSession };
+// kFirstSession: the first session makes the map, every other one queries it.
+enum class SplitUnit { kNode, kSession, kFirstSession };
 std::string ToString(SplitUnit unit);
 StatusOr<SplitUnit> SplitUnitFromString(const std::string& name);
 
@@ -41,7 +42,9 @@ struct EvaluationOptions {
   bool IsValid(std::string* error) const;
   template <typename Visitor>
   void VisitFields(Visitor&& v) {
-    v("split", split, "one data set for map and queries: split by node or by session");
+    v("split", split,
+      "one data set for map and queries: split by node, session, or first_session (map = the "
+      "first session, queries = the others)");
     v("map_fraction", map_fraction, "share of nodes (or sessions) in the map; the rest query");
     v("frame_spacing_m", frame_spacing_m,
       "image folders have no positions: frame i is at i * this along its floor");

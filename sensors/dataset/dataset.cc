@@ -156,7 +156,8 @@ StatusOr<Dataset> ReadDataset(const std::string& folder) {
   };
   Dataset d;
   d.folder = folder;
-  static const std::vector<std::string> kTopKeys = {"format", "format_version", "name", "streams"};
+  static const std::vector<std::string> kTopKeys = {"format", "format_version", "name", "streams",
+                                                    "session_start_times_s"};
   static const std::vector<std::string> kStreams = {"odometry",     "images", "image_folder",
                                                     "ground_truth", "wifi",   "compass"};
   for (const auto& [key, node] : manifest) {
@@ -173,6 +174,18 @@ StatusOr<Dataset> ReadDataset(const std::string& folder) {
         "unsupported format_version (this program reads " + std::to_string(kFormatVersion) + ")");
   }
   d.name = manifest["name"].value_or(fs::path(folder).filename().string());
+  if (const toml::node* starts = manifest.get("session_start_times_s")) {
+    const toml::array* list = starts->as_array();
+    if (!list) return error_at(starts, "session_start_times_s must be a list of times");
+    for (const auto& t : *list) {
+      const std::optional<double> v = t.value<double>();
+      if (!v || !std::isfinite(*v) ||
+          (!d.session_start_times_s.empty() && *v < d.session_start_times_s.back())) {
+        return error_at(&t, "session_start_times_s must be increasing finite times");
+      }
+      d.session_start_times_s.push_back(*v);
+    }
+  }
   const toml::table* streams = manifest["streams"].as_table();
   if (!streams) return error_at(nullptr, "missing [streams] table");
   std::map<std::string, std::string> files;
@@ -210,7 +223,15 @@ Status WriteDataset(const Dataset& d, const std::string& folder) {
   std::ofstream manifest;
   RATSLAM_RETURN_IF_ERROR(open("manifest.toml", manifest));
   manifest << "format = \"ratslam-replay\"\nformat_version = " << kFormatVersion << "\n"
-           << "name = \"" << d.name << "\"\n\n[streams]\nodometry = \"odometry.csv\"\n";
+           << "name = \"" << d.name << "\"\n";
+  if (d.session_start_times_s.size() > 1) {
+    manifest << "session_start_times_s = [";
+    for (size_t i = 0; i < d.session_start_times_s.size(); ++i) {
+      manifest << (i ? ", " : "") << Number(d.session_start_times_s[i]);
+    }
+    manifest << "]\n";
+  }
+  manifest << "\n[streams]\nodometry = \"odometry.csv\"\n";
   if (!d.images.empty()) {
     manifest << "images = \"images.csv\"\nimage_folder = \"" << d.image_folder << "\"\n";
   }
