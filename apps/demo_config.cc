@@ -3,6 +3,24 @@
 namespace ratslam {
 
 PipelineOptions DemoPipelineOptions() {
+  // As configs/sim-fused.toml (see the comments there).
+  PipelineOptions o;
+  o.sensors.front_end.kind = FrontEndKind::kFused;
+  o.sensors.fused.use_camera = true;
+  o.sensors.fused.use_wifi = true;
+  o.sensors.fused.use_compass = true;
+  o.sensors.fused.recency_s = 20.0;
+  o.sensors.fused.max_wifi_age_s = 3.0;
+  o.sensors.camera_12x9.match_threshold = 0.99;
+  o.sensors.wifi.match_threshold = 0.25;
+  o.ratslam.pose_cells.cell_size_m = 1.0;
+  o.ratslam.local_view.injection_gain = 0.3;
+  return o;
+}
+
+std::string DemoWorldName() { return "day_night"; }
+
+PipelineOptions SyntheticPipelineOptions() {
   PipelineOptions o;
   // The synthetic camera is 120x40 px with the horizon at row 20: keep the band where the
   // pillars are, drop most of the featureless sky and ground.

@@ -1,14 +1,22 @@
-// The configuration of `ratslam demo`, tuned for the built-in synthetic data set. The same
-// values are committed as configs/demo.toml (a test keeps the two equal).
+// The configuration of `ratslam demo` (the fused front end on a simulated world) and the one
+// tuned for the built-in synthetic camera loop (`ratslam synthesize`). The same values are
+// committed as configs/demo.toml and configs/synthetic.toml (a test keeps them equal).
 #ifndef RATSLAM_APPS_DEMO_CONFIG_H_
 #define RATSLAM_APPS_DEMO_CONFIG_H_
+
+#include <string>
 
 #include "fusion/replay_pipeline.h"
 #include "sensors/dataset/synthetic_dataset.h"
 
 namespace ratslam {
 
+// Camera (12x9) + Wi-Fi + compass with the b_out rule, for the simulated worlds.
 PipelineOptions DemoPipelineOptions();
+// The built-in world the demo simulates.
+std::string DemoWorldName();
+// The classic camera matcher on the synthetic pillar loop.
+PipelineOptions SyntheticPipelineOptions();
 SyntheticOptions DemoSyntheticOptions();
 
 }  // namespace ratslam

@@ -17,6 +17,13 @@ TEST(DemoConfigTest, CommittedDemoTomlEqualsBuiltInDemoConfig) {
   EXPECT_EQ(PrintConfig(committed.value()), PrintConfig(DemoPipelineOptions()));
 }
 
+TEST(DemoConfigTest, CommittedSyntheticTomlEqualsBuiltInSyntheticConfig) {
+  StatusOr<PipelineOptions> committed =
+      LoadConfigFile(std::string(RATSLAM_SOURCE_DIR) + "/configs/synthetic.toml");
+  ASSERT_TRUE(committed.ok()) << committed.status().message();
+  EXPECT_EQ(PrintConfig(committed.value()), PrintConfig(SyntheticPipelineOptions()));
+}
+
 TEST(DemoConfigTest, CommittedDefaultTomlEqualsDefaults) {
   StatusOr<PipelineOptions> committed =
       LoadConfigFile(std::string(RATSLAM_SOURCE_DIR) + "/configs/default.toml");
@@ -46,6 +53,7 @@ TEST(DemoConfigTest, EveryKeyIsDocumentedInConfigsReadme) {
 TEST(DemoConfigTest, DemoOptionsAreValid) {
   std::string error;
   EXPECT_TRUE(DemoPipelineOptions().IsValid(&error)) << error;
+  EXPECT_TRUE(SyntheticPipelineOptions().IsValid(&error)) << error;
   EXPECT_TRUE(DemoSyntheticOptions().IsValid(&error)) << error;
 }
 

@@ -29,6 +29,7 @@
 #include "sensors/dataset/image_loader.h"
 #include "sensors/dataset/synthetic_dataset.h"
 #include "sensors/dataset/visual_odometry_source.h"
+#include "sim/world.h"
 #include "viewer/animation.h"
 #include "viewer/figures.h"
 #include "viewer/renderer.h"
@@ -57,14 +58,14 @@ const char kUsage[] =
     "  ratslam import --data D [--data D2 ...] --out F [--config C] [--lenient]\n"
     "      Converts data sets (IPIN logs, ...) to the replay format in folder F.\n"
     "  ratslam demo --out O [--quiet]\n"
-    "      Writes the built-in synthetic data set to O/data, replays it into O and renders\n"
-    "      the images.\n"
+    "      Simulates the built-in day_night world (camera, Wi-Fi, compass, odometry) into\n"
+    "      O/data, replays it into O with the fused front end and renders the images.\n"
     "  ratslam print-config [--config C]\n"
     "      Prints the resolved configuration (the defaults when no file is given).\n"
     "  ratslam import-openratslam FILE.ini\n"
     "      Converts an OpenRatSLAM configuration file to ours (TOML on stdout).\n"
     "  ratslam synthesize --out D [--seed S] [--laps N]\n"
-    "      Writes the built-in synthetic data set into D.\n"
+    "      Writes the built-in synthetic camera loop into D (configs/synthetic.toml).\n"
     "  ratslam render experience-map --run O [--data D] [--out F] [--size WxH]\n"
     "                 [--color time|session] [--sessions T1,T2,...]\n"
     "  ratslam render template-graph --run O [--out F] [--size WxH] [--spans A-B:label,...]\n"
@@ -316,7 +317,18 @@ int Demo(int argc, char** argv) {
   }
   const std::string out = args->values["--out"];
   const std::string data = (fs::path(out) / "data").string();
-  if (int code = Synthesize(DemoSyntheticOptions(), data); code != kExitOk) return code;
+  // The demo's data: a built-in simulated world with camera, Wi-Fi, compass and odometry.
+  auto world = sim::BuiltInWorld(DemoWorldName());
+  if (!world.ok()) {
+    std::cerr << "ratslam: " << world.status().message() << "\n";
+    return kExitError;
+  }
+  Dataset simulated;
+  Status s = SimulateWorld(*world, 1, data, args->quiet, &simulated);
+  if (!s.ok()) {
+    std::cerr << "ratslam: " << s.message() << "\n";
+    return kExitError;
+  }
   ReplayRequest request;
   request.options = DemoPipelineOptions();
   request.config_path = "(built-in demo configuration, as configs/demo.toml)";

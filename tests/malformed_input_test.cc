@@ -105,8 +105,8 @@ TEST(MalformedInputTest, VisualModelFilesNeverCrash) {
     // A decodable mutation must give a model that FABMAP accepts or refuses cleanly.
     fabmap::DetectorBlock block;
     block.count = decoded->vocabulary.size();
-    auto fabmap_model = fabmap::FabmapModel::Create(decoded->model.tree, {block},
-                                                    decoded->model.samples, {});
+    auto fabmap_model =
+        fabmap::FabmapModel::Create(decoded->model.tree, {block}, decoded->model.samples, {});
     if (fabmap_model.ok()) {
       (void)fabmap_model->AddPlace({0, 3});
       (void)fabmap_model->Localise({0, 1, 5});

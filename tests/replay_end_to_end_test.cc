@@ -52,7 +52,7 @@ class ReplayEndToEndTest : public ::testing::Test {
     fs::create_directories(root_);
     StatusOr<Dataset> d = WriteSyntheticDataset(DemoSyntheticOptions(), (root_ / "data").string());
     ASSERT_TRUE(d.ok()) << d.status().message();
-    config_ = (fs::path(RATSLAM_SOURCE_DIR) / "configs" / "demo.toml").string();
+    config_ = (fs::path(RATSLAM_SOURCE_DIR) / "configs" / "synthetic.toml").string();
   }
   static void TearDownTestSuite() { fs::remove_all(root_); }
   // Replays the demo data with a config given as TOML text; returns the summary.
