@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Fresh Debian 12 machine -> installs packages, builds, and runs the main job: the demo replay of
-# the built-in synthetic data set, writing the map, trajectory and summary into out/demo.
+# Fresh Debian 12 machine -> installs packages, builds, and runs the main job: the demo simulates
+# the built-in day/night world and maps it with camera + Wi-Fi + compass fusion into out/demo.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
