@@ -236,9 +236,44 @@ Status World::Validate() const {
       !(odometry.turn_noise_rad_per_s >= 0.0) || !(odometry.speed_scale_error > -1.0)) {
     return bad("odometry: a setting is out of range");
   }
-  if (!(motion.speed_m_per_s > 0.0) || !(motion.turn_rate_rad_per_s > 0.0) ||
-      !(motion.lift_time_s >= 0.0) || !(motion.session_gap_s >= 0.0)) {
+  if (!(motion.speed_m_per_s >= 0.01) || !(motion.turn_rate_rad_per_s >= 0.01) ||
+      !(motion.lift_time_s >= 0.0 && motion.lift_time_s <= 3600.0) ||
+      !(motion.session_gap_s >= 0.0 && motion.session_gap_s <= 86400.0)) {
     return bad("motion: a setting is out of range");
+  }
+  if (odometry.rate_hz > 1000.0 || compass.rate_hz > 1000.0 || camera.rate_hz > 100.0 ||
+      wifi.scan_period_s < 0.01) {
+    return bad("sensor rates: odometry and compass at most 1000 Hz, camera 100 Hz, scans 0.01 s");
+  }
+  // Places within 100 km, and a simulation of at most ten million odometry steps.
+  auto far = [](const Point2& p) { return !(std::abs(p.x_m) <= 1e5 && std::abs(p.y_m) <= 1e5); };
+  for (const Wall& w : walls) {
+    if (far(w.from) || far(w.to)) return bad("a wall is more than 100 km from the origin");
+  }
+  for (const AccessPoint& a : access_points) {
+    if (far(a.position) || far(a.moved_to)) return bad("access point '" + a.name + "' is too far");
+  }
+  double seconds = 0.0;
+  for (const Session& s : sessions) {
+    for (const Route& r : routes) {
+      if (r.name != s.route) continue;
+      double length = 0.0;
+      for (size_t i = 0; i < r.points.size(); ++i) {
+        if (far(r.points[i].position)) return bad("route '" + r.name + "' goes too far");
+        const RoutePoint& b = r.points[(i + 1) % r.points.size()];
+        if (i + 1 < r.points.size() || r.closed) {
+          length += std::hypot(b.position.x_m - r.points[i].position.x_m,
+                               b.position.y_m - r.points[i].position.y_m);
+        }
+      }
+      seconds +=
+          (length * std::max(1.0, s.laps) / motion.speed_m_per_s +
+           (r.points.size() + 1) * (motion.lift_time_s + 2 * M_PI / motion.turn_rate_rad_per_s)) *
+          motion.session_gap_s;
+    }
+  }
+  if (seconds * odometry.rate_hz > 1e7) {
+    return bad("the sessions would take more than ten million odometry steps");
   }
   return Status::Ok();
 }

@@ -14,6 +14,9 @@
 #include "sensors/dataset/dataset.h"
 #include "sensors/dataset/ipin_log.h"
 #include "sensors/dataset/msft_log.h"
+#include "sim/propagation.h"
+#include "sim/simulator.h"
+#include "sim/world.h"
 
 namespace ratslam {
 namespace {
@@ -113,6 +116,26 @@ TEST(MalformedInputTest, VisualModelFilesNeverCrash) {
     }
   }
   EXPECT_GT(errors, 1000);
+}
+
+TEST(MalformedInputTest, WorldFilesNeverCrash) {
+  const std::string text = sim::PrintWorld(*sim::BuiltInWorld("apartment"));
+  Random rng(6);
+  int errors = 0;
+  for (int k = 0; k < 400; ++k) {
+    StatusOr<sim::World> w = sim::ParseWorld(Mutate(text, rng), "fuzz.toml");
+    if (!w.ok()) {
+      ++errors;
+      EXPECT_EQ(w.status().message().rfind("fuzz.toml", 0), 0u) << w.status().message();
+      continue;
+    }
+    // A world that parses must simulate its motion and Wi-Fi cleanly.
+    const auto poses = sim::TrueTrajectory(*w, 0.5);
+    const sim::WifiPropagation wifi(*w, 1);
+    Random scan_random(1);
+    if (!poses.empty()) (void)wifi.Scan({poses.back().x_m, poses.back().y_m}, 0, 0, &scan_random);
+  }
+  EXPECT_GT(errors, 50);
 }
 
 TEST(MalformedInputTest, ConfigsNeverCrash) {
