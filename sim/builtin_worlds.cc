@@ -185,35 +185,37 @@ World AliasedFloors() {
 World Apartment() {
   World w;
   w.name = "apartment";
-  // 12 m x 8 m: living room, kitchen, two bedrooms; doorways 1 m wide.
+  // 12 m x 8 m, four rooms: walls at y = 4 and x = 6 with 1 m doorways.
   int k = 0;
   AddTexturedWall(&w, 0, {0, 0}, {12, 0}, 3.0, 9, "concrete", &k);
   AddTexturedWall(&w, 0, {12, 0}, {12, 8}, 3.0, 9, "concrete", &k);
   AddTexturedWall(&w, 0, {12, 8}, {0, 8}, 3.0, 9, "concrete", &k);
   AddTexturedWall(&w, 0, {0, 8}, {0, 0}, 3.0, 9, "concrete", &k);
-  AddWall(&w, 0, {6, 0}, {6, 3}, "drywall", "wood:1");
-  AddWall(&w, 0, {6, 4}, {6, 8}, "drywall", "wood:2");
   AddWall(&w, 0, {0, 4}, {2.5, 4}, "drywall", "posters:31");
   AddWall(&w, 0, {3.5, 4}, {6, 4}, "drywall", "stripes:32");
   AddWall(&w, 0, {6, 4}, {8.5, 4}, "drywall", "checker:33");
   AddWall(&w, 0, {9.5, 4}, {12, 4}, "drywall", "tiles:34");
+  AddWall(&w, 0, {6, 0}, {6, 1}, "drywall", "wood:1");
+  AddWall(&w, 0, {6, 2}, {6, 6}, "drywall", "wood:2");
+  AddWall(&w, 0, {6, 7}, {6, 8}, "drywall", "wood:3");
   AddAccessPoint(&w, "home-router", {3, 2}, 0, 6);
   AddAccessPoint(&w, "home-extender", {10, 6}, 0, 44);
   AddAccessPoint(&w, "neighbour-west", {-6, 4}, 0, 1);
   AddAccessPoint(&w, "neighbour-east", {18, 3}, 0, 11);
   AddAccessPoint(&w, "neighbour-above", {6, 4}, 1, 6);
+  // Through all four rooms by their doorways.
   w.routes.push_back({"rooms",
                       {{{1.5, 1.5}, 0},
                        {{4.5, 1.5}, 0},
-                       {{3, 3.5}, 0},
-                       {{3, 6}, 0},
-                       {{5, 6.5}, 0},
-                       {{6, 3.5}, 0},
-                       {{9, 3.5}, 0},
-                       {{9, 6.5}, 0},
-                       {{10.5, 6}, 0},
+                       {{7.5, 1.5}, 0},
                        {{10.5, 1.5}, 0},
-                       {{7.5, 1.5}, 0}},
+                       {{10.5, 3}, 0},
+                       {{9, 3}, 0},
+                       {{9, 5}, 0},
+                       {{10.5, 6.5}, 0},
+                       {{4.5, 6.5}, 0},
+                       {{3, 5}, 0},
+                       {{3, 3}, 0}},
                       true});
   w.wifi.path_loss_exponent = 2.5;
   Session s;  // three visits: one to map, two to query (FABMAP evaluation by session)

@@ -202,6 +202,29 @@ Status World::Validate() const {
     if (!route_names.insert(r.name).second) return bad("two routes named '" + r.name + "'");
     if (r.points.size() < 2) return bad("route '" + r.name + "' needs at least two points");
   }
+  // A route must not pass through a wall of its floor.
+  auto crosses = [](Point2 p1, Point2 p2, Point2 q1, Point2 q2) {
+    auto orient = [](Point2 a, Point2 b, Point2 c) {
+      return (b.x_m - a.x_m) * (c.y_m - a.y_m) - (b.y_m - a.y_m) * (c.x_m - a.x_m);
+    };
+    return ((orient(q1, q2, p1) > 0) != (orient(q1, q2, p2) > 0)) &&
+           ((orient(p1, p2, q1) > 0) != (orient(p1, p2, q2) > 0));
+  };
+  for (const Route& r : routes) {
+    const size_t segments = r.closed ? r.points.size() : r.points.size() - 1;
+    for (size_t i = 0; i < segments && r.points.size() >= 2; ++i) {
+      const RoutePoint& a = r.points[i];
+      const RoutePoint& b = r.points[(i + 1) % r.points.size()];
+      if (a.floor != b.floor) continue;  // a lift
+      for (size_t k = 0; k < walls.size(); ++k) {
+        if (walls[k].floor == a.floor &&
+            crosses(a.position, b.position, walls[k].from, walls[k].to)) {
+          return bad("route '" + r.name + "' segment " + std::to_string(i) +
+                     " passes through wall " + std::to_string(k));
+        }
+      }
+    }
+  }
   if (sessions.empty()) return bad("no sessions");
   for (size_t i = 0; i < sessions.size(); ++i) {
     const Session& s = sessions[i];

@@ -5,6 +5,7 @@
 #include <set>
 
 #include "viewer/figures.h"
+#include "viewer/image.h"
 
 namespace ratslam::sim {
 
@@ -31,14 +32,15 @@ Scene WorldMapScene(const World& world, const Dataset& dataset, int panel_px) {
   max_y += margin;
   const double scale = panel_px / std::max(max_x - min_x, max_y - min_y);
   const int panel_h = static_cast<int>((max_y - min_y) * scale);
-  const int top = 60, gap = 30;
-  Scene scene(static_cast<int>(floors.size()) * (panel_px + gap) + gap, panel_h + top + 70,
-              Rgba{255, 255, 255, 255});
+  const int top = 84, gap = 30;
+  const std::string legend =
+      "walls (grey: light, black: heavy), access points (red), true path (blue)";
+  const int width = std::max(static_cast<int>(floors.size()) * (panel_px + gap) + gap,
+                             static_cast<int>(TextWidthPx(legend, 15)) + 40);
+  Scene scene(width, panel_h + top + 70, Rgba{255, 255, 255, 255});
   const Rgba ink{30, 30, 30, 255};
-  scene.Text({20, 30},
-             "world '" + world.name +
-                 "': walls (grey: light, black: heavy), access points (red), true path (blue)",
-             16, ink);
+  scene.Text({20, 28}, "world '" + world.name + "'", 18, ink);
+  scene.Text({20, 52}, legend, 15, ink);
   for (size_t f = 0; f < floors.size(); ++f) {
     const double left = gap + f * (panel_px + gap);
     WorldToImage to;
