@@ -83,6 +83,32 @@ TEST(PropagationTest, FreeSpaceAndOneWallByHand) {
   EXPECT_DOUBLE_EQ(ChannelFrequencyMhz(36), 5180.0);
 }
 
+TEST(PropagationTest, AccessPointsSwitchedOffOrMovedBetweenSessions) {
+  World w = Small();
+  w.wifi.miss_probability = 0.0;
+  w.wifi.fading_sigma_db = 0.0;
+  AccessPoint second = w.access_points[0];
+  second.name = "ap-2";
+  second.off_in_sessions = {1};
+  w.access_points[0].moved_in_sessions = {2};
+  w.access_points[0].moved_to = {9.0, 2.0};
+  w.access_points.push_back(second);
+  const WifiPropagation p(w, 3);
+  Random random(1);
+  auto rssi_of = [&](int session, const std::string& name) {
+    for (const WifiReading& r : p.Scan({1.0, 2.0}, 0, session, &random)) {
+      if (r.bssid == name) return r.rssi_dbm;
+    }
+    return -999.0;
+  };
+  EXPECT_GT(rssi_of(0, "ap-2"), -90.0);
+  EXPECT_EQ(rssi_of(1, "ap-2"), -999.0);  // off in session 1
+  EXPECT_GT(rssi_of(2, "ap-2"), -90.0);
+  // Moved from 4 m away to 8 m away in session 2: 10 n log10(2) = 9 dB weaker on average.
+  EXPECT_NEAR(p.MeanPowerDbm(0, {1.0, 2.0}, 0, 0) - p.MeanPowerDbm(0, {1.0, 2.0}, 0, 2),
+              30.0 * std::log10(2.0), 1e-9);
+}
+
 TEST(PropagationTest, ShadowingIsSpatiallyCorrelated) {
   World w = Small();
   w.wifi.shadowing_sigma_db = 6.0;
