@@ -65,30 +65,19 @@ Status VisualWords(const fabmap::TrainedVisualModel& model, std::vector<Evaluati
 
 StatusOr<fabmap::TrainedVisualModel> GetVisualModel(const FabmapSettings& settings,
                                                     const std::string& out, bool quiet) {
-  const auto& source = settings.visual_model;
-  if (!source.file.empty()) {
-    std::ifstream in(source.file, std::ios::binary);
-    if (!in) return Status::Error(source.file + ": cannot open visual model");
-    std::stringstream bytes;
-    bytes << in.rdbuf();
-    return fabmap::DecodeVisualModel(bytes.str(), source.file);
-  }
-  if (source.training_images.empty()) {
-    return Status::Error(
-        "[visual_model] needs file or training_images for a mode that uses vision");
-  }
-  auto all = fabmap::ListImages(source.training_images);
-  if (!all.ok()) return all.status();
-  std::vector<std::string> images;
-  for (size_t i = 0; i < all->size(); i += source.training_image_step) images.push_back((*all)[i]);
   FileImageLoader loader;
-  StepProgress progress("training images", images.size(), quiet);
-  auto model = fabmap::TrainVisualModel(images, settings.features, settings.vocabulary,
-                                        settings.localiser.chow_liu, loader,
-                                        [&](size_t done, size_t) { progress.Update(done); });
+  StepProgress progress("training images", 1, quiet);
+  auto model = fabmap::LoadOrTrainVisualModel(
+      settings.visual_model, settings.features, settings.vocabulary, settings.localiser.chow_liu,
+      loader, [&](size_t done, size_t total) {
+        if (done == 1) progress = StepProgress("training images", total, quiet);
+        progress.Update(done);
+      });
   if (!model.ok()) return model.status();
-  RATSLAM_RETURN_IF_ERROR(WriteFileAtomically((fs::path(out) / "visual_model.bin").string(),
-                                              fabmap::EncodeVisualModel(*model)));
+  if (settings.visual_model.file.empty()) {  // trained here: keep it for later runs
+    RATSLAM_RETURN_IF_ERROR(WriteFileAtomically((fs::path(out) / "visual_model.bin").string(),
+                                                fabmap::EncodeVisualModel(*model)));
+  }
   return model;
 }
 

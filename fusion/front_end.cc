@@ -1,9 +1,7 @@
 #include "fusion/front_end.h"
 
 #include <cmath>
-#include <fstream>
 #include <limits>
-#include <sstream>
 #include <stdexcept>
 
 #include "ratslam/byte_buffer.h"
@@ -474,29 +472,12 @@ StatusOr<std::shared_ptr<const FabmapResources>> PrepareFabmapResources(
   auto resources = std::make_shared<FabmapResources>();
   const fabmap::FabmapMode mode = f.localiser.localiser.mode;
   if (fabmap::UsesVision(mode)) {
-    if (!f.visual_model.file.empty()) {
-      std::ifstream in(f.visual_model.file, std::ios::binary);
-      if (!in) return Status::Error(f.visual_model.file + ": cannot open visual model");
-      std::stringstream bytes;
-      bytes << in.rdbuf();
-      auto model = fabmap::DecodeVisualModel(bytes.str(), f.visual_model.file);
-      if (!model.ok()) return model.status();
-      resources->visual = *std::move(model);
-    } else if (!f.visual_model.training_images.empty()) {
-      auto all = fabmap::ListImages(f.visual_model.training_images);
-      if (!all.ok()) return all.status();
-      std::vector<std::string> chosen;
-      for (size_t i = 0; i < all->size(); i += f.visual_model.training_image_step) {
-        chosen.push_back((*all)[i]);
-      }
-      auto model = fabmap::TrainVisualModel(chosen, f.features, f.vocabulary, f.localiser.chow_liu,
-                                            images, nullptr);
-      if (!model.ok()) return model.status();
-      resources->visual = *std::move(model);
-    } else {
-      return Status::Error("FABMAP mode " + fabmap::ToString(mode) +
-                           " needs [visual_model] file or training_images");
+    auto model = fabmap::LoadOrTrainVisualModel(f.visual_model, f.features, f.vocabulary,
+                                                f.localiser.chow_liu, images, nullptr);
+    if (!model.ok()) {
+      return model.status().WithContext("FABMAP mode " + fabmap::ToString(mode));
     }
+    resources->visual = *std::move(model);
   }
   if (fabmap::UsesWifi(mode)) {
     // Travel at each scan from the odometry (speed held from one row's time to the next's).

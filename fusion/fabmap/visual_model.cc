@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <system_error>
 
 #include "ratslam/byte_buffer.h"
@@ -66,6 +68,27 @@ StatusOr<TrainedVisualModel> TrainVisualModel(const std::vector<std::string>& im
   if (!tree.ok()) return tree.status();
   trained.model.tree = *std::move(tree);
   return trained;
+}
+
+StatusOr<TrainedVisualModel> LoadOrTrainVisualModel(
+    const VisualModelOptions& options, const FeatureOptions& features,
+    const VocabularyOptions& vocabulary, const ChowLiuOptions& chow_liu, ImageLoader& loader,
+    const std::function<void(size_t, size_t)>& progress) {
+  if (!options.file.empty()) {
+    std::ifstream in(options.file, std::ios::binary);
+    if (!in) return Status::Error(options.file + ": cannot open visual model");
+    std::stringstream bytes;
+    bytes << in.rdbuf();
+    return DecodeVisualModel(bytes.str(), options.file);
+  }
+  if (options.training_images.empty()) {
+    return Status::Error("[visual_model] needs file or training_images");
+  }
+  auto all = ListImages(options.training_images);
+  if (!all.ok()) return all.status();
+  std::vector<std::string> chosen;
+  for (size_t i = 0; i < all->size(); i += options.training_image_step) chosen.push_back((*all)[i]);
+  return TrainVisualModel(chosen, features, vocabulary, chow_liu, loader, progress);
 }
 
 StatusOr<Observation> ImageWords(const TrainedVisualModel& model, const GrayImage& image) {

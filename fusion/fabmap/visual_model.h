@@ -46,6 +46,13 @@ StatusOr<TrainedVisualModel> TrainVisualModel(const std::vector<std::string>& im
                                               const ChowLiuOptions& chow_liu, ImageLoader& loader,
                                               const std::function<void(size_t, size_t)>& progress);
 
+// The model `options` names: read from `file`, or trained on every training_image_step-th image
+// under `training_images`.
+StatusOr<TrainedVisualModel> LoadOrTrainVisualModel(
+    const VisualModelOptions& options, const FeatureOptions& features,
+    const VocabularyOptions& vocabulary, const ChowLiuOptions& chow_liu, ImageLoader& loader,
+    const std::function<void(size_t, size_t)>& progress);
+
 // Visual words of one image.
 StatusOr<Observation> ImageWords(const TrainedVisualModel& model, const GrayImage& image);
 
