@@ -13,7 +13,7 @@ for w in "${worlds[@]}"; do
   [[ -f "$out/sim-$w/manifest.toml" ]] || "$ratslam" simulate --quiet --world "$w" --out "$out/sim-$w"
 done
 
-echo "### RatSLAM (b_out front end): map ATE m / matches within 5 m / floor mistakes"
+echo "#### RatSLAM (b_out front end): map ATE m / matches within 5 m / floor mistakes"
 echo
 printf "| world | dead reckoning |"
 modes=("camera:true:false:false" "wifi:false:true:false" "wifi + compass:false:true:true"
@@ -44,7 +44,7 @@ PY
 done
 echo
 
-echo "### FABMAP: correct within 5 m / misplaced beyond 5 m / rejected / floor mistakes (%)"
+echo "#### FABMAP: correct within 5 m / misplaced beyond 5 m / rejected / floor mistakes (%)"
 echo
 fab_modes=(vision wifi early late wifi_guided wifi_check)
 printf "| world |"; for m in "${fab_modes[@]}"; do printf " %s |" "$m"; done; echo
