@@ -140,14 +140,30 @@ std::vector<TruePose> TrueTrajectory(const World& world, double step_s) {
   return poses;
 }
 
-ViewMesh FloorMesh(const World& world, int floor, double time_s) {
+namespace {
+
+// One floor's static geometry and texture atlas; people are added per frame (PlacePeople).
+struct FloorGeometry {
+  ViewMesh mesh;
+  std::map<std::string, int> tiles;  // texture name -> atlas tile
+  size_t static_vertices = 0;
+  uint64_t static_id = 0;
+};
+
+// Texture v runs top (0) to bottom (1) of the image; walls put v = 0 at their top.
+void AddQuad(const ViewVertex& a, const ViewVertex& b, const ViewVertex& c, const ViewVertex& d,
+             ViewMesh* mesh) {
+  for (const ViewVertex* v : {&a, &b, &c, &a, &c, &d}) mesh->triangles.push_back(*v);
+}
+
+FloorGeometry BuildFloor(const World& world, int floor) {
+  FloorGeometry g;
   // The texture atlas: every texture name used, in order of first use.
-  std::map<std::string, int> tiles;
   auto tile_of = [&](const std::string& name) {
-    auto it = tiles.find(name);
-    if (it != tiles.end()) return it->second;
-    const int index = static_cast<int>(tiles.size()) % (kTilesPerSide * kTilesPerSide);
-    tiles[name] = index;
+    auto it = g.tiles.find(name);
+    if (it != g.tiles.end()) return it->second;
+    const int index = static_cast<int>(g.tiles.size()) % (kTilesPerSide * kTilesPerSide);
+    g.tiles[name] = index;
     return index;
   };
   tile_of("floor");
@@ -158,12 +174,12 @@ ViewMesh FloorMesh(const World& world, int floor, double time_s) {
   for (const Person& p : world.people) {
     if (p.floor == floor) tile_of(p.texture);
   }
-  ViewMesh mesh;
+  ViewMesh& mesh = g.mesh;
   mesh.tile_px = kTilePx;
   mesh.tiles_per_side = kTilesPerSide;
   const int atlas_px = kTilePx * kTilesPerSide;
   mesh.atlas.assign(static_cast<size_t>(atlas_px) * atlas_px, 0);
-  for (const auto& [name, index] : tiles) {
+  for (const auto& [name, index] : g.tiles) {
     const std::vector<uint8_t> texture = MakeTexture(name, kTilePx);
     const int col = index % kTilesPerSide, row = index / kTilesPerSide;
     for (int y = 0; y < kTilePx; ++y) {
@@ -171,11 +187,6 @@ ViewMesh FloorMesh(const World& world, int floor, double time_s) {
                   &mesh.atlas[(static_cast<size_t>(row) * kTilePx + y) * atlas_px + col * kTilePx]);
     }
   }
-  // Texture v runs top (0) to bottom (1) of the image; walls put v = 0 at their top.
-  auto quad = [&](const ViewVertex& a, const ViewVertex& b, const ViewVertex& c,
-                  const ViewVertex& d) {
-    for (const ViewVertex* v : {&a, &b, &c, &a, &c, &d}) mesh.triangles.push_back(*v);
-  };
   double min_x = 1e300, min_y = 1e300, max_x = -1e300, max_y = -1e300, top = 3.0;
   for (const Wall& w : world.walls) {
     if (w.floor != floor) continue;
@@ -194,8 +205,8 @@ ViewMesh FloorMesh(const World& world, int floor, double time_s) {
     const float h = static_cast<float>(w.height_m);
     const float x0 = static_cast<float>(w.from.x_m), y0 = static_cast<float>(w.from.y_m);
     const float x1 = static_cast<float>(w.to.x_m), y1 = static_cast<float>(w.to.y_m);
-    quad({x0, y0, 0, 0, 0.999f, t, shade}, {x1, y1, 0, repeats, 0.999f, t, shade},
-         {x1, y1, h, repeats, 0.0f, t, shade}, {x0, y0, h, 0, 0.0f, t, shade});
+    AddQuad({x0, y0, 0, 0, 0.999f, t, shade}, {x1, y1, 0, repeats, 0.999f, t, shade},
+            {x1, y1, h, repeats, 0.0f, t, shade}, {x0, y0, h, 0, 0.0f, t, shade}, &mesh);
   }
   if (min_x <= max_x) {
     const float x0 = static_cast<float>(min_x - 1), x1 = static_cast<float>(max_x + 1);
@@ -203,12 +214,31 @@ ViewMesh FloorMesh(const World& world, int floor, double time_s) {
     const float ux = (x1 - x0) / 2.0f, uy = (y1 - y0) / 2.0f, z = static_cast<float>(top);
     const float f = static_cast<float>(tile_of("floor")),
                 c = static_cast<float>(tile_of("ceiling"));
-    quad({x0, y0, 0, 0, 0, f, 0.8f}, {x1, y0, 0, ux, 0, f, 0.8f}, {x1, y1, 0, ux, uy, f, 0.8f},
-         {x0, y1, 0, 0, uy, f, 0.8f});
-    quad({x0, y0, z, 0, 0, c, 0.9f}, {x1, y0, z, ux, 0, c, 0.9f}, {x1, y1, z, ux, uy, c, 0.9f},
-         {x0, y1, z, 0, uy, c, 0.9f});
+    AddQuad({x0, y0, 0, 0, 0, f, 0.8f}, {x1, y0, 0, ux, 0, f, 0.8f}, {x1, y1, 0, ux, uy, f, 0.8f},
+            {x0, y1, 0, 0, uy, f, 0.8f}, &mesh);
+    AddQuad({x0, y0, z, 0, 0, c, 0.9f}, {x1, y0, z, ux, 0, c, 0.9f}, {x1, y1, z, ux, uy, c, 0.9f},
+            {x0, y1, z, 0, uy, c, 0.9f}, &mesh);
   }
-  uint64_t id = 1469598103934665603ULL ^ static_cast<uint64_t>(floor + 1000);
+  // Ids from the content (FNV-1a), so that a renderer reused across worlds never draws a stale
+  // atlas or stale walls.
+  auto fnv = [](uint64_t h, const void* data, size_t n) {
+    const auto* bytes = static_cast<const unsigned char*>(data);
+    for (size_t i = 0; i < n; ++i) h = (h ^ bytes[i]) * 1099511628211ULL;
+    return h;
+  };
+  mesh.atlas_id = fnv(1469598103934665603ULL, mesh.atlas.data(), mesh.atlas.size());
+  mesh.id = fnv(mesh.atlas_id, mesh.triangles.data(), mesh.triangles.size() * sizeof(ViewVertex));
+  g.static_vertices = mesh.triangles.size();
+  g.static_id = mesh.id;
+  return g;
+}
+
+// Replaces the people of `g` by their panels at `time_s`; the geometry id follows them.
+void PlacePeople(const World& world, int floor, double time_s, FloorGeometry* g) {
+  ViewMesh& mesh = g->mesh;
+  mesh.triangles.resize(g->static_vertices);
+  // The static geometry's id, extended by each person's position.
+  uint64_t id = g->static_id;
   // People walk back and forth; drawn as upright panels facing along their path's normal.
   for (const Person& p : world.people) {
     if (p.floor != floor) continue;
@@ -221,16 +251,23 @@ ViewMesh FloorMesh(const World& world, int floor, double time_s) {
     const double cy = p.from.y_m + s * (p.to.y_m - p.from.y_m);
     const double ux = (p.to.x_m - p.from.x_m) / length * 0.3,
                  uy = (p.to.y_m - p.from.y_m) / length * 0.3;
-    const float t = static_cast<float>(tile_of(p.texture));
+    const float t = static_cast<float>(g->tiles.at(p.texture));
     const float ax = static_cast<float>(cx - ux), ay = static_cast<float>(cy - uy);
     const float bx = static_cast<float>(cx + ux), by = static_cast<float>(cy + uy);
-    quad({ax, ay, 0, 0, 0.999f, t, 1.0f}, {bx, by, 0, 0.999f, 0.999f, t, 1.0f},
-         {bx, by, 1.75f, 0.999f, 0, t, 1.0f}, {ax, ay, 1.75f, 0, 0, t, 1.0f});
+    AddQuad({ax, ay, 0, 0, 0.999f, t, 1.0f}, {bx, by, 0, 0.999f, 0.999f, t, 1.0f},
+            {bx, by, 1.75f, 0.999f, 0, t, 1.0f}, {ax, ay, 1.75f, 0, 0, t, 1.0f}, &mesh);
     id = id * 1099511628211ULL ^
          static_cast<uint64_t>(std::llround(cx * 1000) * 31 + std::llround(cy * 1000));
   }
   mesh.id = id;
-  return mesh;
+}
+
+}  // namespace
+
+ViewMesh FloorMesh(const World& world, int floor, double time_s) {
+  FloorGeometry g = BuildFloor(world, floor);
+  PlacePeople(world, floor, time_s, &g);
+  return std::move(g.mesh);
 }
 
 ViewCamera CameraAt(const World& world, const TruePose& pose) {
@@ -279,7 +316,8 @@ Status Simulate(const World& world, uint64_t seed, ViewRenderer* renderer,
   int session = -1;
   double next_image = poses.front().time_s, next_scan = poses.front().time_s,
          next_compass = poses.front().time_s;
-  ViewMesh mesh;
+  // The floor's walls and atlas are built when the floor changes; only people move per frame.
+  FloorGeometry geometry;
   int mesh_floor = std::numeric_limits<int>::min();
   const double end = poses.back().time_s;
   int last_decile = -1;
@@ -317,11 +355,12 @@ Status Simulate(const World& world, uint64_t seed, ViewRenderer* renderer,
       next_scan += world.wifi.scan_period_s;
     }
     if (renderer && p.time_s >= next_image - 1e-9) {
-      if (p.floor != mesh_floor || !world.people.empty()) {
-        mesh = FloorMesh(world, p.floor, p.time_s);
+      if (p.floor != mesh_floor) {
+        geometry = BuildFloor(world, p.floor);
         mesh_floor = p.floor;
       }
-      auto view = renderer->Render(mesh, CameraAt(world, p), LightingOf(world, p.session));
+      PlacePeople(world, p.floor, p.time_s, &geometry);
+      auto view = renderer->Render(geometry.mesh, CameraAt(world, p), LightingOf(world, p.session));
       if (!view.ok()) return view.status();
       cv::Mat image(view->height, view->width, CV_8UC1, view->pixels.data());
       if (world.camera.motion_blur && std::abs(p.turn_rate_rad_per_s) > 1e-6) {

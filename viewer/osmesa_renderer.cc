@@ -540,11 +540,27 @@ class OsMesaViewRenderer : public ViewRenderer, public OsMesaContextHolder {
 
  private:
   void Upload(const ViewMesh& mesh) {
-    if (vao_ && mesh.id == uploaded_id_ && mesh.triangles.size() == uploaded_vertices_) return;
     if (!vao_) {
       gl_.GenVertexArrays(1, &vao_);
       gl_.GenBuffers(1, &vbo_);
       gl_.GenTextures(1, &texture_);
+    } else if (mesh.id == uploaded_id_ && mesh.triangles.size() == uploaded_vertices_ &&
+               mesh.atlas_id == uploaded_atlas_id_) {
+      return;
+    }
+    if (!atlas_uploaded_ || mesh.atlas_id != uploaded_atlas_id_) {
+      const int atlas_px = mesh.tile_px * mesh.tiles_per_side;
+      gl_.ActiveTexture(GL_TEXTURE0);
+      gl_.BindTexture(GL_TEXTURE_2D, texture_);
+      gl_.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+      gl_.TexImage2D(GL_TEXTURE_2D, 0, GL_R8, atlas_px, atlas_px, 0, GL_RED, GL_UNSIGNED_BYTE,
+                     mesh.atlas.data());
+      gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+      gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+      gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+      gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+      uploaded_atlas_id_ = mesh.atlas_id;
+      atlas_uploaded_ = true;
     }
     gl_.BindVertexArray(vao_);
     gl_.BindBuffer(GL_ARRAY_BUFFER, vbo_);
@@ -560,16 +576,6 @@ class OsMesaViewRenderer : public ViewRenderer, public OsMesaContextHolder {
     gl_.EnableVertexAttribArray(2);
     gl_.VertexAttribPointer(3, 1, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<const void*>(24));
     gl_.EnableVertexAttribArray(3);
-    const int atlas_px = mesh.tile_px * mesh.tiles_per_side;
-    gl_.ActiveTexture(GL_TEXTURE0);
-    gl_.BindTexture(GL_TEXTURE_2D, texture_);
-    gl_.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    gl_.TexImage2D(GL_TEXTURE_2D, 0, GL_R8, atlas_px, atlas_px, 0, GL_RED, GL_UNSIGNED_BYTE,
-                   mesh.atlas.data());
-    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
     uploaded_id_ = mesh.id;
     uploaded_vertices_ = mesh.triangles.size();
   }
@@ -615,8 +621,9 @@ class OsMesaViewRenderer : public ViewRenderer, public OsMesaContextHolder {
   }
 
   GLuint program_ = 0, vao_ = 0, vbo_ = 0, texture_ = 0;
-  uint64_t uploaded_id_ = 0;
+  uint64_t uploaded_id_ = 0, uploaded_atlas_id_ = 0;
   size_t uploaded_vertices_ = 0;
+  bool atlas_uploaded_ = false;
 };
 
 }  // namespace

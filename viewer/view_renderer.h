@@ -22,7 +22,8 @@ struct ViewVertex {
 };
 
 struct ViewMesh {
-  uint64_t id = 0;  // meshes with the same id and size are uploaded once
+  uint64_t id = 0;        // meshes with the same id and size share their triangles (uploaded once)
+  uint64_t atlas_id = 0;  // and meshes with the same atlas_id their texture atlas
   std::vector<ViewVertex> triangles;
   int tile_px = 64;            // each texture is tile_px x tile_px grey levels
   int tiles_per_side = 8;      // the atlas is a square of tiles_per_side^2 textures
