@@ -147,14 +147,22 @@ std::vector<EvaluationNode> DatasetNodes(const Dataset& d, bool as_map, bool wan
     nodes.push_back(std::move(n));
   };
   if (want_images && !d.images.empty()) {
+    std::vector<double> scan_times;
+    for (const WifiScan& s : d.wifi) scan_times.push_back(s.time_s);
     for (const ImageRow& row : d.images) {
       // Map: the temporally closest scan; queries: the last scan before the image (sec. 5.2).
+      // Scans are in time order; of scans at one time the first counts.
       const WifiScan* best = nullptr;
-      for (const WifiScan& s : d.wifi) {
-        if (!as_map && s.time_s > row.time_s) break;
-        if (!best || std::abs(s.time_s - row.time_s) < std::abs(best->time_s - row.time_s)) {
-          best = &s;
-        }
+      const size_t next = static_cast<size_t>(
+          std::upper_bound(scan_times.begin(), scan_times.end(), row.time_s) - scan_times.begin());
+      if (next > 0) {
+        const double t = scan_times[next - 1];
+        best =
+            &d.wifi[std::lower_bound(scan_times.begin(), scan_times.end(), t) - scan_times.begin()];
+      }
+      if (as_map && next < d.wifi.size() &&
+          (!best || scan_times[next] - row.time_s < row.time_s - best->time_s)) {
+        best = &d.wifi[next];
       }
       std::optional<std::vector<WifiReading>> wifi;
       if (best && std::abs(best->time_s - row.time_s) <= options.image_wifi_max_gap_s) {
