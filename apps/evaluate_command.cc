@@ -26,20 +26,18 @@ using fabmap::EvaluationNode;
 // Progress lines on stderr: every tenth of the work.
 class StepProgress {
  public:
-  StepProgress(std::string what, size_t total, bool quiet)
-      : what_(std::move(what)), total_(total), quiet_(quiet) {}
-  void Update(size_t done) {
-    if (quiet_ || total_ == 0) return;
-    const size_t decile = done * 10 / total_;
+  StepProgress(std::string what, bool quiet) : what_(std::move(what)), quiet_(quiet) {}
+  void Update(size_t done, size_t total) {
+    if (quiet_ || total == 0) return;
+    const size_t decile = done * 10 / total;
     if (decile != last_) {
       last_ = decile;
-      std::fprintf(stderr, "evaluate: %s %zu/%zu\n", what_.c_str(), done, total_);
+      std::fprintf(stderr, "evaluate: %s %zu/%zu\n", what_.c_str(), done, total);
     }
   }
 
  private:
   std::string what_;
-  size_t total_;
   bool quiet_;
   size_t last_ = static_cast<size_t>(-1);
 };
@@ -47,7 +45,7 @@ class StepProgress {
 Status VisualWords(const fabmap::TrainedVisualModel& model, std::vector<EvaluationNode>& nodes,
                    std::vector<fabmap::Observation>* words, const std::string& what, bool quiet) {
   FileImageLoader loader;
-  StepProgress progress("visual words of " + what, nodes.size(), quiet);
+  StepProgress progress("visual words of " + what, quiet);
   words->clear();
   for (size_t i = 0; i < nodes.size(); ++i) {
     if (nodes[i].image.empty()) {
@@ -58,7 +56,7 @@ Status VisualWords(const fabmap::TrainedVisualModel& model, std::vector<Evaluati
     auto w = fabmap::ImageWords(model, *image);
     if (!w.ok()) return w.status().WithContext(nodes[i].image);
     words->push_back(*std::move(w));
-    progress.Update(i + 1);
+    progress.Update(i + 1, nodes.size());
   }
   return Status::Ok();
 }
@@ -66,13 +64,10 @@ Status VisualWords(const fabmap::TrainedVisualModel& model, std::vector<Evaluati
 StatusOr<fabmap::TrainedVisualModel> GetVisualModel(const FabmapSettings& settings,
                                                     const std::string& out, bool quiet) {
   FileImageLoader loader;
-  StepProgress progress("training images", 1, quiet);
+  StepProgress progress("training images", quiet);
   auto model = fabmap::LoadOrTrainVisualModel(
       settings.visual_model, settings.features, settings.vocabulary, settings.localiser.chow_liu,
-      loader, [&](size_t done, size_t total) {
-        if (done == 1) progress = StepProgress("training images", total, quiet);
-        progress.Update(done);
-      });
+      loader, [&](size_t done, size_t total) { progress.Update(done, total); });
   if (!model.ok()) return model.status();
   if (settings.visual_model.file.empty()) {  // trained here: keep it for later runs
     RATSLAM_RETURN_IF_ERROR(WriteFileAtomically((fs::path(out) / "visual_model.bin").string(),
@@ -182,13 +177,13 @@ int EvaluateCommand(int argc, char** argv) {
 
   std::vector<int64_t> matches;
   const auto query_start = std::chrono::steady_clock::now();
-  StepProgress progress("queries", queries.size(), quiet);
+  StepProgress progress("queries", quiet);
   for (size_t i = 0; i < queries.size(); ++i) {
     fabmap::Query q;
     if (vision) q.visual = query_words[i];
     q.wifi = queries[i].wifi;
     matches.push_back((*localiser)->Localise(q).best_place);
-    progress.Update(i + 1);
+    progress.Update(i + 1, queries.size());
   }
   const double query_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - query_start)
