@@ -124,7 +124,14 @@ class TableReader {
       }
     }
   }
-  const toml::table& table() const { return table_; }
+  // The visitor form of the readers above, for the field lists below.
+  void operator()(const char* key, double& f) { Number(key, &f); }
+  void operator()(const char* key, int& f) { Integer(key, &f); }
+  void operator()(const char* key, bool& f) { Bool(key, &f); }
+  void operator()(const char* key, std::string& f) { String(key, &f); }
+  void operator()(const char* key, Point2& f) { Point(key, &f); }
+  void operator()(const char* key, std::vector<int>& f) { Integers(key, &f); }
+  void operator()(const char* key, std::vector<RoutePoint>& f) { RoutePoints(key, &f); }
 
  private:
   const toml::node* Find(const char* key) {
@@ -301,6 +308,132 @@ Status World::Validate() const {
   return Status::Ok();
 }
 
+namespace {
+
+// Every key of every table, shared by the reader and the printer: (key, field) pairs in file
+// order. `T` is the struct or its const version.
+template <typename T, typename V>
+void WallFields(T& w, V&& v) {
+  v("floor", w.floor);
+  v("from", w.from);
+  v("to", w.to);
+  v("material", w.material);
+  v("texture", w.texture);
+  v("height_m", w.height_m);
+}
+template <typename T, typename V>
+void AccessPointFields(T& a, V&& v) {
+  v("name", a.name);
+  v("position", a.position);
+  v("floor", a.floor);
+  v("tx_power_dbm", a.tx_power_dbm);
+  v("channel", a.channel);
+  v("off_in_sessions", a.off_in_sessions);
+  v("moved_in_sessions", a.moved_in_sessions);
+  v("moved_to", a.moved_to);
+}
+template <typename T, typename V>
+void DisturbanceFields(T& d, V&& v) {
+  v("position", d.position);
+  v("floor", d.floor);
+  v("radius_m", d.radius_m);
+  v("strength_deg", d.strength_deg);
+}
+template <typename T, typename V>
+void PersonFields(T& p, V&& v) {
+  v("floor", p.floor);
+  v("from", p.from);
+  v("to", p.to);
+  v("speed_m_per_s", p.speed_m_per_s);
+  v("texture", p.texture);
+}
+template <typename T, typename V>
+void RouteFields(T& r, V&& v) {
+  v("name", r.name);
+  v("closed", r.closed);
+  v("points", r.points);
+}
+template <typename T, typename V>
+void SessionFields(T& s, V&& v) {
+  v("route", s.route);
+  v("laps", s.laps);
+  v("reverse", s.reverse);
+  v("lighting", s.lighting);
+}
+template <typename T, typename V>
+void CameraFields(T& c, V&& v) {
+  v("width_px", c.width_px);
+  v("height_px", c.height_px);
+  v("horizontal_fov_deg", c.horizontal_fov_deg);
+  v("height_m", c.height_m);
+  v("pitch_deg", c.pitch_deg);
+  v("rate_hz", c.rate_hz);
+  v("noise_sigma", c.noise_sigma);
+  v("motion_blur", c.motion_blur);
+}
+template <typename T, typename V>
+void WifiFields(T& w, V&& v) {
+  v("path_loss_exponent", w.path_loss_exponent);
+  v("reference_distance_m", w.reference_distance_m);
+  v("floor_attenuation_db", w.floor_attenuation_db);
+  v("shadowing_sigma_db", w.shadowing_sigma_db);
+  v("shadowing_correlation_m", w.shadowing_correlation_m);
+  v("fading_sigma_db", w.fading_sigma_db);
+  v("sensitivity_dbm", w.sensitivity_dbm);
+  v("scan_period_s", w.scan_period_s);
+  v("miss_probability", w.miss_probability);
+}
+template <typename T, typename V>
+void CompassFields(T& c, V&& v) {
+  v("rate_hz", c.rate_hz);
+  v("noise_sigma_deg", c.noise_sigma_deg);
+}
+template <typename T, typename V>
+void OdometryFields(T& o, V&& v) {
+  v("rate_hz", o.rate_hz);
+  v("speed_scale_error", o.speed_scale_error);
+  v("turn_bias_rad_per_s", o.turn_bias_rad_per_s);
+  v("speed_noise_m_per_s", o.speed_noise_m_per_s);
+  v("turn_noise_rad_per_s", o.turn_noise_rad_per_s);
+}
+template <typename T, typename V>
+void MotionFields(T& m, V&& v) {
+  v("speed_m_per_s", m.speed_m_per_s);
+  v("turn_rate_rad_per_s", m.turn_rate_rad_per_s);
+  v("lift_time_s", m.lift_time_s);
+  v("session_gap_s", m.session_gap_s);
+}
+
+// Calls `f(key, table_fields, list)` for every [[array]] of the world, and
+// `g(key, table_fields, settings)` for every [table] of settings.
+template <typename W, typename Arrays, typename Tables>
+void WorldSections(W& w, Arrays&& arrays, Tables&& tables) {
+  tables(
+      "camera", [](auto& x, auto&& v) { CameraFields(x, v); }, w.camera);
+  tables(
+      "wifi", [](auto& x, auto&& v) { WifiFields(x, v); }, w.wifi);
+  tables(
+      "compass", [](auto& x, auto&& v) { CompassFields(x, v); }, w.compass);
+  tables(
+      "odometry", [](auto& x, auto&& v) { OdometryFields(x, v); }, w.odometry);
+  tables(
+      "motion", [](auto& x, auto&& v) { MotionFields(x, v); }, w.motion);
+  arrays(
+      "walls", [](auto& x, auto&& v) { WallFields(x, v); }, w.walls);
+  arrays(
+      "access_points", [](auto& x, auto&& v) { AccessPointFields(x, v); }, w.access_points);
+  arrays(
+      "disturbances", [](auto& x, auto&& v) { DisturbanceFields(x, v); }, w.disturbances);
+  arrays(
+      "people", [](auto& x, auto&& v) { PersonFields(x, v); }, w.people);
+  arrays(
+      "routes", [](auto& x, auto&& v) { RouteFields(x, v); }, w.routes);
+  arrays(
+      "sessions", [](auto& x, auto&& v) { SessionFields(x, v); }, w.sessions);
+}
+
+}  // namespace
+
 StatusOr<World> ParseWorld(const std::string& text, const std::string& source) {
   toml::table root;
   try {
@@ -327,124 +460,24 @@ StatusOr<World> ParseWorld(const std::string& text, const std::string& source) {
       world.materials_db[std::string(key.str())] = db;
     }
   }
-  for (const toml::table* t : top.Tables("walls")) {
-    Wall w;
-    TableReader r(*t, "[[walls]]", source, &status);
-    r.Integer("floor", &w.floor);
-    r.Point("from", &w.from);
-    r.Point("to", &w.to);
-    r.String("material", &w.material);
-    r.String("texture", &w.texture);
-    r.Number("height_m", &w.height_m);
-    r.Finish();
-    world.walls.push_back(w);
-  }
-  for (const toml::table* t : top.Tables("access_points")) {
-    AccessPoint a;
-    TableReader r(*t, "[[access_points]]", source, &status);
-    r.String("name", &a.name);
-    r.Point("position", &a.position);
-    r.Integer("floor", &a.floor);
-    r.Number("tx_power_dbm", &a.tx_power_dbm);
-    r.Integer("channel", &a.channel);
-    r.Integers("off_in_sessions", &a.off_in_sessions);
-    r.Integers("moved_in_sessions", &a.moved_in_sessions);
-    r.Point("moved_to", &a.moved_to);
-    r.Finish();
-    world.access_points.push_back(a);
-  }
-  for (const toml::table* t : top.Tables("disturbances")) {
-    Disturbance d;
-    TableReader r(*t, "[[disturbances]]", source, &status);
-    r.Point("position", &d.position);
-    r.Integer("floor", &d.floor);
-    r.Number("radius_m", &d.radius_m);
-    r.Number("strength_deg", &d.strength_deg);
-    r.Finish();
-    world.disturbances.push_back(d);
-  }
-  for (const toml::table* t : top.Tables("people")) {
-    Person p;
-    TableReader r(*t, "[[people]]", source, &status);
-    r.Integer("floor", &p.floor);
-    r.Point("from", &p.from);
-    r.Point("to", &p.to);
-    r.Number("speed_m_per_s", &p.speed_m_per_s);
-    r.String("texture", &p.texture);
-    r.Finish();
-    world.people.push_back(p);
-  }
-  for (const toml::table* t : top.Tables("routes")) {
-    Route route;
-    TableReader r(*t, "[[routes]]", source, &status);
-    r.String("name", &route.name);
-    r.RoutePoints("points", &route.points);
-    r.Bool("closed", &route.closed);
-    r.Finish();
-    world.routes.push_back(route);
-  }
-  for (const toml::table* t : top.Tables("sessions")) {
-    Session s;
-    TableReader r(*t, "[[sessions]]", source, &status);
-    r.String("route", &s.route);
-    r.Number("laps", &s.laps);
-    r.Bool("reverse", &s.reverse);
-    r.String("lighting", &s.lighting);
-    r.Finish();
-    world.sessions.push_back(s);
-  }
-  if (const toml::table* t = top.Table("camera")) {
-    CameraSettings& c = world.camera;
-    TableReader r(*t, "[camera]", source, &status);
-    r.Integer("width_px", &c.width_px);
-    r.Integer("height_px", &c.height_px);
-    r.Number("horizontal_fov_deg", &c.horizontal_fov_deg);
-    r.Number("height_m", &c.height_m);
-    r.Number("pitch_deg", &c.pitch_deg);
-    r.Number("rate_hz", &c.rate_hz);
-    r.Number("noise_sigma", &c.noise_sigma);
-    r.Bool("motion_blur", &c.motion_blur);
-    r.Finish();
-  }
-  if (const toml::table* t = top.Table("wifi")) {
-    WifiSettings& w = world.wifi;
-    TableReader r(*t, "[wifi]", source, &status);
-    r.Number("path_loss_exponent", &w.path_loss_exponent);
-    r.Number("reference_distance_m", &w.reference_distance_m);
-    r.Number("floor_attenuation_db", &w.floor_attenuation_db);
-    r.Number("shadowing_sigma_db", &w.shadowing_sigma_db);
-    r.Number("shadowing_correlation_m", &w.shadowing_correlation_m);
-    r.Number("fading_sigma_db", &w.fading_sigma_db);
-    r.Number("sensitivity_dbm", &w.sensitivity_dbm);
-    r.Number("scan_period_s", &w.scan_period_s);
-    r.Number("miss_probability", &w.miss_probability);
-    r.Finish();
-  }
-  if (const toml::table* t = top.Table("compass")) {
-    TableReader r(*t, "[compass]", source, &status);
-    r.Number("rate_hz", &world.compass.rate_hz);
-    r.Number("noise_sigma_deg", &world.compass.noise_sigma_deg);
-    r.Finish();
-  }
-  if (const toml::table* t = top.Table("odometry")) {
-    OdometrySettings& o = world.odometry;
-    TableReader r(*t, "[odometry]", source, &status);
-    r.Number("rate_hz", &o.rate_hz);
-    r.Number("speed_scale_error", &o.speed_scale_error);
-    r.Number("turn_bias_rad_per_s", &o.turn_bias_rad_per_s);
-    r.Number("speed_noise_m_per_s", &o.speed_noise_m_per_s);
-    r.Number("turn_noise_rad_per_s", &o.turn_noise_rad_per_s);
-    r.Finish();
-  }
-  if (const toml::table* t = top.Table("motion")) {
-    MotionSettings& m = world.motion;
-    TableReader r(*t, "[motion]", source, &status);
-    r.Number("speed_m_per_s", &m.speed_m_per_s);
-    r.Number("turn_rate_rad_per_s", &m.turn_rate_rad_per_s);
-    r.Number("lift_time_s", &m.lift_time_s);
-    r.Number("session_gap_s", &m.session_gap_s);
-    r.Finish();
-  }
+  WorldSections(
+      world,
+      [&](const char* key, auto fields, auto& list) {
+        for (const toml::table* t : top.Tables(key)) {
+          typename std::decay_t<decltype(list)>::value_type item;
+          TableReader r(*t, "[[" + std::string(key) + "]]", source, &status);
+          fields(item, r);
+          r.Finish();
+          list.push_back(item);
+        }
+      },
+      [&](const char* key, auto fields, auto& settings) {
+        if (const toml::table* t = top.Table(key)) {
+          TableReader r(*t, "[" + std::string(key) + "]", source, &status);
+          fields(settings, r);
+          r.Finish();
+        }
+      });
   top.Finish();
   if (!status.ok()) return status;
   Status valid = world.Validate();
@@ -485,73 +518,46 @@ std::string Ints(const std::vector<int>& v) {
 }
 }  // namespace
 
+namespace {
+// Writes `key = value` lines.
+struct FieldPrinter {
+  std::ostringstream& o;
+  void operator()(const char* key, double v) { o << key << " = " << Num(v) << "\n"; }
+  void operator()(const char* key, int v) { o << key << " = " << v << "\n"; }
+  void operator()(const char* key, bool v) { o << key << " = " << (v ? "true" : "false") << "\n"; }
+  void operator()(const char* key, const std::string& v) { o << key << " = " << Quote(v) << "\n"; }
+  void operator()(const char* key, const Point2& v) { o << key << " = " << Pt(v) << "\n"; }
+  void operator()(const char* key, const std::vector<int>& v) {
+    o << key << " = " << Ints(v) << "\n";
+  }
+  void operator()(const char* key, const std::vector<RoutePoint>& v) {
+    o << key << " = [";
+    for (size_t i = 0; i < v.size(); ++i) {
+      o << (i ? ", " : "") << "[" << Num(v[i].position.x_m) << ", " << Num(v[i].position.y_m)
+        << ", " << v[i].floor << "]";
+    }
+    o << "]\n";
+  }
+};
+}  // namespace
+
 std::string PrintWorld(const World& w) {
   std::ostringstream o;
   o << "name = " << Quote(w.name) << "\n\n[materials]\n";
   for (const auto& [name, db] : w.materials_db) o << Quote(name) << " = " << Num(db) << "\n";
-  const CameraSettings& c = w.camera;
-  o << "\n[camera]\nwidth_px = " << c.width_px << "\nheight_px = " << c.height_px
-    << "\nhorizontal_fov_deg = " << Num(c.horizontal_fov_deg) << "\nheight_m = " << Num(c.height_m)
-    << "\npitch_deg = " << Num(c.pitch_deg) << "\nrate_hz = " << Num(c.rate_hz)
-    << "\nnoise_sigma = " << Num(c.noise_sigma)
-    << "\nmotion_blur = " << (c.motion_blur ? "true" : "false") << "\n";
-  const WifiSettings& f = w.wifi;
-  o << "\n[wifi]\npath_loss_exponent = " << Num(f.path_loss_exponent)
-    << "\nreference_distance_m = " << Num(f.reference_distance_m)
-    << "\nfloor_attenuation_db = " << Num(f.floor_attenuation_db)
-    << "\nshadowing_sigma_db = " << Num(f.shadowing_sigma_db)
-    << "\nshadowing_correlation_m = " << Num(f.shadowing_correlation_m)
-    << "\nfading_sigma_db = " << Num(f.fading_sigma_db)
-    << "\nsensitivity_dbm = " << Num(f.sensitivity_dbm)
-    << "\nscan_period_s = " << Num(f.scan_period_s)
-    << "\nmiss_probability = " << Num(f.miss_probability) << "\n";
-  o << "\n[compass]\nrate_hz = " << Num(w.compass.rate_hz)
-    << "\nnoise_sigma_deg = " << Num(w.compass.noise_sigma_deg) << "\n";
-  const OdometrySettings& d = w.odometry;
-  o << "\n[odometry]\nrate_hz = " << Num(d.rate_hz)
-    << "\nspeed_scale_error = " << Num(d.speed_scale_error)
-    << "\nturn_bias_rad_per_s = " << Num(d.turn_bias_rad_per_s)
-    << "\nspeed_noise_m_per_s = " << Num(d.speed_noise_m_per_s)
-    << "\nturn_noise_rad_per_s = " << Num(d.turn_noise_rad_per_s) << "\n";
-  const MotionSettings& m = w.motion;
-  o << "\n[motion]\nspeed_m_per_s = " << Num(m.speed_m_per_s)
-    << "\nturn_rate_rad_per_s = " << Num(m.turn_rate_rad_per_s)
-    << "\nlift_time_s = " << Num(m.lift_time_s) << "\nsession_gap_s = " << Num(m.session_gap_s)
-    << "\n";
-  for (const Wall& x : w.walls) {
-    o << "\n[[walls]]\nfloor = " << x.floor << "\nfrom = " << Pt(x.from) << "\nto = " << Pt(x.to)
-      << "\nmaterial = " << Quote(x.material) << "\ntexture = " << Quote(x.texture)
-      << "\nheight_m = " << Num(x.height_m) << "\n";
-  }
-  for (const AccessPoint& a : w.access_points) {
-    o << "\n[[access_points]]\nname = " << Quote(a.name) << "\nposition = " << Pt(a.position)
-      << "\nfloor = " << a.floor << "\ntx_power_dbm = " << Num(a.tx_power_dbm)
-      << "\nchannel = " << a.channel << "\noff_in_sessions = " << Ints(a.off_in_sessions)
-      << "\nmoved_in_sessions = " << Ints(a.moved_in_sessions) << "\nmoved_to = " << Pt(a.moved_to)
-      << "\n";
-  }
-  for (const Disturbance& x : w.disturbances) {
-    o << "\n[[disturbances]]\nposition = " << Pt(x.position) << "\nfloor = " << x.floor
-      << "\nradius_m = " << Num(x.radius_m) << "\nstrength_deg = " << Num(x.strength_deg) << "\n";
-  }
-  for (const Person& p : w.people) {
-    o << "\n[[people]]\nfloor = " << p.floor << "\nfrom = " << Pt(p.from) << "\nto = " << Pt(p.to)
-      << "\nspeed_m_per_s = " << Num(p.speed_m_per_s) << "\ntexture = " << Quote(p.texture) << "\n";
-  }
-  for (const Route& r : w.routes) {
-    o << "\n[[routes]]\nname = " << Quote(r.name) << "\nclosed = " << (r.closed ? "true" : "false")
-      << "\npoints = [";
-    for (size_t i = 0; i < r.points.size(); ++i) {
-      o << (i ? ", " : "") << "[" << Num(r.points[i].position.x_m) << ", "
-        << Num(r.points[i].position.y_m) << ", " << r.points[i].floor << "]";
-    }
-    o << "]\n";
-  }
-  for (const Session& s : w.sessions) {
-    o << "\n[[sessions]]\nroute = " << Quote(s.route) << "\nlaps = " << Num(s.laps)
-      << "\nreverse = " << (s.reverse ? "true" : "false") << "\nlighting = " << Quote(s.lighting)
-      << "\n";
-  }
+  FieldPrinter printer{o};
+  WorldSections(
+      w,
+      [&](const char* key, auto fields, const auto& list) {
+        for (const auto& item : list) {
+          o << "\n[[" << key << "]]\n";
+          fields(item, printer);
+        }
+      },
+      [&](const char* key, auto fields, const auto& settings) {
+        o << "\n[" << key << "]\n";
+        fields(settings, printer);
+      });
   return o.str();
 }
 
