@@ -317,7 +317,7 @@ class FabmapFrontEnd : public FrontEnd {
  public:
   FabmapFrontEnd(const FabmapSettings& settings, std::shared_ptr<const FabmapResources> resources)
       : settings_(settings), resources_(std::move(resources)) {
-    if (!resources_) {
+    if (!resources_ || !resources_->empty_localiser) {
       throw std::invalid_argument("the FABMAP front end needs PrepareFabmapResources' models");
     }
     Reset();
@@ -419,11 +419,7 @@ class FabmapFrontEnd : public FrontEnd {
   fabmap::FabmapMode mode() const { return settings_.localiser.localiser.mode; }
 
   void Reset() {
-    auto l = fabmap::Localiser::Create(settings_.localiser,
-                                       resources_->visual ? &resources_->visual->model : nullptr,
-                                       resources_->exploration);
-    if (!l.ok()) throw std::invalid_argument("FABMAP front end: " + l.status().message());
-    localiser_ = std::move(l).value();
+    localiser_ = std::make_unique<fabmap::Localiser>(*resources_->empty_localiser);
     places_.clear();
     created_time_s_.clear();
   }
@@ -479,6 +475,7 @@ StatusOr<std::shared_ptr<const FabmapResources>> PrepareFabmapResources(
     }
     resources->visual = *std::move(model);
   }
+  fabmap::WifiExploration exploration;
   if (fabmap::UsesWifi(mode)) {
     // Travel at each scan from the odometry (speed held from one row's time to the next's).
     double travelled = 0.0, last_time = 0.0;
@@ -490,14 +487,15 @@ StatusOr<std::shared_ptr<const FabmapResources>> PrepareFabmapResources(
         last_time = dataset.odometry[k].time_s;
         ++k;
       }
-      resources->exploration.scans.push_back(scan.readings);
-      resources->exploration.travelled_m.push_back(travelled);
-      resources->exploration.time_s.push_back(scan.time_s);
+      exploration.scans.push_back(scan.readings);
+      exploration.travelled_m.push_back(travelled);
+      exploration.time_s.push_back(scan.time_s);
     }
   }
-  auto check = fabmap::Localiser::Create(
-      f.localiser, resources->visual ? &resources->visual->model : nullptr, resources->exploration);
-  if (!check.ok()) return check.status();
+  auto localiser = fabmap::Localiser::Create(
+      f.localiser, resources->visual ? &resources->visual->model : nullptr, exploration);
+  if (!localiser.ok()) return localiser.status();
+  resources->empty_localiser = std::move(localiser).value();
   return std::shared_ptr<const FabmapResources>(std::move(resources));
 }
 

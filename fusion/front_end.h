@@ -114,8 +114,10 @@ struct FabmapSettings {
 
 // What the FABMAP front end is built from, prepared once per run (PrepareFabmapResources).
 struct FabmapResources {
-  std::optional<fabmap::TrainedVisualModel> visual;
-  fabmap::WifiExploration exploration;
+  std::optional<fabmap::TrainedVisualModel> visual;  // to turn images into words
+  // The localiser with no places yet (words, trees, unknown world): each front end, and each
+  // restore, starts from a copy instead of learning the Wi-Fi tree again.
+  std::shared_ptr<const fabmap::Localiser> empty_localiser;
 };
 
 // Which sensor decided a frame.
@@ -154,8 +156,9 @@ struct FrontEndSettings {
 };
 
 // The FABMAP front end's models for `dataset`: the visual model (loaded, or trained from
-// [visual_model] training_images) when the mode uses vision, and the Wi-Fi exploration (every
-// scan, with odometry travel) when it uses Wi-Fi. Fails on a bad file or an unusable mode.
+// [visual_model] training_images) when the mode uses vision, and the Wi-Fi words and tree from
+// an exploration of every scan (with odometry travel) when it uses Wi-Fi. Fails on a bad file
+// or an unusable mode.
 StatusOr<std::shared_ptr<const FabmapResources>> PrepareFabmapResources(
     const FrontEndSettings& settings, const Dataset& dataset, ImageLoader& images);
 
