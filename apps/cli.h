@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <iostream>
 #include <map>
@@ -18,6 +19,7 @@ namespace ratslam {
 inline constexpr int kExitOk = 0;
 inline constexpr int kExitError = 1;
 inline constexpr int kExitUsage = 2;
+inline constexpr int kExitInternal = 70;  // a bug or an exhausted machine (EX_SOFTWARE)
 inline constexpr int kExitInterrupted = 130;
 
 // Parsed "--flag value" pairs and bare flags.
@@ -68,6 +70,21 @@ inline std::optional<double> ParseNumber(const std::string& flag, const std::str
     return std::nullopt;
   }
   return value;
+}
+
+// A whole number in [min, max] (written as digits, no fraction, no exponent overflow); prints why
+// not and returns nullopt otherwise. Casting a double instead overflowed silently.
+inline std::optional<int64_t> ParseInteger(const std::string& flag, const std::string& text,
+                                           int64_t min, int64_t max) {
+  const std::optional<double> value = ParseNumber(flag, text);
+  if (!value) return std::nullopt;
+  if (*value != std::floor(*value) || *value < static_cast<double>(min) ||
+      *value > static_cast<double>(max)) {
+    std::cerr << "ratslam: " << flag << ": expected a whole number in " << min << ".." << max
+              << ", got '" << text << "'\n";
+    return std::nullopt;
+  }
+  return static_cast<int64_t>(*value);
 }
 
 // The options of --config, or the defaults; prints the error and returns nullopt on a bad file.

@@ -9,10 +9,10 @@
 #include <sstream>
 
 #include "apps/cli.h"
+#include "common/file_util.h"
 #include "fusion/fabmap/evaluation.h"
 #include "fusion/fabmap/localiser.h"
 #include "fusion/fabmap/visual_model.h"
-#include "fusion/io/file_util.h"
 #include "viewer/localisation_figure.h"
 #include "viewer/renderer.h"
 

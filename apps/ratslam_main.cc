@@ -19,8 +19,8 @@
 #include "apps/cli.h"
 #include "apps/demo_config.h"
 #include "apps/progress.h"
+#include "common/file_util.h"
 #include "fusion/io/config.h"
-#include "fusion/io/file_util.h"
 #include "fusion/io/map_file.h"
 #include "fusion/io/run_outputs.h"
 #include "fusion/replay_pipeline.h"
@@ -286,11 +286,8 @@ int Replay(int argc, char** argv) {
     request.until_s = *until;
   }
   if (args->values.count("--animate")) {
-    auto every = ParseNumber("--animate", args->values["--animate"]);
-    if (!every || *every < 1) {
-      std::cerr << "ratslam: --animate takes a positive number of events\n";
-      return kExitUsage;
-    }
+    auto every = ParseInteger("--animate", args->values["--animate"], 1, int64_t{1} << 53);
+    if (!every) return kExitUsage;
     request.animate_every = static_cast<uint64_t>(*every);
   }
   request.quiet = args->quiet;
@@ -413,12 +410,12 @@ int SynthesizeCommand(int argc, char** argv) {
   }
   SyntheticOptions options = DemoSyntheticOptions();
   if (args->values.count("--seed")) {
-    auto seed = ParseNumber("--seed", args->values["--seed"]);
-    if (!seed || *seed < 0) return kExitUsage;
+    auto seed = ParseInteger("--seed", args->values["--seed"], 0, int64_t{1} << 53);
+    if (!seed) return kExitUsage;
     options.seed = static_cast<uint64_t>(*seed);
   }
   if (args->values.count("--laps")) {
-    auto laps = ParseNumber("--laps", args->values["--laps"]);
+    auto laps = ParseInteger("--laps", args->values["--laps"], 1, 1000);
     if (!laps) return kExitUsage;
     options.laps = static_cast<int>(*laps);
   }
@@ -428,7 +425,9 @@ int SynthesizeCommand(int argc, char** argv) {
 }  // namespace
 }  // namespace ratslam
 
-int main(int argc, char** argv) {
+namespace {
+
+int Dispatch(int argc, char** argv) {
   using namespace ratslam;
   if (argc < 2) {
     std::cerr << kUsage;
@@ -450,4 +449,19 @@ int main(int argc, char** argv) {
   }
   std::cerr << "ratslam: unknown command '" << command << "'\n" << kUsage;
   return kExitUsage;
+}
+
+}  // namespace
+
+// Expected failures come back as Status; an exception here is a bug or an exhausted machine
+// (std::bad_alloc). Either way the program says so and exits non-zero instead of aborting.
+int main(int argc, char** argv) {
+  try {
+    return Dispatch(argc, argv);
+  } catch (const std::bad_alloc&) {
+    std::cerr << "ratslam: out of memory\n";
+  } catch (const std::exception& e) {
+    std::cerr << "ratslam: internal error: " << e.what() << "\n";
+  }
+  return ratslam::kExitInternal;
 }

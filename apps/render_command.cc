@@ -184,8 +184,8 @@ int RenderSimilarity(const Arguments& args) {
   if (!options) return kExitError;
   int frames = 600;
   if (auto it = args.values.find("--frames"); it != args.values.end()) {
-    auto n = ParseNumber("--frames", it->second);
-    if (!n || *n < 2 || *n > 5000) return Fail("--frames must be in 2..5000");
+    auto n = ParseInteger("--frames", it->second, 2, 5000);
+    if (!n) return kExitUsage;
     frames = static_cast<int>(*n);
   }
   PhoneLogOptions phone;

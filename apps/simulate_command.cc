@@ -6,7 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/cli.h"
-#include "fusion/io/file_util.h"
+#include "common/file_util.h"
 #include "sim/simulator.h"
 #include "sim/world_figure.h"
 #include "viewer/renderer.h"
@@ -61,8 +61,8 @@ int SimulateCommand(int argc, char** argv) {
   }
   uint64_t seed = 1;
   if (args->values.count("--seed")) {
-    const auto s = ParseNumber("--seed", args->values.at("--seed"));
-    if (!s || *s < 0 || *s != std::floor(*s)) return kExitUsage;
+    const auto s = ParseInteger("--seed", args->values.at("--seed"), 0, int64_t{1} << 53);
+    if (!s) return kExitUsage;
     seed = static_cast<uint64_t>(*s);
   }
   auto world = LoadWorld(args->values.at("--world"));

@@ -6,9 +6,9 @@
 #include <memory>
 #include <utility>
 
+#include "common/random.h"
 #include "fusion/fabmap/fabmap.h"
 #include "fusion/fabmap/synthetic_words.h"
-#include "ratslam/random.h"
 
 namespace ratslam::fabmap {
 namespace {

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <vector>
 
-#include "ratslam/circular.h"
+#include "common/circular.h"
 #include "ratslam/pose_cell_network.h"
 
 namespace ratslam {

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <filesystem>
 
-#include "ratslam/random.h"
+#include "common/random.h"
 #include "viewer/figures.h"
 #include "viewer/renderer.h"
 

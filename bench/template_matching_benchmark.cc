@@ -5,7 +5,7 @@
 #include <cmath>
 #include <vector>
 
-#include "ratslam/random.h"
+#include "common/random.h"
 #include "sensors/classic_camera_matcher.h"
 
 namespace ratslam {

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "ratslam/random.h"
+#include "common/random.h"
 #include "sensors/wifi_fingerprint_matcher.h"
 
 namespace ratslam {

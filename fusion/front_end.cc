@@ -1,11 +1,12 @@
 #include "fusion/front_end.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 
-#include "ratslam/byte_buffer.h"
-#include "ratslam/circular.h"
+#include "common/byte_buffer.h"
+#include "common/circular.h"
 
 namespace ratslam {
 
@@ -49,11 +50,11 @@ bool FabmapSettings::IsValid(std::string* error) const {
 
 bool FabmapFrontEndOptions::IsValid(std::string* error) const {
   if (!(match_probability > 0.0 && match_probability <= 1.0)) {
-    *error = "match_probability must be in (0, 1]";
+    if (error) *error = "match_probability: must be in (0, 1]";
     return false;
   }
   if (recency_templates < 0 || !(recency_s >= 0.0) || !(max_wifi_age_s >= 0.0)) {
-    *error = "recency_templates, recency_s and max_wifi_age_s must not be negative";
+    if (error) *error = "recency_templates: must not be negative, nor recency_s and max_wifi_age_s";
     return false;
   }
   return true;
@@ -87,6 +88,12 @@ bool FusedOptions::IsValid(std::string* error) const {
 }
 
 namespace {
+
+template <typename T>
+bool AllFinite(const std::vector<T>& values) {
+  return std::all_of(values.begin(), values.end(), [](T v) { return std::isfinite(v); });
+}
+bool FiniteOrAbsent(const std::optional<double>& v) { return !v || std::isfinite(*v); }
 
 GrayImageView ViewOf(const GrayImage& image) {
   return {image.width, image.height, image.width, image.pixels.data()};
@@ -225,6 +232,20 @@ class FusedFrontEnd : public FrontEnd {
     if (camera.size() != created.size() || ws.fingerprints.size() != created.size() ||
         headings.size() != created.size()) {
       return Status::Error("fused front-end state: sensor template counts differ");
+    }
+    if (!AllFinite(created) || !std::all_of(headings.begin(), headings.end(), FiniteOrAbsent) ||
+        !FiniteOrAbsent(newest_time) || !FiniteOrAbsent(heading) || !AllFinite(newest.rssi_dbm) ||
+        newest.ap_ids.size() != newest.rssi_dbm.size() ||
+        std::any_of(newest.ap_ids.begin(), newest.ap_ids.end(),
+                    [&ws](uint32_t id) { return id >= ws.bssids.size(); })) {
+      return Status::Error(
+          "fused front-end state: a time, heading or RSSI is not finite, or the newest scan "
+          "names an unknown access point");
+    }
+    for (const Fingerprint& f : ws.fingerprints) {
+      if (!AllFinite(f.rssi_dbm)) {
+        return Status::Error("fused front-end state: a fingerprint RSSI is not finite");
+      }
     }
     RATSLAM_RETURN_IF_ERROR(camera_.SetTemplates(std::move(camera)));
     RATSLAM_RETURN_IF_ERROR(wifi_.SetState(std::move(ws)));
@@ -404,6 +425,15 @@ class FabmapFrontEnd : public FrontEnd {
     ok = ok && r.Optional(&newest_time) && readings(&newest) &&
          (r.AtEnd() || r.Fail("trailing bytes"));
     if (!ok) return Status::Error(r.error());
+    auto readings_ok = [](const std::vector<WifiReading>& scan) {
+      return std::all_of(scan.begin(), scan.end(),
+                         [](const WifiReading& x) { return std::isfinite(x.rssi_dbm); });
+    };
+    if (!AllFinite(times) || !FiniteOrAbsent(newest_time) || !readings_ok(newest) ||
+        !std::all_of(places.begin(), places.end(),
+                     [&](const fabmap::Query& q) { return !q.wifi || readings_ok(*q.wifi); })) {
+      return Status::Error("FABMAP front-end state: a time or RSSI is not finite");
+    }
     Reset();
     for (size_t i = 0; i < places.size(); ++i) {
       RATSLAM_RETURN_IF_ERROR(localiser_->AddPlace(places[i]));

@@ -28,12 +28,12 @@
 #include <optional>
 #include <string>
 
+#include "common/status.h"
 #include "fusion/fabmap/evaluation.h"
 #include "fusion/fabmap/localiser.h"
 #include "fusion/fabmap/visual_model.h"
 #include "fusion/fabmap/vocabulary.h"
 #include "ratslam/local_view_cells.h"
-#include "ratslam/status.h"
 #include "sensors/classic_camera_matcher.h"
 #include "sensors/dataset/dataset.h"
 #include "sensors/dataset/image_loader.h"

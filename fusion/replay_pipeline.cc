@@ -3,7 +3,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "ratslam/circular.h"
+#include "common/circular.h"
 
 namespace ratslam {
 
@@ -22,6 +22,42 @@ bool PipelineOptions::IsValid(std::string* error) const {
 }
 
 namespace {
+
+bool Bounded(double v) { return std::isfinite(v) && std::abs(v) <= kMaxCoordinate; }
+
+// The pipeline's own records point into the spine's templates and experiences; the outputs
+// follow those ids, so every one is checked before a restored state is taken over.
+Status CheckRecords(const ReplayPipeline::State& state) {
+  const auto templates = static_cast<int64_t>(state.ratslam.local_view.templates.size());
+  const auto experiences = static_cast<int64_t>(state.ratslam.experience_map.experiences.size());
+  auto experience_ok = [experiences](int64_t id) { return id >= -1 && id < experiences; };
+  for (size_t i = 0; i < state.trajectory.size(); ++i) {
+    const TrajectoryRecord& t = state.trajectory[i];
+    if (!experience_ok(t.experience_id)) {
+      return Status::Error("saved map: trajectory record " + std::to_string(i) +
+                           " refers to an experience that does not exist");
+    }
+    if (!Bounded(t.time_s) || !Bounded(t.offset.forward_m) || !Bounded(t.offset.left_m) ||
+        !Bounded(t.offset.facing_rad) || !Bounded(t.odometry_x_m) || !Bounded(t.odometry_y_m) ||
+        !Bounded(t.odometry_theta_rad)) {
+      return Status::Error("saved map: trajectory record " + std::to_string(i) +
+                           " has a non-finite or out-of-range value");
+    }
+  }
+  for (size_t i = 0; i < state.frames.size(); ++i) {
+    const FrameRecord& f = state.frames[i];
+    if (f.template_id >= templates || !experience_ok(f.experience_id) || !Bounded(f.time_s)) {
+      return Status::Error("saved map: frame record " + std::to_string(i) +
+                           " refers to a template or experience that does not exist");
+    }
+  }
+  if (!Bounded(state.last_odometry_time_s) || !Bounded(state.odometry_x_m) ||
+      !Bounded(state.odometry_y_m) || !Bounded(state.odometry_theta_rad)) {
+    return Status::Error("saved map: dead-reckoned pose is not finite");
+  }
+  return Status::Ok();
+}
+
 const PipelineOptions& Validated(const PipelineOptions& options) {
   std::string error;
   if (!options.IsValid(&error)) throw std::invalid_argument("PipelineOptions: " + error);
@@ -161,6 +197,7 @@ Status ReplayPipeline::Restore(const State& state) {
                          std::to_string(events_.size()));
   }
   if (state.next_event > events_.size()) return Status::Error("saved map is past the data set");
+  RATSLAM_RETURN_IF_ERROR(CheckRecords(state));
   auto slam = std::make_unique<Ratslam>(options_.ratslam);
   RATSLAM_RETURN_IF_ERROR(slam->SetState(state.ratslam));
   std::unique_ptr<FrontEnd> front_end = CreateFrontEnd(options_.sensors, fabmap_);

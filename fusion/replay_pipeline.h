@@ -13,9 +13,9 @@
 #include <string>
 #include <vector>
 
+#include "common/status.h"
 #include "fusion/front_end.h"
 #include "ratslam/ratslam.h"
-#include "ratslam/status.h"
 #include "sensors/dataset/dataset.h"
 #include "sensors/dataset/image_loader.h"
 #include "sensors/pedestrian_dead_reckoning.h"

@@ -6,7 +6,7 @@
 #include <limits>
 #include <stdexcept>
 
-#include "ratslam/circular.h"
+#include "common/circular.h"
 
 namespace ratslam {
 
@@ -173,22 +173,42 @@ std::vector<uint32_t> ExperienceMap::ShortestPath(uint32_t from, uint32_t to) co
 }
 
 Status ExperienceMap::SetState(State state) {
+  // Every id and number is checked before anything is taken over: a restored map is untrusted
+  // input, and a dangling id or a NaN would crash or poison the next action.
+  auto fail = [](const std::string& what) {
+    return Status::Error("experience map state: " + what);
+  };
+  auto finite = [](double v) { return std::isfinite(v) && std::abs(v) <= kMaxCoordinate; };
   const size_t n = state.experiences.size();
-  for (size_t i = 0; i < n; ++i) {
-    if (state.experiences[i].id != i) {
-      return Status::Error("experience map state: experience " + std::to_string(i) + " has id " +
-                           std::to_string(state.experiences[i].id));
-    }
-  }
-  for (size_t i = 0; i < state.links.size(); ++i) {
+  const size_t n_links = state.links.size();
+  for (size_t i = 0; i < n_links; ++i) {
     const Link& l = state.links[i];
     if (l.id != i || l.from >= n || l.to >= n) {
-      return Status::Error("experience map state: link " + std::to_string(i) +
-                           " is inconsistent with the experiences");
+      return fail("link " + std::to_string(i) + " is inconsistent with the experiences");
+    }
+    if (!finite(l.distance_m) || l.distance_m < 0.0 || !finite(l.heading_rad) ||
+        !finite(l.facing_rad) || !finite(l.duration_s)) {
+      return fail("link " + std::to_string(i) + " has a non-finite or out-of-range value");
     }
   }
-  if (state.current && *state.current >= n) {
-    return Status::Error("experience map state: current experience does not exist");
+  for (size_t i = 0; i < n; ++i) {
+    const Experience& e = state.experiences[i];
+    const std::string name = "experience " + std::to_string(i);
+    if (e.id != i) return fail(name + " has id " + std::to_string(e.id));
+    if (!finite(e.x_m) || !finite(e.y_m) || !finite(e.theta_rad) || !finite(e.time_s) ||
+        (e.compass_heading_rad && !finite(*e.compass_heading_rad))) {
+      return fail(name + " has a non-finite or out-of-range value");
+    }
+    for (uint32_t link : e.link_ids) {
+      if (link >= n_links || (state.links[link].from != i && state.links[link].to != i)) {
+        return fail(name + " lists link " + std::to_string(link) + ", which does not join it");
+      }
+    }
+  }
+  if (state.current && *state.current >= n) return fail("current experience does not exist");
+  if (!finite(state.offset.forward_m) || !finite(state.offset.left_m) ||
+      !finite(state.offset.facing_rad) || !finite(state.offset_start_time_s)) {
+    return fail("offset since the current experience is not finite");
   }
   state_ = std::move(state);
   return Status::Ok();

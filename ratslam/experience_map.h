@@ -8,10 +8,14 @@
 #include <string>
 #include <vector>
 
+#include "common/status.h"
 #include "ratslam/pose_cell_network.h"
-#include "ratslam/status.h"
 
 namespace ratslam {
+
+// Largest magnitude a coordinate (m), angle (rad) or time (s) may have in a restored state: larger
+// values, like non-finite ones, mean a corrupt file (data times are at most epoch seconds).
+inline constexpr double kMaxCoordinate = 1e12;
 
 struct ExperienceMapOptions {
   int relaxation_sweeps = 10;            // relaxation passes over all links after each action
@@ -108,6 +112,8 @@ class ExperienceMap {
   std::optional<uint32_t> current() const { return state_.current; }
   const LocalOffset& offset() const { return state_.offset; }
   const State& state() const { return state_; }
+  // Restores a state; fails, changing nothing, on an id that points nowhere (a link's ends, an
+  // experience's links, the current experience) or a non-finite or out-of-range number.
   Status SetState(State state);
 
  private:

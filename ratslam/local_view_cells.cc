@@ -5,7 +5,8 @@
 #include <numbers>
 #include <stdexcept>
 
-#include "ratslam/circular.h"
+#include "common/circular.h"
+#include "ratslam/experience_map.h"
 
 namespace ratslam {
 
@@ -95,9 +96,18 @@ StatusOr<std::optional<Injection>> LocalViewCells::Observe(const ViewDecision& d
 
 Status LocalViewCells::SetState(State state) {
   for (size_t i = 0; i < state.templates.size(); ++i) {
-    if (state.templates[i].id != i) {
-      return Status::Error("local view state: template " + std::to_string(i) + " has id " +
-                           std::to_string(state.templates[i].id));
+    const ViewTemplate& t = state.templates[i];
+    const std::string name = "local view state: template " + std::to_string(i);
+    if (t.id != i) return Status::Error(name + " has id " + std::to_string(t.id));
+    if (!std::isfinite(t.decay) || std::abs(t.decay) > kMaxCoordinate ||
+        !std::isfinite(t.created_time_s) || std::abs(t.created_time_s) > kMaxCoordinate) {
+      return Status::Error(name + " has a non-finite or out-of-range decay or time");
+    }
+    if (t.decay_frame > state.frame) {
+      return Status::Error(name + " was last matched after the last frame");
+    }
+    if (!(t.pose_cells.theta >= 0.0 && t.pose_cells.theta <= dim_theta_cells_)) {
+      return Status::Error(name + " has a pose-cell theta outside the ring");
     }
   }
   state_ = std::move(state);

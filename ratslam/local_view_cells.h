@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "common/status.h"
 #include "ratslam/pose_cell_network.h"
-#include "ratslam/status.h"
 
 namespace ratslam {
 
@@ -90,6 +90,8 @@ class LocalViewCells {
   const ViewTemplate& at(uint32_t id) const { return state_.templates[id]; }
   ViewTemplate& at(uint32_t id) { return state_.templates[id]; }
   const State& state() const { return state_; }
+  // Restores a state; fails, changing nothing, on ids out of order, a decay or time that is not
+  // finite, or a theta outside the ring (x and y are checked by Ratslam, which knows the grid).
   Status SetState(State state);
 
  private:

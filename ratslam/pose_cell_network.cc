@@ -6,7 +6,7 @@
 #include <numbers>
 #include <stdexcept>
 
-#include "ratslam/circular.h"
+#include "common/circular.h"
 
 namespace ratslam {
 namespace {
@@ -446,6 +446,13 @@ Status PoseCellNetwork::SetState(const State& state) {
   if (state.residual_x_cells.size() != static_cast<size_t>(dim_t_) ||
       state.residual_y_cells.size() != static_cast<size_t>(dim_t_)) {
     return Status::Error("pose-cell state: residuals do not match dim_theta_cells");
+  }
+  // Path integration keeps every residual within half a cell (rounding to whole cells).
+  auto residual_ok = [](double r) { return std::isfinite(r) && std::abs(r) <= 0.5 + 1e-9; };
+  if (!std::all_of(state.residual_x_cells.begin(), state.residual_x_cells.end(), residual_ok) ||
+      !std::all_of(state.residual_y_cells.begin(), state.residual_y_cells.end(), residual_ok) ||
+      !residual_ok(state.residual_theta_cells)) {
+    return Status::Error("pose-cell state: a residual is not finite or exceeds half a cell");
   }
   for (size_t i = 0; i < state.active_indices.size(); ++i) {
     if (state.active_indices[i] >= activity_.size()) {

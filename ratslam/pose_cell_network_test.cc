@@ -7,7 +7,7 @@
 #include <random>
 #include <vector>
 
-#include "ratslam/circular.h"
+#include "common/circular.h"
 
 namespace ratslam {
 namespace {

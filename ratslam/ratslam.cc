@@ -110,16 +110,46 @@ Ratslam::State Ratslam::GetState() const {
           current_template_,      counters_,           compass_heading_rad_};
 }
 
-Status Ratslam::SetState(const State& state) {
-  for (const Experience& e : state.experience_map.experiences) {
-    if (e.template_id >= state.local_view.templates.size()) {
-      return Status::Error("state: experience " + std::to_string(e.id) +
-                           " refers to a template that does not exist");
+namespace {
+
+// The cross-references between the components that none of them can check alone.
+Status CheckCrossReferences(const Ratslam::State& state, const PoseCellOptions& grid) {
+  const auto& templates = state.local_view.templates;
+  const auto& experiences = state.experience_map.experiences;
+  auto on_grid = [&grid](const PoseCellPosition& p) {
+    return p.x >= 0.0 && p.x <= grid.dim_xy_cells && p.y >= 0.0 && p.y <= grid.dim_xy_cells &&
+           p.theta >= 0.0 && p.theta <= grid.dim_theta_cells;
+  };
+  for (const ViewTemplate& t : templates) {
+    const std::string name = "state: template " + std::to_string(t.id);
+    if (!on_grid(t.pose_cells)) return Status::Error(name + " lies outside the pose-cell grid");
+    for (uint32_t id : t.experience_ids) {
+      if (id >= experiences.size() || experiences[id].template_id != t.id) {
+        return Status::Error(name + " lists experience " + std::to_string(id) +
+                             ", which does not exist or belongs to another template");
+      }
     }
   }
-  if (state.current_template && *state.current_template >= state.local_view.templates.size()) {
+  for (const Experience& e : experiences) {
+    const std::string name = "state: experience " + std::to_string(e.id);
+    if (e.template_id >= templates.size()) {
+      return Status::Error(name + " refers to a template that does not exist");
+    }
+    if (!on_grid(e.pose_cells)) return Status::Error(name + " lies outside the pose-cell grid");
+  }
+  if (state.current_template && *state.current_template >= templates.size()) {
     return Status::Error("state: current template does not exist");
   }
+  if (state.compass_heading_rad && !std::isfinite(*state.compass_heading_rad)) {
+    return Status::Error("state: compass heading is not finite");
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status Ratslam::SetState(const State& state) {
+  RATSLAM_RETURN_IF_ERROR(CheckCrossReferences(state, options_.pose_cells));
   // All or nothing: restore into fresh components, then swap them in.
   PoseCellNetwork pose_cells(options_.pose_cells);
   LocalViewCells local_view(options_.local_view, options_.pose_cells.dim_theta_cells);

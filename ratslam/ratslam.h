@@ -8,10 +8,10 @@
 #include <optional>
 #include <string>
 
+#include "common/status.h"
 #include "ratslam/experience_map.h"
 #include "ratslam/local_view_cells.h"
 #include "ratslam/pose_cell_network.h"
-#include "ratslam/status.h"
 
 namespace ratslam {
 

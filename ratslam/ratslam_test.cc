@@ -2,7 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <functional>
+#include <limits>
 #include <numbers>
+#include <utility>
+#include <vector>
 
 namespace ratslam {
 namespace {
@@ -95,6 +99,77 @@ TEST(RatslamTest, FailedSetStateChangesNothing) {
   EXPECT_EQ(b.local_view().size(), 0u);  // the valid parts were not applied either
   EXPECT_EQ(b.experience_map().num_experiences(), 0u);
   EXPECT_EQ(b.pose_cells().BestPosition().x, before.x);
+}
+
+// A restored state is untrusted input: every corruption below once loaded and crashed (or
+// poisoned) the next step. Each must be refused with a message, and the spine left unchanged.
+TEST(RatslamTest, SetStateRefusesDanglingIdsAndNonFiniteValues) {
+  Ratslam a({});
+  for (uint32_t i = 0; i < 30; ++i) {
+    ASSERT_TRUE(a.OnView({i * 1.0, i % 10, i < 10, 0.0}).ok());
+    ASSERT_TRUE(a.OnOdometry({i * 1.0, 0.8, 0.3}).ok());
+  }
+  const Ratslam::State good = a.GetState();
+  ASSERT_GE(good.experience_map.experiences.size(), 3u);
+  ASSERT_GE(good.experience_map.links.size(), 2u);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const std::vector<std::pair<const char*, std::function<void(Ratslam::State&)>>> corruptions = {
+      {"template -> missing experience",  // the ASan SEGV at ratslam.cc:77
+       [](auto& s) { s.local_view.templates[0].experience_ids.push_back(4000); }},
+      {"template -> another template's experience",
+       [](auto& s) {
+         const uint32_t owner = s.experience_map.experiences[0].template_id;
+         s.local_view.templates[owner == 0 ? 1 : 0].experience_ids.push_back(0);
+       }},
+      {"experience -> missing link",
+       [](auto& s) { s.experience_map.experiences[0].link_ids = {77}; }},
+      {"experience -> link that does not join it",
+       [](auto& s) {
+         auto& e = s.experience_map.experiences;
+         const auto& l = s.experience_map.links;
+         for (uint32_t k = 0; k < l.size(); ++k) {
+           if (l[k].from != e.back().id && l[k].to != e.back().id) {
+             e.back().link_ids.push_back(k);
+             return;
+           }
+         }
+       }},
+      {"experience x NaN", [nan](auto& s) { s.experience_map.experiences[1].x_m = nan; }},
+      {"experience y huge", [](auto& s) { s.experience_map.experiences[1].y_m = 1e300; }},
+      {"link distance infinite",
+       [](auto& s) {
+         s.experience_map.links[0].distance_m = std::numeric_limits<double>::infinity();
+       }},
+      {"offset NaN", [nan](auto& s) { s.experience_map.offset.left_m = nan; }},
+      {"pose-cell residual NaN", [nan](auto& s) { s.pose_cells.residual_x_cells[3] = nan; }},
+      {"pose-cell residual beyond a cell",
+       [](auto& s) { s.pose_cells.residual_theta_cells = 7.0; }},
+      {"template off the grid", [](auto& s) { s.local_view.templates[2].pose_cells.x = -1e9; }},
+      {"template theta NaN", [nan](auto& s) { s.local_view.templates[2].pose_cells.theta = nan; }},
+      {"experience off the grid",
+       [](auto& s) { s.experience_map.experiences[0].pose_cells.y = 1e6; }},
+      {"template decay NaN", [nan](auto& s) { s.local_view.templates[1].decay = nan; }},
+      {"template matched in the future",
+       [](auto& s) { s.local_view.templates[1].decay_frame = s.local_view.frame + 5; }},
+      {"compass NaN", [nan](auto& s) { s.compass_heading_rad = nan; }},
+      {"current template missing", [](auto& s) { s.current_template = 500; }},
+  };
+  for (const auto& [name, corrupt] : corruptions) {
+    Ratslam::State bad = good;
+    corrupt(bad);
+    Ratslam b({});
+    const Status status = b.SetState(bad);
+    EXPECT_FALSE(status.ok()) << name;
+    EXPECT_FALSE(status.message().empty()) << name;
+    EXPECT_EQ(b.local_view().size(), 0u) << name;
+  }
+  // The untouched state still restores and runs on.
+  Ratslam b({});
+  ASSERT_TRUE(b.SetState(good).ok());
+  for (uint32_t i = 30; i < 60; ++i) {
+    ASSERT_TRUE(b.OnView({i * 1.0, i % 10, false, 0.0}).ok());
+    ASSERT_TRUE(b.OnOdometry({i * 1.0, 0.8, 0.3}).ok());
+  }
 }
 
 }  // namespace

@@ -11,7 +11,7 @@
 #define RATSLAM_HAVE_X86_SIMD 1
 #endif
 
-#include "ratslam/circular.h"
+#include "common/circular.h"
 
 namespace ratslam {
 

@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "common/status.h"
 #include "ratslam/local_view_cells.h"
-#include "ratslam/status.h"
 
 namespace ratslam {
 

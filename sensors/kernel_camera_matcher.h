@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "ratslam/status.h"
+#include "common/status.h"
 #include "sensors/classic_camera_matcher.h"
 
 namespace ratslam {

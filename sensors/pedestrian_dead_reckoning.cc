@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "ratslam/circular.h"
+#include "common/circular.h"
 
 namespace ratslam {
 bool PdrOptions::IsValid(std::string* error) const {

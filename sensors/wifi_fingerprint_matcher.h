@@ -20,7 +20,7 @@
 #include <unordered_map>
 #include <vector>
 
-#include "ratslam/status.h"
+#include "common/status.h"
 
 namespace ratslam {
 

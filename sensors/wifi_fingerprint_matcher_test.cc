@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "ratslam/random.h"
+#include "common/random.h"
 
 namespace ratslam {
 namespace {

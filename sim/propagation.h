@@ -13,7 +13,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "ratslam/random.h"
+#include "common/random.h"
 #include "sensors/dataset/dataset.h"
 #include "sim/world.h"
 

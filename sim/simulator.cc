@@ -9,8 +9,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "ratslam/circular.h"
-#include "ratslam/random.h"
+#include "common/circular.h"
+#include "common/random.h"
 #include "sim/propagation.h"
 #include "sim/textures.h"
 

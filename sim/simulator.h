@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "ratslam/status.h"
+#include "common/status.h"
 #include "sensors/dataset/dataset.h"
 #include "sim/world.h"
 #include "viewer/view_renderer.h"

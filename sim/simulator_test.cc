@@ -260,5 +260,18 @@ TEST(WorldTest, ErrorsNameTheLineAndRoundTrip) {
   EXPECT_FALSE(BuiltInWorld("castle").ok());
 }
 
+// The step budget adds the gap between sessions; it once multiplied by it, so a gap of 0 let any
+// world through. 1000 laps of the apartment at 1 cm/s is far beyond ten million steps.
+TEST(WorldTest, StepBudgetHoldsWithoutASessionGap) {
+  World world = *BuiltInWorld("apartment");
+  world.motion.session_gap_s = 0.0;
+  ASSERT_TRUE(world.Validate().ok());
+  world.motion.speed_m_per_s = 0.01;
+  world.sessions.front().laps = 1000;
+  const Status status = world.Validate();
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("ten million"), std::string::npos) << status.message();
+}
+
 }  // namespace
 }  // namespace ratslam::sim

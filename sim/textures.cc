@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "ratslam/random.h"
+#include "common/random.h"
 
 namespace ratslam::sim {
 

@@ -298,7 +298,7 @@ Status World::Validate() const {
       }
       seconds +=
           (length * std::max(1.0, s.laps) / motion.speed_m_per_s +
-           (r.points.size() + 1) * (motion.lift_time_s + 2 * M_PI / motion.turn_rate_rad_per_s)) *
+           (r.points.size() + 1) * (motion.lift_time_s + 2 * M_PI / motion.turn_rate_rad_per_s)) +
           motion.session_gap_s;
     }
   }

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "ratslam/status.h"
+#include "common/status.h"
 
 namespace ratslam::sim {
 

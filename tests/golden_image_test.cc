@@ -3,6 +3,7 @@
 // Mesa release passes while a real change in a figure fails. After an intended change, run with
 // RATSLAM_UPDATE_GOLDEN=1, look at the new images, and commit them.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -38,7 +39,8 @@ void ExpectMatchesGolden(const Scene& scene, const std::string& name) {
   }
   const double mean = sum / actual->pixels.size();
   const double large_fraction = static_cast<double>(large) / actual->pixels.size();
-  const fs::path written = fs::temp_directory_path() / ("ratslam_actual_" + name + ".png");
+  const fs::path written = fs::temp_directory_path() /
+                           ("ratslam_actual_" + std::to_string(::getpid()) + "_" + name + ".png");
   if (mean > 1.0 || large_fraction > 0.005) (void)WritePng(actual.value(), written.string());
   EXPECT_LE(mean, 1.0) << name << ": mean channel difference; actual image in " << written;
   EXPECT_LE(large_fraction, 0.005)

@@ -6,11 +6,11 @@
 #include <filesystem>
 #include <fstream>
 
+#include "common/random.h"
 #include "fusion/fabmap/fabmap.h"
 #include "fusion/fabmap/visual_model.h"
 #include "fusion/io/config.h"
 #include "fusion/io/map_file.h"
-#include "ratslam/random.h"
 #include "sensors/dataset/dataset.h"
 #include "sensors/dataset/ipin_log.h"
 #include "sensors/dataset/msft_log.h"

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "apps/demo_config.h"
+#include "common/scratch_dir.h"
 #include "sensors/dataset/synthetic_dataset.h"
 #include "viewer/image.h"
 #include "viewer/renderer.h"
@@ -154,6 +155,104 @@ TEST_F(ReplayEndToEndTest, SaveAndResumeEqualsUninterruptedRun) {
     j->erase("resumed_from");
   }
   EXPECT_EQ(a, b);
+}
+
+// Compares two run folders' outputs, summary included (less wall times and provenance).
+void ExpectSameRun(const fs::path& a_folder, const fs::path& b_folder) {
+  for (const char* name : kOutputs) {
+    EXPECT_EQ(Slurp(a_folder / name), Slurp(b_folder / name)) << name;
+  }
+  nlohmann::json a = Summary(a_folder), b = Summary(b_folder);
+  for (auto* j : {&a, &b}) {
+    for (const char* key : {"wall_seconds", "frames_per_second", "resumed_from", "data_folder"}) {
+      j->erase(key);
+    }
+  }
+  EXPECT_EQ(a, b);
+}
+
+// A map file written by the release before the schema rewrite (format version 2, made with
+// `ratslam replay --config configs/synthetic.toml --until 75 --save-map`) must still load and
+// resume to exactly the uninterrupted run.
+TEST_F(ReplayEndToEndTest, MapFromThePreviousReleaseResumesToTheSameRun) {
+  const fs::path whole = root_ / "whole_v2", rest = root_ / "rest_v2";
+  const std::string fixture =
+      (fs::path(RATSLAM_SOURCE_DIR) / "tests" / "data" / "map-v2-synthetic.map").string();
+  ASSERT_EQ(RunRatslam(ReplayArgs(whole), root_).exit_code, 0);
+  const Result r = RunRatslam(ReplayArgs(rest) + " --load-map " + fixture, root_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  ExpectSameRun(whole, rest);
+}
+
+// Save and resume for the fused (Wi-Fi + 12x9 camera + compass) and the FABMAP front ends, on
+// the simulated day/night world; the fused one also from a map of the previous release.
+class SimulatedSaveResumeTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    root_ = new ScratchDir("ratslam_e2e_sim");
+    const Result r = RunRatslam(
+        "simulate --quiet --world day_night --seed 1 --out " + (root_->path() / "data").string(),
+        root_->path());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+  }
+  static void TearDownTestSuite() {
+    delete root_;
+    root_ = nullptr;
+  }
+  static std::string Args(const std::string& config, const fs::path& out) {
+    return "replay --quiet --config " + config + " --data " + (root_->path() / "data").string() +
+           " --out " + out.string();
+  }
+  // Runs whole, then in two halves split at `until_s`; the halves must equal the whole.
+  static void ExpectResumeEqualsWhole(const std::string& config, double until_s) {
+    const fs::path& dir = root_->path();
+    const std::string stem = fs::path(config).stem().string();
+    const fs::path whole = dir / (stem + "_whole"), part = dir / (stem + "_part"),
+                   rest = dir / (stem + "_rest"), map = dir / (stem + ".map");
+    ASSERT_EQ(RunRatslam(Args(config, whole), dir).exit_code, 0);
+    ASSERT_EQ(RunRatslam(Args(config, part) + " --until " + std::to_string(until_s) +
+                             " --save-map " + map.string(),
+                         dir)
+                  .exit_code,
+              0);
+    EXPECT_EQ(Summary(part)["finished"], false);
+    const Result r = RunRatslam(Args(config, rest) + " --load-map " + map.string(), dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    ExpectSameRun(whole, rest);
+    // Matches before and after the split, so the front end's restored places were used.
+    EXPECT_GT(Summary(part)["matches"].get<int>(), 0);
+    EXPECT_GT(Summary(whole)["matches"].get<int>(), Summary(part)["matches"].get<int>());
+  }
+  static ScratchDir* root_;
+};
+ScratchDir* SimulatedSaveResumeTest::root_ = nullptr;
+
+TEST_F(SimulatedSaveResumeTest, FusedFrontEnd) {
+  ExpectResumeEqualsWhole((fs::path(RATSLAM_SOURCE_DIR) / "configs" / "demo.toml").string(), 250.0);
+}
+
+TEST_F(SimulatedSaveResumeTest, FusedFrontEndFromAMapOfThePreviousRelease) {
+  // Made with `ratslam replay --config configs/demo.toml --until 200 --save-map` by format 2.
+  const std::string config = (fs::path(RATSLAM_SOURCE_DIR) / "configs" / "demo.toml").string();
+  const fs::path& dir = root_->path();
+  const fs::path whole = dir / "v2_whole", rest = dir / "v2_rest";
+  ASSERT_EQ(RunRatslam(Args(config, whole), dir).exit_code, 0);
+  const Result r = RunRatslam(
+      Args(config, rest) + " --load-map " +
+          (fs::path(RATSLAM_SOURCE_DIR) / "tests" / "data" / "map-v2-fused.map").string(),
+      dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  ExpectSameRun(whole, rest);
+}
+
+TEST_F(SimulatedSaveResumeTest, FabmapFrontEnd) {
+  const fs::path config = root_->path() / "fabmap-wifi.toml";
+  std::ofstream(config) << "[front_end]\nkind = \"fabmap\"\n[fabmap]\nmode = \"wifi\"\n"
+                           "[fabmap_front_end]\nmatch_probability = 0.5\nrecency_s = 40.0\n"
+                           "[wifi_words]\nbins = 4\nencoding = \"incremental\"\n"
+                           "[virtual_wifi]\nuse_exploration_scans = true\n"
+                           "[pose_cells]\ncell_size_m = 2.0\n";
+  ExpectResumeEqualsWhole(config.string(), 250.0);
 }
 
 TEST_F(ReplayEndToEndTest, ResumeWithAnotherConfigIsRefused) {

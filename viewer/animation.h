@@ -5,7 +5,7 @@
 #include <memory>
 #include <string>
 
-#include "ratslam/status.h"
+#include "common/status.h"
 #include "viewer/image.h"
 
 namespace ratslam {

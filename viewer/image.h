@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "ratslam/status.h"
+#include "common/status.h"
 #include "viewer/scene.h"
 
 namespace ratslam {

@@ -4,7 +4,7 @@
 
 #include <memory>
 
-#include "ratslam/status.h"
+#include "common/status.h"
 #include "viewer/image.h"
 #include "viewer/scene.h"
 

@@ -7,8 +7,16 @@
 #include <cstdlib>
 #include <filesystem>
 
+#include "common/scratch_dir.h"
+
 namespace ratslam {
 namespace {
+
+// One fresh folder per test process (two checkouts testing at once never collide).
+const ScratchDir& TestScratch() {
+  static const ScratchDir dir("ratslam_test");
+  return dir;
+}
 
 std::unique_ptr<SceneRenderer> MakeRenderer() {
   StatusOr<std::unique_ptr<SceneRenderer>> renderer = CreateOsMesaRenderer();
@@ -101,14 +109,14 @@ TEST(OsMesaRendererTest, MissingLibraryIsAClearError) {
       << renderer.status().message();
   const Scene scene(10, 10, {0, 0, 0, 255});
   ::setenv("RATSLAM_OSMESA_LIBRARY", "/nonexistent/libOSMesa.so.8", 1);
-  EXPECT_FALSE(RenderToPng(scene, "/tmp/never_written.png").ok());
+  EXPECT_FALSE(RenderToPng(scene, (TestScratch() / "never_written.png").string()).ok());
   ::unsetenv("RATSLAM_OSMESA_LIBRARY");
 }
 
 TEST(PngTest, WriteReadRoundTrip) {
   RgbaImage image{3, 2, {1,  2,  3,  255, 4,  5,  6,  255, 7,  8,  9,  255,
                          10, 11, 12, 255, 13, 14, 15, 255, 16, 17, 18, 128}};
-  const auto path = std::filesystem::temp_directory_path() / "ratslam_png_test.png";
+  const auto path = TestScratch().path() / "ratslam_png_test.png";
   ASSERT_TRUE(WritePng(image, path.string()).ok());
   StatusOr<RgbaImage> back = ReadPng(path.string());
   ASSERT_TRUE(back.ok());

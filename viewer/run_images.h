@@ -5,8 +5,8 @@
 
 #include <string>
 
+#include "common/status.h"
 #include "fusion/replay_pipeline.h"
-#include "ratslam/status.h"
 #include "viewer/figures.h"
 #include "viewer/renderer.h"
 

@@ -5,9 +5,9 @@
 #include <string>
 #include <vector>
 
+#include "common/status.h"
 #include "fusion/replay_pipeline.h"
 #include "ratslam/experience_map.h"
-#include "ratslam/status.h"
 
 namespace ratslam {
 

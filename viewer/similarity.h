@@ -4,7 +4,7 @@
 
 #include <vector>
 
-#include "ratslam/status.h"
+#include "common/status.h"
 #include "sensors/classic_camera_matcher.h"
 #include "sensors/dataset/dataset.h"
 #include "sensors/dataset/image_loader.h"

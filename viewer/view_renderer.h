@@ -7,7 +7,7 @@
 #include <memory>
 #include <vector>
 
-#include "ratslam/status.h"
+#include "common/status.h"
 #include "sensors/dataset/image_loader.h"
 
 namespace ratslam {

@@ -7,7 +7,7 @@ namespace ratslam::fabmap {
 
 bool ChowLiuOptions::IsValid(std::string* error) const {
   if (!(pseudo_count > 0.0) || !std::isfinite(pseudo_count)) {
-    *error = "pseudo_count must be positive and finite";
+    if (error) *error = "pseudo_count: must be positive and finite";
     return false;
   }
   return true;

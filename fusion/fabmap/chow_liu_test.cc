@@ -6,8 +6,8 @@
 #include <set>
 #include <utility>
 
+#include "common/random.h"
 #include "fusion/fabmap/synthetic_words.h"
-#include "ratslam/random.h"
 
 namespace ratslam::fabmap {
 namespace {

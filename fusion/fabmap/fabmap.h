@@ -32,8 +32,8 @@
 #include <string>
 #include <vector>
 
+#include "common/status.h"
 #include "fusion/fabmap/chow_liu.h"
-#include "ratslam/status.h"
 
 namespace ratslam::fabmap {
 

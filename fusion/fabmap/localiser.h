@@ -25,10 +25,10 @@
 #include <string>
 #include <vector>
 
+#include "common/status.h"
 #include "fusion/fabmap/chow_liu.h"
 #include "fusion/fabmap/fabmap.h"
 #include "fusion/fabmap/wifi_words.h"
-#include "ratslam/status.h"
 #include "sensors/dataset/dataset.h"
 
 namespace ratslam::fabmap {

@@ -4,8 +4,8 @@
 
 #include <cmath>
 
+#include "common/random.h"
 #include "fusion/fabmap/synthetic_words.h"
-#include "ratslam/random.h"
 
 namespace ratslam::fabmap {
 namespace {

@@ -7,8 +7,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "common/random.h"
 #include "fusion/fabmap/chow_liu.h"
-#include "ratslam/random.h"
 
 namespace ratslam::fabmap {
 

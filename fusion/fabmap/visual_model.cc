@@ -7,13 +7,13 @@
 #include <sstream>
 #include <system_error>
 
-#include "ratslam/byte_buffer.h"
+#include "common/byte_buffer.h"
 
 namespace ratslam::fabmap {
 
 bool VisualModelOptions::IsValid(std::string* error) const {
   if (training_image_step < 1) {
-    *error = "training_image_step must be at least 1";
+    if (error) *error = "training_image_step: must be at least 1";
     return false;
   }
   return true;

@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
+#include "common/status.h"
 #include "fusion/fabmap/localiser.h"
 #include "fusion/fabmap/vocabulary.h"
-#include "ratslam/status.h"
 #include "sensors/dataset/image_loader.h"
 
 namespace ratslam::fabmap {

@@ -8,8 +8,8 @@
 #include <opencv2/core.hpp>
 #include <opencv2/features2d.hpp>
 
-#include "ratslam/byte_buffer.h"
-#include "ratslam/random.h"
+#include "common/byte_buffer.h"
+#include "common/random.h"
 
 namespace ratslam::fabmap {
 
@@ -23,11 +23,11 @@ StatusOr<DescriptorKind> DescriptorKindFromString(const std::string& name) {
 
 bool FeatureOptions::IsValid(std::string* error) const {
   if (max_features < 1) {
-    *error = "max_features must be at least 1";
+    if (error) *error = "max_features: must be at least 1";
     return false;
   }
   if (fast_threshold < 1 || fast_threshold > 255) {
-    *error = "fast_threshold must be in 1..255";
+    if (error) *error = "fast_threshold: must be in 1..255";
     return false;
   }
   return true;
@@ -35,15 +35,15 @@ bool FeatureOptions::IsValid(std::string* error) const {
 
 bool VocabularyOptions::IsValid(std::string* error) const {
   if (words < 1) {
-    *error = "words must be at least 1";
+    if (error) *error = "words: must be at least 1";
     return false;
   }
   if (iterations < 1) {
-    *error = "iterations must be at least 1";
+    if (error) *error = "iterations: must be at least 1";
     return false;
   }
   if (max_descriptors < 1) {
-    *error = "max_descriptors must be at least 1";
+    if (error) *error = "max_descriptors: must be at least 1";
     return false;
   }
   return true;

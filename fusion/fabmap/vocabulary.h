@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "common/status.h"
 #include "fusion/fabmap/chow_liu.h"
-#include "ratslam/status.h"
 #include "sensors/dataset/image_loader.h"
 
 namespace ratslam::fabmap {

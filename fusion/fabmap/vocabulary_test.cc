@@ -4,7 +4,7 @@
 
 #include <filesystem>
 
-#include "ratslam/random.h"
+#include "common/random.h"
 
 namespace ratslam::fabmap {
 namespace {

@@ -19,8 +19,8 @@
 #include <unordered_map>
 #include <vector>
 
+#include "common/status.h"
 #include "fusion/fabmap/chow_liu.h"
-#include "ratslam/status.h"
 #include "sensors/dataset/dataset.h"
 
 namespace ratslam::fabmap {

@@ -263,7 +263,9 @@ StatusOr<ImportedConfig> ImportOpenRatslamIni(const std::string& path) {
   using Setter = std::function<Status(double)>;
   auto whole = [](int& field) {
     return [&field](double v) {
-      if (v != std::floor(v)) return Status::Error("expected a whole number");
+      if (v != std::floor(v) || !(std::abs(v) <= std::numeric_limits<int>::max())) {
+        return Status::Error("expected a whole number within the range of int");
+      }
       field = static_cast<int>(v);
       return Status::Ok();
     };

@@ -5,8 +5,16 @@
 #include <filesystem>
 #include <fstream>
 
+#include "common/scratch_dir.h"
+
 namespace ratslam {
 namespace {
+
+// One fresh folder per test process (two checkouts testing at once never collide).
+const ScratchDir& TestScratch() {
+  static const ScratchDir dir("ratslam_test");
+  return dir;
+}
 
 std::string ErrorOf(const std::string& text) {
   StatusOr<PipelineOptions> o = ParseConfig(text, "c.toml");
@@ -54,6 +62,32 @@ TEST(ConfigTest, OutOfRangeValueNamesLine) {
             "c.toml:4: pose_cells.excitation_size_cells: must be odd and at least 1");
 }
 
+// Every section's range errors name the line: the FABMAP sections once reported "c.toml:" with no
+// line because their checks wrote "field reason" instead of "field: reason".
+TEST(ConfigTest, OutOfRangeValueNamesLineInEverySection) {
+  const std::pair<const char*, const char*> cases[] = {
+      {"fabmap_front_end", "match_probability = 2.0"},
+      {"fabmap", "max_candidates = 0"},
+      {"fabmap_model", "p_new_place = 1.5"},
+      {"visual_detector", "p_observed_given_exists = 0.0"},
+      {"wifi_detector", "p_observed_given_exists = 1.0"},
+      {"visual_words", "max_features = 0"},
+      {"vocabulary", "words = 0"},
+      {"visual_model", "training_image_step = 0"},
+      {"wifi_words", "bins = 0"},
+      {"virtual_wifi", "samples = 0"},
+      {"evaluation", "map_fraction = 1.5"},
+      {"camera", "match_threshold = -1.0"},
+      {"local_view", "energy_limit = 0.0"},
+  };
+  for (const auto& [section, line] : cases) {
+    const std::string error =
+        ErrorOf("# a comment\n[" + std::string(section) + "]\n\n" + std::string(line) + "\n");
+    const std::string key = std::string(line).substr(0, std::string(line).find(' '));
+    EXPECT_EQ(error.rfind("c.toml:4: " + std::string(section) + "." + key + ": ", 0), 0u) << error;
+  }
+}
+
 TEST(ConfigTest, BadEnumListsValidNames) {
   const std::string error = ErrorOf("[front_end]\nkind = \"wifi\"\n");
   EXPECT_NE(error.find("c.toml:2"), std::string::npos) << error;
@@ -79,7 +113,7 @@ TEST(ConfigTest, PrintThenParseRoundTrips) {
 }
 
 TEST(ConfigTest, ImportsOpenRatslamIniAndReportsUnusedKeys) {
-  const auto path = std::filesystem::temp_directory_path() / "ratslam_import_test.ini";
+  const auto path = TestScratch().path() / "ratslam_import_test.ini";
   std::ofstream(path) << "[general]\ntopic_root=irat_red\n\n[ratslam]\n"
                          "vt_match_threshold=0.085\npc_dim_xy=30\npc_cell_x_size=0.015\n"
                          "exp_loops=20\nvt_active_decay = 1.5 ; comment\nvt_panoramic=1\n"

@@ -8,8 +8,8 @@
 #include <cstdint>
 #include <string>
 
+#include "common/status.h"
 #include "fusion/replay_pipeline.h"
-#include "ratslam/status.h"
 
 namespace ratslam {
 

@@ -4,8 +4,17 @@
 
 #include <filesystem>
 
+#include "common/scratch_dir.h"
+#include "fusion/io/state_schema.h"
+
 namespace ratslam {
 namespace {
+
+// One fresh folder per test process (two checkouts testing at once never collide).
+const ScratchDir& TestScratch() {
+  static const ScratchDir dir("ratslam_test");
+  return dir;
+}
 
 MapFile SampleMap() {
   // A small but complete state, produced by running the spine.
@@ -62,7 +71,7 @@ TEST(MapFileTest, CorruptCountsAndTrailingBytesAreErrors) {
 }
 
 TEST(MapFileTest, SaveIsAtomicAndLoads) {
-  const auto path = std::filesystem::temp_directory_path() / "ratslam_map_file_test.map";
+  const auto path = TestScratch().path() / "ratslam_map_file_test.map";
   ASSERT_TRUE(SaveMapFile(SampleMap(), path.string()).ok());
   StatusOr<MapFile> back = LoadMapFile(path.string());
   ASSERT_TRUE(back.ok()) << back.status().message();
@@ -72,6 +81,82 @@ TEST(MapFileTest, SaveIsAtomicAndLoads) {
   }
   std::filesystem::remove(path);
   EXPECT_FALSE(LoadMapFile(path.string()).ok());
+}
+
+// The number of members of an aggregate, found by trying brace-initialisation with ever more
+// arguments convertible to anything (the technique of Boost.PFR; no code from it). Independent
+// of the schema, so it catches a member added to a state struct but not to its Describe.
+struct AnyMember {
+  template <typename T>
+  operator T&() const;  // NOLINT: implicit by design; never defined (unevaluated use only)
+  template <typename T>
+  operator T&&() const;  // NOLINT
+};
+
+template <typename T, typename... Members>
+constexpr size_t MemberCount() {
+  if constexpr (requires { T{Members{}..., AnyMember{}}; }) {
+    return MemberCount<T, Members..., AnyMember>();
+  } else {
+    return sizeof...(Members);
+  }
+}
+
+// Counts the fields a Describe function lists (nested objects count once, as one member).
+class CountingArchive {
+ public:
+  uint32_t version() const { return 2; }
+  template <typename T>
+  bool operator()(T&) {
+    ++count;
+    return true;
+  }
+  template <typename T>
+  bool Object(T&) {
+    ++count;
+    return true;
+  }
+  template <typename T>
+  bool Objects(std::vector<T>&, size_t) {
+    ++count;
+    return true;
+  }
+  bool Check(bool, const char*) { return true; }
+  size_t count = 0;
+};
+
+template <typename T>
+size_t DescribedCount() {
+  T object{};
+  CountingArchive archive;
+  Describe(archive, object);
+  return archive.count;
+}
+
+template <typename T>
+void ExpectSchemaComplete(const char* name, size_t expected_by_hand) {
+  EXPECT_EQ(MemberCount<T>(), expected_by_hand) << name << ": the member count probe is off";
+  EXPECT_EQ(DescribedCount<T>(), MemberCount<T>())
+      << name << " has members that state_schema.h does not save";
+}
+
+TEST(MapFileTest, SchemaListsEveryMemberOfEverySavedStruct) {
+  // The hand counts pin the probe itself: if a struct grows, both this number and the schema
+  // must change, and the test says which struct.
+  ExpectSchemaComplete<PoseCellPosition>("PoseCellPosition", 3);
+  ExpectSchemaComplete<LocalOffset>("LocalOffset", 3);
+  ExpectSchemaComplete<PoseCellNetwork::State>("PoseCellNetwork::State", 5);
+  ExpectSchemaComplete<ViewTemplate>("ViewTemplate", 7);
+  ExpectSchemaComplete<LocalViewCells::State>("LocalViewCells::State", 2);
+  ExpectSchemaComplete<Experience>("Experience", 9);
+  ExpectSchemaComplete<Link>("Link", 8);
+  ExpectSchemaComplete<ExperienceMap::State>("ExperienceMap::State", 5);
+  ExpectSchemaComplete<Ratslam::Counters>("Ratslam::Counters", 5);
+  ExpectSchemaComplete<Ratslam::State>("Ratslam::State", 6);
+  ExpectSchemaComplete<TrajectoryRecord>("TrajectoryRecord", 6);
+  ExpectSchemaComplete<FrameRecord>("FrameRecord", 6);
+  ExpectSchemaComplete<ReplayPipeline::State>("ReplayPipeline::State", 14);
+  ExpectSchemaComplete<MapFile>("MapFile", 3);
 }
 
 }  // namespace

@@ -6,9 +6,9 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "fusion/io/file_util.h"
+#include "common/circular.h"
+#include "common/file_util.h"
 #include "fusion/trajectory_metrics.h"
-#include "ratslam/circular.h"
 
 namespace ratslam {
 namespace {

@@ -7,8 +7,8 @@
 #include <optional>
 #include <string>
 
+#include "common/status.h"
 #include "fusion/replay_pipeline.h"
-#include "ratslam/status.h"
 
 namespace ratslam {
 

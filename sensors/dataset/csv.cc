@@ -6,6 +6,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "common/text_file.h"
+
 namespace ratslam {
 namespace {
 
@@ -27,15 +29,21 @@ std::vector<std::string> SplitFields(const std::string& line) {
 
 StatusOr<CsvTable> CsvTable::Read(const std::string& path, const std::vector<std::string>& required,
                                   const std::vector<std::string>& optional) {
-  std::ifstream in(path);
-  if (!in) return Status::Error(path + ": cannot open file");
+  std::ifstream in;
+  RATSLAM_RETURN_IF_ERROR(OpenRegularFile(path, "file", &in));
   CsvTable table;
   table.path_ = path;
   std::string line;
   int line_number = 0;
   bool have_header = false;
-  while (std::getline(in, line)) {
+  for (;;) {
+    const LineResult read = ReadLine(in, &line);
+    if (read == LineResult::kEnd) break;
     ++line_number;
+    if (read == LineResult::kTooLong) {
+      return Status::Error(path + ":" + std::to_string(line_number) + ": line longer than " +
+                           std::to_string(kMaxLineBytes) + " bytes");
+    }
     if (line.find_first_not_of(" \t\r") == std::string::npos) continue;  // blank line
     if (line[line.find_first_not_of(" \t")] == '#') continue;            // comment
     std::vector<std::string> fields = SplitFields(line);
@@ -90,6 +98,9 @@ StatusOr<double> CsvTable::Number(size_t row, const std::string& column) const {
     return ErrorAt(row, column, "not a number: '" + text + "'");
   }
   if (!std::isfinite(value)) return ErrorAt(row, column, "not finite: '" + text + "'");
+  if (std::abs(value) > kMaxCsvMagnitude) {
+    return ErrorAt(row, column, "out of range (magnitude above 1e12): '" + text + "'");
+  }
   return value;
 }
 

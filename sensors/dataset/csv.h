@@ -7,14 +7,19 @@
 #include <string>
 #include <vector>
 
-#include "ratslam/status.h"
+#include "common/status.h"
 
 namespace ratslam {
 
+// No number in a data set is larger: metres, seconds (epoch times included), dBm and radians all
+// stay far below it, and anything beyond is corruption that would overflow later arithmetic.
+inline constexpr double kMaxCsvMagnitude = 1e12;
+
 class CsvTable {
  public:
-  // Reads `path`. `required` columns must be present; `optional` ones may be; any other column
-  // is an error (a typo in a column name must not be silently ignored).
+  // Reads `path` (a regular file; lines of at most kMaxLineBytes). `required` columns must be
+  // present; `optional` ones may be; any other column is an error (a typo in a column name must not
+  // be silently ignored).
   static StatusOr<CsvTable> Read(const std::string& path, const std::vector<std::string>& required,
                                  const std::vector<std::string>& optional = {});
 
@@ -23,7 +28,8 @@ class CsvTable {
   int line(size_t row) const { return lines_[row]; }  // 1-based line in the file
   const std::string& path() const { return path_; }
 
-  // The field as a finite number, or an error naming file, line and column.
+  // The field as a finite number of magnitude at most kMaxCsvMagnitude, or an error naming
+  // file, line and column.
   StatusOr<double> Number(size_t row, const std::string& column) const;
   StatusOr<std::string> Text(size_t row, const std::string& column) const;
   // "path:line: column 'name': message".

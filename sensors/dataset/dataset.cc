@@ -9,7 +9,9 @@
 #include <fstream>
 #include <map>
 
-#include "ratslam/circular.h"
+#include "common/circular.h"
+#include "common/file_util.h"
+#include "common/text_file.h"
 #include "sensors/dataset/csv.h"
 
 namespace ratslam {
@@ -18,8 +20,9 @@ namespace {
 
 constexpr int kFormatVersion = 1;
 
-// Fails when time goes backwards between consecutive rows.
+// Fails when a time is negative or goes backwards between consecutive rows.
 Status CheckTimeOrder(const CsvTable& table, size_t row, double previous, double current) {
+  if (current < 0.0) return table.ErrorAt(row, "time_s", "must not be negative");
   if (row > 0 && current < previous) {
     return table.ErrorAt(row, "time_s",
                          "time goes backwards (" + std::to_string(current) + " after " +
@@ -104,9 +107,8 @@ Status ReadWifi(const std::string& path, Dataset* d) {
     StatusOr<std::string> bssid = t->Text(r, "bssid");
     if (!bssid.ok()) return bssid.status();
     reading.bssid = *bssid;
-    if (!d->wifi.empty() && time_s < d->wifi.back().time_s) {
-      return t->ErrorAt(r, "time_s", "time goes backwards");
-    }
+    RATSLAM_RETURN_IF_ERROR(
+        CheckTimeOrder(*t, r, d->wifi.empty() ? 0.0 : d->wifi.back().time_s, time_s));
     if (d->wifi.empty() || d->wifi.back().time_s != time_s) d->wifi.push_back({time_s, {}});
     d->wifi.back().readings.push_back(reading);
   }
@@ -143,9 +145,11 @@ StatusOr<Dataset> ReadDataset(const std::string& folder) {
   const std::string manifest_path = (fs::path(folder) / "manifest.toml").string();
   if (!fs::is_directory(folder)) return Status::Error(folder + ": not a data-set folder");
   if (!fs::exists(manifest_path)) return Status::Error(manifest_path + ": missing manifest");
+  StatusOr<std::string> manifest_text = ReadRegularFile(manifest_path, "manifest", 1 << 20);
+  if (!manifest_text.ok()) return manifest_text.status();
   toml::table manifest;
   try {
-    manifest = toml::parse_file(manifest_path);
+    manifest = toml::parse(*manifest_text, manifest_path);
   } catch (const toml::parse_error& e) {
     return Status::Error(manifest_path + ":" + std::to_string(e.source().begin.line) + ": " +
                          std::string(e.description()));
@@ -194,7 +198,16 @@ StatusOr<Dataset> ReadDataset(const std::string& folder) {
       return error_at(&node, "unknown stream '" + std::string(key.str()) + "'");
     }
     if (!node.is_string()) return error_at(&node, std::string(key.str()) + " must be a string");
-    files[std::string(key.str())] = *node.value<std::string>();
+    const std::string file = *node.value<std::string>();
+    // Streams live inside the data-set folder: no absolute paths, no way out through "..".
+    const fs::path relative(file);
+    if (file.empty() || relative.is_absolute() ||
+        std::any_of(relative.begin(), relative.end(),
+                    [](const fs::path& p) { return p == ".."; })) {
+      return error_at(
+          &node, std::string(key.str()) + " must be a relative path inside the data-set folder");
+    }
+    files[std::string(key.str())] = file;
   }
   if (!files.count("odometry")) return error_at(streams, "streams.odometry is required");
   if (files.count("image_folder")) d.image_folder = files["image_folder"];
@@ -211,76 +224,123 @@ StatusOr<Dataset> ReadDataset(const std::string& folder) {
   return d;
 }
 
+namespace {
+
+// A text field the CSV reader gives back unchanged: not empty, no separator, line break or
+// comment start, no spaces at either end (the reader trims them).
+bool CsvSafe(const std::string& text) {
+  return !text.empty() && text.find_first_of(",\n\r") == std::string::npos && text.front() != '#' &&
+         text.front() != ' ' && text.front() != '\t' && text.back() != ' ' && text.back() != '\t';
+}
+
+// A TOML basic string with every character that needs it escaped.
+std::string TomlString(const std::string& text) {
+  std::string out = "\"";
+  for (unsigned char c : text) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += static_cast<char>(c);
+    } else if (c < 0x20 || c == 0x7f) {
+      char buffer[8];
+      std::snprintf(buffer, sizeof buffer, "\\u%04x", c);
+      out += buffer;
+    } else {
+      out += static_cast<char>(c);
+    }
+  }
+  return out + "\"";
+}
+
+// Every number the reader will accept back (finite, within kMaxCsvMagnitude).
+class Numbers {
+ public:
+  std::string operator()(double value, const char* what) {
+    if (!std::isfinite(value) || std::abs(value) > kMaxCsvMagnitude) {
+      if (error.empty()) error = std::string(what) + " " + Number(value) + " is not writable";
+    }
+    return Number(value);
+  }
+  std::string error;
+};
+
+}  // namespace
+
 Status WriteDataset(const Dataset& d, const std::string& folder) {
+  // Everything is checked and formatted before the first byte is written: a data set we write
+  // must read back, so a value the reader would refuse is an error here, naming it.
+  Numbers num;
+  std::string odometry = "time_s,forward_speed_m_per_s,turn_rate_rad_per_s\n";
+  for (const OdometryRow& r : d.odometry) {
+    odometry += num(r.time_s, "odometry time") + ',' +
+                num(r.forward_speed_m_per_s, "odometry speed") + ',' +
+                num(r.turn_rate_rad_per_s, "odometry turn rate") + '\n';
+  }
+  std::string images = "time_s,file\n";
+  for (const ImageRow& r : d.images) {
+    if (!CsvSafe(r.file))
+      return Status::Error(folder + ": image file name '" + r.file +
+                           "' cannot be stored in images.csv");
+    images += num(r.time_s, "image time") + ',' + r.file + '\n';
+  }
+  std::string ground_truth = "time_s,x_m,y_m,theta_rad,floor\n";
+  for (const GroundTruthRow& r : d.ground_truth) {
+    ground_truth += num(r.time_s, "ground-truth time") + ',' + num(r.x_m, "ground-truth x") + ',' +
+                    num(r.y_m, "ground-truth y") + ',' + num(r.theta_rad, "ground-truth heading") +
+                    ',' + std::to_string(r.floor) + '\n';
+  }
+  std::string wifi = "time_s,bssid,rssi_dbm\n";
+  for (const WifiScan& scan : d.wifi) {
+    for (const WifiReading& r : scan.readings) {
+      if (!CsvSafe(r.bssid)) {
+        return Status::Error(folder + ": BSSID '" + r.bssid + "' cannot be stored in wifi.csv");
+      }
+      wifi += num(scan.time_s, "scan time") + ',' + r.bssid + ',' + num(r.rssi_dbm, "RSSI") + '\n';
+    }
+  }
+  std::string compass = "time_s,heading_rad\n";
+  for (const CompassRow& r : d.compass) {
+    compass += num(r.time_s, "compass time") + ',' + num(r.heading_rad, "compass heading") + '\n';
+  }
+  std::string manifest =
+      "format = \"ratslam-replay\"\nformat_version = " + std::to_string(kFormatVersion) +
+      "\nname = " + TomlString(d.name) + "\n";
+  if (d.session_start_times_s.size() > 1) {
+    manifest += "session_start_times_s = [";
+    for (size_t i = 0; i < d.session_start_times_s.size(); ++i) {
+      manifest += (i ? ", " : "") + num(d.session_start_times_s[i], "session start");
+    }
+    manifest += "]\n";
+  }
+  if (!num.error.empty()) return Status::Error(folder + ": " + num.error);
+  const fs::path image_folder(d.image_folder);
+  if (d.image_folder.empty() || image_folder.is_absolute() ||
+      std::any_of(image_folder.begin(), image_folder.end(),
+                  [](const fs::path& p) { return p == ".."; })) {
+    return Status::Error(folder + ": image folder '" + d.image_folder +
+                         "' must be a relative path inside the data set");
+  }
+  manifest += "\n[streams]\nodometry = \"odometry.csv\"\n";
+  if (!d.images.empty()) {
+    manifest += "images = \"images.csv\"\nimage_folder = " + TomlString(d.image_folder) + "\n";
+  }
+  if (!d.ground_truth.empty()) manifest += "ground_truth = \"ground_truth.csv\"\n";
+  if (!d.wifi.empty()) manifest += "wifi = \"wifi.csv\"\n";
+  if (!d.compass.empty()) manifest += "compass = \"compass.csv\"\n";
+
   std::error_code ec;
   fs::create_directories(fs::path(folder) / d.image_folder, ec);
   if (ec) return Status::Error(folder + ": cannot create folder: " + ec.message());
-  auto open = [&](const std::string& name, std::ofstream& out) {
-    out.open(fs::path(folder) / name);
-    return out ? Status::Ok()
-               : Status::Error((fs::path(folder) / name).string() + ": cannot write");
+  auto write = [&](const char* name, const std::string& text) {
+    return WriteFileAtomically((fs::path(folder) / name).string(), text);
   };
-  std::ofstream manifest;
-  RATSLAM_RETURN_IF_ERROR(open("manifest.toml", manifest));
-  manifest << "format = \"ratslam-replay\"\nformat_version = " << kFormatVersion << "\n"
-           << "name = \"" << d.name << "\"\n";
-  if (d.session_start_times_s.size() > 1) {
-    manifest << "session_start_times_s = [";
-    for (size_t i = 0; i < d.session_start_times_s.size(); ++i) {
-      manifest << (i ? ", " : "") << Number(d.session_start_times_s[i]);
-    }
-    manifest << "]\n";
-  }
-  manifest << "\n[streams]\nodometry = \"odometry.csv\"\n";
-  if (!d.images.empty()) {
-    manifest << "images = \"images.csv\"\nimage_folder = \"" << d.image_folder << "\"\n";
-  }
-  if (!d.ground_truth.empty()) manifest << "ground_truth = \"ground_truth.csv\"\n";
-  if (!d.wifi.empty()) manifest << "wifi = \"wifi.csv\"\n";
-  if (!d.compass.empty()) manifest << "compass = \"compass.csv\"\n";
-
-  std::ofstream out;
-  RATSLAM_RETURN_IF_ERROR(open("odometry.csv", out));
-  out << "time_s,forward_speed_m_per_s,turn_rate_rad_per_s\n";
-  for (const OdometryRow& r : d.odometry) {
-    out << Number(r.time_s) << ',' << Number(r.forward_speed_m_per_s) << ','
-        << Number(r.turn_rate_rad_per_s) << '\n';
-  }
-  out.close();
-  if (!d.images.empty()) {
-    RATSLAM_RETURN_IF_ERROR(open("images.csv", out));
-    out << "time_s,file\n";
-    for (const ImageRow& r : d.images) out << Number(r.time_s) << ',' << r.file << '\n';
-    out.close();
-  }
-  if (!d.ground_truth.empty()) {
-    RATSLAM_RETURN_IF_ERROR(open("ground_truth.csv", out));
-    out << "time_s,x_m,y_m,theta_rad,floor\n";
-    for (const GroundTruthRow& r : d.ground_truth) {
-      out << Number(r.time_s) << ',' << Number(r.x_m) << ',' << Number(r.y_m) << ','
-          << Number(r.theta_rad) << ',' << r.floor << '\n';
-    }
-    out.close();
-  }
-  if (!d.wifi.empty()) {
-    RATSLAM_RETURN_IF_ERROR(open("wifi.csv", out));
-    out << "time_s,bssid,rssi_dbm\n";
-    for (const WifiScan& s : d.wifi) {
-      for (const WifiReading& r : s.readings) {
-        out << Number(s.time_s) << ',' << r.bssid << ',' << Number(r.rssi_dbm) << '\n';
-      }
-    }
-    out.close();
-  }
-  if (!d.compass.empty()) {
-    RATSLAM_RETURN_IF_ERROR(open("compass.csv", out));
-    out << "time_s,heading_rad\n";
-    for (const CompassRow& r : d.compass) {
-      out << Number(r.time_s) << ',' << Number(r.heading_rad) << '\n';
-    }
-    out.close();
-  }
-  return out.good() || !out.is_open() ? Status::Ok() : Status::Error(folder + ": write failed");
+  // Each file is complete or absent; the manifest comes last, so a data set cut short by a
+  // failure has no manifest and never reads as complete.
+  RATSLAM_RETURN_IF_ERROR(write("odometry.csv", odometry));
+  if (!d.images.empty()) RATSLAM_RETURN_IF_ERROR(write("images.csv", images));
+  if (!d.ground_truth.empty()) RATSLAM_RETURN_IF_ERROR(write("ground_truth.csv", ground_truth));
+  if (!d.wifi.empty()) RATSLAM_RETURN_IF_ERROR(write("wifi.csv", wifi));
+  if (!d.compass.empty()) RATSLAM_RETURN_IF_ERROR(write("compass.csv", compass));
+  return write("manifest.toml", manifest);
 }
 
 std::vector<Event> MergeEvents(const Dataset& d) {

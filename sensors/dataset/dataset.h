@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "ratslam/status.h"
+#include "common/status.h"
 
 namespace ratslam {
 
@@ -65,11 +65,15 @@ struct Dataset {
   std::string ImagePath(const ImageRow& row) const;
 };
 
-// Reads a replay data-set folder. Errors name the file, line and column.
+// Reads a replay data-set folder. Errors name the file, line and column. Streams must be regular
+// files inside the folder; times must be non-negative and never go backwards.
 StatusOr<Dataset> ReadDataset(const std::string& folder);
 
 // Writes `dataset` (without images) into `folder` (created if needed): manifest and CSVs with
-// every number printed so that it reads back bit for bit.
+// every number printed so that it reads back bit for bit. What the reader would refuse (a BSSID
+// or file name with a comma, a non-finite number) is an error before anything is written; each
+// file is written atomically and checked, and the manifest last, so a failed write never leaves
+// a data set that reads as complete.
 Status WriteDataset(const Dataset& dataset, const std::string& folder);
 
 // Events in replay order.

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "ratslam/status.h"
+#include "common/status.h"
 #include "sensors/dataset/dataset.h"
 #include "sensors/dataset/ipin_log.h"
 

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "ratslam/status.h"
+#include "common/status.h"
 
 namespace ratslam {
 

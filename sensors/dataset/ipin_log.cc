@@ -9,7 +9,7 @@
 #include <map>
 #include <numbers>
 
-#include "ratslam/circular.h"
+#include "common/circular.h"
 
 namespace ratslam {
 namespace {

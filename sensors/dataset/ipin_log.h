@@ -13,7 +13,7 @@
 #include <optional>
 #include <string>
 
-#include "ratslam/status.h"
+#include "common/status.h"
 #include "sensors/dataset/dataset.h"
 #include "sensors/pedestrian_dead_reckoning.h"
 

@@ -6,10 +6,17 @@
 #include <filesystem>
 #include <fstream>
 
+#include "common/scratch_dir.h"
 #include "sensors/dataset/dataset_loader.h"
 
 namespace ratslam {
 namespace {
+
+// One fresh folder per test process (two checkouts testing at once never collide).
+const ScratchDir& TestScratch() {
+  static const ScratchDir dir("ratslam_test");
+  return dir;
+}
 namespace fs = std::filesystem;
 
 const char kFixture[] =
@@ -25,7 +32,7 @@ const char kFixture[] =
     "POSI;3.0;2;49.461275602490;11.110988346746;0;100\n";
 
 fs::path WriteFixture(const std::string& name, const std::string& text) {
-  const fs::path path = fs::temp_directory_path() / name;
+  const fs::path path = TestScratch().path() / name;
   std::ofstream(path) << text;
   return path;
 }

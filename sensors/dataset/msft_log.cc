@@ -9,7 +9,7 @@
 #include <map>
 #include <sstream>
 
-#include "ratslam/circular.h"
+#include "common/circular.h"
 
 namespace ratslam {
 namespace {

@@ -11,7 +11,7 @@
 
 #include <string>
 
-#include "ratslam/status.h"
+#include "common/status.h"
 #include "sensors/dataset/dataset.h"
 #include "sensors/dataset/ipin_log.h"
 

@@ -6,10 +6,17 @@
 #include <filesystem>
 #include <fstream>
 
+#include "common/scratch_dir.h"
 #include "sensors/dataset/dataset_loader.h"
 
 namespace ratslam {
 namespace {
+
+// One fresh folder per test process (two checkouts testing at once never collide).
+const ScratchDir& TestScratch() {
+  static const ScratchDir dir("ratslam_test");
+  return dir;
+}
 namespace fs = std::filesystem;
 
 const char kFixture[] =
@@ -24,7 +31,7 @@ const char kFixture[] =
     "1574559503836\tTYPE_WAYPOINT\t75.371765\t94.800575\n";
 
 TEST(MicrosoftLogTest, ReadsScansWaypointsAndFloor) {
-  const fs::path path = fs::temp_directory_path() / "ratslam_msft_fixture.txt";
+  const fs::path path = TestScratch().path() / "ratslam_msft_fixture.txt";
   std::ofstream(path) << kFixture;
   StatusOr<Dataset> d = ReadMicrosoftLog(path.string(), {});
   ASSERT_TRUE(d.ok()) << d.status().message();
@@ -42,7 +49,7 @@ TEST(MicrosoftLogTest, ReadsScansWaypointsAndFloor) {
 }
 
 TEST(MicrosoftLogTest, BrokenLineNamesFileAndLine) {
-  const fs::path path = fs::temp_directory_path() / "ratslam_msft_broken.txt";
+  const fs::path path = TestScratch().path() / "ratslam_msft_broken.txt";
   std::ofstream(path) << kFixture << "1574559503900\tTYPE_WAYPOINT\t75.3\n";
   StatusOr<Dataset> d = ReadMicrosoftLog(path.string(), {});
   ASSERT_FALSE(d.ok());

@@ -7,8 +7,8 @@
 #include <numbers>
 #include <opencv2/imgcodecs.hpp>
 
-#include "ratslam/circular.h"
-#include "ratslam/random.h"
+#include "common/circular.h"
+#include "common/random.h"
 
 namespace ratslam {
 namespace {

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "ratslam/status.h"
+#include "common/status.h"
 #include "sensors/dataset/dataset.h"
 
 namespace ratslam {

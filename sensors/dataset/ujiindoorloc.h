@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "ratslam/status.h"
+#include "common/status.h"
 #include "sensors/dataset/dataset.h"
 
 namespace ratslam {

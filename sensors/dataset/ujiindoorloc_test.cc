@@ -5,8 +5,16 @@
 #include <filesystem>
 #include <fstream>
 
+#include "common/scratch_dir.h"
+
 namespace ratslam {
 namespace {
+
+// One fresh folder per test process (two checkouts testing at once never collide).
+const ScratchDir& TestScratch() {
+  static const ScratchDir dir("ratslam_test");
+  return dir;
+}
 namespace fs = std::filesystem;
 
 const char kHeader[] =
@@ -14,7 +22,7 @@ const char kHeader[] =
     "RELATIVEPOSITION,USERID,PHONEID,TIMESTAMP\n";
 
 fs::path Write(const std::string& name, const std::string& text) {
-  const fs::path p = fs::temp_directory_path() / name;
+  const fs::path p = TestScratch().path() / name;
   std::ofstream(p) << text;
   return p;
 }

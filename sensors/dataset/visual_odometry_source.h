@@ -3,7 +3,7 @@
 #ifndef RATSLAM_SENSORS_DATASET_VISUAL_ODOMETRY_SOURCE_H_
 #define RATSLAM_SENSORS_DATASET_VISUAL_ODOMETRY_SOURCE_H_
 
-#include "ratslam/status.h"
+#include "common/status.h"
 #include "sensors/dataset/dataset.h"
 #include "sensors/dataset/image_loader.h"
 #include "sensors/visual_odometry.h"

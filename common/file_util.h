@@ -1,10 +1,10 @@
 // Writing files so that a reader never sees a half-written one.
-#ifndef RATSLAM_FUSION_IO_FILE_UTIL_H_
-#define RATSLAM_FUSION_IO_FILE_UTIL_H_
+#ifndef RATSLAM_COMMON_FILE_UTIL_H_
+#define RATSLAM_COMMON_FILE_UTIL_H_
 
 #include <string>
 
-#include "ratslam/status.h"
+#include "common/status.h"
 
 namespace ratslam {
 
@@ -14,4 +14,4 @@ Status WriteFileAtomically(const std::string& path, const std::string& contents)
 
 }  // namespace ratslam
 
-#endif  // RATSLAM_FUSION_IO_FILE_UTIL_H_
+#endif  // RATSLAM_COMMON_FILE_UTIL_H_

@@ -1,6 +1,6 @@
 // Helpers for quantities that wrap around: angles and toroidal cell coordinates.
-#ifndef RATSLAM_CIRCULAR_H_
-#define RATSLAM_CIRCULAR_H_
+#ifndef RATSLAM_COMMON_CIRCULAR_H_
+#define RATSLAM_COMMON_CIRCULAR_H_
 
 #include <cmath>
 #include <numbers>
@@ -32,4 +32,4 @@ inline double WrapAngle(double angle_rad) {
 
 }  // namespace ratslam
 
-#endif  // RATSLAM_CIRCULAR_H_
+#endif  // RATSLAM_COMMON_CIRCULAR_H_

@@ -1,9 +1,10 @@
 // Error reporting for expected failures (bad input, bad configuration, inconsistent ids).
 // Library code returns a Status instead of throwing across module boundaries or exiting.
-#ifndef RATSLAM_STATUS_H_
-#define RATSLAM_STATUS_H_
+#ifndef RATSLAM_COMMON_STATUS_H_
+#define RATSLAM_COMMON_STATUS_H_
 
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <utility>
 
@@ -40,15 +41,27 @@ class [[nodiscard]] StatusOr {
 
   bool ok() const { return status_.ok(); }
   const Status& status() const { return status_; }
-  const T& value() const& { return *value_; }
-  T& value() & { return *value_; }
-  T&& value() && { return std::move(*value_); }
-  const T* operator->() const { return &*value_; }
-  T* operator->() { return &*value_; }
-  const T& operator*() const& { return *value_; }
-  T& operator*() & { return *value_; }
+  // The value; on an error, a programming mistake, throws std::logic_error with the error's
+  // message (defined behaviour, caught at the top of the program), never reads garbage.
+  const T& value() const& { return Checked(); }
+  T& value() & { return Checked(); }
+  T&& value() && { return std::move(Checked()); }
+  const T* operator->() const { return &Checked(); }
+  T* operator->() { return &Checked(); }
+  const T& operator*() const& { return Checked(); }
+  T& operator*() & { return Checked(); }
+  T&& operator*() && { return std::move(Checked()); }
 
  private:
+  T& Checked() {
+    if (!value_) throw std::logic_error("StatusOr: value of an error: " + status_.message());
+    return *value_;
+  }
+  const T& Checked() const {
+    if (!value_) throw std::logic_error("StatusOr: value of an error: " + status_.message());
+    return *value_;
+  }
+
   Status status_;
   std::optional<T> value_;
 };
@@ -61,4 +74,4 @@ class [[nodiscard]] StatusOr {
     if (!ratslam_status_.ok()) return ratslam_status_; \
   } while (false)
 
-#endif  // RATSLAM_STATUS_H_
+#endif  // RATSLAM_COMMON_STATUS_H_

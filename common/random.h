@@ -1,7 +1,7 @@
 // A small seeded random generator whose sequence is the same on every platform and standard
 // library (std::normal_distribution is not), so that a seed always gives the same data.
-#ifndef RATSLAM_RANDOM_H_
-#define RATSLAM_RANDOM_H_
+#ifndef RATSLAM_COMMON_RANDOM_H_
+#define RATSLAM_COMMON_RANDOM_H_
 
 #include <cmath>
 #include <cstdint>
@@ -37,4 +37,4 @@ class Random {
 
 }  // namespace ratslam
 
-#endif  // RATSLAM_RANDOM_H_
+#endif  // RATSLAM_COMMON_RANDOM_H_
