@@ -42,8 +42,9 @@ bool PoseCellOptions::IsValid(std::string* error) const {
   };
   if (dim_xy_cells < 1) return fail("dim_xy_cells: must be at least 1");
   if (dim_theta_cells < 1) return fail("dim_theta_cells: must be at least 1");
-  if (static_cast<long long>(dim_xy_cells) * dim_xy_cells * dim_theta_cells > (1LL << 30)) {
-    return fail("dim_xy_cells: grid larger than 2^30 cells");
+  // Three buffers of doubles per cell: 2^24 cells need 384 MiB; 2^30 needed 24 GiB and passed.
+  if (static_cast<long long>(dim_xy_cells) * dim_xy_cells * dim_theta_cells > kMaxPoseCells) {
+    return fail("dim_xy_cells: grid of dim_xy_cells^2 x dim_theta_cells larger than 2^24 cells");
   }
   if (!(cell_size_m > 0.0) || !std::isfinite(cell_size_m)) {
     return fail("cell_size_m: must be a positive number");

@@ -22,6 +22,9 @@
 
 namespace ratslam {
 
+// Largest grid (cells) a valid configuration may ask for: a few hundred MiB of activity buffers.
+inline constexpr long long kMaxPoseCells = 1LL << 24;
+
 struct PoseCellOptions {
   int dim_xy_cells = 21;                    // cells along x and along y (the grid wraps)
   int dim_theta_cells = 36;                 // cells around the heading ring

@@ -7,6 +7,8 @@
 #include <set>
 #include <sstream>
 
+#include "common/text_file.h"
+#include "common/toml_string.h"
 #include "sim/textures.h"
 
 namespace ratslam::sim {
@@ -71,7 +73,9 @@ class TableReader {
     field->clear();
     for (const auto& e : *a) {
       const auto* i = e.as_integer();
-      if (!i) return Fail(n, key, "expected a list of integers");
+      if (!i || i->get() < -1000000 || i->get() > 1000000) {
+        return Fail(n, key, "expected a list of integers");
+      }
       field->push_back(static_cast<int>(i->get()));
     }
   }
@@ -83,8 +87,8 @@ class TableReader {
     field->clear();
     for (const auto& e : *a) {
       std::vector<double> v;
-      if (!Numbers(e, &v) || v.size() != 3 || v[2] != std::floor(v[2])) {
-        return Fail(&e, key, "expected [x, y, floor] with an integer floor");
+      if (!Numbers(e, &v) || v.size() != 3 || v[2] != std::floor(v[2]) || std::abs(v[2]) > 1000) {
+        return Fail(&e, key, "expected [x, y, floor] with an integer floor in -1000..1000");
       }
       field->push_back({{v[0], v[1]}, static_cast<int>(v[2])});
     }
@@ -253,8 +257,10 @@ Status World::Validate() const {
     return bad("camera: rate_hz and height_m must be positive, noise_sigma not negative");
   }
   const WifiSettings& w = wifi;
+  // A correlation length below a centimetre would make the shadowing grid index of a point 100 km
+  // away overflow an integer.
   if (!(w.path_loss_exponent > 0.0) || !(w.reference_distance_m > 0.0) ||
-      !(w.scan_period_s > 0.0) || !(w.shadowing_correlation_m > 0.0) ||
+      !(w.scan_period_s > 0.0) || !(w.shadowing_correlation_m >= 0.01) ||
       !(w.shadowing_sigma_db >= 0.0) || !(w.fading_sigma_db >= 0.0) ||
       !(w.floor_attenuation_db >= 0.0) ||
       !(w.miss_probability >= 0.0 && w.miss_probability < 1.0)) {
@@ -486,11 +492,9 @@ StatusOr<World> ParseWorld(const std::string& text, const std::string& source) {
 }
 
 StatusOr<World> LoadWorldFile(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) return Status::Error(path + ": cannot open world file");
-  std::stringstream text;
-  text << in.rdbuf();
-  return ParseWorld(text.str(), path);
+  StatusOr<std::string> text = ReadRegularFile(path, "world file", size_t{16} << 20);
+  if (!text.ok()) return text.status();
+  return ParseWorld(*text, path);
 }
 
 namespace {
@@ -503,14 +507,7 @@ std::string Num(double v) {
   return s;
 }
 std::string Pt(const Point2& p) { return "[" + Num(p.x_m) + ", " + Num(p.y_m) + "]"; }
-std::string Quote(const std::string& s) {
-  std::string q = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') q += '\\';
-    q += c;
-  }
-  return q + "\"";
-}
+std::string Quote(const std::string& s) { return TomlQuoted(s); }
 std::string Ints(const std::vector<int>& v) {
   std::string s = "[";
   for (size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + std::to_string(v[i]);

@@ -363,7 +363,7 @@ Scene TemplateGraphScene(const std::vector<TemplateGraphPoint>& points,
   if (!std::isfinite(t0)) t0 = 0, t1 = 1;
   if (t1 <= t0) t1 = t0 + 1;
   const Rgba source_colors[] = {{31, 119, 180, 255}, {44, 160, 44, 255}, {150, 150, 150, 255}};
-  constexpr Rgba kExperienceColor{230, 110, 0, 255};
+  static constexpr Rgba kExperienceColor{230, 110, 0, 255};
   // Legend, only for what the graph contains, in rows under the title.
   bool present[3] = {false, false, false};
   for (const TemplateGraphPoint& p : points) present[static_cast<int>(p.source)] = true;

@@ -8,6 +8,7 @@
 #include <system_error>
 
 #include "common/byte_buffer.h"
+#include "common/text_file.h"
 
 namespace ratslam::fabmap {
 
@@ -75,11 +76,9 @@ StatusOr<TrainedVisualModel> LoadOrTrainVisualModel(
     const VocabularyOptions& vocabulary, const ChowLiuOptions& chow_liu, ImageLoader& loader,
     const std::function<void(size_t, size_t)>& progress) {
   if (!options.file.empty()) {
-    std::ifstream in(options.file, std::ios::binary);
-    if (!in) return Status::Error(options.file + ": cannot open visual model");
-    std::stringstream bytes;
-    bytes << in.rdbuf();
-    return DecodeVisualModel(bytes.str(), options.file);
+    StatusOr<std::string> bytes = ReadRegularFile(options.file, "visual model", size_t{1} << 34);
+    if (!bytes.ok()) return bytes.status();
+    return DecodeVisualModel(*bytes, options.file);
   }
   if (options.training_images.empty()) {
     return Status::Error("[visual_model] needs file or training_images");

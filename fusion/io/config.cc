@@ -12,8 +12,13 @@
 #include <sstream>
 #include <type_traits>
 
+#include "common/text_file.h"
+#include "common/toml_string.h"
+
 namespace ratslam {
 namespace {
+
+constexpr size_t kMaxConfigBytes = 1 << 20;  // a config is a few kB; a megabyte is not a config
 
 std::string Location(const std::string& source, const toml::node* node) {
   return source + ":" + (node ? std::to_string(node->source().begin.line) : std::string("?"));
@@ -152,15 +157,7 @@ class SectionPrinter {
   static std::string Format(double v) { return FormatDouble(v); }
   static std::string Format(bool v) { return v ? "true" : "false"; }
   static std::string Format(uint64_t v) { return std::to_string(v); }
-  static std::string Format(const std::string& v) {
-    std::string quoted(1, '"');  // appended piecewise: GCC 12 warns falsely on "\"" + s
-    for (char c : v) {
-      if (c == '"' || c == '\\') quoted += '\\';
-      quoted += c;
-    }
-    quoted += '"';
-    return quoted;
-  }
+  static std::string Format(const std::string& v) { return TomlQuoted(v); }
   template <typename Enum>
   static std::string Format(Enum v) requires std::is_enum_v<Enum> {
     return Format(ToString(v));
@@ -225,11 +222,9 @@ StatusOr<PipelineOptions> ParseConfig(const std::string& text, const std::string
 }
 
 StatusOr<PipelineOptions> LoadConfigFile(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) return Status::Error(path + ": cannot open config file");
-  std::stringstream text;
-  text << in.rdbuf();
-  return ParseConfig(text.str(), path);
+  StatusOr<std::string> text = ReadRegularFile(path, "config file", kMaxConfigBytes);
+  if (!text.ok()) return text.status();
+  return ParseConfig(*text, path);
 }
 
 std::string PrintConfig(const PipelineOptions& options, bool comments) {
@@ -256,8 +251,9 @@ uint64_t ConfigFingerprint(const PipelineOptions& options) {
 }
 
 StatusOr<ImportedConfig> ImportOpenRatslamIni(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) return Status::Error(path + ": cannot open INI file");
+  StatusOr<std::string> text = ReadRegularFile(path, "INI file", kMaxConfigBytes);
+  if (!text.ok()) return text.status();
+  std::istringstream in(*text);
   ImportedConfig imported;
   PipelineOptions& o = imported.options;
   using Setter = std::function<Status(double)>;

@@ -88,6 +88,13 @@ TEST(ConfigTest, OutOfRangeValueNamesLineInEverySection) {
   }
 }
 
+// A valid config must not exhaust memory: this grid once passed and needed 24 GiB.
+TEST(ConfigTest, PoseCellGridSizeIsBounded) {
+  const std::string error = ErrorOf("[pose_cells]\ndim_xy_cells = 32768\ndim_theta_cells = 1\n");
+  EXPECT_EQ(error.rfind("c.toml:2: pose_cells.dim_xy_cells: grid", 0), 0u) << error;
+  EXPECT_TRUE(ParseConfig("[pose_cells]\ndim_xy_cells = 200\ndim_theta_cells = 36\n", "c").ok());
+}
+
 TEST(ConfigTest, BadEnumListsValidNames) {
   const std::string error = ErrorOf("[front_end]\nkind = \"wifi\"\n");
   EXPECT_NE(error.find("c.toml:2"), std::string::npos) << error;

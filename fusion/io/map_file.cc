@@ -8,6 +8,7 @@
 
 #include "common/byte_buffer.h"
 #include "common/file_util.h"
+#include "common/text_file.h"
 #include "fusion/io/state_schema.h"
 
 namespace ratslam {
@@ -56,11 +57,9 @@ Status SaveMapFile(const MapFile& map, const std::string& path) {
 }
 
 StatusOr<MapFile> LoadMapFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Status::Error(path + ": cannot open map file");
-  std::stringstream bytes;
-  bytes << in.rdbuf();
-  return DecodeMapFile(bytes.str(), path);
+  StatusOr<std::string> bytes = ReadRegularFile(path, "map file", size_t{1} << 36);
+  if (!bytes.ok()) return bytes.status();
+  return DecodeMapFile(*bytes, path);
 }
 
 }  // namespace ratslam

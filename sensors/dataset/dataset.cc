@@ -12,6 +12,7 @@
 #include "common/circular.h"
 #include "common/file_util.h"
 #include "common/text_file.h"
+#include "common/toml_string.h"
 #include "sensors/dataset/csv.h"
 
 namespace ratslam {
@@ -233,24 +234,6 @@ bool CsvSafe(const std::string& text) {
          text.front() != ' ' && text.front() != '\t' && text.back() != ' ' && text.back() != '\t';
 }
 
-// A TOML basic string with every character that needs it escaped.
-std::string TomlString(const std::string& text) {
-  std::string out = "\"";
-  for (unsigned char c : text) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += static_cast<char>(c);
-    } else if (c < 0x20 || c == 0x7f) {
-      char buffer[8];
-      std::snprintf(buffer, sizeof buffer, "\\u%04x", c);
-      out += buffer;
-    } else {
-      out += static_cast<char>(c);
-    }
-  }
-  return out + "\"";
-}
-
 // Every number the reader will accept back (finite, within kMaxCsvMagnitude).
 class Numbers {
  public:
@@ -303,7 +286,7 @@ Status WriteDataset(const Dataset& d, const std::string& folder) {
   }
   std::string manifest =
       "format = \"ratslam-replay\"\nformat_version = " + std::to_string(kFormatVersion) +
-      "\nname = " + TomlString(d.name) + "\n";
+      "\nname = " + TomlQuoted(d.name) + "\n";
   if (d.session_start_times_s.size() > 1) {
     manifest += "session_start_times_s = [";
     for (size_t i = 0; i < d.session_start_times_s.size(); ++i) {
@@ -321,7 +304,7 @@ Status WriteDataset(const Dataset& d, const std::string& folder) {
   }
   manifest += "\n[streams]\nodometry = \"odometry.csv\"\n";
   if (!d.images.empty()) {
-    manifest += "images = \"images.csv\"\nimage_folder = " + TomlString(d.image_folder) + "\n";
+    manifest += "images = \"images.csv\"\nimage_folder = " + TomlQuoted(d.image_folder) + "\n";
   }
   if (!d.ground_truth.empty()) manifest += "ground_truth = \"ground_truth.csv\"\n";
   if (!d.wifi.empty()) manifest += "wifi = \"wifi.csv\"\n";

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 
 #include "sensors/dataset/image_loader.h"
 #include "sensors/dataset/synthetic_dataset.h"
@@ -107,6 +108,69 @@ TEST_F(DatasetTest, MissingStreamFileAndUnknownManifestKey) {
         "odometer = \"x.csv\"\n");
   const std::string error = ReadError();
   EXPECT_NE(error.find("manifest.toml:5: unknown stream 'odometer'"), std::string::npos) << error;
+}
+
+// A manifest is untrusted: streams must be regular files inside the data-set folder. These once
+// grew without end (/dev/zero) or read another file and echoed its first line.
+TEST_F(DatasetTest, StreamsOutsideTheFolderOrNotRegularFilesAreRefused) {
+  const std::string head =
+      "format = \"ratslam-replay\"\nformat_version = 1\n[streams]\nodometry = ";
+  Write("manifest.toml", head + "\"/dev/zero\"\n");
+  EXPECT_NE(ReadError().find("must be a relative path inside the data-set folder"),
+            std::string::npos);
+  Write("manifest.toml", head + "\"../../etc/passwd\"\n");
+  const std::string escape = ReadError();
+  EXPECT_NE(escape.find("manifest.toml:4: odometry must be a relative path"), std::string::npos)
+      << escape;
+  EXPECT_EQ(escape.find("root"), std::string::npos) << escape;
+  fs::create_symlink("/dev/zero", folder_ / "zero.csv");
+  Write("manifest.toml", head + "\"zero.csv\"\n");
+  EXPECT_NE(ReadError().find("zero.csv: file is not a regular file"), std::string::npos);
+  fs::create_directory(folder_ / "folder.csv");
+  Write("manifest.toml", head + "\"folder.csv\"\n");
+  EXPECT_NE(ReadError().find("not a regular file"), std::string::npos);
+}
+
+TEST_F(DatasetTest, OverlongLinesHugeNumbersAndNegativeTimesAreRefused) {
+  Write("odometry.csv", "time_s,forward_speed_m_per_s,turn_rate_rad_per_s\n0,0," +
+                            std::string(2 << 20, '1') + "\n");
+  EXPECT_NE(ReadError().find("odometry.csv:2: line longer than"), std::string::npos);
+  Write("odometry.csv", "time_s,forward_speed_m_per_s,turn_rate_rad_per_s\n0,1e300,0\n");
+  EXPECT_NE(ReadError().find("odometry.csv:2: column 'forward_speed_m_per_s': out of range"),
+            std::string::npos);
+  Write("odometry.csv", "time_s,forward_speed_m_per_s,turn_rate_rad_per_s\n-1,0,0\n");
+  EXPECT_NE(ReadError().find("odometry.csv:2: column 'time_s': must not be negative"),
+            std::string::npos);
+}
+
+// Whatever WriteDataset writes reads back: names with quotes, backslashes and control characters
+// are escaped; a BSSID or image name the CSV cannot hold, or a non-finite number, is an error
+// before any file is written.
+TEST_F(DatasetTest, HostileNamesRoundTripOrAreRefusedBeforeWriting) {
+  Dataset d = ReadDataset(folder_.string()).value();
+  d.name = "a \"quoted\" \\ name\twith\x01control";
+  d.wifi[0].readings[0].bssid = "ssid with spaces:inside";
+  const fs::path copy = folder_ / "copy";
+  ASSERT_TRUE(WriteDataset(d, copy.string()).ok());
+  StatusOr<Dataset> back = ReadDataset(copy.string());
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  EXPECT_EQ(back->name, d.name);
+  EXPECT_EQ(back->wifi[0].readings[0].bssid, d.wifi[0].readings[0].bssid);
+
+  const fs::path refused = folder_ / "refused";
+  for (const char* bssid : {"aa,bb", " leading", "line\nbreak", "#comment", ""}) {
+    Dataset bad = d;
+    bad.wifi[0].readings[0].bssid = bssid;
+    const Status status = WriteDataset(bad, refused.string());
+    EXPECT_FALSE(status.ok()) << bssid;
+    EXPECT_NE(status.message().find("cannot be stored in wifi.csv"), std::string::npos);
+  }
+  Dataset infinite = d;
+  infinite.ground_truth[1].x_m = std::numeric_limits<double>::infinity();
+  EXPECT_NE(WriteDataset(infinite, refused.string()).message().find("ground-truth x inf"),
+            std::string::npos);
+  EXPECT_FALSE(fs::exists(refused / "manifest.toml"));
+  EXPECT_FALSE(fs::exists(refused / "odometry.csv"));
 }
 
 TEST_F(DatasetTest, EventsAreOrderedByTimeThenStream) {

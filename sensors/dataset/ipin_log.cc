@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -10,11 +11,26 @@
 #include <numbers>
 
 #include "common/circular.h"
+#include "common/text_file.h"
 
 namespace ratslam {
 namespace {
 
 constexpr double kEarthRadiusM = 6371008.8;  // mean Earth radius (IUGG)
+constexpr double kMaxTimeS = 1e12;           // app timestamps: seconds, never negative
+constexpr double kMaxSensor = 1e4;  // accelerations (m/s^2) and angles (deg) beyond are corrupt
+
+struct Field {
+  size_t index;
+  const char* name;
+  double min, max;
+};
+
+std::string FormatBound(double v) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%g", v);
+  return buffer;
+}
 
 std::vector<std::string> Split(const std::string& line) {
   std::vector<std::string> fields;
@@ -48,8 +64,17 @@ bool ParseDouble(const std::string& text, double* value) {
 Status OpenPhoneLog(const std::string& path, const PhoneLogOptions& options, std::ifstream* in) {
   std::string pdr_error;
   if (!options.pdr.IsValid(&pdr_error)) return Status::Error("pdr." + pdr_error);
-  in->open(path);
-  if (!*in) return Status::Error(path + ": cannot open log file");
+  return OpenRegularFile(path, "log file", in);
+}
+
+Status ReadPhoneLogLine(std::istream& in, const std::string& path, int number, std::string* line,
+                        bool* more) {
+  const LineResult result = ReadLine(in, line);
+  *more = result != LineResult::kEnd;
+  if (result == LineResult::kTooLong) {
+    return Status::Error(path + ":" + std::to_string(number + 1) + ": line longer than " +
+                         std::to_string(kMaxLineBytes) + " bytes");
+  }
   return Status::Ok();
 }
 
@@ -129,7 +154,9 @@ StatusOr<Dataset> ReadIpinLog(const std::string& path, const PhoneLogOptions& op
   std::string line;
   int number = 0;
   double first_time = std::numeric_limits<double>::infinity();
-  while (std::getline(in, line)) {
+  for (bool more = true;;) {
+    RATSLAM_RETURN_IF_ERROR(ReadPhoneLogLine(in, path, number, &line, &more));
+    if (!more) break;
     ++number;
     ++r.lines;
     if (line.empty() || line[0] == '%' || line.find_first_not_of(" \t\r") == std::string::npos) {
@@ -141,14 +168,18 @@ StatusOr<Dataset> ReadIpinLog(const std::string& path, const PhoneLogOptions& op
       return Status::Error(path + ":" + std::to_string(number) + ": " + type + ": " + what);
     };
     std::vector<double> v(f.size(), 0.0);
-    auto numbers = [&](std::initializer_list<size_t> indices,
-                       std::initializer_list<const char*> names) {
-      auto name = names.begin();
-      for (size_t i : indices) {
-        if (i >= f.size()) return fail(std::string("missing field ") + *name);
-        if (!ParseDouble(f[i], &v[i]))
-          return fail(std::string(*name) + " is not a number: '" + f[i] + "'");
-        ++name;
+    // Every number is range-checked: a latitude of 4000 degrees or a floor of 1e300 is a
+    // corrupt line, not a position 440,000 km away or floor 0.
+    auto numbers = [&](std::initializer_list<Field> fields) {
+      for (const Field& field : fields) {
+        if (field.index >= f.size()) return fail(std::string("missing field ") + field.name);
+        if (!ParseDouble(f[field.index], &v[field.index])) {
+          return fail(std::string(field.name) + " is not a number: '" + f[field.index] + "'");
+        }
+        if (!(v[field.index] >= field.min && v[field.index] <= field.max)) {
+          return fail(std::string(field.name) + " is out of range [" + FormatBound(field.min) +
+                      ", " + FormatBound(field.max) + "]: '" + f[field.index] + "'");
+        }
       }
       return Status::Ok();
     };
@@ -159,15 +190,19 @@ StatusOr<Dataset> ReadIpinLog(const std::string& path, const PhoneLogOptions& op
         status = fail("expected 6 or 7 fields, found " + std::to_string(f.size()));
       } else {
         const size_t rss = f.size() - 1;
-        status = numbers({1, rss}, {"AppTimestamp(s)", "RSS(dBm)"});
+        status = numbers({{1, "AppTimestamp(s)", 0, kMaxTimeS}, {rss, "RSS(dBm)", -200, 50}});
         if (status.ok() && f[4].empty()) status = fail("empty BSSID");
         if (status.ok()) scans[v[1]].push_back({f[4], v[rss]});
       }
     } else if (type == "ACCE") {
-      status = numbers({1, 3, 4, 5}, {"AppTimestamp(s)", "Acc_X", "Acc_Y", "Acc_Z"});
+      status = numbers({{1, "AppTimestamp(s)", 0, kMaxTimeS},
+                        {3, "Acc_X", -kMaxSensor, kMaxSensor},
+                        {4, "Acc_Y", -kMaxSensor, kMaxSensor},
+                        {5, "Acc_Z", -kMaxSensor, kMaxSensor}});
       if (status.ok()) accelerometer.push_back({v[1], v[3], v[4], v[5]});
     } else if (type == "AHRS") {
-      status = numbers({1, 5}, {"AppTimestamp(s)", "YawZ(deg)"});
+      status = numbers(
+          {{1, "AppTimestamp(s)", 0, kMaxTimeS}, {5, "YawZ(deg)", -kMaxSensor, kMaxSensor}});
       // The app's yaw turns counter-clockwise from north (checked on the training logs: dead
       // reckoning with it needs 2-10 degrees of rotation to fit the ground truth, and the
       // clockwise reading fits 2-3 times worse). Ours: counter-clockwise from east.
@@ -175,8 +210,12 @@ StatusOr<Dataset> ReadIpinLog(const std::string& path, const PhoneLogOptions& op
         headings.push_back({v[1], WrapAngle(v[5] * std::numbers::pi / 180 + std::numbers::pi / 2)});
       }
     } else if (type == "POSI") {
-      status = numbers({1, 3, 4, 5}, {"Timestamp(s)", "Latitude", "Longitude", "floor"});
-      if (status.ok()) posi.push_back({v[1], v[3], v[4], static_cast<int>(std::lround(v[5]))});
+      status = numbers({{1, "Timestamp(s)", 0, kMaxTimeS},
+                        {3, "Latitude", -90, 90},
+                        {4, "Longitude", -180, 180},
+                        {5, "floor", -1000, 1000}});
+      if (status.ok() && v[5] != std::floor(v[5])) status = fail("floor is not a whole number");
+      if (status.ok()) posi.push_back({v[1], v[3], v[4], static_cast<int>(v[5])});
     } else {
       ++r.skipped_other_types;
       continue;

@@ -48,8 +48,13 @@ struct PhoneLogReport {
 StatusOr<Dataset> ReadIpinLog(const std::string& path, const PhoneLogOptions& options,
                               PhoneLogReport* report = nullptr);
 
-// Checks the options and opens a phone log for reading (shared by the phone log readers).
+// Checks the options and opens a phone log (a regular file) for reading (shared by the phone log
+// readers).
 Status OpenPhoneLog(const std::string& path, const PhoneLogOptions& options, std::ifstream* in);
+// Reads line `number + 1` of a phone log into *line (at most kMaxLineBytes; longer is an error
+// naming the line); *more is false at the end of the file.
+Status ReadPhoneLogLine(std::istream& in, const std::string& path, int number, std::string* line,
+                        bool* more);
 
 // What a phone log reader collects, before it becomes a data set.
 struct PhoneLogStreams {

@@ -82,6 +82,29 @@ TEST(IpinLogTest, BrokenLinesNameFileAndLineOrAreCountedWhenLenient) {
   EXPECT_FALSE(ReadIpinLog("/nonexistent.txt", {}).ok());
 }
 
+// Nonsense that once loaded silently: a latitude of 4000 degrees (y = 4.4e8 m), a floor of 1e300
+// (read as floor 0, and an undefined cast), a negative time, a latitude of 1e308.
+TEST(IpinLogTest, OutOfRangeValuesNameTheFieldAndLine) {
+  const std::pair<const char*, const char*> cases[] = {
+      {"POSI;5.0;3;4000.0;11.11;0;100\n", "Latitude is out of range [-90, 90]"},
+      {"POSI;5.0;3;1e308;11.11;0;100\n", "Latitude is out of range"},
+      {"POSI;5.0;3;49.46;11.11;1e300;100\n", "floor is out of range [-1000, 1000]"},
+      {"POSI;5.0;3;49.46;11.11;1.5;100\n", "floor is not a whole number"},
+      {"WIFI;-5.0;105.0;net;aa:bb;2437;-60\n", "AppTimestamp(s) is out of range"},
+      {"ACCE;5.1;105.1;0.1;0.2;1e9;3\n", "Acc_Z is out of range"},
+  };
+  for (const auto& [line, expected] : cases) {
+    const fs::path path = WriteFixture("ratslam_ipin_range.txt", std::string(kFixture) + line);
+    StatusOr<Dataset> d = ReadIpinLog(path.string(), {});
+    ASSERT_FALSE(d.ok()) << line;
+    EXPECT_NE(d.status().message().find("ratslam_ipin_range.txt:11: "), std::string::npos)
+        << d.status().message();
+    EXPECT_NE(d.status().message().find(expected), std::string::npos) << d.status().message();
+  }
+  EXPECT_NE(ReadIpinLog("/dev/zero", {}).status().message().find("not a regular file"),
+            std::string::npos);
+}
+
 TEST(IpinLogTest, StepsBecomeOdometryRows) {
   const std::vector<Step> steps = {{1.0, 0.7, 0.0}, {1.5, 0.8, 0.5}};
   const std::vector<OdometryRow> rows = StepsToOdometry(steps, 0.0);

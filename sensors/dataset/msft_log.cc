@@ -14,6 +14,10 @@
 namespace ratslam {
 namespace {
 
+constexpr double kMaxTimeMs = 1e15;    // epoch milliseconds (year 2001 is 1e12)
+constexpr double kMaxSensor = 1e4;     // accelerations (m/s^2) and rotation-vector parts
+constexpr double kMaxPositionM = 1e7;  // waypoint coordinates in a building's frame
+
 std::vector<std::string> SplitTabs(const std::string& line) {
   std::vector<std::string> fields;
   std::string field;
@@ -69,7 +73,9 @@ StatusOr<Dataset> ReadMicrosoftLog(const std::string& path, const PhoneLogOption
   double start_ms = std::numeric_limits<double>::quiet_NaN();
   std::string line;
   int number = 0;
-  while (std::getline(in, line)) {
+  for (bool more = true;;) {
+    RATSLAM_RETURN_IF_ERROR(ReadPhoneLogLine(in, path, number, &line, &more));
+    if (!more) break;
     ++number;
     ++r.lines;
     if (line.empty() || line.find_first_not_of(" \t\r") == std::string::npos) continue;
@@ -81,7 +87,7 @@ StatusOr<Dataset> ReadMicrosoftLog(const std::string& path, const PhoneLogOption
         }
         double start = 0.0;
         if (field.rfind("startTime:", 0) == 0 && ParseNumber(field.substr(10), &start) &&
-            std::isnan(start_ms)) {
+            start >= 0 && start <= kMaxTimeMs && std::isnan(start_ms)) {
           start_ms = start;  // times count from the recording's start
         }
       }
@@ -93,36 +99,46 @@ StatusOr<Dataset> ReadMicrosoftLog(const std::string& path, const PhoneLogOption
                            (type.empty() ? std::string("line") : type) + ": " + what);
     };
     std::vector<double> v(f.size(), 0.0);
-    auto numbers = [&](std::initializer_list<size_t> indices) {
+    // Every number is range-checked (`limit` on its magnitude): corrupt values must not become
+    // infinite times or positions.
+    auto numbers = [&](std::initializer_list<size_t> indices, double limit) {
       for (size_t i : indices) {
         if (i >= f.size()) return fail("missing field " + std::to_string(i + 1));
         if (!ParseNumber(f[i], &v[i])) {
           return fail("field " + std::to_string(i + 1) + " is not a number: '" + f[i] + "'");
         }
+        if (!(std::abs(v[i]) <= limit)) {
+          return fail("field " + std::to_string(i + 1) + " is out of range: '" + f[i] + "'");
+        }
       }
       return Status::Ok();
     };
-    Status status = numbers({0});
+    Status status = numbers({0}, kMaxTimeMs);
+    if (status.ok() && v[0] < 0) status = fail("negative timestamp");
     if (status.ok() && std::isnan(start_ms)) start_ms = v[0];
+    if (status.ok() && v[0] < start_ms) {
+      status = fail("timestamp " + f[0] + " is before the walk's start time");
+    }
     const double t = status.ok() ? (v[0] - start_ms) / 1000.0 : 0.0;
     if (!status.ok()) {
       // the timestamp itself is broken
     } else if (type == "TYPE_WIFI") {
       status = f.size() < 6 ? fail("expected ssid, bssid, rssi, frequency and last-seen time")
-                            : numbers({4, 5, 6 < f.size() ? size_t{6} : size_t{5}});
+                            : numbers({5, 6 < f.size() ? size_t{6} : size_t{5}}, kMaxTimeMs);
+      if (status.ok()) status = numbers({4}, 200.0);
       if (status.ok() && f[3].empty()) status = fail("empty BSSID");
       if (status.ok()) {
         const bool stale = f.size() > 6 && v[0] - v[6] > max_wifi_staleness_s * 1000.0;
         if (!stale) scans[t].push_back({f[3], v[4]});
       }
     } else if (type == "TYPE_ACCELEROMETER") {
-      status = numbers({2, 3, 4});
+      status = numbers({2, 3, 4}, kMaxSensor);
       if (status.ok()) accelerometer.push_back({t, v[2], v[3], v[4]});
     } else if (type == "TYPE_ROTATION_VECTOR") {
-      status = numbers({2, 3, 4});
+      status = numbers({2, 3, 4}, kMaxSensor);
       if (status.ok()) headings.push_back({t, HeadingFromRotationVector(v[2], v[3], v[4])});
     } else if (type == "TYPE_WAYPOINT") {
-      status = numbers({2, 3});
+      status = numbers({2, 3}, kMaxPositionM);
       if (status.ok()) {
         GroundTruthRow row;
         row.time_s = t;

@@ -64,6 +64,25 @@ TEST(MicrosoftLogTest, BrokenLineNamesFileAndLine) {
   fs::remove(path);
 }
 
+// Timestamps before the walk's start once gave negative times, and huge ones minus infinity.
+TEST(MicrosoftLogTest, TimesBeforeTheStartAndHugeValuesAreRefused) {
+  const std::pair<const char*, const char*> cases[] = {
+      {"1574559400000\tTYPE_WAYPOINT\t75.3\t94.8\n", "is before the walk's start time"},
+      {"-1e308\tTYPE_WAYPOINT\t75.3\t94.8\n", "field 1 is out of range"},
+      {"1574559503900\tTYPE_WAYPOINT\t1e300\t94.8\n", "field 3 is out of range"},
+      {"1574559503900\tTYPE_WIFI\tx\taa:bb\t-50\t2412\t-1e300\n", "field 7 is out of range"},
+  };
+  for (const auto& [line, expected] : cases) {
+    const fs::path path = TestScratch().path() / "ratslam_msft_range.txt";
+    std::ofstream(path) << kFixture << line;
+    StatusOr<Dataset> d = ReadMicrosoftLog(path.string(), {});
+    ASSERT_FALSE(d.ok()) << line;
+    EXPECT_NE(d.status().message().find("ratslam_msft_range.txt:10: "), std::string::npos)
+        << d.status().message();
+    EXPECT_NE(d.status().message().find(expected), std::string::npos) << d.status().message();
+  }
+}
+
 TEST(MicrosoftLogTest, FloorNamesAndRotationVectors) {
   EXPECT_EQ(FloorFromName("B1"), -1);
   EXPECT_EQ(FloorFromName("F1"), 0);

@@ -5,10 +5,15 @@
 #include <fstream>
 #include <sstream>
 
+#include "common/text_file.h"
+
 namespace ratslam {
 namespace {
 
 constexpr double kNotDetected = 100.0;
+// Largest magnitude of each label column, in the order of `labels` below: metres (UTM), ids,
+// seconds. Ids are whole numbers that fit an int; larger values are corrupt rows.
+constexpr double kLabelLimits[] = {1e8, 1e8, 1e6, 1e6, 1e6, 1e6, 1e6, 1e6, 1e12};
 
 std::vector<std::string> SplitCommas(const std::string& line) {
   std::vector<std::string> fields;
@@ -32,13 +37,14 @@ bool ParseNumber(const std::string& text, double* value) {
 
 StatusOr<std::vector<LabelledScan>> ReadUjiIndoorLoc(const std::string& path, bool lenient,
                                                      UjiReadReport* report) {
-  std::ifstream in(path);
-  if (!in) return Status::Error(path + ": cannot open file");
+  std::ifstream in;
+  RATSLAM_RETURN_IF_ERROR(OpenRegularFile(path, "file", &in));
   UjiReadReport local;
   UjiReadReport& r = report ? *report : local;
   r = UjiReadReport();
   std::string line;
-  if (!std::getline(in, line)) return Status::Error(path + ": empty file");
+  // The real file has 529 columns: its lines are about 2 kB.
+  if (ReadLine(in, &line) != LineResult::kLine) return Status::Error(path + ": empty file");
   const std::vector<std::string> header = SplitCommas(line);
   std::vector<size_t> waps;
   const char* labels[] = {"LONGITUDE",        "LATITUDE", "FLOOR",   "BUILDINGID", "SPACEID",
@@ -67,8 +73,14 @@ StatusOr<std::vector<LabelledScan>> ReadUjiIndoorLoc(const std::string& path, bo
   r.access_points = waps.size();
   std::vector<LabelledScan> scans;
   int number = 1;
-  while (std::getline(in, line)) {
+  for (;;) {
+    const LineResult read = ReadLine(in, &line);
+    if (read == LineResult::kEnd) break;
     ++number;
+    if (read == LineResult::kTooLong) {
+      return Status::Error(path + ":" + std::to_string(number) + ": line longer than " +
+                           std::to_string(kMaxLineBytes) + " bytes");
+    }
     if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
     ++r.rows;
     const std::vector<std::string> f = SplitCommas(line);
@@ -98,6 +110,12 @@ StatusOr<std::vector<LabelledScan>> ReadUjiIndoorLoc(const std::string& path, bo
       if (label_column[k] < 0) continue;
       if (!ParseNumber(f[label_column[k]], &values[k])) {
         status = error(labels[k], "not a number: '" + f[label_column[k]] + "'");
+      } else if (!(std::abs(values[k]) <= kLabelLimits[k])) {
+        status = error(labels[k], "out of range: '" + f[label_column[k]] + "'");
+      } else if (k >= 2 && k < 8 && values[k] != std::floor(values[k])) {
+        status = error(labels[k], "not a whole number: '" + f[label_column[k]] + "'");
+      } else if (k == 8 && values[k] < 0) {
+        status = error(labels[k], "negative time: '" + f[label_column[k]] + "'");
       }
     }
     if (!status.ok()) {

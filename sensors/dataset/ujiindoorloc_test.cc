@@ -65,6 +65,23 @@ TEST(UjiIndoorLocTest, BrokenRowsNameLineAndColumn) {
   fs::remove(q);
 }
 
+// A floor of 1e300 was cast to int (undefined; found by the fuzzer); ids must be whole numbers.
+TEST(UjiIndoorLocTest, OutOfRangeAndFractionalLabelsAreRefused) {
+  const std::pair<const char*, const char*> cases[] = {
+      {"100,-71,100,-7541.26,4864920.77,1e300,1,106,2,2,23,1\n", "column 'FLOOR': out of range"},
+      {"100,-71,100,-7541.26,4864920.77,2.5,1,106,2,2,23,1\n", "'FLOOR': not a whole number"},
+      {"100,-71,100,-7541.26,4864920.77,2,1,106,2,2,23,-5\n", "'TIMESTAMP': negative time"},
+  };
+  for (const auto& [row, expected] : cases) {
+    const fs::path p = Write("ratslam_uji_range.csv", std::string(kHeader) + row);
+    StatusOr<std::vector<LabelledScan>> scans = ReadUjiIndoorLoc(p.string());
+    ASSERT_FALSE(scans.ok()) << row;
+    EXPECT_NE(scans.status().message().find("ratslam_uji_range.csv:2: "), std::string::npos);
+    EXPECT_NE(scans.status().message().find(expected), std::string::npos)
+        << scans.status().message();
+  }
+}
+
 TEST(UjiIndoorLocTest, RealTrainingFile) {
   const fs::path p = fs::path(RATSLAM_SHARED_DATA_DIR) / "ujiindoorloc" / "trainingData.csv";
   if (!fs::exists(p)) GTEST_SKIP() << "missing " << p;

@@ -1,0 +1,38 @@
+// TOML configuration files: errors name the file; an accepted config is valid and prints to text
+// that reads back to the same config.
+#include <string>
+
+#include "fusion/io/config.h"
+#include "fuzz/fuzz_support.h"
+
+namespace ratslam::fuzz {
+
+std::vector<std::string> FuzzSeeds() {
+  PipelineOptions fused;
+  fused.sensors.front_end.kind = FrontEndKind::kFused;
+  fused.sensors.fused.use_camera = true;
+  fused.sensors.fused.use_compass = true;
+  return {PrintConfig(PipelineOptions()), PrintConfig(fused, false),
+          "[front_end]\nkind = \"fabmap\"\n[fabmap]\nmode = \"early\"\n[wifi_words]\nbins = 8\n"};
+}
+
+}  // namespace ratslam::fuzz
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  using namespace ratslam;
+  const std::string text(reinterpret_cast<const char*>(data), size);
+  StatusOr<PipelineOptions> options = ParseConfig(text, "fuzz.toml");
+  if (!options.ok()) {
+    if (options.status().message().rfind("fuzz.toml", 0) != 0) {
+      fuzz::InvariantFailed("error does not name the file: " + options.status().message());
+    }
+    return 0;
+  }
+  std::string error;
+  if (!options->IsValid(&error)) fuzz::InvariantFailed("accepted an invalid config: " + error);
+  const std::string printed = PrintConfig(*options);
+  StatusOr<PipelineOptions> back = ParseConfig(printed, "printed.toml");
+  if (!back.ok()) fuzz::InvariantFailed("printed config does not read: " + back.status().message());
+  if (PrintConfig(*back) != printed) fuzz::InvariantFailed("print/parse round trip differs");
+  return 0;
+}

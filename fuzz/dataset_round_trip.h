@@ -1,0 +1,43 @@
+// The invariant every data-set reader must keep: what it returns can be written in the replay
+// format and read back, with the same rows. `ratslam import` depends on it.
+#ifndef RATSLAM_FUZZ_DATASET_ROUND_TRIP_H_
+#define RATSLAM_FUZZ_DATASET_ROUND_TRIP_H_
+
+#include <cmath>
+#include <string>
+
+#include "fuzz/fuzz_support.h"
+#include "sensors/dataset/dataset.h"
+
+namespace ratslam::fuzz {
+
+inline size_t Readings(const Dataset& d) {
+  size_t n = 0;
+  for (const WifiScan& s : d.wifi) n += s.readings.size();
+  return n;
+}
+
+inline void CheckWritesAndReadsBack(const Dataset& d) {
+  const std::string folder = (Scratch() / "round_trip").string();
+  const Status written = WriteDataset(d, folder);
+  if (!written.ok()) {
+    // Refusing to write a value the reader cannot give back is allowed, and must say so.
+    if (written.message().find("cannot be stored") == std::string::npos &&
+        written.message().find("not writable") == std::string::npos) {
+      InvariantFailed("write failed: " + written.message());
+    }
+    return;
+  }
+  StatusOr<Dataset> back = ReadDataset(folder);
+  if (!back.ok())
+    InvariantFailed("a written data set does not read back: " + back.status().message());
+  if (back->odometry.size() != d.odometry.size() || back->images.size() != d.images.size() ||
+      back->ground_truth.size() != d.ground_truth.size() ||
+      back->compass.size() != d.compass.size() || Readings(*back) != Readings(d)) {
+    InvariantFailed("a written data set reads back with other row counts");
+  }
+}
+
+}  // namespace ratslam::fuzz
+
+#endif  // RATSLAM_FUZZ_DATASET_ROUND_TRIP_H_

@@ -1,0 +1,37 @@
+#include "fuzz/fuzz_support.h"
+
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+
+namespace ratslam::fuzz {
+
+std::string WriteScratchFile(const std::string& name, const uint8_t* data, size_t size) {
+  const std::string path = (Scratch() / name).string();
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
+  return path;
+}
+
+std::vector<std::string> SplitParts(const uint8_t* data, size_t size,
+                                    const std::string& separator) {
+  const std::string text(reinterpret_cast<const char*>(data), size);
+  std::vector<std::string> parts;
+  size_t start = 0;
+  for (;;) {
+    const size_t at = text.find(separator, start);
+    if (at == std::string::npos) {
+      parts.push_back(text.substr(start));
+      return parts;
+    }
+    parts.push_back(text.substr(start, at - start));
+    start = at + separator.size();
+  }
+}
+
+void InvariantFailed(const std::string& message) {
+  std::fprintf(stderr, "fuzz invariant failed: %s\n", message.c_str());
+  std::abort();
+}
+
+}  // namespace ratslam::fuzz

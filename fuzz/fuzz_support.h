@@ -1,0 +1,41 @@
+// Shared by the coverage-guided fuzz harnesses (libFuzzer, built with clang by
+// scripts/fuzz.sh) and by their replay drivers (any compiler; ctest runs every committed
+// regression input and every seed through them).
+//
+// Each harness defines LLVMFuzzerTestOneInput and FuzzSeeds(): small valid inputs that start
+// the corpus, generated in code so that no data set is copied into the repository.
+#ifndef RATSLAM_FUZZ_FUZZ_SUPPORT_H_
+#define RATSLAM_FUZZ_FUZZ_SUPPORT_H_
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "common/scratch_dir.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size);
+
+namespace ratslam::fuzz {
+
+// Valid example inputs for this harness (the driver writes them with --seeds DIR).
+std::vector<std::string> FuzzSeeds();
+
+// One scratch folder per process, for readers that take a path.
+inline const ScratchDir& Scratch() {
+  static const ScratchDir dir("ratslam_fuzz");
+  return dir;
+}
+
+// Writes `size` bytes to `name` in the scratch folder; returns its path.
+std::string WriteScratchFile(const std::string& name, const uint8_t* data, size_t size);
+
+// Splits an input into parts at a separator line; a data set's files are fuzzed as one input.
+std::vector<std::string> SplitParts(const uint8_t* data, size_t size, const std::string& separator);
+
+// A failed invariant: prints the message and aborts, which the fuzzer reports as a crash.
+[[noreturn]] void InvariantFailed(const std::string& message);
+
+}  // namespace ratslam::fuzz
+
+#endif  // RATSLAM_FUZZ_FUZZ_SUPPORT_H_
