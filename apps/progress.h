@@ -5,16 +5,16 @@
 #include <cstdio>
 #include <string>
 
-#include "fusion/replay_pipeline.h"
+#include "common/progress.h"
 
 namespace ratslam {
 
-class ProgressPrinter {
+class ProgressPrinter : public ProgressSink {
  public:
   // Writes to `stream` (normally stderr); `quiet` prints nothing.
   ProgressPrinter(std::FILE* stream, bool quiet);
-  void Update(const ReplayProgress& progress);
-  void Finish();
+  void Update(const ProgressUpdate& progress) override;
+  void Finish() override;
 
  private:
   std::FILE* stream_;

@@ -20,6 +20,7 @@
 #include "apps/demo_config.h"
 #include "apps/progress.h"
 #include "common/file_util.h"
+#include "common/output_folder.h"
 #include "fusion/io/config.h"
 #include "fusion/io/map_file.h"
 #include "fusion/io/run_outputs.h"
@@ -29,6 +30,7 @@
 #include "sensors/dataset/image_loader.h"
 #include "sensors/dataset/synthetic_dataset.h"
 #include "sensors/dataset/visual_odometry_source.h"
+#include "session/replay_session.h"
 #include "sim/world.h"
 #include "viewer/animation.h"
 #include "viewer/figures.h"
@@ -83,180 +85,100 @@ const char kUsage[] =
     "      simulation.json and ground_truth.png.\n";
 
 struct ReplayRequest {
-  PipelineOptions options;
-  std::string config_path;        // empty: built-in
-  std::vector<std::string> data;  // one data set, or several sessions
-  bool lenient = false;           // skip malformed lines of phone logs
+  ReplaySessionOptions session;
   std::string out;
-  std::string save_map;
-  std::string load_map;
-  double until_s = std::numeric_limits<double>::infinity();
   bool quiet = false;
   bool render = false;         // write experience_map.png, template_graph.png, pose_cells.png
   uint64_t animate_every = 0;  // events between animation frames; 0: no animation
 };
 
+// Parses nothing and decides nothing: runs a replay session and reports what it did.
 int RunReplay(const ReplayRequest& request) {
-  PhoneLogOptions phone;
-  phone.lenient = request.lenient;
-  phone.pdr = request.options.pdr;
-  StatusOr<Dataset> dataset = LoadSessions(request.data, phone);
-  if (!dataset.ok()) {
-    std::cerr << "ratslam: " << dataset.status().message() << "\n";
+  auto fail = [](const Status& s) {
+    std::cerr << "ratslam: " << s.message() << "\n";
     return kExitError;
-  }
-  FileImageLoader images;
-  if (request.options.visual_odometry.enabled) {
-    Status replaced =
-        ReplaceOdometryWithVisual(&dataset.value(), &images, request.options.visual_odometry);
-    if (!replaced.ok()) {
-      std::cerr << "ratslam: visual odometry: " << replaced.message() << "\n";
-      return kExitError;
-    }
-  }
-  std::error_code ec;
-  fs::create_directories(request.out, ec);
-  if (ec) {
-    std::cerr << "ratslam: " << request.out << ": cannot create: " << ec.message() << "\n";
-    return kExitError;
-  }
-  const std::string resolved =
-      "# Resolved configuration of this run (ratslam print-config format).\n" +
-      PrintConfig(request.options);
-  Status written = WriteFileAtomically((fs::path(request.out) / "config.toml").string(), resolved);
-  if (!written.ok()) {
-    std::cerr << "ratslam: " << written.message() << "\n";
-    return kExitError;
-  }
-
-  std::shared_ptr<const FabmapResources> fabmap;
-  if (request.options.sensors.front_end.kind == FrontEndKind::kFabmap) {
-    auto prepared = PrepareFabmapResources(request.options.sensors, dataset.value(), images);
-    if (!prepared.ok()) {
-      std::cerr << "ratslam: FABMAP front end: " << prepared.status().message() << "\n";
-      return kExitError;
-    }
-    fabmap = *prepared;
-  }
-  ReplayPipeline pipeline(request.options, dataset.value(), &images, fabmap);
-  const uint64_t fingerprint = ConfigFingerprint(request.options);
-  if (!request.load_map.empty()) {
-    StatusOr<MapFile> map = LoadMapFile(request.load_map);
-    if (!map.ok()) {
-      std::cerr << "ratslam: " << map.status().message() << "\n";
-      return kExitError;
-    }
-    if (map->config_fingerprint != fingerprint) {
-      std::cerr << "ratslam: " << request.load_map
-                << ": the map was made with a different configuration\n";
-      return kExitError;
-    }
-    if (map->dataset_name != dataset->name) {
-      std::cerr << "ratslam: " << request.load_map << ": the map was made from data set '"
-                << map->dataset_name << "', not '" << dataset->name << "'\n";
-      return kExitError;
-    }
-    Status restored = pipeline.Restore(map->state);
-    if (!restored.ok()) {
-      std::cerr << "ratslam: " << request.load_map << ": " << restored.message() << "\n";
-      return kExitError;
-    }
-  }
-
+  };
+  StatusOr<std::unique_ptr<DiskFolder>> out = DiskFolder::Open(request.out);
+  if (!out.ok()) return fail(out.status());
+  ProgressPrinter progress(stderr, request.quiet);
+  SessionEnvironment environment;
+  environment.out = out->get();
+  environment.progress = &progress;
+  environment.stop_requested = &g_stop_requested;
+  ReplaySession session(request.session, environment);
+  // Ctrl-C stops the replay cleanly; the handler stays until the outputs and the map are saved,
+  // so a second signal during the writes cannot lose them.
   std::signal(SIGINT, OnSignal);
   std::signal(SIGTERM, OnSignal);
-  ProgressPrinter progress(stderr, request.quiet);
-  ReplayControl control;
-  control.until_time_s = request.until_s;
-  control.stop_requested = &g_stop_requested;
-  control.progress = [&progress](const ReplayProgress& p) { progress.Update(p); };
+  struct RestoreSignals {
+    ~RestoreSignals() {
+      std::signal(SIGINT, SIG_DFL);
+      std::signal(SIGTERM, SIG_DFL);
+    }
+  } restore_signals;
+
   // Animation: a frame of the experience map every `animate_every` events.
   std::unique_ptr<SceneRenderer> animation_renderer;
   std::unique_ptr<AnimationWriter> animation;
+  ReplayCheckpoint checkpoint;
   if (request.animate_every > 0) {
     StatusOr<std::unique_ptr<SceneRenderer>> renderer = CreateOsMesaRenderer();
-    if (!renderer.ok()) {
-      std::cerr << "ratslam: --animate: " << renderer.status().message() << "\n";
-      return kExitError;
-    }
+    if (!renderer.ok()) return fail(renderer.status().WithContext("--animate"));
     animation_renderer = std::move(renderer.value());
     animation =
         std::make_unique<AnimationWriter>((fs::path(request.out) / "animation").string(), 10.0);
-    control.checkpoint_every = request.animate_every;
-    control.checkpoint = [&](const ReplayPipeline& p) -> Status {
+    checkpoint.every = request.animate_every;
+    checkpoint.callback = [&](const ReplayPipeline& p) -> Status {
       ExperienceMapImageOptions options;
       options.width_px = 960;
       options.height_px = 720;
       char title[96];
-      std::snprintf(title, sizeof title, "%s  t = %.1f s", dataset->name.c_str(),
+      std::snprintf(title, sizeof title, "%s  t = %.1f s", session.dataset().name.c_str(),
                     p.state().trajectory.empty() ? 0.0 : p.state().trajectory.back().time_s);
       options.title = title;
       StatusOr<RgbaImage> frame = animation_renderer->Render(
-          ExperienceMapScene(ExperienceMapDataOf(p, dataset.value()), options));
+          ExperienceMapScene(ExperienceMapDataOf(p, session.dataset()), options));
       if (!frame.ok()) return frame.status();
       return animation->AddFrame(frame.value());
     };
   }
-  const uint64_t frames_before = pipeline.state().frames.size();
-  const auto start = std::chrono::steady_clock::now();
-  const Status run = pipeline.Run(control);
-  const double wall_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  progress.Finish();
+  if (Status loaded = session.Load(); !loaded.ok()) return fail(loaded);
+  if (Status prepared = session.Prepare(); !prepared.ok()) return fail(prepared);
+  (void)session.Replay(checkpoint);
   if (animation) {
     const bool video = animation->Close();
     std::cerr << "ratslam: wrote " << animation->frames() << " animation frames"
               << (video ? " and animation.avi" : " (no video writer available)") << " to "
               << (fs::path(request.out) / "animation").string() << "\n";
   }
-  std::signal(SIGINT, SIG_DFL);
-  std::signal(SIGTERM, SIG_DFL);
-  const bool interrupted = g_stop_requested.load();
+  (void)session.WriteOutputs();
+  (void)session.SaveMap();
+  const ReplayResult& result = session.result();
 
-  // Whatever happened, write what exists.
-  RunInfo info;
-  info.wall_seconds = wall_seconds;
-  info.frames_this_run = pipeline.state().frames.size() - frames_before;
-  info.interrupted = interrupted;
-  info.config_path = request.config_path;
-  info.config_fingerprint = fingerprint;
-  info.resumed_from = request.load_map;
-  StatusOr<RunSummary> summary = WriteRunOutputs(request.out, pipeline, dataset.value(), info);
-  if (!summary.ok()) {
-    std::cerr << "ratslam: " << summary.status().message() << "\n";
-    return kExitError;
-  }
-  std::string save_path = request.save_map;
-  if (save_path.empty() && (interrupted || !run.ok())) {
-    save_path = (fs::path(request.out) / "interrupted.map").string();
-  }
-  if (!save_path.empty()) {
-    MapFile map{fingerprint, dataset->name, pipeline.Snapshot()};
-    Status saved = SaveMapFile(map, save_path);
-    if (!saved.ok()) {
-      std::cerr << "ratslam: " << saved.message() << "\n";
-      return kExitError;
-    }
-  }
-  std::cout << summary->json;
-  if (request.render) {
+  int exit_code = kExitOk;
+  if (result.summary) std::cout << result.summary->json;
+  if (!result.outputs.ok()) exit_code = fail(result.outputs);
+  if (!result.save.ok()) exit_code = fail(result.save);
+  if (request.render && result.outputs.ok()) {
     StatusOr<std::unique_ptr<SceneRenderer>> renderer = CreateOsMesaRenderer();
-    Status rendered =
-        renderer.ok() ? WriteRunImages(*renderer.value(), pipeline, dataset.value(), request.out)
-                      : renderer.status();
-    if (!rendered.ok()) {
-      std::cerr << "ratslam: images not written: " << rendered.message() << "\n";
-      return kExitError;
-    }
+    Status rendered = renderer.ok() ? WriteRunImages(*renderer.value(), session.pipeline(),
+                                                     session.dataset(), request.out)
+                                    : renderer.status();
+    if (!rendered.ok()) exit_code = fail(rendered.WithContext("images not written"));
   }
-  if (!run.ok()) {
-    std::cerr << "ratslam: " << run.message() << "\n"
-              << "ratslam: outputs up to the last complete event are in " << request.out
-              << "; the state is saved in " << save_path << "\n";
+  if (!result.replay.ok()) {
+    std::cerr << "ratslam: " << result.replay.message() << "\n";
+    if (result.outputs.ok()) {
+      std::cerr << "ratslam: outputs up to the last complete event are in " << request.out << "\n";
+    }
+    if (!result.saved_map.empty()) {
+      std::cerr << "ratslam: the state is saved in " << result.saved_map << "\n";
+    }
     return kExitError;
   }
-  if (interrupted) {
-    std::cerr << "ratslam: interrupted; state saved in " << save_path << "\n";
+  if (exit_code != kExitOk) return exit_code;
+  if (result.interrupted) {
+    std::cerr << "ratslam: interrupted; state saved in " << result.saved_map << "\n";
     return kExitInterrupted;
   }
   return kExitOk;
@@ -272,18 +194,18 @@ int Replay(int argc, char** argv) {
     return kExitUsage;
   }
   ReplayRequest request;
-  auto options = LoadOptions(*args, &request.config_path);
+  auto options = LoadOptions(*args, &request.session.config_path);
   if (!options) return kExitError;
-  request.options = *options;
-  request.data = args->all["--data"];
-  request.lenient = args->lenient;
+  request.session.pipeline = *options;
+  request.session.data = args->all["--data"];
+  request.session.lenient = args->lenient;
   request.out = args->values["--out"];
-  request.save_map = args->values.count("--save-map") ? args->values["--save-map"] : "";
-  request.load_map = args->values.count("--load-map") ? args->values["--load-map"] : "";
+  request.session.save_map = args->values.count("--save-map") ? args->values["--save-map"] : "";
+  request.session.load_map = args->values.count("--load-map") ? args->values["--load-map"] : "";
   if (args->values.count("--until")) {
     auto until = ParseNumber("--until", args->values["--until"]);
     if (!until) return kExitUsage;
-    request.until_s = *until;
+    request.session.until_s = *until;
   }
   if (args->values.count("--animate")) {
     auto every = ParseInteger("--animate", args->values["--animate"], 1, int64_t{1} << 53);
@@ -327,9 +249,9 @@ int Demo(int argc, char** argv) {
     return kExitError;
   }
   ReplayRequest request;
-  request.options = DemoPipelineOptions();
-  request.config_path = "(built-in demo configuration, as configs/demo.toml)";
-  request.data = {data};
+  request.session.pipeline = DemoPipelineOptions();
+  request.session.config_path = "(built-in demo configuration, as configs/demo.toml)";
+  request.session.data = {data};
   request.out = out;
   request.quiet = args->quiet;
   request.render = true;

@@ -1,16 +1,42 @@
 #include "common/file_util.h"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
+#include <system_error>
 
 namespace ratslam {
+namespace {
 
-Status WriteFileAtomically(const std::string& path, const std::string& contents) {
-  const std::string temp = path + ".tmp" + std::to_string(::getpid());
+std::string TempPath(const std::string& path) { return path + ".tmp" + std::to_string(::getpid()); }
+
+// Removes `path.tmp<pid>` files whose writer no longer runs (killed mid-save).
+void RemoveStaleTemps(const std::string& path) {
+  namespace fs = std::filesystem;
+  const fs::path target(path);
+  const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  const std::string prefix = target.filename().string() + ".tmp";
+  std::error_code ec;
+  for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.size() <= prefix.size() || name.compare(0, prefix.size(), prefix) != 0) continue;
+    const std::string digits = name.substr(prefix.size());
+    if (digits.find_first_not_of("0123456789") != std::string::npos || digits.size() > 9) continue;
+    const pid_t pid = static_cast<pid_t>(std::stol(digits));
+    if (pid != ::getpid() && ::kill(pid, 0) != 0 && errno == ESRCH) {
+      std::error_code ignored;
+      fs::remove(it->path(), ignored);
+    }
+  }
+}
+
+// Writes and flushes `contents` to `temp`; on failure removes it and names `temp`.
+Status WriteAndFlush(const std::string& temp, const std::string& contents) {
   const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
   if (fd < 0) return Status::Error(temp + ": cannot create: " + std::strerror(errno));
   size_t written = 0;
@@ -25,14 +51,45 @@ Status WriteFileAtomically(const std::string& path, const std::string& contents)
     }
     written += static_cast<size_t>(n);
   }
-  if (::fsync(fd) != 0 || ::close(fd) != 0) {
+  if (::fsync(fd) != 0) {
+    const std::string reason = std::strerror(errno);
+    ::close(fd);
     ::unlink(temp.c_str());
-    return Status::Error(temp + ": cannot flush to disk");
+    return Status::Error(temp + ": cannot flush to disk: " + reason);
   }
-  if (std::rename(temp.c_str(), path.c_str()) != 0) {
+  if (::close(fd) != 0) {
     const std::string reason = std::strerror(errno);
     ::unlink(temp.c_str());
-    return Status::Error(path + ": cannot rename the temporary file into place: " + reason);
+    return Status::Error(temp + ": cannot flush to disk: " + reason);
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status WriteFileAtomically(const std::string& path, const std::string& contents) {
+  return WriteFilesAtomically({{path, contents}});
+}
+
+Status WriteFilesAtomically(const std::vector<std::pair<std::string, std::string>>& files) {
+  std::vector<std::string> temps;
+  for (const auto& [path, contents] : files) {
+    RemoveStaleTemps(path);
+    const std::string temp = TempPath(path);
+    const Status written = WriteAndFlush(temp, contents);
+    if (!written.ok()) {
+      for (const std::string& t : temps) ::unlink(t.c_str());
+      return written;
+    }
+    temps.push_back(temp);
+  }
+  for (size_t i = 0; i < files.size(); ++i) {
+    if (std::rename(temps[i].c_str(), files[i].first.c_str()) != 0) {
+      const std::string reason = std::strerror(errno);
+      for (size_t k = i; k < temps.size(); ++k) ::unlink(temps[k].c_str());
+      return Status::Error(files[i].first +
+                           ": cannot rename the temporary file into place: " + reason);
+    }
   }
   return Status::Ok();
 }

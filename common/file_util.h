@@ -3,14 +3,23 @@
 #define RATSLAM_COMMON_FILE_UTIL_H_
 
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "common/status.h"
 
 namespace ratslam {
 
-// Writes `contents` to a temporary file beside `path`, flushes it to disk and renames it over
-// `path`: the file is either the old one or the complete new one.
+// Writes `contents` to a temporary file beside `path` (`path.tmp<pid>`), flushes it to disk and
+// renames it over `path`: the file is either the old one or the complete new one. Temporary
+// files that a killed writer left beside `path` (their process is gone) are removed first.
 Status WriteFileAtomically(const std::string& path, const std::string& contents);
+
+// Several files that belong together (a run's outputs): every one is first written to its
+// temporary file and flushed; only when all of them are on disk are they renamed into place. A
+// failure (a full disk) removes the temporary files and leaves every earlier file as it was;
+// the error names the file.
+Status WriteFilesAtomically(const std::vector<std::pair<std::string, std::string>>& files);
 
 }  // namespace ratslam
 

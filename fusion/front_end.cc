@@ -44,7 +44,6 @@ bool FabmapSettings::IsValid(std::string* error) const {
          check(visual_model.IsValid(&inner), "visual_model") &&
          check(localiser.wifi_words.IsValid(&inner), "wifi_words") &&
          check(localiser.virtual_wifi.IsValid(&inner), "virtual_wifi") &&
-         check(evaluation.IsValid(&inner), "evaluation") &&
          check(front_end.IsValid(&inner), "fabmap_front_end");
 }
 

@@ -29,7 +29,6 @@
 #include <string>
 
 #include "common/status.h"
-#include "fusion/fabmap/evaluation.h"
 #include "fusion/fabmap/localiser.h"
 #include "fusion/fabmap/visual_model.h"
 #include "fusion/fabmap/vocabulary.h"
@@ -106,7 +105,6 @@ struct FabmapSettings {
   fabmap::FeatureOptions features;
   fabmap::VocabularyOptions vocabulary;
   fabmap::VisualModelOptions visual_model;
-  fabmap::EvaluationOptions evaluation;
   FabmapFrontEndOptions front_end;
 
   bool IsValid(std::string* error) const;

@@ -18,7 +18,7 @@ bool PipelineOptions::IsValid(std::string* error) const {
          check(sensors.camera_12x9.IsValid(&inner), "camera_12x9") &&
          check(sensors.wifi.IsValid(&inner), "wifi") && check(pdr.IsValid(&inner), "pdr") &&
          check(visual_odometry.IsValid(&inner), "visual_odometry") && ratslam.IsValid(error) &&
-         sensors.fabmap.IsValid(error);
+         sensors.fabmap.IsValid(error) && check(evaluation.IsValid(&inner), "evaluation");
 }
 
 namespace {

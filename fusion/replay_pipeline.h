@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "common/status.h"
+#include "fusion/fabmap/evaluation.h"
 #include "fusion/front_end.h"
 #include "ratslam/ratslam.h"
 #include "sensors/dataset/dataset.h"
@@ -29,7 +30,7 @@ struct PipelineOptions {
   PdrOptions pdr;                         // odometry from phone logs
   VisualOdometryOptions visual_odometry;  // odometry from a camera alone
   RatslamOptions ratslam;
-  FabmapSettings fabmap;  // `ratslam evaluate`
+  fabmap::EvaluationOptions evaluation;  // `ratslam evaluate` only: how map and queries split
 
   bool IsValid(std::string* error) const;
 
@@ -57,7 +58,7 @@ struct PipelineOptions {
     v("visual_model", sensors.fabmap.visual_model);
     v("wifi_words", sensors.fabmap.localiser.wifi_words);
     v("virtual_wifi", sensors.fabmap.localiser.virtual_wifi);
-    v("evaluation", sensors.fabmap.evaluation);
+    v("evaluation", evaluation);
   }
 };
 

@@ -70,7 +70,7 @@ run_one() {
   local h=$1
   local log=$build/logs/$h.log
   ASAN_OPTIONS=detect_leaks=0 "$build/fuzz/$h" "$build/corpus/$h" -max_total_time="$seconds" \
-    -timeout=20 -rss_limit_mb=4096 -max_len=262144 -print_final_stats=1 \
+    -seed="${FUZZ_SEED:-1}" -timeout=20 -rss_limit_mb=4096 -max_len=262144 -print_final_stats=1 \
     -artifact_prefix="$build/findings/$h/" >"$log" 2>&1 || true
 }
 export -f run_one

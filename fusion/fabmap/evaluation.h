@@ -53,17 +53,17 @@ struct EvaluationOptions {
   }
 };
 
+// The places of one data set divided into map and queries by `options.split`: interleaved by
+// node or by session (InterleavedSplit with map_fraction), or the first session as the map.
+struct SplitNodes {
+  std::vector<EvaluationNode> map, queries;
+};
+SplitNodes SplitEvaluationNodes(const std::vector<EvaluationNode>& nodes,
+                                const EvaluationOptions& options);
+
 // Interleaved split: item i goes to the map when floor((i+1) f) > floor(i f), so that every
 // stretch of 1/f items has one in the map. Returns true for map items.
 std::vector<bool> InterleavedSplit(size_t count, double map_fraction);
-
-// Nodes of a data set (replay folder, IPIN or Microsoft log, UJIIndoorLoc CSV, image folder,
-// or a folder of logs). `as_map` picks how images get scans: the temporally closest scan for
-// the map, the last scan before the image for queries (the paper's section 5.2). Nodes of
-// data without camera images are the Wi-Fi scans. Nodes without ground truth are skipped.
-StatusOr<std::vector<EvaluationNode>> LoadEvaluationNodes(const std::string& path, bool as_map,
-                                                          bool want_images,
-                                                          const EvaluationOptions& options);
 
 struct EvaluationMetrics {
   size_t queries = 0;

@@ -55,27 +55,32 @@ TEST(EvaluationTest, InterleavedSplitKeepsTheFraction) {
   }
 }
 
-TEST(EvaluationTest, LoadsAnImageFolderWithFloors) {
-  const std::string path = std::string(RATSLAM_SHARED_DATA_DIR) + "/multifloor-corridors";
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << "missing " << path;
+// Split by session keeps whole sessions together; first_session maps with the first only.
+TEST(EvaluationTest, SplitBySessionAndFirstSession) {
+  std::vector<EvaluationNode> nodes;
+  for (int session = 0; session < 5; ++session) {
+    for (int i = 0; i < 3; ++i) {
+      nodes.push_back(At(i, session, 0));
+      nodes.back().session = session;
+    }
+  }
   EvaluationOptions options;
-  options.frame_spacing_m = 0.5;
-  const auto nodes = LoadEvaluationNodes(path, true, true, options);
-  ASSERT_TRUE(nodes.ok()) << nodes.status().message();
-  ASSERT_EQ(nodes->size(), 1500u);
-  EXPECT_EQ(nodes->front().floor, 1);
-  EXPECT_EQ(nodes->back().floor, 3);
-  EXPECT_DOUBLE_EQ((*nodes)[1].x_m, 0.5);
-  EXPECT_FALSE(nodes->front().wifi.has_value());
-}
-
-TEST(EvaluationTest, BadPathsAndOptionsAreErrors) {
-  EvaluationOptions options;
-  const auto missing = LoadEvaluationNodes("/no/such/place", true, false, options);
-  ASSERT_FALSE(missing.ok());
-  EXPECT_NE(missing.status().message().find("/no/such/place"), std::string::npos);
-  options.map_fraction = 1.5;
-  EXPECT_FALSE(LoadEvaluationNodes(RATSLAM_SOURCE_DIR, true, false, options).ok());
+  options.split = SplitUnit::kSession;
+  options.map_fraction = 0.4;  // sessions 2 and 4: floor((i+1) 0.4) > floor(i 0.4)
+  const SplitNodes by_session = SplitEvaluationNodes(nodes, options);
+  ASSERT_EQ(by_session.map.size(), 6u);
+  EXPECT_EQ(by_session.map.front().session, 2);
+  EXPECT_EQ(by_session.map.back().session, 4);
+  EXPECT_EQ(by_session.queries.size(), 9u);
+  options.split = SplitUnit::kFirstSession;
+  const SplitNodes first = SplitEvaluationNodes(nodes, options);
+  ASSERT_EQ(first.map.size(), 3u);
+  for (const auto& n : first.map) EXPECT_EQ(n.session, 0);
+  EXPECT_EQ(first.queries.size(), 12u);
+  options.split = SplitUnit::kNode;
+  const SplitNodes by_node = SplitEvaluationNodes(nodes, options);
+  EXPECT_EQ(by_node.map.size(), 6u);  // 15 nodes at 0.4
+  EXPECT_EQ(by_node.map.size() + by_node.queries.size(), nodes.size());
   EXPECT_FALSE(SplitUnitFromString("nodes").ok());
 }
 

@@ -7,7 +7,6 @@
 #include <sstream>
 
 #include "common/circular.h"
-#include "common/file_util.h"
 #include "fusion/trajectory_metrics.h"
 
 namespace ratslam {
@@ -152,12 +151,11 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
   return s;
 }
 
-StatusOr<RunSummary> WriteRunOutputs(const std::string& folder, const ReplayPipeline& pipeline,
+StatusOr<RunSummary> WriteRunOutputs(OutputFolder& folder, const ReplayPipeline& pipeline,
                                      const Dataset& dataset, const RunInfo& info) {
-  namespace fs = std::filesystem;
-  auto path = [&](const char* name) { return (fs::path(folder) / name).string(); };
   const ExperienceMap& map = pipeline.slam().experience_map();
   const ReplayPipeline::State& state = pipeline.state();
+  std::vector<std::pair<std::string, std::string>> files;
 
   std::ostringstream experiences;
   experiences
@@ -167,7 +165,7 @@ StatusOr<RunSummary> WriteRunOutputs(const std::string& folder, const ReplayPipe
                 << e.template_id << ',' << Num(e.time_s) << ',' << Num(e.pose_cells.x) << ','
                 << Num(e.pose_cells.y) << ',' << Num(e.pose_cells.theta) << '\n';
   }
-  RATSLAM_RETURN_IF_ERROR(WriteFileAtomically(path("experiences.csv"), experiences.str()));
+  files.emplace_back("experiences.csv", experiences.str());
 
   std::ostringstream links;
   links << "id,from_id,to_id,distance_m,heading_rad,facing_rad,duration_s,loop_closure\n";
@@ -176,7 +174,7 @@ StatusOr<RunSummary> WriteRunOutputs(const std::string& folder, const ReplayPipe
           << Num(l.heading_rad) << ',' << Num(l.facing_rad) << ',' << Num(l.duration_s) << ','
           << (l.loop_closure ? 1 : 0) << '\n';
   }
-  RATSLAM_RETURN_IF_ERROR(WriteFileAtomically(path("links.csv"), links.str()));
+  files.emplace_back("links.csv", links.str());
 
   std::ostringstream trajectory, odometry;
   trajectory << "# timestamp tx ty tz qx qy qz qw (experience map, final relaxation)\n";
@@ -187,8 +185,8 @@ StatusOr<RunSummary> WriteRunOutputs(const std::string& folder, const ReplayPipe
     trajectory << TumLine(r.time_s, x, y, theta);
     odometry << TumLine(r.time_s, r.odometry_x_m, r.odometry_y_m, r.odometry_theta_rad);
   }
-  RATSLAM_RETURN_IF_ERROR(WriteFileAtomically(path("trajectory_tum.txt"), trajectory.str()));
-  RATSLAM_RETURN_IF_ERROR(WriteFileAtomically(path("odometry_tum.txt"), odometry.str()));
+  files.emplace_back("trajectory_tum.txt", trajectory.str());
+  files.emplace_back("odometry_tum.txt", odometry.str());
 
   // g2o: poses, and each link as a relative pose in its source's frame; unit information.
   std::ostringstream g2o;
@@ -202,7 +200,7 @@ StatusOr<RunSummary> WriteRunOutputs(const std::string& folder, const ReplayPipe
         << Num(l.distance_m * std::sin(l.heading_rad)) << ' ' << Num(l.facing_rad)
         << " 1 0 0 1 0 1\n";
   }
-  RATSLAM_RETURN_IF_ERROR(WriteFileAtomically(path("experience_map.g2o"), g2o.str()));
+  files.emplace_back("experience_map.g2o", g2o.str());
 
   std::ostringstream frames;
   frames << "time_s,template_id,new_template,experience_id,source,recent\n";
@@ -210,10 +208,12 @@ StatusOr<RunSummary> WriteRunOutputs(const std::string& folder, const ReplayPipe
     frames << Num(f.time_s) << ',' << f.template_id << ',' << (f.is_new ? 1 : 0) << ','
            << f.experience_id << ',' << ToString(f.source) << ',' << (f.recent ? 1 : 0) << '\n';
   }
-  RATSLAM_RETURN_IF_ERROR(WriteFileAtomically(path("frames.csv"), frames.str()));
+  files.emplace_back("frames.csv", frames.str());
 
   RunSummary summary = Summarise(pipeline, dataset, info);
-  RATSLAM_RETURN_IF_ERROR(WriteFileAtomically(path("summary.json"), summary.json));
+  files.emplace_back("summary.json", summary.json);
+  // All or nothing: a full disk leaves the previous run's complete set, not a mix.
+  RATSLAM_RETURN_IF_ERROR(folder.Write(files));
   return summary;
 }
 

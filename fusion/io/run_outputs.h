@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 
+#include "common/output_folder.h"
 #include "common/status.h"
 #include "fusion/replay_pipeline.h"
 
@@ -39,8 +40,9 @@ void RecordPose(const ExperienceMap& map, const TrajectoryRecord& record, double
 RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, const RunInfo& info);
 
 // Writes experiences.csv, links.csv, trajectory_tum.txt, odometry_tum.txt, experience_map.g2o,
-// frames.csv and summary.json into `folder` (which must exist), each file atomically.
-StatusOr<RunSummary> WriteRunOutputs(const std::string& folder, const ReplayPipeline& pipeline,
+// frames.csv and summary.json into `folder`, all of them or none (a failure keeps the earlier
+// files and names the one that failed).
+StatusOr<RunSummary> WriteRunOutputs(OutputFolder& folder, const ReplayPipeline& pipeline,
                                      const Dataset& dataset, const RunInfo& info);
 
 }  // namespace ratslam

@@ -1,0 +1,178 @@
+#include "session/evaluation_nodes.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <system_error>
+
+#include "fusion/fabmap/visual_model.h"
+#include "sensors/dataset/dataset_loader.h"
+#include "sensors/dataset/ujiindoorloc.h"
+
+namespace ratslam {
+
+using fabmap::EvaluationNode;
+using fabmap::EvaluationOptions;
+
+namespace {
+
+namespace fs = std::filesystem;
+
+int FloorOfFolder(const std::string& name, int fallback) {
+  std::string digits;
+  for (char c : name) {
+    if (std::isdigit(static_cast<unsigned char>(c)) || (c == '-' && digits.empty())) digits += c;
+  }
+  if (digits.empty() || digits == "-") return fallback;
+  return std::stoi(digits);
+}
+
+// Image folder: each sub-folder is a floor (the number in its name), frames along a line.
+StatusOr<std::vector<EvaluationNode>> ImageFolderNodes(const std::string& path,
+                                                       const EvaluationOptions& options) {
+  std::vector<std::string> floors;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(path, ec)) {
+    if (entry.is_directory(ec)) floors.push_back(entry.path().string());
+  }
+  std::sort(floors.begin(), floors.end());
+  if (floors.empty()) floors.push_back(path);
+  std::vector<EvaluationNode> nodes;
+  for (size_t f = 0; f < floors.size(); ++f) {
+    auto images = fabmap::ListImages(floors[f]);
+    if (!images.ok()) return images.status();
+    const int floor = FloorOfFolder(fs::path(floors[f]).filename().string(), static_cast<int>(f));
+    for (size_t i = 0; i < images->size(); ++i) {
+      EvaluationNode n;
+      n.x_m = options.frame_spacing_m * static_cast<double>(i);
+      n.floor = floor;
+      n.time_s = static_cast<double>(i);
+      n.travelled_m = n.x_m;
+      n.session = static_cast<int>(f);
+      n.image = (*images)[i];
+      nodes.push_back(std::move(n));
+    }
+  }
+  return nodes;
+}
+
+StatusOr<std::vector<EvaluationNode>> UjiNodes(const std::string& path, bool lenient) {
+  auto rows = ReadUjiIndoorLoc(path, lenient);
+  if (!rows.ok()) return rows.status();
+  std::vector<EvaluationNode> nodes;
+  for (const LabelledScan& s : *rows) {
+    EvaluationNode n;
+    n.x_m = s.x_m;
+    n.y_m = s.y_m;
+    n.floor = s.building * 100 + s.floor;  // another building counts as another floor
+    n.time_s = s.time_s;
+    n.session = s.user * 100 + s.phone;
+    n.wifi = s.readings;
+    nodes.push_back(std::move(n));
+  }
+  // In time order, so that an interleaved split alternates captures.
+  std::stable_sort(
+      nodes.begin(), nodes.end(),
+      [](const EvaluationNode& a, const EvaluationNode& b) { return a.time_s < b.time_s; });
+  return nodes;
+}
+
+std::vector<EvaluationNode> DatasetNodes(const Dataset& d, bool as_map, bool want_images,
+                                         const EvaluationOptions& options) {
+  std::vector<EvaluationNode> nodes;
+  auto session_of = [&](double t) {
+    int s = 0;
+    for (size_t k = 1; k < d.session_start_times_s.size(); ++k) {
+      if (t >= d.session_start_times_s[k]) s = static_cast<int>(k);
+    }
+    return s;
+  };
+  auto add = [&](double t, std::string image, std::optional<std::vector<WifiReading>> wifi) {
+    const auto truth = InterpolateGroundTruth(d.ground_truth, t);
+    if (!truth) return;
+    EvaluationNode n;
+    n.x_m = truth->x_m;
+    n.y_m = truth->y_m;
+    n.floor = truth->floor;
+    n.time_s = t;
+    n.session = session_of(t);
+    if (!nodes.empty() && nodes.back().session == n.session) {
+      n.travelled_m =
+          nodes.back().travelled_m + std::hypot(n.x_m - nodes.back().x_m, n.y_m - nodes.back().y_m);
+    }
+    n.image = std::move(image);
+    n.wifi = std::move(wifi);
+    nodes.push_back(std::move(n));
+  };
+  if (want_images && !d.images.empty()) {
+    std::vector<double> scan_times;
+    for (const WifiScan& s : d.wifi) scan_times.push_back(s.time_s);
+    for (const ImageRow& row : d.images) {
+      // Map: the temporally closest scan; queries: the last scan before the image (sec. 5.2).
+      // Scans are in time order; of scans at one time the first counts.
+      const WifiScan* best = nullptr;
+      const size_t next = static_cast<size_t>(
+          std::upper_bound(scan_times.begin(), scan_times.end(), row.time_s) - scan_times.begin());
+      if (next > 0) {
+        const double t = scan_times[next - 1];
+        best =
+            &d.wifi[std::lower_bound(scan_times.begin(), scan_times.end(), t) - scan_times.begin()];
+      }
+      if (as_map && next < d.wifi.size() &&
+          (!best || scan_times[next] - row.time_s < row.time_s - best->time_s)) {
+        best = &d.wifi[next];
+      }
+      std::optional<std::vector<WifiReading>> wifi;
+      if (best && std::abs(best->time_s - row.time_s) <= options.image_wifi_max_gap_s) {
+        wifi = best->readings;
+      }
+      add(row.time_s, d.ImagePath(row), std::move(wifi));
+    }
+  } else {
+    for (const WifiScan& s : d.wifi) add(s.time_s, "", s.readings);
+  }
+  return nodes;
+}
+
+bool HasManifest(const std::string& path) {
+  std::error_code ec;
+  return fs::exists(fs::path(path) / "manifest.toml", ec);
+}
+
+}  // namespace
+
+StatusOr<std::vector<EvaluationNode>> LoadEvaluationNodes(const std::string& path, bool as_map,
+                                                          bool want_images,
+                                                          const EvaluationOptions& options,
+                                                          const PhoneLogOptions& phone) {
+  std::string error;
+  if (!options.IsValid(&error)) return Status::Error("[evaluation] " + error);
+  std::error_code ec;
+  if (!fs::exists(path, ec)) return Status::Error(path + ": no such file or folder");
+  if (fs::is_regular_file(path, ec) && fs::path(path).extension() == ".csv") {
+    return UjiNodes(path, phone.lenient);
+  }
+  if (fs::is_directory(path, ec) && !HasManifest(path)) {
+    // A folder of phone logs (recursively), or else of images.
+    std::vector<std::string> logs;
+    for (auto it = fs::recursive_directory_iterator(path, ec);
+         !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
+      if (it->is_regular_file(ec) && it->path().extension() == ".txt" &&
+          DetectDatasetFormat(it->path().string()).ok()) {
+        logs.push_back(it->path().string());
+      }
+    }
+    std::sort(logs.begin(), logs.end());
+    if (logs.empty()) return ImageFolderNodes(path, options);
+    auto d = LoadSessions(logs, phone);
+    if (!d.ok()) return d.status();
+    return DatasetNodes(*d, as_map, want_images, options);
+  }
+  auto d = LoadDataset(path, phone);
+  if (!d.ok()) return d.status();
+  return DatasetNodes(*d, as_map, want_images, options);
+}
+
+}  // namespace ratslam

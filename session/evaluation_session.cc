@@ -1,0 +1,209 @@
+#include "session/evaluation_session.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <stdexcept>
+#include <utility>
+
+#include "fusion/io/config.h"
+#include "session/evaluation_nodes.h"
+
+namespace ratslam {
+namespace {
+
+std::string Key(double d) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", d);
+  return text;
+}
+
+const std::vector<double> kDistancesM = {2, 5, 10, 20};
+
+}  // namespace
+
+EvaluationSession::EvaluationSession(EvaluationSessionOptions options, OutputFolder* out,
+                                     const Clock* clock, ProgressSink* progress,
+                                     ImageLoader* images)
+    : options_(std::move(options)),
+      out_(out),
+      clock_(clock ? clock : &system_clock_),
+      progress_(progress ? progress : &no_progress_),
+      images_(images) {
+  if (out_ == nullptr) throw std::invalid_argument("EvaluationSession needs an output folder");
+  if (images_ == nullptr) {
+    own_images_ = std::make_unique<FileImageLoader>();
+    images_ = own_images_.get();
+  }
+  started_s_ = clock_->Seconds();
+}
+
+EvaluationSession::~EvaluationSession() = default;
+
+fabmap::FabmapMode EvaluationSession::mode() const {
+  return options_.pipeline.sensors.fabmap.localiser.localiser.mode;
+}
+
+Status EvaluationSession::Load() {
+  std::string error;
+  if (!options_.pipeline.IsValid(&error)) return Status::Error("configuration: " + error);
+  RATSLAM_RETURN_IF_ERROR(out_->Write("config.toml", PrintConfig(options_.pipeline)));
+  const bool vision = fabmap::UsesVision(mode());
+  PhoneLogOptions phone;
+  phone.lenient = options_.lenient;
+  phone.pdr = options_.pipeline.pdr;
+  const fabmap::EvaluationOptions& evaluation = options_.pipeline.evaluation;
+  auto map_nodes = LoadEvaluationNodes(options_.map_path, true, vision, evaluation, phone);
+  if (!map_nodes.ok()) return map_nodes.status();
+  std::error_code ec;
+  if (std::filesystem::equivalent(options_.map_path, options_.query_path, ec)) {
+    // One data set: the documented split by node, by session, or the first session as the map.
+    fabmap::SplitNodes split = fabmap::SplitEvaluationNodes(*map_nodes, evaluation);
+    result_.map = std::move(split.map);
+    result_.queries = std::move(split.queries);
+  } else {
+    result_.map = *std::move(map_nodes);
+    auto q = LoadEvaluationNodes(options_.query_path, false, vision, evaluation, phone);
+    if (!q.ok()) return q.status();
+    result_.queries = *std::move(q);
+  }
+  if (result_.map.empty() || result_.queries.empty()) {
+    return Status::Error("no map or no query nodes with ground truth (map " +
+                         std::to_string(result_.map.size()) + ", queries " +
+                         std::to_string(result_.queries.size()) + ")");
+  }
+  return Status::Ok();
+}
+
+Status EvaluationSession::Words(const std::vector<fabmap::EvaluationNode>& nodes,
+                                const std::string& what, std::vector<fabmap::Observation>* words) {
+  words->clear();
+  for (size_t i = 0; i < nodes.size(); ++i) {
+    if (nodes[i].image.empty()) {
+      return Status::Error(what + " node " + std::to_string(i) + " has no image");
+    }
+    auto image = images_->Load(nodes[i].image);
+    if (!image.ok()) return image.status();
+    auto w = fabmap::ImageWords(*visual_, *image);
+    if (!w.ok()) return w.status().WithContext(nodes[i].image);
+    words->push_back(*std::move(w));
+    progress_->Update({"visual words of " + what, i + 1, nodes.size()});
+  }
+  progress_->Finish();
+  return Status::Ok();
+}
+
+Status EvaluationSession::Prepare() {
+  const FabmapSettings& settings = options_.pipeline.sensors.fabmap;
+  const bool vision = fabmap::UsesVision(mode());
+  if (vision) {
+    auto model = fabmap::LoadOrTrainVisualModel(
+        settings.visual_model, settings.features, settings.vocabulary, settings.localiser.chow_liu,
+        *images_, [this](size_t done, size_t total) {
+          progress_->Update({"training images", done, total});
+        });
+    if (!model.ok()) return model.status();
+    progress_->Finish();
+    visual_ = *std::move(model);
+    trained_here_ = settings.visual_model.file.empty();
+    if (trained_here_) {  // keep it for later runs
+      RATSLAM_RETURN_IF_ERROR(out_->Write("visual_model.bin", fabmap::EncodeVisualModel(*visual_)));
+    }
+    RATSLAM_RETURN_IF_ERROR(Words(result_.map, "map", &map_words_));
+    RATSLAM_RETURN_IF_ERROR(Words(result_.queries, "queries", &query_words_));
+  }
+  std::vector<fabmap::MapNode> places;
+  for (size_t i = 0; i < result_.map.size(); ++i) {
+    fabmap::MapNode n;
+    if (vision) n.visual = map_words_[i];
+    n.wifi = result_.map[i].wifi;
+    n.travelled_m = result_.map[i].travelled_m;
+    n.time_s = result_.map[i].time_s;
+    places.push_back(std::move(n));
+  }
+  auto localiser =
+      fabmap::Localiser::Build(settings.localiser, visual_ ? &visual_->model : nullptr, places);
+  if (!localiser.ok()) return localiser.status();
+  localiser_ = *std::move(localiser);
+  result_.wifi_words = localiser_->wifi_words();
+  result_.visual_words = visual_ ? visual_->vocabulary.size() : 0u;
+  return Status::Ok();
+}
+
+Status EvaluationSession::Localise() {
+  if (!localiser_) return Status::Error("evaluation session: Localise before Prepare");
+  const bool vision = fabmap::UsesVision(mode());
+  result_.matches.clear();
+  const double start = clock_->Seconds();
+  for (size_t i = 0; i < result_.queries.size(); ++i) {
+    fabmap::Query q;
+    if (vision) q.visual = query_words_[i];
+    q.wifi = result_.queries[i].wifi;
+    result_.matches.push_back(localiser_->Localise(q).best_place);
+    progress_->Update({"queries", i + 1, result_.queries.size()});
+  }
+  progress_->Finish();
+  result_.query_time_ms =
+      1000.0 * (clock_->Seconds() - start) / static_cast<double>(result_.queries.size());
+  result_.metrics =
+      fabmap::ComputeMetrics(result_.map, result_.queries, result_.matches, kDistancesM);
+  return Status::Ok();
+}
+
+Status EvaluationSession::WriteOutputs() {
+  const fabmap::EvaluationMetrics& m = result_.metrics;
+  nlohmann::ordered_json j;
+  j["mode"] = fabmap::ToString(mode());
+  j["map"] = options_.map_path;
+  j["query"] = options_.query_path;
+  j["config"] = options_.config_path;
+  j["map_nodes"] = result_.map.size();
+  j["queries"] = m.queries;
+  j["correct_within_m"] = nlohmann::ordered_json::object();
+  j["misplaced_beyond_m"] = nlohmann::ordered_json::object();
+  for (size_t k = 0; k < kDistancesM.size(); ++k) {
+    j["correct_within_m"][Key(kDistancesM[k])] = m.correct_within[k];
+    j["misplaced_beyond_m"][Key(kDistancesM[k])] = m.misplaced_beyond[k];
+  }
+  j["rejection_rate"] = m.rejection_rate;
+  j["floor_mistake_rate"] = m.floor_mistake_rate;
+  j["wifi_words"] = result_.wifi_words;
+  j["visual_words"] = result_.visual_words;
+  j["query_time_ms"] = result_.query_time_ms;
+  result_.wall_time_s = clock_->Seconds() - started_s_;
+  j["wall_time_s"] = result_.wall_time_s;
+  result_.json = j.dump(2) + "\n";
+
+  std::ostringstream csv;
+  csv << "query,x_m,y_m,floor,match,match_x_m,match_y_m,match_floor,error_m\n";
+  for (size_t i = 0; i < result_.queries.size(); ++i) {
+    const auto& q = result_.queries[i];
+    const int64_t match = result_.matches[i];
+    csv << i << ',' << q.x_m << ',' << q.y_m << ',' << q.floor << ',' << match;
+    if (match >= 0) {
+      const auto& p = result_.map[match];
+      csv << ',' << p.x_m << ',' << p.y_m << ',' << p.floor;
+    } else {
+      csv << ",,,";
+    }
+    const double e = m.errors_m[i];
+    csv << ','
+        << (std::isnan(e)   ? std::string("rejected")
+            : std::isinf(e) ? "other_floor"
+                            : Key(e))
+        << '\n';
+  }
+  return out_->Write({{"evaluation.json", result_.json}, {"queries.csv", csv.str()}});
+}
+
+StatusOr<EvaluationResult> EvaluationSession::Run() {
+  RATSLAM_RETURN_IF_ERROR(Load());
+  RATSLAM_RETURN_IF_ERROR(Prepare());
+  RATSLAM_RETURN_IF_ERROR(Localise());
+  RATSLAM_RETURN_IF_ERROR(WriteOutputs());
+  return result_;
+}
+
+}  // namespace ratslam

@@ -1,0 +1,86 @@
+// The FABMAP localisation benchmark (`ratslam evaluate`) as a library session: Load the map and
+// query places (splitting one data set when map and query are the same), Prepare the visual
+// model, words and localiser, Localise every query, WriteOutputs (evaluation.json, queries.csv,
+// config.toml and a trained visual_model.bin). Figures are the caller's (the viewer draws them
+// from the result).
+#ifndef RATSLAM_SESSION_EVALUATION_SESSION_H_
+#define RATSLAM_SESSION_EVALUATION_SESSION_H_
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "common/clock.h"
+#include "common/output_folder.h"
+#include "common/progress.h"
+#include "common/status.h"
+#include "fusion/fabmap/evaluation.h"
+#include "fusion/fabmap/localiser.h"
+#include "fusion/fabmap/visual_model.h"
+#include "fusion/replay_pipeline.h"
+#include "sensors/dataset/image_loader.h"
+
+namespace ratslam {
+
+struct EvaluationSessionOptions {
+  PipelineOptions pipeline;  // [fabmap...] sections, [evaluation], and [pdr] for phone logs
+  std::string config_path;   // as given, for evaluation.json
+  std::string map_path;
+  std::string query_path;  // may name the same data set as map_path: then it is split
+  bool lenient = false;    // skip (and count) malformed lines of phone logs and CSVs
+};
+
+struct EvaluationResult {
+  std::vector<fabmap::EvaluationNode> map, queries;
+  std::vector<int64_t> matches;  // per query: map index, or -1 for a new place (rejection)
+  fabmap::EvaluationMetrics metrics;
+  size_t wifi_words = 0, visual_words = 0;
+  double query_time_ms = 0.0;  // mean per query
+  double wall_time_s = 0.0;    // of the whole session so far
+  std::string json;            // evaluation.json
+};
+
+class EvaluationSession {
+ public:
+  // `out` is required; `clock`, `progress` and `images` may be null (system clock, silence,
+  // images from files).
+  EvaluationSession(EvaluationSessionOptions options, OutputFolder* out,
+                    const Clock* clock = nullptr, ProgressSink* progress = nullptr,
+                    ImageLoader* images = nullptr);
+  ~EvaluationSession();
+
+  Status Load();
+  Status Prepare();
+  Status Localise();
+  Status WriteOutputs();
+  // All four; the first error stops it.
+  StatusOr<EvaluationResult> Run();
+
+  const EvaluationResult& result() const { return result_; }
+  fabmap::FabmapMode mode() const;
+
+ private:
+  Status Words(const std::vector<fabmap::EvaluationNode>& nodes, const std::string& what,
+               std::vector<fabmap::Observation>* words);
+
+  EvaluationSessionOptions options_;
+  OutputFolder* out_;
+  const Clock* clock_;
+  ProgressSink* progress_;
+  ImageLoader* images_;
+  SteadyClock system_clock_;
+  SilentProgress no_progress_;
+  std::unique_ptr<ImageLoader> own_images_;
+  double started_s_ = 0.0;
+  std::optional<fabmap::TrainedVisualModel> visual_;
+  bool trained_here_ = false;
+  std::vector<fabmap::Observation> map_words_, query_words_;
+  std::unique_ptr<fabmap::Localiser> localiser_;
+  EvaluationResult result_;
+};
+
+}  // namespace ratslam
+
+#endif  // RATSLAM_SESSION_EVALUATION_SESSION_H_

@@ -1,0 +1,136 @@
+#include "session/replay_session.h"
+
+#include <stdexcept>
+#include <utility>
+
+#include "fusion/io/config.h"
+#include "fusion/io/map_file.h"
+#include "sensors/dataset/dataset_loader.h"
+#include "sensors/dataset/visual_odometry_source.h"
+
+namespace ratslam {
+
+ReplaySession::ReplaySession(ReplaySessionOptions options, SessionEnvironment environment)
+    : options_(std::move(options)), env_(environment) {
+  if (env_.out == nullptr) throw std::invalid_argument("ReplaySession needs an output folder");
+  if (env_.clock == nullptr) env_.clock = &system_clock_;
+  if (env_.progress == nullptr) env_.progress = &no_progress_;
+  if (env_.images == nullptr) {
+    own_images_ = std::make_unique<FileImageLoader>();
+    env_.images = own_images_.get();
+  }
+  fingerprint_ = ConfigFingerprint(options_.pipeline);
+}
+
+ReplaySession::~ReplaySession() = default;
+
+Status ReplaySession::Load() {
+  std::string error;
+  if (!options_.pipeline.IsValid(&error)) return Status::Error("configuration: " + error);
+  PhoneLogOptions phone;
+  phone.lenient = options_.lenient;
+  phone.pdr = options_.pipeline.pdr;
+  StatusOr<Dataset> dataset = LoadSessions(options_.data, phone);
+  if (!dataset.ok()) return dataset.status();
+  if (options_.pipeline.visual_odometry.enabled) {
+    RATSLAM_RETURN_IF_ERROR(
+        ReplaceOdometryWithVisual(&dataset.value(), env_.images, options_.pipeline.visual_odometry)
+            .WithContext("visual odometry"));
+  }
+  dataset_ = std::move(dataset).value();
+  return env_.out->Write("config.toml",
+                         "# Resolved configuration of this run (ratslam print-config format).\n" +
+                             PrintConfig(options_.pipeline));
+}
+
+Status ReplaySession::Prepare() {
+  if (!dataset_) return Status::Error("replay session: Prepare before Load");
+  std::shared_ptr<const FabmapResources> fabmap;
+  if (options_.pipeline.sensors.front_end.kind == FrontEndKind::kFabmap) {
+    auto prepared = PrepareFabmapResources(options_.pipeline.sensors, *dataset_, *env_.images);
+    if (!prepared.ok()) return prepared.status().WithContext("FABMAP front end");
+    fabmap = *prepared;
+  }
+  auto pipeline = std::make_unique<ReplayPipeline>(options_.pipeline, *dataset_, env_.images,
+                                                   std::move(fabmap));
+  if (!options_.load_map.empty()) {
+    const std::string& path = options_.load_map;
+    StatusOr<MapFile> map = LoadMapFile(path);
+    if (!map.ok()) return map.status();
+    if (map->config_fingerprint != fingerprint_) {
+      return Status::Error(path + ": the map was made with a different configuration");
+    }
+    if (map->dataset_name != dataset_->name) {
+      return Status::Error(path + ": the map was made from data set '" + map->dataset_name +
+                           "', not '" + dataset_->name + "'");
+    }
+    RATSLAM_RETURN_IF_ERROR(pipeline->Restore(map->state).WithContext(path));
+  }
+  pipeline_ = std::move(pipeline);
+  return Status::Ok();
+}
+
+Status ReplaySession::Replay(const ReplayCheckpoint& checkpoint) {
+  if (!pipeline_) return Status::Error("replay session: Replay before Prepare");
+  ReplayControl control;
+  control.until_time_s = options_.until_s;
+  control.stop_requested = env_.stop_requested;
+  control.progress = [this](const ReplayProgress& p) {
+    env_.progress->Update({"replay", p.events_done, p.events_total, p.data_time_s});
+  };
+  control.checkpoint = checkpoint.callback;
+  control.checkpoint_every = checkpoint.callback ? checkpoint.every : 0;
+  const uint64_t frames_before = pipeline_->state().frames.size();
+  const double start = env_.clock->Seconds();
+  result_.replay = pipeline_->Run(control);
+  result_.wall_seconds = env_.clock->Seconds() - start;
+  env_.progress->Finish();
+  result_.frames_this_run = pipeline_->state().frames.size() - frames_before;
+  result_.interrupted = env_.stop_requested != nullptr && env_.stop_requested->load();
+  result_.finished = pipeline_->finished();
+  return result_.replay;
+}
+
+Status ReplaySession::WriteOutputs() {
+  if (!pipeline_) return Status::Error("replay session: WriteOutputs before Prepare");
+  RunInfo info;
+  info.wall_seconds = result_.wall_seconds;
+  info.frames_this_run = result_.frames_this_run;
+  info.interrupted = result_.interrupted;
+  info.config_path = options_.config_path;
+  info.config_fingerprint = fingerprint_;
+  info.resumed_from = options_.load_map;
+  StatusOr<RunSummary> summary = WriteRunOutputs(*env_.out, *pipeline_, *dataset_, info);
+  if (summary.ok()) {
+    result_.summary = std::move(summary).value();
+    result_.outputs = Status::Ok();
+  } else {
+    result_.outputs = summary.status();
+  }
+  return result_.outputs;
+}
+
+Status ReplaySession::SaveMap() {
+  if (!pipeline_) return Status::Error("replay session: SaveMap before Prepare");
+  std::string path = options_.save_map;
+  if (path.empty() && (result_.interrupted || !result_.replay.ok() || !result_.outputs.ok())) {
+    path = env_.out->Path("interrupted.map");
+  }
+  if (path.empty()) return Status::Ok();
+  result_.save = SaveMapFile({fingerprint_, dataset_->name, pipeline_->Snapshot()}, path);
+  if (result_.save.ok()) result_.saved_map = path;
+  return result_.save;
+}
+
+StatusOr<ReplayResult> ReplaySession::Run(const ReplayCheckpoint& checkpoint) {
+  RATSLAM_RETURN_IF_ERROR(Load());
+  RATSLAM_RETURN_IF_ERROR(Prepare());
+  // From here on every stage runs: outputs and the map are written whatever the replay did, and
+  // the map is saved even when the outputs could not be written (it may go to another disk).
+  (void)Replay(checkpoint);
+  (void)WriteOutputs();
+  (void)SaveMap();
+  return result_;
+}
+
+}  // namespace ratslam

@@ -1,0 +1,108 @@
+// A replay as a library session: what `ratslam replay` does, as named stages that return errors,
+// driven by the command line, by sweeps, by tests and by bindings alike. Side effects go through
+// the environment (output folder, clock, progress, image loader, stop flag), so tests use fakes.
+//
+// Stages, in order: Load (data sets, visual odometry, the resolved config written), Prepare (the
+// FABMAP front end's models, the pipeline, resuming from a saved map), Replay, WriteOutputs,
+// SaveMap. Run() calls them all and returns a ReplayResult; once the replay has started, every
+// later stage runs even when an earlier one failed, so that nothing computed is lost.
+#ifndef RATSLAM_SESSION_REPLAY_SESSION_H_
+#define RATSLAM_SESSION_REPLAY_SESSION_H_
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "common/clock.h"
+#include "common/output_folder.h"
+#include "common/progress.h"
+#include "common/status.h"
+#include "fusion/io/run_outputs.h"
+#include "fusion/replay_pipeline.h"
+#include "sensors/dataset/dataset.h"
+#include "sensors/dataset/image_loader.h"
+
+namespace ratslam {
+
+struct ReplaySessionOptions {
+  PipelineOptions pipeline;
+  std::string config_path;        // as given by the user, for the summary; empty: defaults
+  std::vector<std::string> data;  // one data set, or several sessions of one run
+  bool lenient = false;           // skip (and count) malformed lines of phone logs
+  std::string load_map;           // resume from this map file
+  std::string save_map;           // save the final state here
+  double until_s = std::numeric_limits<double>::infinity();  // stop after this data time
+};
+
+// What the session needs from outside. `out` is required; the others may be null (system clock,
+// no progress, images from files, no stop request).
+struct SessionEnvironment {
+  OutputFolder* out = nullptr;
+  const Clock* clock = nullptr;
+  ProgressSink* progress = nullptr;
+  ImageLoader* images = nullptr;
+  const std::atomic<bool>* stop_requested = nullptr;  // checked between events
+};
+
+// Called every `every` events with the pipeline (read only), e.g. to draw animation frames; an
+// error stops the replay like a data error does.
+struct ReplayCheckpoint {
+  std::function<Status(const ReplayPipeline&)> callback;
+  uint64_t every = 0;  // 0: never
+};
+
+struct ReplayResult {
+  std::optional<RunSummary> summary;  // present when the outputs were written
+  Status replay;                      // the replay itself (a data error stops it early)
+  Status outputs;                     // writing the run's files
+  Status save;                        // saving the map, when one was saved
+  std::string saved_map;              // where the state was saved; empty when not saved
+  bool interrupted = false;           // a stop was requested
+  bool finished = false;              // the data set was replayed to its end
+  uint64_t frames_this_run = 0;
+  double wall_seconds = 0.0;  // of the replay stage
+  bool ok() const { return replay.ok() && outputs.ok() && save.ok(); }
+};
+
+class ReplaySession {
+ public:
+  ReplaySession(ReplaySessionOptions options, SessionEnvironment environment);
+  ~ReplaySession();
+
+  Status Load();
+  Status Prepare();
+  Status Replay(const ReplayCheckpoint& checkpoint = {});
+  Status WriteOutputs();
+  // Saves to save_map; when none is given, to the output folder's interrupted.map if the replay
+  // failed, was interrupted, or its outputs could not be written.
+  Status SaveMap();
+
+  // All stages. An error of Load or Prepare (nothing replayed yet) is returned as such; after
+  // that the result says what each stage did.
+  StatusOr<ReplayResult> Run(const ReplayCheckpoint& checkpoint = {});
+
+  const ReplaySessionOptions& options() const { return options_; }
+  const Dataset& dataset() const { return *dataset_; }           // after Load
+  const ReplayPipeline& pipeline() const { return *pipeline_; }  // after Prepare
+  const ReplayResult& result() const { return result_; }
+
+ private:
+  ReplaySessionOptions options_;
+  SessionEnvironment env_;
+  SteadyClock system_clock_;
+  SilentProgress no_progress_;
+  std::unique_ptr<ImageLoader> own_images_;
+  std::optional<Dataset> dataset_;
+  std::unique_ptr<ReplayPipeline> pipeline_;
+  uint64_t fingerprint_ = 0;
+  ReplayResult result_;
+};
+
+}  // namespace ratslam
+
+#endif  // RATSLAM_SESSION_REPLAY_SESSION_H_

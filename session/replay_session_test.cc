@@ -1,0 +1,197 @@
+#include "session/replay_session.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+
+#include "common/scratch_dir.h"
+#include "fusion/io/map_file.h"
+#include "sensors/dataset/synthetic_dataset.h"
+
+namespace ratslam {
+namespace {
+namespace fs = std::filesystem;
+
+// Files in memory; can refuse writes of chosen names (a full disk) and counts attempts.
+class MemoryFolder : public OutputFolder {
+ public:
+  explicit MemoryFolder(std::string root) : root_(std::move(root)) {}
+  std::string Path(const std::string& name) const override { return root_ + "/" + name; }
+  using OutputFolder::Write;
+  Status Write(const std::vector<std::pair<std::string, std::string>>& files) override {
+    for (const auto& [name, contents] : files) {
+      if (refuse.count(name)) return Status::Error(Path(name) + ": write failed: No space left");
+    }
+    for (const auto& [name, contents] : files) written[name] = contents;
+    return Status::Ok();
+  }
+  std::set<std::string> refuse;
+  std::map<std::string, std::string> written;
+
+ private:
+  std::string root_;
+};
+
+// Each call advances by a second: wall times become known numbers.
+class FakeClock : public Clock {
+ public:
+  double Seconds() const override { return now_ += 1.0; }
+
+ private:
+  mutable double now_ = 100.0;
+};
+
+class RecordingProgress : public ProgressSink {
+ public:
+  void Update(const ProgressUpdate& u) override { updates.push_back(u); }
+  void Finish() override { ++finishes; }
+  std::vector<ProgressUpdate> updates;
+  int finishes = 0;
+};
+
+class ReplaySessionTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new ScratchDir("ratslam_session");
+    SyntheticOptions small;
+    small.laps = 1;
+    ASSERT_TRUE(WriteSyntheticDataset(small, (dir_->path() / "data").string()).ok());
+  }
+  static void TearDownTestSuite() { delete dir_; }
+  static ReplaySessionOptions Options() {
+    ReplaySessionOptions o;
+    o.data = {(dir_->path() / "data").string()};
+    o.pipeline.sensors.classic_camera.match_threshold = 0.06;
+    return o;
+  }
+  static ScratchDir* dir_;
+};
+ScratchDir* ReplaySessionTest::dir_ = nullptr;
+
+TEST_F(ReplaySessionTest, RunsEveryStageAndReportsThroughTheEnvironment) {
+  MemoryFolder out("mem");
+  FakeClock clock;
+  RecordingProgress progress;
+  ReplaySession session(Options(), {&out, &clock, &progress, nullptr, nullptr});
+  StatusOr<ReplayResult> result = session.Run();
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  EXPECT_TRUE(result->ok());
+  EXPECT_TRUE(result->finished);
+  EXPECT_EQ(result->wall_seconds, 1.0);  // two clock readings a second apart
+  for (const char* name :
+       {"config.toml", "experiences.csv", "links.csv", "trajectory_tum.txt", "odometry_tum.txt",
+        "experience_map.g2o", "frames.csv", "summary.json"}) {
+    EXPECT_TRUE(out.written.count(name)) << name;
+  }
+  EXPECT_FALSE(out.written.count("interrupted.map"));
+  EXPECT_TRUE(result->saved_map.empty());
+  const auto summary = nlohmann::json::parse(out.written["summary.json"]);
+  EXPECT_EQ(summary["wall_seconds"], 1.0);
+  EXPECT_EQ(summary["frames"].get<uint64_t>(), session.pipeline().state().frames.size());
+  EXPECT_EQ(summary["finished"], true);
+  ASSERT_FALSE(progress.updates.empty());
+  EXPECT_EQ(progress.updates.back().phase, "replay");
+  EXPECT_EQ(progress.updates.back().done, progress.updates.back().total);
+  EXPECT_EQ(progress.finishes, 1);
+}
+
+// A full disk when the outputs are written: the error names the file, the map is still saved
+// where the user asked (another disk), and nothing of the outputs is half-written.
+TEST_F(ReplaySessionTest, OutputFailureStillSavesTheMap) {
+  MemoryFolder out("mem");
+  out.refuse = {"frames.csv"};
+  ReplaySessionOptions options = Options();
+  options.until_s = 30.0;
+  options.save_map = (dir_->path() / "elsewhere.map").string();
+  ReplaySession session(options, {&out, nullptr, nullptr, nullptr, nullptr});
+  StatusOr<ReplayResult> result = session.Run();
+  ASSERT_TRUE(result.ok());
+  EXPECT_TRUE(result->replay.ok());
+  ASSERT_FALSE(result->outputs.ok());
+  EXPECT_NE(result->outputs.message().find("mem/frames.csv"), std::string::npos);
+  EXPECT_FALSE(out.written.count("summary.json"));
+  EXPECT_FALSE(out.written.count("experiences.csv"));  // all or nothing
+  EXPECT_TRUE(result->save.ok()) << result->save.message();
+  EXPECT_EQ(result->saved_map, options.save_map);
+  EXPECT_TRUE(LoadMapFile(options.save_map).ok());
+}
+
+// Without --save-map, a failure to write the outputs saves interrupted.map beside them so that
+// the replay's work can be resumed.
+TEST_F(ReplaySessionTest, OutputFailureWithoutSaveMapSavesInterruptedMap) {
+  MemoryFolder out((dir_->path() / "run").string());
+  fs::create_directories(dir_->path() / "run");
+  out.refuse = {"summary.json"};
+  ReplaySessionOptions options = Options();
+  options.until_s = 20.0;
+  ReplaySession session(options, {&out, nullptr, nullptr, nullptr, nullptr});
+  StatusOr<ReplayResult> result = session.Run();
+  ASSERT_TRUE(result.ok());
+  EXPECT_FALSE(result->outputs.ok());
+  EXPECT_EQ(result->saved_map, (dir_->path() / "run" / "interrupted.map").string());
+  EXPECT_TRUE(fs::exists(dir_->path() / "run" / "interrupted.map"));
+}
+
+TEST_F(ReplaySessionTest, StopRequestInterruptsAndSavesState) {
+  MemoryFolder out((dir_->path() / "stopped").string());
+  fs::create_directories(dir_->path() / "stopped");
+  std::atomic<bool> stop{false};
+  ReplaySession session(Options(), {&out, nullptr, nullptr, nullptr, &stop});
+  ReplayCheckpoint checkpoint;
+  checkpoint.every = 100;
+  checkpoint.callback = [&stop](const ReplayPipeline&) {
+    stop.store(true);  // as a signal handler would, after the first 100 events
+    return Status::Ok();
+  };
+  StatusOr<ReplayResult> result = session.Run(checkpoint);
+  ASSERT_TRUE(result.ok());
+  EXPECT_TRUE(result->interrupted);
+  EXPECT_FALSE(result->finished);
+  EXPECT_EQ(session.pipeline().state().next_event, 100u);
+  EXPECT_EQ(nlohmann::json::parse(out.written["summary.json"])["interrupted"], true);
+  StatusOr<MapFile> map = LoadMapFile(result->saved_map);
+  ASSERT_TRUE(map.ok()) << map.status().message();
+  EXPECT_EQ(map->state.next_event, 100u);
+}
+
+TEST_F(ReplaySessionTest, LoadAndPrepareErrorsAreReturnedBeforeAnythingRuns) {
+  MemoryFolder out("mem");
+  ReplaySessionOptions missing = Options();
+  missing.data = {(dir_->path() / "no-such-data").string()};
+  ReplaySession a(missing, {&out, nullptr, nullptr, nullptr, nullptr});
+  EXPECT_FALSE(a.Run().ok());
+  EXPECT_TRUE(out.written.empty());
+
+  ReplaySessionOptions wrong_map = Options();
+  wrong_map.load_map = (dir_->path() / "no-such.map").string();
+  ReplaySession b(wrong_map, {&out, nullptr, nullptr, nullptr, nullptr});
+  const StatusOr<ReplayResult> result = b.Run();
+  ASSERT_FALSE(result.ok());
+  EXPECT_NE(result.status().message().find("no-such.map"), std::string::npos);
+  EXPECT_FALSE(out.written.count("summary.json"));
+}
+
+// A map from another configuration is refused, naming the file.
+TEST_F(ReplaySessionTest, ResumeChecksConfigurationAndDataSet) {
+  MemoryFolder out("mem");
+  ReplaySessionOptions first = Options();
+  first.until_s = 10.0;
+  first.save_map = (dir_->path() / "first.map").string();
+  ReplaySession a(first, {&out, nullptr, nullptr, nullptr, nullptr});
+  ASSERT_TRUE(a.Run().ok());
+  ReplaySessionOptions other = Options();
+  other.pipeline.sensors.classic_camera.match_threshold = 0.07;
+  other.load_map = first.save_map;
+  ReplaySession b(other, {&out, nullptr, nullptr, nullptr, nullptr});
+  const StatusOr<ReplayResult> refused = b.Run();
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.status().message().find("different configuration"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace ratslam
