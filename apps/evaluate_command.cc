@@ -5,9 +5,9 @@
 
 #include "apps/cli.h"
 #include "common/output_folder.h"
+#include "render/renderer.h"
 #include "session/evaluation_session.h"
 #include "viewer/localisation_figure.h"
-#include "viewer/renderer.h"
 
 namespace ratslam {
 

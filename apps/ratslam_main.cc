@@ -25,6 +25,7 @@
 #include "fusion/io/map_file.h"
 #include "fusion/io/run_outputs.h"
 #include "fusion/replay_pipeline.h"
+#include "render/renderer.h"
 #include "sensors/dataset/dataset.h"
 #include "sensors/dataset/dataset_loader.h"
 #include "sensors/dataset/image_loader.h"
@@ -34,7 +35,6 @@
 #include "sim/world.h"
 #include "viewer/animation.h"
 #include "viewer/figures.h"
-#include "viewer/renderer.h"
 #include "viewer/run_images.h"
 
 namespace ratslam {
@@ -137,7 +137,7 @@ int RunReplay(const ReplayRequest& request) {
                     p.state().trajectory.empty() ? 0.0 : p.state().trajectory.back().time_s);
       options.title = title;
       StatusOr<RgbaImage> frame = animation_renderer->Render(
-          ExperienceMapScene(ExperienceMapDataOf(p, session.dataset()), options));
+          ExperienceMapScene(ExperienceMapDataOf(p.View(), session.dataset()), options));
       if (!frame.ok()) return frame.status();
       return animation->AddFrame(frame.value());
     };
@@ -161,7 +161,7 @@ int RunReplay(const ReplayRequest& request) {
   if (!result.save.ok()) exit_code = fail(result.save);
   if (request.render && result.outputs.ok()) {
     StatusOr<std::unique_ptr<SceneRenderer>> renderer = CreateOsMesaRenderer();
-    Status rendered = renderer.ok() ? WriteRunImages(*renderer.value(), session.pipeline(),
+    Status rendered = renderer.ok() ? WriteRunImages(*renderer.value(), session.pipeline().View(),
                                                      session.dataset(), request.out)
                                     : renderer.status();
     if (!rendered.ok()) exit_code = fail(rendered.WithContext("images not written"));

@@ -6,13 +6,13 @@
 #include "apps/cli.h"
 #include "fusion/io/config.h"
 #include "fusion/io/map_file.h"
+#include "fusion/io/run_reader.h"
+#include "render/renderer.h"
 #include "sensors/dataset/dataset.h"
 #include "sensors/dataset/dataset_loader.h"
 #include "sensors/dataset/image_loader.h"
 #include "viewer/figures.h"
-#include "viewer/renderer.h"
 #include "viewer/run_images.h"
-#include "viewer/run_reader.h"
 #include "viewer/similarity.h"
 
 namespace ratslam {

@@ -7,9 +7,9 @@
 
 #include "apps/cli.h"
 #include "common/file_util.h"
+#include "render/renderer.h"
 #include "sim/simulator.h"
-#include "sim/world_figure.h"
-#include "viewer/renderer.h"
+#include "viewer/world_figure.h"
 
 namespace ratslam {
 

@@ -6,8 +6,8 @@
 #include <filesystem>
 
 #include "common/random.h"
+#include "render/renderer.h"
 #include "viewer/figures.h"
-#include "viewer/renderer.h"
 
 namespace ratslam {
 namespace {

@@ -59,18 +59,6 @@ bool FabmapFrontEndOptions::IsValid(std::string* error) const {
   return true;
 }
 
-std::string ToString(DecisionSource source) {
-  switch (source) {
-    case DecisionSource::kCamera:
-      return "camera";
-    case DecisionSource::kWifi:
-      return "wifi";
-    case DecisionSource::kNew:
-      return "new";
-  }
-  return "unknown";
-}
-
 bool FusedOptions::IsValid(std::string* error) const {
   auto fail = [error](const std::string& message) {
     if (error) *error = message;

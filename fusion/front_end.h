@@ -33,6 +33,7 @@
 #include "fusion/fabmap/visual_model.h"
 #include "fusion/fabmap/vocabulary.h"
 #include "ratslam/local_view_cells.h"
+#include "ratslam/records.h"
 #include "sensors/classic_camera_matcher.h"
 #include "sensors/dataset/dataset.h"
 #include "sensors/dataset/image_loader.h"
@@ -117,10 +118,6 @@ struct FabmapResources {
   // restore, starts from a copy instead of learning the Wi-Fi tree again.
   std::shared_ptr<const fabmap::Localiser> empty_localiser;
 };
-
-// Which sensor decided a frame.
-enum class DecisionSource : uint8_t { kCamera = 0, kWifi = 1, kNew = 2 };
-std::string ToString(DecisionSource source);
 
 struct FrameDecision {
   ViewDecision view;

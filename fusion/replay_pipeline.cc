@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "common/circular.h"
+#include "common/geometry.h"
 
 namespace ratslam {
 
@@ -131,10 +132,11 @@ Status ReplayPipeline::HandleOdometry(const Event& event) {
   if (!action.ok()) return action.status();
 
   // Raw dead reckoning with the same midpoint rule as the experience map.
-  const double heading = state_.odometry_theta_rad + 0.5 * step.rotation_rad;
-  state_.odometry_x_m += step.forward_m * std::cos(heading);
-  state_.odometry_y_m += step.forward_m * std::sin(heading);
-  state_.odometry_theta_rad = WrapAngle(state_.odometry_theta_rad + step.rotation_rad);
+  Pose2 odometry{state_.odometry_x_m, state_.odometry_y_m, state_.odometry_theta_rad};
+  AdvanceMidpoint(&odometry, step.forward_m, step.rotation_rad);
+  state_.odometry_x_m = odometry.x_m;
+  state_.odometry_y_m = odometry.y_m;
+  state_.odometry_theta_rad = odometry.theta_rad;
 
   TrajectoryRecord record;
   record.time_s = row.time_s;

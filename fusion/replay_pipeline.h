@@ -17,6 +17,7 @@
 #include "fusion/fabmap/evaluation.h"
 #include "fusion/front_end.h"
 #include "ratslam/ratslam.h"
+#include "ratslam/records.h"
 #include "sensors/dataset/dataset.h"
 #include "sensors/dataset/image_loader.h"
 #include "sensors/pedestrian_dead_reckoning.h"
@@ -60,25 +61,6 @@ struct PipelineOptions {
     v("virtual_wifi", sensors.fabmap.localiser.virtual_wifi);
     v("evaluation", evaluation);
   }
-};
-
-// One odometry step's outcome: where the map puts the robot (by experience and offset, so that
-// the final relaxed map gives the final trajectory) and where raw odometry puts it.
-struct TrajectoryRecord {
-  double time_s = 0.0;
-  int64_t experience_id = -1;  // -1 before the first experience
-  LocalOffset offset;
-  double odometry_x_m = 0.0, odometry_y_m = 0.0, odometry_theta_rad = 0.0;
-};
-
-// One view frame's outcome, for template graphs.
-struct FrameRecord {
-  double time_s = 0.0;
-  uint32_t template_id = 0;
-  bool is_new = false;
-  int64_t experience_id = -1;  // current experience after the frame
-  DecisionSource source = DecisionSource::kNew;
-  bool recent = false;  // re-used a recent template (no injection; not counted as a match)
 };
 
 struct ReplayProgress {
@@ -128,6 +110,10 @@ class ReplayPipeline {
   bool finished() const { return state_.next_event >= events_.size(); }
   const Ratslam& slam() const { return *slam_; }
   const State& state() const { return state_; }
+  // The run so far as plain records (what outputs and figures read).
+  RunView View() const {
+    return {slam_->experience_map(), slam_->pose_cells(), state_.frames, state_.trajectory};
+  }
   // A snapshot of the complete state (spine included).
   State Snapshot() const;
   // Restores a snapshot; fails if it does not belong to this data set and these options.

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "common/circular.h"
+#include "common/geometry.h"
 
 namespace ratslam {
 
@@ -29,24 +30,22 @@ ExperienceMap::ExperienceMap(const ExperienceMapOptions& options) : options_(opt
 
 void ExperienceMap::Integrate(double forward_m, double rotation_rad) {
   LocalOffset& o = state_.offset;
-  const double heading = o.facing_rad + 0.5 * rotation_rad;
-  o.forward_m += forward_m * std::cos(heading);
-  o.left_m += forward_m * std::sin(heading);
-  o.facing_rad = WrapAngle(o.facing_rad + rotation_rad);
+  Pose2 pose{o.forward_m, o.left_m, o.facing_rad};
+  AdvanceMidpoint(&pose, forward_m, rotation_rad);
+  o = {pose.x_m, pose.y_m, pose.theta_rad};
 }
 
 void ExperienceMap::CurrentPose(double* x_m, double* y_m, double* theta_rad) const {
-  double x = 0.0, y = 0.0, theta = 0.0;
+  Pose2 base;
   if (state_.current) {
     const Experience& e = state_.experiences[*state_.current];
-    x = e.x_m;
-    y = e.y_m;
-    theta = e.theta_rad;
+    base = {e.x_m, e.y_m, e.theta_rad};
   }
   const LocalOffset& o = state_.offset;
-  *x_m = x + o.forward_m * std::cos(theta) - o.left_m * std::sin(theta);
-  *y_m = y + o.forward_m * std::sin(theta) + o.left_m * std::cos(theta);
-  *theta_rad = WrapAngle(theta + o.facing_rad);
+  const Pose2 pose = Compose(base, o.forward_m, o.left_m, o.facing_rad);
+  *x_m = pose.x_m;
+  *y_m = pose.y_m;
+  *theta_rad = pose.theta_rad;
 }
 
 void ExperienceMap::AddLink(uint32_t from, uint32_t to, double time_s,

@@ -101,6 +101,64 @@ TEST(RatslamTest, FailedSetStateChangesNothing) {
   EXPECT_EQ(b.pose_cells().BestPosition().x, before.x);
 }
 
+// Two experiences of one template lie within match distance of the pose and the nearer one is
+// not current: refuse_ambiguous_links makes no link (and counts it); the default links.
+TEST(RatslamTest, RefuseAmbiguousLinksDecidesBetweenTwoCandidates) {
+  for (bool refuse : {false, true}) {
+    RatslamOptions options;
+    options.action.refuse_ambiguous_links = refuse;
+    Ratslam slam(options);
+    ASSERT_TRUE(slam.OnView({0.0, 0, true, 0.0}).ok());
+    ASSERT_TRUE(slam.OnOdometry({0.0, 0.0, 0.0}).ok());  // experience 0 at x = 0
+    ASSERT_TRUE(slam.OnOdometry({1.0, 2.5, 0.0}).ok());  // 2.5 cells on: experience 1
+    ASSERT_EQ(slam.experience_map().num_experiences(), 2u);
+    ASSERT_EQ(*slam.experience_map().current(), 1u);
+    // Back 1.6 cells: 0.9 from experience 0, 1.6 from experience 1; both within 2.
+    StatusOr<ActionKind> action = slam.OnOdometry({2.0, -1.6, 0.0});
+    ASSERT_TRUE(action.ok());
+    if (refuse) {
+      EXPECT_EQ(action.value(), ActionKind::kRefusedAmbiguous);
+      EXPECT_EQ(slam.counters().refused_ambiguous, 1u);
+      EXPECT_EQ(slam.experience_map().num_links(), 1u);
+      EXPECT_EQ(*slam.experience_map().current(), 1u);
+    } else {
+      // Experiences 0 and 1 are joined already (1 was made from 0): no new link, but the map
+      // moves to experience 0.
+      EXPECT_EQ(action.value(), ActionKind::kLinkedExisting);
+      EXPECT_EQ(slam.experience_map().num_links(), 1u);
+      EXPECT_EQ(*slam.experience_map().current(), 0u);
+    }
+  }
+}
+
+// A place seen again facing the other way: with match_heading the pose-cell theta differs by
+// half the ring, so a new experience is made; without it the old one is re-used (a loop closure).
+TEST(RatslamTest, MatchHeadingFalseReusesAPlaceSeenTheOtherWay) {
+  for (bool match_heading : {true, false}) {
+    RatslamOptions options;
+    options.action.match_heading = match_heading;
+    Ratslam slam(options);
+    ASSERT_TRUE(slam.OnView({0.0, 0, true, 0.0}).ok());
+    ASSERT_TRUE(slam.OnOdometry({0.0, 0.0, 0.0}).ok());  // experience 0, facing +x
+    ASSERT_TRUE(slam.OnView({1.0, 1, true, 0.0}).ok());
+    ASSERT_TRUE(slam.OnOdometry({1.0, 3.0, 0.0}).ok());               // experience 1, 3 cells on
+    ASSERT_TRUE(slam.OnOdometry({2.0, 0.0, std::numbers::pi}).ok());  // turn round
+    ASSERT_TRUE(slam.OnOdometry({3.0, 3.0, 0.0}).ok());               // walk back
+    const size_t before = slam.experience_map().num_experiences();
+    ASSERT_TRUE(slam.OnView({4.0, 0, false, 0.0}).ok());  // template 0 again, facing -x
+    StatusOr<ActionKind> action = slam.OnOdometry({4.0, 0.0, 0.0});
+    ASSERT_TRUE(action.ok());
+    if (match_heading) {
+      EXPECT_EQ(action.value(), ActionKind::kCreatedExperience);
+      EXPECT_EQ(slam.experience_map().num_experiences(), before + 1);
+    } else {
+      EXPECT_EQ(action.value(), ActionKind::kLinkedExisting);
+      EXPECT_EQ(*slam.experience_map().current(), 0u);
+      EXPECT_EQ(slam.counters().loop_closures, 1u);
+    }
+  }
+}
+
 // A restored state is untrusted input: every corruption below once loaded and crashed (or
 // poisoned) the next step. Each must be refused with a message, and the spine left unchanged.
 TEST(RatslamTest, SetStateRefusesDanglingIdsAndNonFiniteValues) {

@@ -18,9 +18,9 @@
 #include <vector>
 
 #include "common/status.h"
+#include "render/view_renderer.h"
 #include "sensors/dataset/dataset.h"
 #include "sim/world.h"
-#include "viewer/view_renderer.h"
 
 namespace ratslam::sim {
 

@@ -9,8 +9,8 @@
 #include <cstdlib>
 #include <filesystem>
 
+#include "render/renderer.h"
 #include "viewer/figures.h"
-#include "viewer/renderer.h"
 
 namespace ratslam {
 namespace {

@@ -9,9 +9,9 @@
 
 #include "apps/demo_config.h"
 #include "common/scratch_dir.h"
+#include "render/image.h"
+#include "render/renderer.h"
 #include "sensors/dataset/synthetic_dataset.h"
-#include "viewer/image.h"
-#include "viewer/renderer.h"
 
 namespace ratslam {
 namespace {

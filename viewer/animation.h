@@ -6,7 +6,7 @@
 #include <string>
 
 #include "common/status.h"
-#include "viewer/image.h"
+#include "render/image.h"
 
 namespace ratslam {
 

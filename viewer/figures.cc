@@ -7,7 +7,7 @@
 #include <limits>
 #include <numbers>
 
-#include "viewer/image.h"
+#include "render/image.h"
 
 namespace ratslam {
 namespace {

@@ -9,11 +9,11 @@
 #include <utility>
 #include <vector>
 
-#include "fusion/front_end.h"
-#include "fusion/trajectory_metrics.h"
+#include "common/geometry.h"
 #include "ratslam/experience_map.h"
 #include "ratslam/pose_cell_network.h"
-#include "viewer/scene.h"
+#include "ratslam/records.h"
+#include "render/scene.h"
 
 namespace ratslam {
 

@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "viewer/renderer.h"
+#include "render/renderer.h"
 #include "viewer/run_images.h"
 
 namespace ratslam {

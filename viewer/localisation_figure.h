@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "viewer/scene.h"
+#include "render/scene.h"
 
 namespace ratslam {
 

@@ -5,7 +5,7 @@
 #include <limits>
 #include <set>
 
-#include "fusion/trajectory_metrics.h"
+#include "common/geometry.h"
 
 namespace ratslam {
 
@@ -30,14 +30,14 @@ std::vector<Point2> GroundTruthInMapFrame(const std::vector<Experience>& experie
   return aligned;
 }
 
-ExperienceMapImageData ExperienceMapDataOf(const ReplayPipeline& pipeline, const Dataset& dataset) {
-  const ExperienceMap& map = pipeline.slam().experience_map();
+ExperienceMapImageData ExperienceMapDataOf(const RunView& run, const Dataset& dataset) {
+  const ExperienceMap& map = run.map;
   ExperienceMapImageData data;
   data.experiences = map.experiences();
   data.links = map.links();
   data.current = map.current();
   // Only the part of the ground truth the run has reached.
-  const auto& trajectory = pipeline.state().trajectory;
+  const auto& trajectory = run.trajectory;
   data.ground_truth = GroundTruthInMapFrame(data.experiences, dataset,
                                             trajectory.empty() ? -1.0 : trajectory.back().time_s);
   return data;
@@ -124,17 +124,17 @@ StatusOr<RgbaImage> RenderExperienceMapByFloor(SceneRenderer& renderer,
   return out;
 }
 
-std::vector<TemplateGraphPoint> TemplateGraphOf(const ReplayPipeline& pipeline) {
+std::vector<TemplateGraphPoint> TemplateGraphOf(const RunView& run) {
   std::vector<TemplateGraphPoint> points;
-  points.reserve(pipeline.state().frames.size());
-  for (const FrameRecord& f : pipeline.state().frames) {
+  points.reserve(run.frames.size());
+  for (const FrameRecord& f : run.frames) {
     points.push_back({f.time_s, f.template_id, f.experience_id, f.source});
   }
   return points;
 }
 
-Status WriteRunImages(SceneRenderer& renderer, const ReplayPipeline& pipeline,
-                      const Dataset& dataset, const std::string& folder) {
+Status WriteRunImages(SceneRenderer& renderer, const RunView& run, const Dataset& dataset,
+                      const std::string& folder) {
   namespace fs = std::filesystem;
   auto write = [&](const Scene& scene, const char* name) -> Status {
     StatusOr<RgbaImage> image = renderer.Render(scene);
@@ -150,9 +150,9 @@ Status WriteRunImages(SceneRenderer& renderer, const ReplayPipeline& pipeline,
   }
   {
     // One panel per floor when the ground truth knows several.
-    ExperienceMapImageData map_data = ExperienceMapDataOf(pipeline, dataset);
+    ExperienceMapImageData map_data = ExperienceMapDataOf(run, dataset);
     std::vector<int> truth_floors;
-    const auto& trajectory = pipeline.state().trajectory;
+    const auto& trajectory = run.trajectory;
     map_data.ground_truth =
         GroundTruthInMapFrame(map_data.experiences, dataset,
                               trajectory.empty() ? -1.0 : trajectory.back().time_s, &truth_floors);
@@ -172,8 +172,8 @@ Status WriteRunImages(SceneRenderer& renderer, const ReplayPipeline& pipeline,
     graph_options.shaded_spans.push_back({sessions[i], end, "session " + std::to_string(i + 1)});
   }
   RATSLAM_RETURN_IF_ERROR(
-      write(TemplateGraphScene(TemplateGraphOf(pipeline), graph_options), "template_graph.png"));
-  return write(PoseCellScene(pipeline.slam().pose_cells(), {}), "pose_cells.png");
+      write(TemplateGraphScene(TemplateGraphOf(run), graph_options), "template_graph.png"));
+  return write(PoseCellScene(run.pose_cells, {}), "pose_cells.png");
 }
 
 }  // namespace ratslam

@@ -1,14 +1,15 @@
-// The images of a replay: experience map, template graph and pose-cell activity, drawn from the
-// pipeline's state (at the end of a run, or from a resumed map).
+// The images of a replay: experience map, template graph and pose-cell activity, drawn from a
+// run's records (at the end of a run, or from a resumed map); the viewer never sees the pipeline.
 #ifndef RATSLAM_VIEWER_RUN_IMAGES_H_
 #define RATSLAM_VIEWER_RUN_IMAGES_H_
 
 #include <string>
 
 #include "common/status.h"
-#include "fusion/replay_pipeline.h"
+#include "ratslam/records.h"
+#include "render/renderer.h"
+#include "sensors/dataset/dataset.h"
 #include "viewer/figures.h"
-#include "viewer/renderer.h"
 
 namespace ratslam {
 
@@ -33,13 +34,13 @@ StatusOr<RgbaImage> RenderExperienceMapByFloor(SceneRenderer& renderer,
                                                const ExperienceMapImageOptions& panel);
 
 // The experience-map figure data of a run, with the ground truth (if any) aligned to the map.
-ExperienceMapImageData ExperienceMapDataOf(const ReplayPipeline& pipeline, const Dataset& dataset);
+ExperienceMapImageData ExperienceMapDataOf(const RunView& run, const Dataset& dataset);
 // One template-graph point per view frame.
-std::vector<TemplateGraphPoint> TemplateGraphOf(const ReplayPipeline& pipeline);
+std::vector<TemplateGraphPoint> TemplateGraphOf(const RunView& run);
 
 // Writes experience_map.png, template_graph.png and pose_cells.png into `folder`.
-Status WriteRunImages(SceneRenderer& renderer, const ReplayPipeline& pipeline,
-                      const Dataset& dataset, const std::string& folder);
+Status WriteRunImages(SceneRenderer& renderer, const RunView& run, const Dataset& dataset,
+                      const std::string& folder);
 
 }  // namespace ratslam
 

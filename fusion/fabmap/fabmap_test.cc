@@ -79,6 +79,43 @@ TEST(FabmapTest, SparseLikelihoodEqualsDenseOracle) {
   }
 }
 
+// The formula of fabmap.h worked by hand for two words (not from the code's tables): word 0 is the
+// root with p(z0) = 0.5; word 1 hangs off it with p(z1) = 0.4, p(z1 | z0) = 0.7; detector
+// PzGe = 0.8, PzGNe = 0.1. Existence priors: (0.5 - 0.1) / 0.7 = 4/7 and (0.4 - 0.1) / 0.7 = 3/7.
+// Query Z = {0, 1}.
+// Word 0 at a place that saw it: p(e0 | seen) = 0.8 (4/7) / (0.8 (4/7) + 0.1 (3/7)) = 32/35.
+//   p(z0=1 | e0=1) = beta / (alpha + beta) with alpha = 0.5 * 0.2 * 0.5, beta = 0.5 * 0.8 * 0.5:
+//   0.8; p(z0=1 | e0=0): alpha = 0.5 * 0.9 * 0.5, beta = 0.5 * 0.1 * 0.5: 0.1.
+//   Term: 0.8 (32/35) + 0.1 (3/35) = 37/50.
+// Word 1 given z0 = 1: p(z1=1 | e1=1): alpha = 0.4 * 0.2 * 0.3, beta = 0.6 * 0.8 * 0.7: 14/15;
+//   p(z1=1 | e1=0): alpha = 0.4 * 0.9 * 0.3, beta = 0.6 * 0.1 * 0.7: 7/25.
+//   A place that did not see it: p(e1 | not seen) = 0.2 (3/7) / (0.2 (3/7) + 0.9 (4/7)) = 1/7,
+//   term (14/15)(1/7) + (7/25)(6/7) = 28/75. One that saw it: p(e1 | seen) = 6/7,
+//   term (14/15)(6/7) + (7/25)(1/7) = 21/25.
+TEST(FabmapTest, LikelihoodMatchesAHandWorkedExample) {
+  ChowLiuTree tree;
+  tree.parent = {ChowLiuTree::kNoParent, 0};
+  tree.marginal = {0.5, 0.4};
+  tree.on_given_parent_on = {0.5, 0.7};
+  tree.on_given_parent_off = {0.5, 0.1};
+  DetectorBlock block;
+  block.count = 2;
+  block.detector = {0.8, 0.1};
+  auto model = FabmapModel::Create(tree, {block}, {{0}}, {});
+  ASSERT_TRUE(model.ok()) << model.status().message();
+  ASSERT_TRUE(model->AddPlace({0}).ok());     // place 0 saw word 0 only
+  ASSERT_TRUE(model->AddPlace({0, 1}).ok());  // place 1 saw both
+  std::vector<double> log_likelihood;
+  model->LogLikelihoods({0, 1}, &log_likelihood);
+  ASSERT_EQ(log_likelihood.size(), 2u);
+  const double place0 = std::log(37.0 / 50.0) + std::log(28.0 / 75.0);
+  const double place1 = std::log(37.0 / 50.0) + std::log(21.0 / 25.0);
+  EXPECT_NEAR(log_likelihood[0], place0, 1e-12);
+  EXPECT_NEAR(log_likelihood[1], place1, 1e-12);
+  EXPECT_NEAR(model->DenseLogLikelihood({0, 1}, 0), place0, 1e-12);
+  EXPECT_NEAR(model->DenseLogLikelihood({0, 1}, 1), place1, 1e-12);
+}
+
 TEST(FabmapTest, LikelihoodIsANormalisedDistributionOverObservations) {
   // Summing p(Z | L) over all 2^V observations of a tiny vocabulary gives 1.
   const ChowLiuTree tree = *LearnChowLiuTree({{0, 1}, {1, 2}, {0, 1, 3}, {2}, {0, 3}}, 4);

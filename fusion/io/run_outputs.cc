@@ -7,7 +7,8 @@
 #include <sstream>
 
 #include "common/circular.h"
-#include "fusion/trajectory_metrics.h"
+#include "common/geometry.h"
+#include "fusion/io/run_columns.h"
 
 namespace ratslam {
 namespace {
@@ -27,17 +28,16 @@ std::string TumLine(double t, double x, double y, double theta) {
 
 void RecordPose(const ExperienceMap& map, const TrajectoryRecord& record, double* x_m, double* y_m,
                 double* theta_rad) {
-  double x = 0, y = 0, theta = 0;
+  Pose2 base;
   if (record.experience_id >= 0) {
     const Experience& e = map.experience(static_cast<uint32_t>(record.experience_id));
-    x = e.x_m;
-    y = e.y_m;
-    theta = e.theta_rad;
+    base = {e.x_m, e.y_m, e.theta_rad};
   }
   const LocalOffset& o = record.offset;
-  *x_m = x + o.forward_m * std::cos(theta) - o.left_m * std::sin(theta);
-  *y_m = y + o.forward_m * std::sin(theta) + o.left_m * std::cos(theta);
-  *theta_rad = WrapAngle(theta + o.facing_rad);
+  const Pose2 pose = Compose(base, o.forward_m, o.left_m, o.facing_rad);
+  *x_m = pose.x_m;
+  *y_m = pose.y_m;
+  *theta_rad = pose.theta_rad;
 }
 
 RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, const RunInfo& info) {
@@ -158,8 +158,7 @@ StatusOr<RunSummary> WriteRunOutputs(OutputFolder& folder, const ReplayPipeline&
   std::vector<std::pair<std::string, std::string>> files;
 
   std::ostringstream experiences;
-  experiences
-      << "id,x_m,y_m,theta_rad,template_id,time_s,pose_cell_x,pose_cell_y,pose_cell_theta\n";
+  experiences << kExperienceColumns.Header();
   for (const Experience& e : map.experiences()) {
     experiences << e.id << ',' << Num(e.x_m) << ',' << Num(e.y_m) << ',' << Num(e.theta_rad) << ','
                 << e.template_id << ',' << Num(e.time_s) << ',' << Num(e.pose_cells.x) << ','
@@ -168,7 +167,7 @@ StatusOr<RunSummary> WriteRunOutputs(OutputFolder& folder, const ReplayPipeline&
   files.emplace_back("experiences.csv", experiences.str());
 
   std::ostringstream links;
-  links << "id,from_id,to_id,distance_m,heading_rad,facing_rad,duration_s,loop_closure\n";
+  links << kLinkColumns.Header();
   for (const Link& l : map.links()) {
     links << l.id << ',' << l.from << ',' << l.to << ',' << Num(l.distance_m) << ','
           << Num(l.heading_rad) << ',' << Num(l.facing_rad) << ',' << Num(l.duration_s) << ','
@@ -203,7 +202,7 @@ StatusOr<RunSummary> WriteRunOutputs(OutputFolder& folder, const ReplayPipeline&
   files.emplace_back("experience_map.g2o", g2o.str());
 
   std::ostringstream frames;
-  frames << "time_s,template_id,new_template,experience_id,source,recent\n";
+  frames << kFrameColumns.Header();
   for (const FrameRecord& f : state.frames) {
     frames << Num(f.time_s) << ',' << f.template_id << ',' << (f.is_new ? 1 : 0) << ','
            << f.experience_id << ',' << ToString(f.source) << ',' << (f.recent ? 1 : 0) << '\n';

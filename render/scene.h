@@ -1,7 +1,7 @@
 // A 2D scene in pixel coordinates (origin top-left, y down): the backend-independent description
 // of an image. Figures build scenes; a SceneRenderer turns them into pixels.
-#ifndef RATSLAM_VIEWER_SCENE_H_
-#define RATSLAM_VIEWER_SCENE_H_
+#ifndef RATSLAM_RENDER_SCENE_H_
+#define RATSLAM_RENDER_SCENE_H_
 
 #include <cstdint>
 #include <string>
@@ -75,4 +75,4 @@ class Scene {
 
 }  // namespace ratslam
 
-#endif  // RATSLAM_VIEWER_SCENE_H_
+#endif  // RATSLAM_RENDER_SCENE_H_

@@ -1,7 +1,7 @@
 // Perspective views of a textured 3D world (the simulator's camera), rendered headlessly with
 // OSMesa like the figures. World coordinates: x east, y north, z up, metres.
-#ifndef RATSLAM_VIEWER_VIEW_RENDERER_H_
-#define RATSLAM_VIEWER_VIEW_RENDERER_H_
+#ifndef RATSLAM_RENDER_VIEW_RENDERER_H_
+#define RATSLAM_RENDER_VIEW_RENDERER_H_
 
 #include <cstdint>
 #include <memory>
@@ -57,4 +57,4 @@ StatusOr<std::unique_ptr<ViewRenderer>> CreateOsMesaViewRenderer();
 
 }  // namespace ratslam
 
-#endif  // RATSLAM_VIEWER_VIEW_RENDERER_H_
+#endif  // RATSLAM_RENDER_VIEW_RENDERER_H_

@@ -1,4 +1,4 @@
-#include "viewer/image.h"
+#include "render/image.h"
 
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>

@@ -1,12 +1,12 @@
 // Turns scenes into images. The interface lets figures be tested without a GL context.
-#ifndef RATSLAM_VIEWER_RENDERER_H_
-#define RATSLAM_VIEWER_RENDERER_H_
+#ifndef RATSLAM_RENDER_RENDERER_H_
+#define RATSLAM_RENDER_RENDERER_H_
 
 #include <memory>
 
 #include "common/status.h"
-#include "viewer/image.h"
-#include "viewer/scene.h"
+#include "render/image.h"
+#include "render/scene.h"
 
 namespace ratslam {
 
@@ -27,4 +27,4 @@ Status RenderToPng(const Scene& scene, const std::string& path);
 
 }  // namespace ratslam
 
-#endif  // RATSLAM_VIEWER_RENDERER_H_
+#endif  // RATSLAM_RENDER_RENDERER_H_

@@ -1,6 +1,6 @@
 // Rendering through OSMesa: orientation, colours, antialiasing, errors. Skips (with the reason)
 // where no OSMesa context can be made.
-#include "viewer/renderer.h"
+#include "render/renderer.h"
 
 #include <gtest/gtest.h>
 

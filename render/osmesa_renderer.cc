@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "viewer/renderer.h"
-#include "viewer/view_renderer.h"
+#include "render/renderer.h"
+#include "render/view_renderer.h"
 
 namespace ratslam {
 namespace {

@@ -1,11 +1,11 @@
 // The ground-truth map of a simulated world: walls (by material), access points, disturbances
 // and the true trajectory, one panel per floor.
-#ifndef RATSLAM_SIM_WORLD_FIGURE_H_
-#define RATSLAM_SIM_WORLD_FIGURE_H_
+#ifndef RATSLAM_VIEWER_WORLD_FIGURE_H_
+#define RATSLAM_VIEWER_WORLD_FIGURE_H_
 
+#include "render/scene.h"
 #include "sensors/dataset/dataset.h"
 #include "sim/world.h"
-#include "viewer/scene.h"
 
 namespace ratslam::sim {
 
@@ -13,4 +13,4 @@ Scene WorldMapScene(const World& world, const Dataset& dataset, int panel_px = 7
 
 }  // namespace ratslam::sim
 
-#endif  // RATSLAM_SIM_WORLD_FIGURE_H_
+#endif  // RATSLAM_VIEWER_WORLD_FIGURE_H_

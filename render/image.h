@@ -1,13 +1,13 @@
 // An RGBA image in memory, rows top to bottom, and PNG input and output.
-#ifndef RATSLAM_VIEWER_IMAGE_H_
-#define RATSLAM_VIEWER_IMAGE_H_
+#ifndef RATSLAM_RENDER_IMAGE_H_
+#define RATSLAM_RENDER_IMAGE_H_
 
 #include <cstdint>
 #include <string>
 #include <vector>
 
 #include "common/status.h"
-#include "viewer/scene.h"
+#include "render/scene.h"
 
 namespace ratslam {
 
@@ -33,4 +33,4 @@ void DrawTexts(const Scene& scene, RgbaImage* image);
 
 }  // namespace ratslam
 
-#endif  // RATSLAM_VIEWER_IMAGE_H_
+#endif  // RATSLAM_RENDER_IMAGE_H_

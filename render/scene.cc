@@ -1,4 +1,4 @@
-#include "viewer/scene.h"
+#include "render/scene.h"
 
 #include <cmath>
 

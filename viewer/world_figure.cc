@@ -1,11 +1,11 @@
-#include "sim/world_figure.h"
+#include "viewer/world_figure.h"
 
 #include <algorithm>
 #include <cmath>
 #include <set>
 
+#include "render/image.h"
 #include "viewer/figures.h"
-#include "viewer/image.h"
 
 namespace ratslam::sim {
 

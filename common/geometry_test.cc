@@ -1,4 +1,4 @@
-#include "fusion/trajectory_metrics.h"
+#include "common/geometry.h"
 
 #include <gtest/gtest.h>
 

@@ -1,13 +1,13 @@
 // Reads a replay's output folder back (experiences.csv, links.csv, frames.csv) for rendering.
-#ifndef RATSLAM_VIEWER_RUN_READER_H_
-#define RATSLAM_VIEWER_RUN_READER_H_
+#ifndef RATSLAM_FUSION_IO_RUN_READER_H_
+#define RATSLAM_FUSION_IO_RUN_READER_H_
 
 #include <string>
 #include <vector>
 
 #include "common/status.h"
-#include "fusion/replay_pipeline.h"
 #include "ratslam/experience_map.h"
+#include "ratslam/records.h"
 
 namespace ratslam {
 
@@ -24,4 +24,4 @@ StatusOr<RunFolder> ReadRunFolder(const std::string& folder);
 
 }  // namespace ratslam
 
-#endif  // RATSLAM_VIEWER_RUN_READER_H_
+#endif  // RATSLAM_FUSION_IO_RUN_READER_H_

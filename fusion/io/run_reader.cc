@@ -1,10 +1,11 @@
-#include "viewer/run_reader.h"
+#include "fusion/io/run_reader.h"
 
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "fusion/io/run_columns.h"
 #include "sensors/dataset/csv.h"
 
 namespace ratslam {
@@ -33,8 +34,7 @@ Status ReadId(const CsvTable& t, size_t row, const std::string& column, int64_t 
 StatusOr<RunFolder> ReadRunFolder(const std::string& folder) {
   RunFolder run;
   StatusOr<CsvTable> ex = CsvTable::Read((fs::path(folder) / "experiences.csv").string(),
-                                         {"id", "x_m", "y_m", "theta_rad", "template_id", "time_s"},
-                                         {"pose_cell_x", "pose_cell_y", "pose_cell_theta"});
+                                         kExperienceColumns.required, kExperienceColumns.optional);
   if (!ex.ok()) return ex.status();
   for (size_t r = 0; r < ex->rows(); ++r) {
     Experience e;
@@ -51,8 +51,7 @@ StatusOr<RunFolder> ReadRunFolder(const std::string& folder) {
     run.experiences.push_back(e);
   }
   StatusOr<CsvTable> li = CsvTable::Read((fs::path(folder) / "links.csv").string(),
-                                         {"id", "from_id", "to_id", "distance_m", "heading_rad",
-                                          "facing_rad", "duration_s", "loop_closure"});
+                                         kLinkColumns.required, kLinkColumns.optional);
   if (!li.ok()) return li.status();
   const int64_t n = static_cast<int64_t>(run.experiences.size());
   for (size_t r = 0; r < li->rows(); ++r) {
@@ -75,8 +74,7 @@ StatusOr<RunFolder> ReadRunFolder(const std::string& folder) {
     run.links.push_back(l);
   }
   StatusOr<CsvTable> fr = CsvTable::Read((fs::path(folder) / "frames.csv").string(),
-                                         {"time_s", "template_id", "new_template", "experience_id"},
-                                         {"source", "recent"});
+                                         kFrameColumns.required, kFrameColumns.optional);
   if (!fr.ok()) return fr.status();
   for (size_t r = 0; r < fr->rows(); ++r) {
     FrameRecord f;

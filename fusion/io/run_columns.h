@@ -1,0 +1,36 @@
+// The columns of a run folder's CSV files, written by run_outputs.cc and read back by
+// run_reader.cc: one list, so the two cannot drift apart. Optional columns were added after the
+// first release; readers accept run folders without them.
+#ifndef RATSLAM_FUSION_IO_RUN_COLUMNS_H_
+#define RATSLAM_FUSION_IO_RUN_COLUMNS_H_
+
+#include <string>
+#include <vector>
+
+namespace ratslam {
+
+struct RunCsvColumns {
+  std::vector<std::string> required;
+  std::vector<std::string> optional;
+  // The header line the writer prints: required then optional columns, comma-separated.
+  std::string Header() const {
+    std::string line;
+    for (const auto* list : {&required, &optional}) {
+      for (const std::string& c : *list) line += (line.empty() ? "" : ",") + c;
+    }
+    return line + "\n";
+  }
+};
+
+inline const RunCsvColumns kExperienceColumns = {
+    {"id", "x_m", "y_m", "theta_rad", "template_id", "time_s"},
+    {"pose_cell_x", "pose_cell_y", "pose_cell_theta"}};
+inline const RunCsvColumns kLinkColumns = {{"id", "from_id", "to_id", "distance_m", "heading_rad",
+                                            "facing_rad", "duration_s", "loop_closure"},
+                                           {}};
+inline const RunCsvColumns kFrameColumns = {
+    {"time_s", "template_id", "new_template", "experience_id"}, {"source", "recent"}};
+
+}  // namespace ratslam
+
+#endif  // RATSLAM_FUSION_IO_RUN_COLUMNS_H_
