@@ -56,7 +56,21 @@ bool FabmapFrontEndOptions::IsValid(std::string* error) const {
     if (error) *error = "recency_templates: must not be negative, nor recency_s and max_wifi_age_s";
     return false;
   }
+  if (online_first_scans < 1) {
+    if (error) *error = "online_first_scans: must be at least 1";
+    return false;
+  }
   return true;
+}
+
+std::string ToString(WifiLearning learning) {
+  return learning == WifiLearning::kOnline ? "online" : "whole_data_set";
+}
+
+StatusOr<WifiLearning> WifiLearningFromString(const std::string& name) {
+  if (name == "whole_data_set") return WifiLearning::kWholeDataSet;
+  if (name == "online") return WifiLearning::kOnline;
+  return Status::Error("unknown Wi-Fi learning '" + name + "' (whole_data_set or online)");
 }
 
 bool FusedOptions::IsValid(std::string* error) const {
@@ -325,7 +339,7 @@ class FabmapFrontEnd : public FrontEnd {
  public:
   FabmapFrontEnd(const FabmapSettings& settings, std::shared_ptr<const FabmapResources> resources)
       : settings_(settings), resources_(std::move(resources)) {
-    if (!resources_ || !resources_->empty_localiser) {
+    if (!resources_ || (!online() && !resources_->empty_localiser)) {
       throw std::invalid_argument("the FABMAP front end needs PrepareFabmapResources' models");
     }
     Reset();
@@ -348,6 +362,8 @@ class FabmapFrontEnd : public FrontEnd {
     if (!fabmap::UsesWifi(mode())) return std::optional<FrameDecision>();
     newest_scan_ = scan.readings;
     newest_scan_time_s_ = scan.time_s;
+    ++scans_seen_;
+    if (online() && scans_seen_ >= NextRelearn()) RATSLAM_RETURN_IF_ERROR(Relearn(scans_seen_));
     if (fabmap::UsesVision(mode())) return std::optional<FrameDecision>();  // images are frames
     fabmap::Query q;
     q.wifi = scan.readings;
@@ -358,6 +374,12 @@ class FabmapFrontEnd : public FrontEnd {
   std::optional<double> CompassHeading() const override { return std::nullopt; }
   bool WantsImages() const override { return fabmap::UsesVision(mode()); }
   uint32_t size() const override { return static_cast<uint32_t>(places_.size()); }
+  std::optional<FabmapLearningReport> fabmap_learning() const override {
+    return FabmapLearningReport{
+        settings_.front_end.wifi_learning,
+        online() ? learned_from_ : static_cast<uint64_t>(resources_->scans.scans.size()),
+        online() ? relearnt_ : 1};
+  }
 
   std::string EncodeState() const override {
     ByteWriter w;
@@ -378,6 +400,11 @@ class FabmapFrontEnd : public FrontEnd {
     for (const WifiReading& r : newest_scan_) {
       w.String(r.bssid);
       w.Pod(r.rssi_dbm);
+    }
+    if (online()) {  // whole-data-set states keep the format of earlier releases
+      w.Pod(scans_seen_);
+      w.Pod(learned_from_);
+      w.Pod(relearnt_);
     }
     return std::move(w.bytes());
   }
@@ -409,9 +436,17 @@ class FabmapFrontEnd : public FrontEnd {
     }
     std::optional<double> newest_time;
     std::vector<WifiReading> newest;
+    uint64_t scans_seen = 0, learned_from = 0, relearnt = 0;
     ok = ok && r.Optional(&newest_time) && readings(&newest) &&
+         (!online() || (r.Pod(&scans_seen) && r.Pod(&learned_from) && r.Pod(&relearnt))) &&
          (r.AtEnd() || r.Fail("trailing bytes"));
     if (!ok) return Status::Error(r.error());
+    if (online() &&
+        (scans_seen > resources_->scans.scans.size() || learned_from > scans_seen ||
+         (learned_from > 0 &&
+          learned_from < static_cast<uint64_t>(settings_.front_end.online_first_scans)))) {
+      return Status::Error("FABMAP front-end state: scan counts do not fit the data set");
+    }
     auto readings_ok = [](const std::vector<WifiReading>& scan) {
       return std::all_of(scan.begin(), scan.end(),
                          [](const WifiReading& x) { return std::isfinite(x.rssi_dbm); });
@@ -422,26 +457,77 @@ class FabmapFrontEnd : public FrontEnd {
       return Status::Error("FABMAP front-end state: a time or RSSI is not finite");
     }
     Reset();
-    for (size_t i = 0; i < places.size(); ++i) {
-      RATSLAM_RETURN_IF_ERROR(localiser_->AddPlace(places[i]));
-    }
     places_ = std::move(places);
     created_time_s_ = std::move(times);
     newest_scan_time_s_ = newest_time;
     newest_scan_ = std::move(newest);
+    scans_seen_ = scans_seen;
+    relearnt_ = relearnt;
+    if (online()) {
+      // The model is a function of the scans it learnt from: rebuild it, then re-add the places.
+      if (learned_from > 0) RATSLAM_RETURN_IF_ERROR(Relearn(learned_from, /*count=*/false));
+    } else {
+      for (const fabmap::Query& place : places_) {
+        RATSLAM_RETURN_IF_ERROR(localiser_->AddPlace(place));
+      }
+    }
     return Status::Ok();
   }
 
  private:
   fabmap::FabmapMode mode() const { return settings_.localiser.localiser.mode; }
 
+  // Online learning applies to modes that use Wi-Fi (the visual model never comes from the run).
+  bool online() const {
+    return settings_.front_end.wifi_learning == WifiLearning::kOnline && fabmap::UsesWifi(mode());
+  }
+
   void Reset() {
-    localiser_ = std::make_unique<fabmap::Localiser>(*resources_->empty_localiser);
+    localiser_ =
+        online() ? nullptr : std::make_unique<fabmap::Localiser>(*resources_->empty_localiser);
     places_.clear();
     created_time_s_.clear();
+    scans_seen_ = learned_from_ = relearnt_ = 0;
+  }
+
+  // Online learning: the first model after online_first_scans scans, then one each time the
+  // number of scans seen doubles (O(n log n) learning over a run of n scans).
+  uint64_t NextRelearn() const {
+    const uint64_t first = static_cast<uint64_t>(settings_.front_end.online_first_scans);
+    return learned_from_ == 0 ? first : 2 * learned_from_;
+  }
+
+  // Builds the Wi-Fi model from the first `scans` scans of the data set and maps every place
+  // again in it.
+  Status Relearn(uint64_t scans, bool count = true) {
+    const fabmap::WifiExploration& all = resources_->scans;
+    fabmap::WifiExploration seen;
+    seen.scans.assign(all.scans.begin(), all.scans.begin() + scans);
+    seen.travelled_m.assign(all.travelled_m.begin(), all.travelled_m.begin() + scans);
+    seen.time_s.assign(all.time_s.begin(), all.time_s.begin() + scans);
+    auto localiser = fabmap::Localiser::Create(
+        settings_.localiser, resources_->visual ? &resources_->visual->model : nullptr, seen);
+    if (!localiser.ok()) return localiser.status().WithContext("FABMAP online Wi-Fi learning");
+    for (const fabmap::Query& place : places_) {
+      RATSLAM_RETURN_IF_ERROR((*localiser)->AddPlace(place));
+    }
+    localiser_ = std::move(localiser).value();
+    learned_from_ = scans;
+    if (count) ++relearnt_;
+    return Status::Ok();
   }
 
   StatusOr<std::optional<FrameDecision>> Decide(double time_s, fabmap::Query q) {
+    if (!localiser_) {  // online, before the first model: every frame is a new place
+      places_.push_back(std::move(q));
+      created_time_s_.push_back(time_s);
+      FrameDecision d;
+      d.view.time_s = time_s;
+      d.view.template_id = static_cast<uint32_t>(places_.size() - 1);
+      d.view.is_new = true;
+      d.source = DecisionSource::kNew;
+      return std::optional<FrameDecision>(d);
+    }
     const fabmap::LocalisationResult r = localiser_->Localise(q);
     FrameDecision d;
     d.view.time_s = time_s;
@@ -473,6 +559,9 @@ class FabmapFrontEnd : public FrontEnd {
   std::vector<double> created_time_s_;
   std::vector<WifiReading> newest_scan_;
   std::optional<double> newest_scan_time_s_;
+  uint64_t scans_seen_ = 0;    // Wi-Fi scans received
+  uint64_t learned_from_ = 0;  // online: scans behind the current model (0: none yet)
+  uint64_t relearnt_ = 0;      // online: models built so far
 };
 
 }  // namespace
@@ -509,10 +598,13 @@ StatusOr<std::shared_ptr<const FabmapResources>> PrepareFabmapResources(
       exploration.time_s.push_back(scan.time_s);
     }
   }
-  auto localiser = fabmap::Localiser::Create(
-      f.localiser, resources->visual ? &resources->visual->model : nullptr, exploration);
-  if (!localiser.ok()) return localiser.status();
-  resources->empty_localiser = std::move(localiser).value();
+  if (f.front_end.wifi_learning == WifiLearning::kWholeDataSet || !fabmap::UsesWifi(mode)) {
+    auto localiser = fabmap::Localiser::Create(
+        f.localiser, resources->visual ? &resources->visual->model : nullptr, exploration);
+    if (!localiser.ok()) return localiser.status();
+    resources->empty_localiser = std::move(localiser).value();
+  }
+  resources->scans = std::move(exploration);
   return std::shared_ptr<const FabmapResources>(std::move(resources));
 }
 

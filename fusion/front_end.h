@@ -82,11 +82,23 @@ struct FusedOptions {
   }
 };
 
+// Where the FABMAP front end's Wi-Fi words, tree and unknown world come from.
+//   kWholeDataSet: every scan of the data set, future sessions included (an exploration done
+//     before the run, as in the fusion paper's benchmark; not causal).
+//   kOnline: only the scans seen so far: learnt after `online_first_scans` scans and again each
+//     time the count doubles (mapped places are re-added to the relearnt model); before the first
+//     model every frame is a new place. A decision at time t never depends on data after t.
+enum class WifiLearning { kWholeDataSet, kOnline };
+std::string ToString(WifiLearning learning);
+StatusOr<WifiLearning> WifiLearningFromString(const std::string& name);
+
 struct FabmapFrontEndOptions {
   double match_probability = 0.5;  // least posterior of the best place to re-use its template
   int recency_templates = 0;       // a match this many templates old or newer: no injection
   double recency_s = 10.0;         // nor one made less than this long ago
   double max_wifi_age_s = 5.0;     // an older newest scan counts as absent at an image frame
+  WifiLearning wifi_learning = WifiLearning::kWholeDataSet;  // see WifiLearning
+  int online_first_scans = 20;  // kOnline: scans before the first Wi-Fi model
 
   bool IsValid(std::string* error) const;
   template <typename Visitor>
@@ -97,6 +109,11 @@ struct FabmapFrontEndOptions {
       "matches to one of the newest this-many templates re-use it without injection");
     v("recency_s", recency_s, "so do matches to a template made less than this long ago");
     v("max_wifi_age_s", max_wifi_age_s, "a Wi-Fi scan older than this counts as absent at a frame");
+    v("wifi_learning", wifi_learning,
+      "Wi-Fi words, tree and unknown world from whole_data_set (every scan, future included) or "
+      "online (only the scans seen so far, relearnt as their number doubles)");
+    v("online_first_scans", online_first_scans,
+      "online: scans before the first Wi-Fi model (every frame is a new place until then)");
   }
 };
 
@@ -115,8 +132,19 @@ struct FabmapSettings {
 struct FabmapResources {
   std::optional<fabmap::TrainedVisualModel> visual;  // to turn images into words
   // The localiser with no places yet (words, trees, unknown world): each front end, and each
-  // restore, starts from a copy instead of learning the Wi-Fi tree again.
+  // restore, starts from a copy instead of learning the Wi-Fi tree again. Whole-data-set
+  // learning only; online learning builds its own from `scans`.
   std::shared_ptr<const fabmap::Localiser> empty_localiser;
+  // Every scan of the data set in order, with the odometry travel before it (online learning
+  // uses the first n of them after the n-th scan, never more).
+  fabmap::WifiExploration scans;
+};
+
+// How a FABMAP front end learnt its Wi-Fi model, for the run's summary.
+struct FabmapLearningReport {
+  WifiLearning wifi_learning = WifiLearning::kWholeDataSet;
+  uint64_t wifi_learned_from_scans = 0;  // scans behind the current Wi-Fi model
+  uint64_t wifi_relearnt = 0;            // times the model was (re)built during the run
 };
 
 struct FrameDecision {
@@ -139,6 +167,8 @@ class FrontEnd {
   virtual uint32_t size() const = 0;  // templates stored
   virtual std::string EncodeState() const = 0;
   virtual Status DecodeState(const std::string& bytes) = 0;
+  // FABMAP front ends say how their Wi-Fi model was learnt; others return nothing.
+  virtual std::optional<FabmapLearningReport> fabmap_learning() const { return std::nullopt; }
 };
 
 struct FrontEndSettings {

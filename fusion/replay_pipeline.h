@@ -10,6 +10,7 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -119,6 +120,10 @@ class ReplayPipeline {
   // Restores a snapshot; fails if it does not belong to this data set and these options.
   Status Restore(const State& state);
   const std::vector<Event>& events() const { return events_; }
+  // How a FABMAP front end learnt its Wi-Fi model; nothing for the other front ends.
+  std::optional<FabmapLearningReport> fabmap_learning() const {
+    return front_end_->fabmap_learning();
+  }
 
  private:
   Status HandleOdometry(const Event& event);

@@ -2,8 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -200,6 +202,131 @@ TEST(ReplayPipelineTest, RestoreRefusesStatesThatDoNotFit) {
   PipelineOptions camera;
   ReplayPipeline classic(camera, data, &images);
   EXPECT_FALSE(classic.Restore(good).ok());
+}
+
+// Two laps of the same 20 m square with 20 access points along it, each heard within 7 m: every
+// stretch of the loop has its own set of APs, which FABMAP's presence words can tell apart.
+Dataset ApLoop() {
+  Dataset d = SquareLoop();
+  const double side = 20.0, lap = 80.0;
+  auto position = [&](double along, double* x, double* y) {
+    along = std::fmod(along, lap);
+    const int leg = static_cast<int>(along / side);
+    const double f = along - leg * side;
+    const double c[5][2] = {{0, 0}, {side, 0}, {side, side}, {0, side}, {0, 0}};
+    *x = c[leg][0] + (c[leg + 1][0] - c[leg][0]) * f / side;
+    *y = c[leg][1] + (c[leg + 1][1] - c[leg][1]) * f / side;
+  };
+  for (WifiScan& scan : d.wifi) {
+    double x, y;
+    position(scan.time_s, &x, &y);
+    scan.readings.clear();
+    for (int k = 0; k < 20; ++k) {
+      double ax, ay;
+      position(4.0 * k, &ax, &ay);
+      const double dist = std::hypot(x - ax, y - ay);
+      if (dist < 7.0) {
+        scan.readings.push_back({"ap" + std::to_string(k), -40.0 - 20.0 * std::log10(1.0 + dist)});
+      }
+    }
+  }
+  return d;
+}
+
+PipelineOptions FabmapWifiOptions(WifiLearning learning) {
+  PipelineOptions o;
+  o.sensors.front_end.kind = FrontEndKind::kFabmap;
+  o.sensors.fabmap.localiser.localiser.mode = fabmap::FabmapMode::kWifi;
+  o.sensors.fabmap.front_end.recency_s = 20.0;
+  o.sensors.fabmap.front_end.wifi_learning = learning;
+  o.sensors.fabmap.front_end.online_first_scans = 10;
+  return o;
+}
+
+// Replays `data` with the FABMAP Wi-Fi front end; returns the frames' decisions.
+std::vector<FrameRecord> FabmapFrames(const Dataset& data, WifiLearning learning,
+                                      std::optional<FabmapLearningReport>* report = nullptr) {
+  NoImages images;
+  const PipelineOptions options = FabmapWifiOptions(learning);
+  auto resources = PrepareFabmapResources(options.sensors, data, images);
+  EXPECT_TRUE(resources.ok()) << resources.status().message();
+  ReplayPipeline pipeline(options, data, &images, *resources);
+  EXPECT_TRUE(pipeline.Run({}).ok());
+  if (report) *report = pipeline.fabmap_learning();
+  return pipeline.state().frames;
+}
+
+bool SameDecisions(const std::vector<FrameRecord>& a, const std::vector<FrameRecord>& b,
+                   size_t count) {
+  for (size_t i = 0; i < count; ++i) {
+    if (a[i].template_id != b[i].template_id || a[i].is_new != b[i].is_new ||
+        a[i].recent != b[i].recent) {
+      return false;
+    }
+  }
+  return true;
+}
+
+// Online learning is causal: the decisions up to time T are the same whether the data set ends
+// at T or goes on. Whole-data-set learning sees the future, and its early decisions change when
+// later scans are added (the test checks that too, so that it can fail).
+TEST(ReplayPipelineTest, OnlineFabmapLearningNeverUsesFutureScans) {
+  Dataset whole = ApLoop();
+  Dataset first_lap = whole;
+  // In the second lap the building changed: six new access points are heard everywhere and two
+  // old ones are gone. A model that saw those scans differs from one that did not.
+  for (WifiScan& scan : whole.wifi) {
+    if (scan.time_s < 80.0) continue;
+    std::erase_if(scan.readings,
+                  [](const WifiReading& r) { return r.bssid == "ap3" || r.bssid == "ap9"; });
+    for (int k = 0; k < 6; ++k) scan.readings.push_back({"new" + std::to_string(k), -70.0 + k});
+  }
+  const double cut_s = 70.0;
+  std::erase_if(first_lap.wifi, [&](const WifiScan& s) { return s.time_s > cut_s; });
+  std::erase_if(first_lap.odometry, [&](const OdometryRow& r) { return r.time_s > cut_s; });
+  first_lap.images.clear();
+
+  std::optional<FabmapLearningReport> report;
+  const auto online_whole = FabmapFrames(whole, WifiLearning::kOnline, &report);
+
+  const auto online_cut = FabmapFrames(first_lap, WifiLearning::kOnline);
+  ASSERT_EQ(online_cut.size(), first_lap.wifi.size());
+  EXPECT_TRUE(SameDecisions(online_whole, online_cut, online_cut.size()));
+  ASSERT_TRUE(report.has_value());
+  EXPECT_EQ(report->wifi_learning, WifiLearning::kOnline);
+  // 80 scans: models after 10, 20, 40 and 80 scans.
+  EXPECT_EQ(report->wifi_learned_from_scans, 80u);
+  EXPECT_EQ(report->wifi_relearnt, 4u);
+  // The second lap re-matches places of the first.
+  EXPECT_TRUE(std::any_of(online_whole.begin() + online_cut.size(), online_whole.end(),
+                          [](const FrameRecord& f) { return !f.is_new && !f.recent; }));
+
+  const auto batch_whole = FabmapFrames(whole, WifiLearning::kWholeDataSet, &report);
+  const auto batch_cut = FabmapFrames(first_lap, WifiLearning::kWholeDataSet);
+  EXPECT_FALSE(SameDecisions(batch_whole, batch_cut, batch_cut.size()))
+      << "whole-data-set learning should depend on later scans here";
+  EXPECT_EQ(report->wifi_learned_from_scans, whole.wifi.size());
+}
+
+TEST(ReplayPipelineTest, StopAndResumeEqualsOneRunForOnlineFabmapLearning) {
+  const Dataset data = ApLoop();
+  NoImages images;
+  const PipelineOptions options = FabmapWifiOptions(WifiLearning::kOnline);
+  auto resources = PrepareFabmapResources(options.sensors, data, images);
+  ASSERT_TRUE(resources.ok());
+  ReplayPipeline whole(options, data, &images, *resources);
+  ASSERT_TRUE(whole.Run({}).ok());
+  ReplayPipeline first(options, data, &images, *resources);
+  ReplayControl half;
+  half.until_time_s = 100.0;  // after the model of 40 scans, before the one of 80
+  ASSERT_TRUE(first.Run(half).ok());
+  ReplayPipeline second(options, data, &images, *resources);
+  ASSERT_TRUE(second.Restore(first.Snapshot()).ok());
+  ASSERT_TRUE(second.Run({}).ok());
+  EXPECT_TRUE(
+      SameDecisions(whole.state().frames, second.state().frames, whole.state().frames.size()));
+  EXPECT_EQ(whole.Snapshot().front_end, second.Snapshot().front_end);
+  EXPECT_EQ(second.fabmap_learning()->wifi_relearnt, whole.fabmap_learning()->wifi_relearnt);
 }
 
 }  // namespace

@@ -9,6 +9,33 @@
 #include "sensors/dataset/visual_odometry_source.h"
 
 namespace ratslam {
+namespace {
+
+// A map resumes only under the configuration that made it. Maps of format 3 carry it, so the
+// error names every key that differs; format 2 maps hold a fingerprint, compared as it was then.
+Status CheckSameConfiguration(const MapFile& map, const PipelineOptions& now) {
+  if (!map.config.empty()) {
+    StatusOr<PipelineOptions> before = ParseConfig(map.config, "the map's configuration");
+    if (!before.ok()) return before.status();
+    const std::vector<std::string> differences = ConfigDifferences(*before, now);
+    if (differences.empty()) return Status::Ok();
+    std::string keys;
+    for (const std::string& d : differences) keys += "\n  " + d;
+    return Status::Error("the map was made with a different configuration (map -> now):" + keys);
+  }
+  StatusOr<uint64_t> then = FingerprintAsOfMapVersion(now, map.format_version);
+  if (!then.ok()) {
+    return then.status().WithContext("the map was made with a different configuration");
+  }
+  if (*then != map.config_fingerprint) {
+    return Status::Error("the map was made with a different configuration (a format " +
+                         std::to_string(map.format_version) +
+                         " map names no keys; print the one you used with ratslam print-config)");
+  }
+  return Status::Ok();
+}
+
+}  // namespace
 
 ReplaySession::ReplaySession(ReplaySessionOptions options, SessionEnvironment environment)
     : options_(std::move(options)), env_(environment) {
@@ -57,9 +84,7 @@ Status ReplaySession::Prepare() {
     const std::string& path = options_.load_map;
     StatusOr<MapFile> map = LoadMapFile(path);
     if (!map.ok()) return map.status();
-    if (map->config_fingerprint != fingerprint_) {
-      return Status::Error(path + ": the map was made with a different configuration");
-    }
+    RATSLAM_RETURN_IF_ERROR(CheckSameConfiguration(*map, options_.pipeline).WithContext(path));
     if (map->dataset_name != dataset_->name) {
       return Status::Error(path + ": the map was made from data set '" + map->dataset_name +
                            "', not '" + dataset_->name + "'");
@@ -117,7 +142,12 @@ Status ReplaySession::SaveMap() {
     path = env_.out->Path("interrupted.map");
   }
   if (path.empty()) return Status::Ok();
-  result_.save = SaveMapFile({fingerprint_, dataset_->name, pipeline_->Snapshot()}, path);
+  MapFile map;
+  map.config_fingerprint = fingerprint_;
+  map.dataset_name = dataset_->name;
+  map.config = PrintConfig(options_.pipeline, false);
+  map.state = pipeline_->Snapshot();
+  result_.save = SaveMapFile(map, path);
   if (result_.save.ok()) result_.saved_map = path;
   return result_.save;
 }

@@ -190,7 +190,11 @@ TEST_F(ReplaySessionTest, ResumeChecksConfigurationAndDataSet) {
   ReplaySession b(other, {&out, nullptr, nullptr, nullptr, nullptr});
   const StatusOr<ReplayResult> refused = b.Run();
   ASSERT_FALSE(refused.ok());
+  // The map carries its configuration (format 3): the error names the key and both values.
   EXPECT_NE(refused.status().message().find("different configuration"), std::string::npos);
+  EXPECT_NE(refused.status().message().find("camera.match_threshold: 0.06 -> 0.07"),
+            std::string::npos)
+      << refused.status().message();
 }
 
 }  // namespace

@@ -184,6 +184,25 @@ TEST_F(ReplayEndToEndTest, MapFromThePreviousReleaseResumesToTheSameRun) {
   ExpectSameRun(whole, rest);
 }
 
+// A key added after format 2 must be at its default to resume a format-2 map (which was made
+// without it); the error names the key.
+TEST_F(ReplayEndToEndTest, MapFromThePreviousReleaseRefusesAKeyItCouldNotHaveUsed) {
+  const fs::path config = root_ / "synthetic-online.toml";
+  std::string text = Slurp(config_);
+  const std::string header = "[fabmap_front_end]\n";
+  ASSERT_NE(text.find(header), std::string::npos);
+  text.insert(text.find(header) + header.size(), "wifi_learning = \"online\"\n");
+  std::ofstream(config) << text;
+  const std::string fixture =
+      (fs::path(RATSLAM_SOURCE_DIR) / "tests" / "data" / "map-v2-synthetic.map").string();
+  const Result r = RunRatslam("replay --quiet --config " + config.string() + " --data " +
+                                  (root_ / "data").string() + " --out " +
+                                  (root_ / "v2_online").string() + " --load-map " + fixture,
+                              root_);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("fabmap_front_end.wifi_learning is \"online\""), std::string::npos) << r.err;
+}
+
 // Save and resume for the fused (Wi-Fi + 12x9 camera + compass) and the FABMAP front ends, on
 // the simulated day/night world; the fused one also from a map of the previous release.
 class SimulatedSaveResumeTest : public ::testing::Test {

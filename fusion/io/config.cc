@@ -119,6 +119,9 @@ class SectionReader {
   static Status Assign(const toml::node& node, fabmap::SplitUnit& field) {
     return AssignEnum(node, field, fabmap::SplitUnitFromString);
   }
+  static Status Assign(const toml::node& node, WifiLearning& field) {
+    return AssignEnum(node, field, WifiLearningFromString);
+  }
   static Status Assign(const toml::node& node, FrontEndKind& field) {
     const auto* s = node.as_string();
     if (!s) return Status::Error("expected a string");
@@ -241,13 +244,91 @@ std::string PrintConfig(const PipelineOptions& options, bool comments) {
   return out.str();
 }
 
-uint64_t ConfigFingerprint(const PipelineOptions& options) {
+namespace {
+
+uint64_t Fnv1a(const std::string& text) {
   uint64_t hash = 0xcbf29ce484222325ULL;
-  for (unsigned char c : PrintConfig(options, false)) {
+  for (unsigned char c : text) {
     hash ^= c;
     hash *= 0x100000001b3ULL;
   }
   return hash;
+}
+
+// Each line of a printed config (no comments) as ("section.key", "value"); headers skipped.
+std::vector<std::pair<std::string, std::string>> KeyedLines(const std::string& printed) {
+  std::vector<std::pair<std::string, std::string>> out;
+  std::istringstream in(printed);
+  std::string line, section;
+  while (std::getline(in, line)) {
+    if (line.empty()) continue;
+    if (line.front() == '[') {
+      section = line.substr(1, line.size() - 2);
+      continue;
+    }
+    const size_t eq = line.find(" = ");
+    if (eq == std::string::npos) continue;
+    out.emplace_back(section + "." + line.substr(0, eq), line.substr(eq + 3));
+  }
+  return out;
+}
+
+// Keys added to the configuration after each map format version (the map fingerprint of that
+// version was taken without them).
+struct AddedKey {
+  uint32_t after_version;
+  const char* key;
+};
+constexpr AddedKey kKeysAddedAfter[] = {
+    {2, "fabmap_front_end.wifi_learning"},
+    {2, "fabmap_front_end.online_first_scans"},
+};
+
+}  // namespace
+
+uint64_t ConfigFingerprint(const PipelineOptions& options) {
+  return Fnv1a(PrintConfig(options, false));
+}
+
+std::vector<std::string> ConfigDifferences(const PipelineOptions& before,
+                                           const PipelineOptions& now) {
+  const auto a = KeyedLines(PrintConfig(before, false));
+  const auto b = KeyedLines(PrintConfig(now, false));
+  std::vector<std::string> out;
+  for (size_t i = 0; i < a.size() && i < b.size(); ++i) {
+    if (a[i].second != b[i].second) {
+      out.push_back(a[i].first + ": " + a[i].second + " -> " + b[i].second);
+    }
+  }
+  return out;
+}
+
+StatusOr<uint64_t> FingerprintAsOfMapVersion(const PipelineOptions& options, uint32_t map_version) {
+  const std::string printed = PrintConfig(options, false);
+  const auto defaults = KeyedLines(PrintConfig(PipelineOptions(), false));
+  const auto lines = KeyedLines(printed);
+  std::set<std::string> dropped;
+  for (const AddedKey& added : kKeysAddedAfter) {
+    if (map_version > added.after_version) continue;
+    for (size_t i = 0; i < lines.size(); ++i) {
+      if (lines[i].first == added.key && lines[i].second != defaults[i].second) {
+        return Status::Error(std::string(added.key) + " is " + lines[i].second +
+                             ", but maps of format " + std::to_string(map_version) +
+                             " were made with its default " + defaults[i].second);
+      }
+    }
+    dropped.insert(added.key);
+  }
+  // Print again, leaving out the dropped keys' lines (and keeping the layout otherwise).
+  std::istringstream in(printed);
+  std::string line, section, kept;
+  while (std::getline(in, line)) {
+    if (!line.empty() && line.front() == '[') section = line.substr(1, line.size() - 2);
+    const size_t eq = line.find(" = ");
+    if (eq != std::string::npos && dropped.count(section + "." + line.substr(0, eq))) continue;
+    kept += line + "\n";
+  }
+  return Fnv1a(kept);
 }
 
 StatusOr<ImportedConfig> ImportOpenRatslamIni(const std::string& path) {

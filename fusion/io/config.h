@@ -24,6 +24,16 @@ std::string PrintConfig(const PipelineOptions& options, bool comments = true);
 // comments), stored in map files so that a map is resumed only with the config that made it.
 uint64_t ConfigFingerprint(const PipelineOptions& options);
 
+// The keys whose values differ between two configurations, as "section.key: A -> B" (A from
+// `before`, B from `now`), in file order; empty when they are the same.
+std::vector<std::string> ConfigDifferences(const PipelineOptions& before,
+                                           const PipelineOptions& now);
+
+// The fingerprint a map of format `map_version` holds for `options`: the configuration printed
+// without the keys added since that version. Fails, naming the key, when one of those keys is
+// not at its default (the old program could not have made that map).
+StatusOr<uint64_t> FingerprintAsOfMapVersion(const PipelineOptions& options, uint32_t map_version);
+
 struct ImportedConfig {
   PipelineOptions options;
   std::vector<std::string> notes;  // keys that were not mapped, with their lines

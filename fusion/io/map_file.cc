@@ -17,8 +17,9 @@ namespace {
 constexpr char kMagic[8] = {'R', 'S', 'L', 'M', 'A', 'P', '\0', '\1'};
 // The version written, and the oldest one read. A field added in a new version is listed in
 // state_schema.h as `(a.version() < N || a(field))`, so older files load with its default.
-// Version 2 is the first release with save and resume (tests/data/map-v2-*.map must load).
-constexpr uint32_t kVersion = 2;
+// Version 2 is the first release with save and resume (tests/data/map-v2-*.map must load);
+// version 3 adds the resolved configuration.
+constexpr uint32_t kVersion = 3;
 constexpr uint32_t kOldestVersion = 2;
 
 }  // namespace
@@ -48,6 +49,7 @@ StatusOr<MapFile> DecodeMapFile(const std::string& bytes, const std::string& sou
   }
   DecodeArchive archive(r, version);
   if (!Describe(archive, map)) return Status::Error(r.error());
+  map.format_version = version;
   if (!r.AtEnd()) return Status::Error(source + ": corrupt map file: trailing bytes");
   return map;
 }

@@ -14,8 +14,14 @@
 namespace ratslam {
 
 struct MapFile {
+  // The format version the file was read from (written: always the current one). Not part of
+  // the schema's body: it is the header that says how to read the body.
+  uint32_t format_version = 0;
   uint64_t config_fingerprint = 0;  // ConfigFingerprint of the options that made the map
   std::string dataset_name;
+  // The resolved configuration that made the map (PrintConfig without comments); empty in maps
+  // of format 2, which hold only the fingerprint.
+  std::string config;
   ReplayPipeline::State state;
 };
 

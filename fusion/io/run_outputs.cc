@@ -115,6 +115,12 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
                            {"wifi", by_source[1]},
                            {"new", by_source[2]},
                            {"recent_reuse", recent}};
+  if (const auto learning = pipeline.fabmap_learning()) {
+    // Whether the Wi-Fi model saw the future (whole data set) or only the past (online).
+    j["fabmap_wifi_learning"] = ToString(learning->wifi_learning);
+    j["fabmap_wifi_learned_from_scans"] = learning->wifi_learned_from_scans;
+    j["fabmap_wifi_models_built"] = learning->wifi_relearnt;
+  }
   if (dataset.session_start_times_s.size() > 1)
     j["sessions"] = dataset.session_start_times_s.size();
   j["events_done"] = state.next_event;

@@ -95,10 +95,12 @@ bool Describe(A& a, ReplayPipeline::State& s) {
          a(s.images_skipped);
 }
 
-// The header after the magic bytes and version: which options and data set made the map.
+// The header after the magic bytes and version: which options and data set made the map. The
+// resolved configuration was added in format 3.
 template <typename A>
 bool Describe(A& a, MapFile& m) {
-  return a(m.config_fingerprint) && a(m.dataset_name) && a.Object(m.state);
+  return a(m.config_fingerprint) && a(m.dataset_name) && (a.version() < 3 || a(m.config)) &&
+         a.Object(m.state);
 }
 
 }  // namespace ratslam
