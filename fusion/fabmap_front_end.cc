@@ -1,0 +1,295 @@
+// FABMAP as the front end: a recognised place re-activates its template, otherwise a new place;
+// Wi-Fi learnt from the whole data set or online. See front_end.h.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "common/byte_buffer.h"
+#include "fusion/front_end_internal.h"
+
+namespace ratslam {
+namespace front_end_internal {
+namespace {
+
+class FabmapFrontEnd : public FrontEnd {
+ public:
+  FabmapFrontEnd(const FabmapSettings& settings, std::shared_ptr<const FabmapResources> resources)
+      : settings_(settings), resources_(std::move(resources)) {
+    if (!resources_ || (!online() && !resources_->empty_localiser)) {
+      throw std::invalid_argument("the FABMAP front end needs PrepareFabmapResources' models");
+    }
+    Reset();
+  }
+
+  StatusOr<std::optional<FrameDecision>> OnImage(double time_s, const GrayImage& image) override {
+    if (!fabmap::UsesVision(mode())) return std::optional<FrameDecision>();
+    auto words = fabmap::ImageWords(*resources_->visual, image);
+    if (!words.ok()) return words.status();
+    fabmap::Query q;
+    q.visual = *std::move(words);
+    if (fabmap::UsesWifi(mode()) && newest_scan_time_s_ &&
+        time_s - *newest_scan_time_s_ <= settings_.front_end.max_wifi_age_s) {
+      q.wifi = newest_scan_;
+    }
+    return Decide(time_s, std::move(q));
+  }
+
+  StatusOr<std::optional<FrameDecision>> OnWifi(const WifiScan& scan) override {
+    if (!fabmap::UsesWifi(mode())) return std::optional<FrameDecision>();
+    newest_scan_ = scan.readings;
+    newest_scan_time_s_ = scan.time_s;
+    ++scans_seen_;
+    if (online() && scans_seen_ >= NextRelearn()) RATSLAM_RETURN_IF_ERROR(Relearn(scans_seen_));
+    if (fabmap::UsesVision(mode())) return std::optional<FrameDecision>();  // images are frames
+    fabmap::Query q;
+    q.wifi = scan.readings;
+    return Decide(scan.time_s, std::move(q));
+  }
+
+  void OnCompass(double, double) override {}
+  std::optional<double> CompassHeading() const override { return std::nullopt; }
+  bool WantsImages() const override { return fabmap::UsesVision(mode()); }
+  uint32_t size() const override { return static_cast<uint32_t>(places_.size()); }
+  std::optional<FabmapLearningReport> fabmap_learning() const override {
+    return FabmapLearningReport{
+        settings_.front_end.wifi_learning,
+        online() ? learned_from_ : static_cast<uint64_t>(resources_->scans.scans.size()),
+        online() ? relearnt_ : 1};
+  }
+
+  std::string EncodeState() const override {
+    ByteWriter w;
+    w.Count(places_.size());
+    for (size_t i = 0; i < places_.size(); ++i) {
+      w.Pod(created_time_s_[i]);
+      w.PodVector(places_[i].visual);
+      w.Bool(places_[i].wifi.has_value());
+      const auto& readings = places_[i].wifi ? *places_[i].wifi : std::vector<WifiReading>();
+      w.Count(readings.size());
+      for (const WifiReading& r : readings) {
+        w.String(r.bssid);
+        w.Pod(r.rssi_dbm);
+      }
+    }
+    w.Optional(newest_scan_time_s_);
+    w.Count(newest_scan_.size());
+    for (const WifiReading& r : newest_scan_) {
+      w.String(r.bssid);
+      w.Pod(r.rssi_dbm);
+    }
+    if (online()) {  // whole-data-set states keep the format of earlier releases
+      w.Pod(scans_seen_);
+      w.Pod(learned_from_);
+      w.Pod(relearnt_);
+    }
+    return std::move(w.bytes());
+  }
+
+  Status DecodeState(const std::string& bytes) override {
+    ByteReader r(bytes, "FABMAP front-end state");
+    auto readings = [&r](std::vector<WifiReading>* out) {
+      size_t n = 0;
+      if (!r.Count(9, &n)) return false;
+      out->resize(n);
+      for (WifiReading& x : *out) {
+        if (!(r.String(&x.bssid) && r.Pod(&x.rssi_dbm))) return false;
+      }
+      return true;
+    };
+    size_t count = 0;
+    std::vector<double> times;
+    std::vector<fabmap::Query> places;
+    bool ok = r.Count(8 + 8 + 1 + 8, &count);
+    for (size_t i = 0; ok && i < count; ++i) {
+      double t = 0.0;
+      fabmap::Query q;
+      bool has_wifi = false;
+      std::vector<WifiReading> scan;
+      ok = r.Pod(&t) && r.PodVector(&q.visual) && r.Bool(&has_wifi) && readings(&scan);
+      if (has_wifi) q.wifi = std::move(scan);
+      times.push_back(t);
+      places.push_back(std::move(q));
+    }
+    std::optional<double> newest_time;
+    std::vector<WifiReading> newest;
+    uint64_t scans_seen = 0, learned_from = 0, relearnt = 0;
+    ok = ok && r.Optional(&newest_time) && readings(&newest) &&
+         (!online() || (r.Pod(&scans_seen) && r.Pod(&learned_from) && r.Pod(&relearnt))) &&
+         (r.AtEnd() || r.Fail("trailing bytes"));
+    if (!ok) return Status::Error(r.error());
+    if (online() &&
+        (scans_seen > resources_->scans.scans.size() || learned_from > scans_seen ||
+         (learned_from > 0 &&
+          learned_from < static_cast<uint64_t>(settings_.front_end.online_first_scans)))) {
+      return Status::Error("FABMAP front-end state: scan counts do not fit the data set");
+    }
+    auto readings_ok = [](const std::vector<WifiReading>& scan) {
+      return std::all_of(scan.begin(), scan.end(),
+                         [](const WifiReading& x) { return std::isfinite(x.rssi_dbm); });
+    };
+    if (!AllFinite(times) || !FiniteOrAbsent(newest_time) || !readings_ok(newest) ||
+        !std::all_of(places.begin(), places.end(),
+                     [&](const fabmap::Query& q) { return !q.wifi || readings_ok(*q.wifi); })) {
+      return Status::Error("FABMAP front-end state: a time or RSSI is not finite");
+    }
+    Reset();
+    places_ = std::move(places);
+    created_time_s_ = std::move(times);
+    newest_scan_time_s_ = newest_time;
+    newest_scan_ = std::move(newest);
+    scans_seen_ = scans_seen;
+    relearnt_ = relearnt;
+    if (online()) {
+      // The model is a function of the scans it learnt from: rebuild it, then re-add the places.
+      if (learned_from > 0) RATSLAM_RETURN_IF_ERROR(Relearn(learned_from, /*count=*/false));
+    } else {
+      for (const fabmap::Query& place : places_) {
+        RATSLAM_RETURN_IF_ERROR(localiser_->AddPlace(place));
+      }
+    }
+    return Status::Ok();
+  }
+
+ private:
+  fabmap::FabmapMode mode() const { return settings_.localiser.localiser.mode; }
+
+  // Online learning applies to modes that use Wi-Fi (the visual model never comes from the run).
+  bool online() const {
+    return settings_.front_end.wifi_learning == WifiLearning::kOnline && fabmap::UsesWifi(mode());
+  }
+
+  void Reset() {
+    localiser_ =
+        online() ? nullptr : std::make_unique<fabmap::Localiser>(*resources_->empty_localiser);
+    places_.clear();
+    created_time_s_.clear();
+    scans_seen_ = learned_from_ = relearnt_ = 0;
+  }
+
+  // Online learning: the first model after online_first_scans scans, then one each time the
+  // number of scans seen doubles (O(n log n) learning over a run of n scans).
+  uint64_t NextRelearn() const {
+    const uint64_t first = static_cast<uint64_t>(settings_.front_end.online_first_scans);
+    return learned_from_ == 0 ? first : 2 * learned_from_;
+  }
+
+  // Builds the Wi-Fi model from the first `scans` scans of the data set and maps every place
+  // again in it.
+  Status Relearn(uint64_t scans, bool count = true) {
+    const fabmap::WifiExploration& all = resources_->scans;
+    fabmap::WifiExploration seen;
+    seen.scans.assign(all.scans.begin(), all.scans.begin() + scans);
+    seen.travelled_m.assign(all.travelled_m.begin(), all.travelled_m.begin() + scans);
+    seen.time_s.assign(all.time_s.begin(), all.time_s.begin() + scans);
+    auto localiser = fabmap::Localiser::Create(
+        settings_.localiser, resources_->visual ? &resources_->visual->model : nullptr, seen);
+    if (!localiser.ok()) return localiser.status().WithContext("FABMAP online Wi-Fi learning");
+    for (const fabmap::Query& place : places_) {
+      RATSLAM_RETURN_IF_ERROR((*localiser)->AddPlace(place));
+    }
+    localiser_ = std::move(localiser).value();
+    learned_from_ = scans;
+    if (count) ++relearnt_;
+    return Status::Ok();
+  }
+
+  StatusOr<std::optional<FrameDecision>> Decide(double time_s, fabmap::Query q) {
+    if (!localiser_) {  // online, before the first model: every frame is a new place
+      places_.push_back(std::move(q));
+      created_time_s_.push_back(time_s);
+      FrameDecision d;
+      d.view.time_s = time_s;
+      d.view.template_id = static_cast<uint32_t>(places_.size() - 1);
+      d.view.is_new = true;
+      d.source = DecisionSource::kNew;
+      return std::optional<FrameDecision>(d);
+    }
+    const fabmap::LocalisationResult r = localiser_->Localise(q);
+    FrameDecision d;
+    d.view.time_s = time_s;
+    d.source = fabmap::UsesVision(mode()) ? DecisionSource::kCamera : DecisionSource::kWifi;
+    const int64_t n = static_cast<int64_t>(places_.size());
+    if (r.best_place >= 0 && r.best_probability >= settings_.front_end.match_probability) {
+      const bool old_enough =
+          OldEnough(n, r.best_place, time_s, created_time_s_[r.best_place],
+                    settings_.front_end.recency_templates, settings_.front_end.recency_s);
+      d.view.template_id = static_cast<uint32_t>(r.best_place);
+      d.view.is_new = false;
+      d.recent = !old_enough;
+      d.view.allow_injection = old_enough;
+      return std::optional<FrameDecision>(d);
+    }
+    RATSLAM_RETURN_IF_ERROR(localiser_->AddPlace(q));
+    places_.push_back(std::move(q));
+    created_time_s_.push_back(time_s);
+    d.view.template_id = static_cast<uint32_t>(n);
+    d.view.is_new = true;
+    d.source = DecisionSource::kNew;
+    return std::optional<FrameDecision>(d);
+  }
+
+  FabmapSettings settings_;
+  std::shared_ptr<const FabmapResources> resources_;
+  std::unique_ptr<fabmap::Localiser> localiser_;
+  std::vector<fabmap::Query> places_;
+  std::vector<double> created_time_s_;
+  std::vector<WifiReading> newest_scan_;
+  std::optional<double> newest_scan_time_s_;
+  uint64_t scans_seen_ = 0;    // Wi-Fi scans received
+  uint64_t learned_from_ = 0;  // online: scans behind the current model (0: none yet)
+  uint64_t relearnt_ = 0;      // online: models built so far
+};
+
+}  // namespace
+
+std::unique_ptr<FrontEnd> MakeFabmapFrontEnd(const FabmapSettings& settings,
+                                             std::shared_ptr<const FabmapResources> resources) {
+  return std::make_unique<FabmapFrontEnd>(settings, std::move(resources));
+}
+
+}  // namespace front_end_internal
+
+StatusOr<std::shared_ptr<const FabmapResources>> PrepareFabmapResources(
+    const FrontEndSettings& settings, const Dataset& dataset, ImageLoader& images) {
+  const FabmapSettings& f = settings.fabmap;
+  std::string error;
+  if (!f.IsValid(&error)) return Status::Error("FABMAP settings: " + error);
+  auto resources = std::make_shared<FabmapResources>();
+  const fabmap::FabmapMode mode = f.localiser.localiser.mode;
+  if (fabmap::UsesVision(mode)) {
+    auto model = fabmap::LoadOrTrainVisualModel(f.visual_model, f.features, f.vocabulary,
+                                                f.localiser.chow_liu, images, nullptr);
+    if (!model.ok()) {
+      return model.status().WithContext("FABMAP mode " + fabmap::ToString(mode));
+    }
+    resources->visual = *std::move(model);
+  }
+  fabmap::WifiExploration exploration;
+  if (fabmap::UsesWifi(mode)) {
+    // Travel at each scan from the odometry (speed held from one row's time to the next's).
+    double travelled = 0.0, last_time = 0.0;
+    size_t k = 0;
+    for (const WifiScan& scan : dataset.wifi) {
+      while (k < dataset.odometry.size() && dataset.odometry[k].time_s <= scan.time_s) {
+        travelled += std::abs(dataset.odometry[k].forward_speed_m_per_s) *
+                     std::max(0.0, dataset.odometry[k].time_s - last_time);
+        last_time = dataset.odometry[k].time_s;
+        ++k;
+      }
+      exploration.scans.push_back(scan.readings);
+      exploration.travelled_m.push_back(travelled);
+      exploration.time_s.push_back(scan.time_s);
+    }
+  }
+  if (f.front_end.wifi_learning == WifiLearning::kWholeDataSet || !fabmap::UsesWifi(mode)) {
+    auto localiser = fabmap::Localiser::Create(
+        f.localiser, resources->visual ? &resources->visual->model : nullptr, exploration);
+    if (!localiser.ok()) return localiser.status();
+    resources->empty_localiser = std::move(localiser).value();
+  }
+  resources->scans = std::move(exploration);
+  return std::shared_ptr<const FabmapResources>(std::move(resources));
+}
+
+}  // namespace ratslam

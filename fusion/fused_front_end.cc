@@ -1,0 +1,221 @@
+// The Wi-Fi RatSLAM paper's front end (section III): 12x9 camera, Wi-Fi fingerprints and a
+// compass combined by the b_out rule (eqs. 8-12). See front_end.h.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "common/byte_buffer.h"
+#include "common/circular.h"
+#include "fusion/front_end_internal.h"
+
+namespace ratslam {
+namespace front_end_internal {
+namespace {
+
+class FusedFrontEnd : public FrontEnd {
+ public:
+  FusedFrontEnd(const FusedOptions& options, const KernelCameraOptions& camera,
+                const WifiMatcherOptions& wifi)
+      : options_(options), camera_(camera), wifi_(wifi) {}
+
+  StatusOr<std::optional<FrameDecision>> OnImage(double time_s, const GrayImage& image) override {
+    if (!options_.use_camera) return std::optional<FrameDecision>();
+    StatusOr<std::vector<float>> view = camera_.MakeTemplate(ViewOf(image));
+    if (!view.ok()) return view.status();
+    // The newest scan, if fresh enough, is this frame's Wi-Fi observation.
+    const bool fresh = options_.use_wifi && newest_scan_time_s_ &&
+                       time_s - *newest_scan_time_s_ <= options_.max_wifi_age_s;
+    return std::optional<FrameDecision>(
+        Decide(time_s, &view.value(), fresh ? &newest_scan_ : nullptr));
+  }
+
+  StatusOr<std::optional<FrameDecision>> OnWifi(const WifiScan& scan) override {
+    if (!options_.use_wifi) return std::optional<FrameDecision>();
+    std::vector<std::pair<std::string, double>> readings;
+    readings.reserve(scan.readings.size());
+    for (const WifiReading& r : scan.readings) readings.emplace_back(r.bssid, r.rssi_dbm);
+    newest_scan_ = wifi_.MakeFingerprint(readings);
+    newest_scan_time_s_ = scan.time_s;
+    if (options_.use_camera) return std::optional<FrameDecision>();  // images are the frames
+    return std::optional<FrameDecision>(Decide(scan.time_s, nullptr, &newest_scan_));
+  }
+
+  void OnCompass(double, double heading_rad) override { heading_rad_ = heading_rad; }
+  std::optional<double> CompassHeading() const override {
+    return options_.use_compass ? heading_rad_ : std::nullopt;
+  }
+  bool WantsImages() const override { return options_.use_camera; }
+  uint32_t size() const override { return static_cast<uint32_t>(created_time_s_.size()); }
+
+  std::string EncodeState() const override {
+    ByteWriter w;
+    w.Count(camera_.templates().size());
+    for (const auto& t : camera_.templates()) w.PodVector(t);
+    const WifiFingerprintMatcher::State& ws = wifi_.state();
+    w.Count(ws.bssids.size());
+    for (const std::string& b : ws.bssids) w.String(b);
+    w.Count(ws.fingerprints.size());
+    for (const Fingerprint& f : ws.fingerprints) {
+      w.PodVector(f.ap_ids);
+      w.PodVector(f.rssi_dbm);
+    }
+    w.PodVector(created_time_s_);
+    w.Count(headings_.size());
+    for (const auto& h : headings_) w.Optional(h);
+    w.PodVector(newest_scan_.ap_ids);
+    w.PodVector(newest_scan_.rssi_dbm);
+    w.Optional(newest_scan_time_s_);
+    w.Optional(heading_rad_);
+    return std::move(w.bytes());
+  }
+
+  Status DecodeState(const std::string& bytes) override {
+    ByteReader r(bytes, "fused front-end state");
+    size_t n = 0;
+    std::vector<std::vector<float>> camera;
+    if (!r.Count(8, &n)) return Status::Error(r.error());
+    camera.resize(n);
+    for (auto& t : camera) {
+      if (!r.PodVector(&t)) return Status::Error(r.error());
+    }
+    WifiFingerprintMatcher::State ws;
+    if (!r.Count(8, &n)) return Status::Error(r.error());
+    ws.bssids.resize(n);
+    for (std::string& b : ws.bssids) {
+      if (!r.String(&b)) return Status::Error(r.error());
+    }
+    if (!r.Count(16, &n)) return Status::Error(r.error());
+    ws.fingerprints.resize(n);
+    for (Fingerprint& f : ws.fingerprints) {
+      if (!(r.PodVector(&f.ap_ids) && r.PodVector(&f.rssi_dbm))) return Status::Error(r.error());
+    }
+    std::vector<double> created;
+    std::vector<std::optional<double>> headings;
+    Fingerprint newest;
+    std::optional<double> newest_time, heading;
+    if (!(r.PodVector(&created) && r.Count(9, &n))) return Status::Error(r.error());
+    headings.resize(n);
+    for (auto& h : headings) {
+      if (!r.Optional(&h)) return Status::Error(r.error());
+    }
+    if (!(r.PodVector(&newest.ap_ids) && r.PodVector(&newest.rssi_dbm) &&
+          r.Optional(&newest_time) && r.Optional(&heading))) {
+      return Status::Error(r.error());
+    }
+    if (!r.AtEnd()) return Status::Error("fused front-end state: trailing bytes");
+    if (camera.size() != created.size() || ws.fingerprints.size() != created.size() ||
+        headings.size() != created.size()) {
+      return Status::Error("fused front-end state: sensor template counts differ");
+    }
+    if (!AllFinite(created) || !std::all_of(headings.begin(), headings.end(), FiniteOrAbsent) ||
+        !FiniteOrAbsent(newest_time) || !FiniteOrAbsent(heading) || !AllFinite(newest.rssi_dbm) ||
+        newest.ap_ids.size() != newest.rssi_dbm.size() ||
+        std::any_of(newest.ap_ids.begin(), newest.ap_ids.end(),
+                    [&ws](uint32_t id) { return id >= ws.bssids.size(); })) {
+      return Status::Error(
+          "fused front-end state: a time, heading or RSSI is not finite, or the newest scan "
+          "names an unknown access point");
+    }
+    for (const Fingerprint& f : ws.fingerprints) {
+      if (!AllFinite(f.rssi_dbm)) {
+        return Status::Error("fused front-end state: a fingerprint RSSI is not finite");
+      }
+    }
+    RATSLAM_RETURN_IF_ERROR(camera_.SetTemplates(std::move(camera)));
+    RATSLAM_RETURN_IF_ERROR(wifi_.SetState(std::move(ws)));
+    created_time_s_ = std::move(created);
+    headings_ = std::move(headings);
+    newest_scan_ = std::move(newest);
+    newest_scan_time_s_ = newest_time;
+    heading_rad_ = heading;
+    return Status::Ok();
+  }
+
+ private:
+  enum class Verdict { kNovel, kFamiliarRecent, kMatch };
+
+  // Eqs. 10-11: a sensor's best match counts when it reaches the threshold and is not recent.
+  Verdict Judge(int32_t best, double score, double threshold, double time_s) const {
+    if (best < 0 || score < threshold) return Verdict::kNovel;
+    const int64_t n = static_cast<int64_t>(created_time_s_.size());
+    const bool old_enough = OldEnough(n, best, time_s, created_time_s_[best],
+                                      options_.recency_templates, options_.recency_s);
+    return old_enough ? Verdict::kMatch : Verdict::kFamiliarRecent;
+  }
+
+  FrameDecision Decide(double time_s, const std::vector<float>* view, const Fingerprint* scan) {
+    const uint32_t n = size();
+    Verdict camera_verdict = Verdict::kNovel, wifi_verdict = Verdict::kNovel;
+    int32_t camera_best = -1, wifi_best = -1;
+    if (view) {
+      const KernelCameraMatch best = camera_.Best(*view);  // eq. 8
+      camera_best = best.id;
+      camera_verdict = Judge(best.id, best.similarity, camera_.options().match_threshold, time_s);
+    }
+    if (scan && !scan->empty()) {
+      const WifiMatch best = wifi_.Best(*scan);  // eq. 9
+      wifi_best = best.id;
+      wifi_verdict = Judge(best.id, best.weight, wifi_.options().match_threshold, time_s);
+    }
+    FrameDecision d;
+    d.view.time_s = time_s;
+    std::optional<uint32_t> chosen;
+    // Eq. 12: camera first, then Wi-Fi; then a familiar recent template; else new.
+    if (camera_verdict == Verdict::kMatch) {
+      chosen = camera_best;
+      d.source = DecisionSource::kCamera;
+    } else if (wifi_verdict == Verdict::kMatch) {
+      chosen = wifi_best;
+      d.source = DecisionSource::kWifi;
+    } else if (camera_verdict == Verdict::kFamiliarRecent) {
+      chosen = camera_best;
+      d.source = DecisionSource::kCamera;
+      d.recent = true;
+    } else if (wifi_verdict == Verdict::kFamiliarRecent) {
+      chosen = wifi_best;
+      d.source = DecisionSource::kWifi;
+      d.recent = true;
+    }
+    if (chosen) {
+      d.view.template_id = *chosen;
+      d.view.is_new = false;
+      d.view.allow_injection = !d.recent;
+      const std::optional<double>& stored = headings_[*chosen];
+      if (options_.use_compass && heading_rad_ && stored) {
+        // Eq. 2 gives theta_j - theta_t; the spine wants the change since the template.
+        d.view.heading_change_rad = WrapAngle(*heading_rad_ - *stored);
+      }
+      return d;
+    }
+    // Both sensors say novel: a new joint template.
+    camera_.Add(view ? *view : std::vector<float>());
+    wifi_.Add(scan ? *scan : Fingerprint());
+    created_time_s_.push_back(time_s);
+    headings_.push_back(options_.use_compass ? heading_rad_ : std::nullopt);
+    d.view.template_id = n;
+    d.view.is_new = true;
+    d.source = DecisionSource::kNew;
+    return d;
+  }
+
+  FusedOptions options_;
+  KernelCameraMatcher camera_;
+  WifiFingerprintMatcher wifi_;
+  std::vector<double> created_time_s_;           // by template
+  std::vector<std::optional<double>> headings_;  // by template
+  Fingerprint newest_scan_;
+  std::optional<double> newest_scan_time_s_;
+  std::optional<double> heading_rad_;
+};
+
+}  // namespace
+
+std::unique_ptr<FrontEnd> MakeFusedFrontEnd(const FusedOptions& options,
+                                            const KernelCameraOptions& camera,
+                                            const WifiMatcherOptions& wifi) {
+  return std::make_unique<FusedFrontEnd>(options, camera, wifi);
+}
+
+}  // namespace front_end_internal
+}  // namespace ratslam
