@@ -75,7 +75,7 @@ const char kUsage[] =
     "  ratslam render similarity --data D [--data D2 ...] [--config C] --out F [--frames N]\n"
     "                 [--sensor camera|wifi]\n"
     "      Images from a run folder, a saved map, or a data set (PNG).\n"
-    "  ratslam evaluate [--config C] --map M --query Q --out O [--quiet]\n"
+    "  ratslam evaluate [--config C] --map M --query Q --out O [--lenient] [--quiet]\n"
     "      FABMAP localisation benchmark: maps M, localises every node of Q, writes\n"
     "      evaluation.json, queries.csv and localisation.png to O. M and Q may be the same\n"
     "      data set: [evaluation] split and map_fraction then divide it.\n"
