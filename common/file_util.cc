@@ -35,8 +35,9 @@ void RemoveStaleTemps(const std::string& path) {
   }
 }
 
-// Writes and flushes `contents` to `temp`; on failure removes it and names `temp`.
-Status WriteAndFlush(const std::string& temp, const std::string& contents) {
+// Writes (and, with `flush`, flushes to disk) `contents` to `temp`; on failure removes it and
+// names `temp`.
+Status WriteAndFlush(const std::string& temp, const std::string& contents, bool flush = true) {
   const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
   if (fd < 0) return Status::Error(temp + ": cannot create: " + std::strerror(errno));
   size_t written = 0;
@@ -51,7 +52,7 @@ Status WriteAndFlush(const std::string& temp, const std::string& contents) {
     }
     written += static_cast<size_t>(n);
   }
-  if (::fsync(fd) != 0) {
+  if (flush && ::fsync(fd) != 0) {
     const std::string reason = std::strerror(errno);
     ::close(fd);
     ::unlink(temp.c_str());
@@ -67,8 +68,18 @@ Status WriteAndFlush(const std::string& temp, const std::string& contents) {
 
 }  // namespace
 
-Status WriteFileAtomically(const std::string& path, const std::string& contents) {
-  return WriteFilesAtomically({{path, contents}});
+Status WriteFileAtomically(const std::string& path, const std::string& contents,
+                           bool flush_to_disk) {
+  if (flush_to_disk) return WriteFilesAtomically({{path, contents}});
+  RemoveStaleTemps(path);
+  const std::string temp = TempPath(path);
+  RATSLAM_RETURN_IF_ERROR(WriteAndFlush(temp, contents, /*flush=*/false));
+  if (std::rename(temp.c_str(), path.c_str()) != 0) {
+    const std::string reason = std::strerror(errno);
+    ::unlink(temp.c_str());
+    return Status::Error(path + ": cannot rename the temporary file into place: " + reason);
+  }
+  return Status::Ok();
 }
 
 Status WriteFilesAtomically(const std::vector<std::pair<std::string, std::string>>& files) {

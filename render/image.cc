@@ -4,6 +4,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "common/file_util.h"
+
 namespace ratslam {
 
 Status WritePng(const RgbaImage& image, const std::string& path) {
@@ -11,12 +13,14 @@ Status WritePng(const RgbaImage& image, const std::string& path) {
   cv::Mat rgba(image.height, image.width, CV_8UC4, const_cast<uint8_t*>(image.pixels.data()));
   cv::Mat bgra;
   cv::cvtColor(rgba, bgra, cv::COLOR_RGBA2BGRA);
+  std::vector<uchar> png;
   try {
-    if (!cv::imwrite(path, bgra)) return Status::Error(path + ": cannot write PNG");
+    if (!cv::imencode(".png", bgra, png)) return Status::Error(path + ": cannot encode PNG");
   } catch (const cv::Exception& e) {
-    return Status::Error(path + ": cannot write PNG: " + e.what());
+    return Status::Error(path + ": cannot encode PNG: " + e.what());
   }
-  return Status::Ok();
+  // Written checked and renamed into place: a full disk is an error, never a 0-byte PNG.
+  return WriteFileAtomically(path, std::string(png.begin(), png.end()), /*flush_to_disk=*/false);
 }
 
 StatusOr<RgbaImage> ReadPng(const std::string& path) {

@@ -10,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "common/circular.h"
+#include "common/file_util.h"
 #include "common/random.h"
 #include "sim/propagation.h"
 #include "sim/textures.h"
@@ -377,7 +378,11 @@ Status Simulate(const World& world, uint64_t seed, ViewRenderer* renderer,
       char name[32];
       std::snprintf(name, sizeof name, "frame_%06zu.png", report->images);
       const std::string path = (std::filesystem::path(image_folder) / name).string();
-      if (!cv::imwrite(path, image)) return Status::Error(path + ": cannot write image");
+      // Encoded in memory and written checked: a full disk is an error, never a 0-byte PNG.
+      std::vector<uchar> png;
+      if (!cv::imencode(".png", image, png)) return Status::Error(path + ": cannot encode image");
+      RATSLAM_RETURN_IF_ERROR(
+          WriteFileAtomically(path, std::string(png.begin(), png.end()), /*flush_to_disk=*/false));
       dataset->images.push_back({p.time_s, name, 0});
       ++report->images;
       next_image += 1.0 / world.camera.rate_hz;

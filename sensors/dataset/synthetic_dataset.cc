@@ -8,6 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "common/circular.h"
+#include "common/file_util.h"
 #include "common/random.h"
 
 namespace ratslam {
@@ -218,7 +219,11 @@ StatusOr<Dataset> WriteSyntheticDataset(const SyntheticOptions& o, const std::st
     char name[32];
     std::snprintf(name, sizeof name, "%06d.png", i);
     const std::string path_out = (std::filesystem::path(folder) / d.image_folder / name).string();
-    if (!cv::imwrite(path_out, image)) return Status::Error(path_out + ": cannot write image");
+    // Encoded in memory and written checked: a full disk is an error, never a 0-byte PNG.
+    std::vector<uchar> png;
+    if (!cv::imencode(".png", image, png)) return Status::Error(path_out + ": cannot encode image");
+    RATSLAM_RETURN_IF_ERROR(WriteFileAtomically(path_out, std::string(png.begin(), png.end()),
+                                                /*flush_to_disk=*/false));
     d.images.push_back({t, name, i + 2});
   }
   RATSLAM_RETURN_IF_ERROR(WriteDataset(d, folder));
