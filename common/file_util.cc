@@ -8,6 +8,8 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <mutex>
+#include <set>
 #include <system_error>
 
 namespace ratslam {
@@ -15,18 +17,31 @@ namespace {
 
 std::string TempPath(const std::string& path) { return path + ".tmp" + std::to_string(::getpid()); }
 
-// Removes `path.tmp<pid>` files whose writer no longer runs (killed mid-save).
+// Removes the `<name>.tmp<pid>` files that writers killed mid-save left in the folder of `path`.
+// Each folder is scanned once per process: a data set's thousands of images go into one folder,
+// and scanning it before every file made writing them quadratic.
 void RemoveStaleTemps(const std::string& path) {
   namespace fs = std::filesystem;
   const fs::path target(path);
   const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  const std::string prefix = target.filename().string() + ".tmp";
+  {
+    static std::mutex mutex;
+    static std::set<std::string> scanned;
+    std::error_code ec;
+    const fs::path key = fs::weakly_canonical(folder, ec);
+    const std::lock_guard<std::mutex> lock(mutex);
+    if (!scanned.insert((ec ? folder : key).string()).second) return;
+  }
   std::error_code ec;
   for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
     const std::string name = it->path().filename().string();
-    if (name.size() <= prefix.size() || name.compare(0, prefix.size(), prefix) != 0) continue;
-    const std::string digits = name.substr(prefix.size());
-    if (digits.find_first_not_of("0123456789") != std::string::npos || digits.size() > 9) continue;
+    const size_t tmp = name.rfind(".tmp");
+    if (tmp == std::string::npos || tmp == 0) continue;
+    const std::string digits = name.substr(tmp + 4);
+    if (digits.empty() || digits.size() > 9 ||
+        digits.find_first_not_of("0123456789") != std::string::npos) {
+      continue;
+    }
     const pid_t pid = static_cast<pid_t>(std::stol(digits));
     if (pid != ::getpid() && ::kill(pid, 0) != 0 && errno == ESRCH) {
       std::error_code ignored;

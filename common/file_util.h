@@ -12,7 +12,8 @@ namespace ratslam {
 
 // Writes `contents` to a temporary file beside `path` (`path.tmp<pid>`), flushes it to disk and
 // renames it over `path`: the file is either the old one or the complete new one. Temporary
-// files that a killed writer left beside `path` (their process is gone) are removed first.
+// files that killed writers left in that folder (their process is gone) are removed the first
+// time this process writes there.
 // With `flush_to_disk` false the data is not fsync'ed (for many small files such as a data set's
 // images, where a power cut may lose the newest but a crash never leaves a torn one).
 Status WriteFileAtomically(const std::string& path, const std::string& contents,
