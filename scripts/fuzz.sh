@@ -16,18 +16,7 @@ seconds=${FUZZ_SECONDS:-30}
 build=$root/build-fuzz
 shared=$root/../shared/data
 
-bash scripts/setup.sh
-need=()
-for p in clang-14 libfuzzer-14-dev; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || need+=("$p")
-done
-if ((${#need[@]})); then
-  sudo_cmd=()
-  if [[ $(id -u) -ne 0 ]]; then sudo_cmd=(sudo); fi
-  echo "fuzz: installing ${need[*]}"
-  "${sudo_cmd[@]}" apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${need[@]}"
-fi
+bash scripts/setup.sh clang-14 libfuzzer-14-dev
 
 harnesses=(config_fuzzer ini_fuzzer map_file_fuzzer visual_model_fuzzer dataset_fuzzer
            ipin_log_fuzzer msft_log_fuzzer ujiindoorloc_fuzzer world_fuzzer)

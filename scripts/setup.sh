@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Installs every Debian 12 package that the build, the tests, the benchmarks and the demo need.
+# Installs every Debian 12 package that the build, the tests, the benchmarks and the demo need,
+# and any packages named as arguments (scripts/fuzz.sh adds clang-14 and libfuzzer-14-dev).
 # Idempotent: packages already present are left alone. Run as root (or through sudo).
 set -euo pipefail
 
@@ -8,6 +9,7 @@ packages=(
   libboost-dev libboost-graph-dev
   libopencv-dev libosmesa6-dev libtomlplusplus-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev googletest libbenchmark-dev
+  "$@"
 )
 
 missing=()
