@@ -8,6 +8,7 @@
 
 #include "fuzz/fuzz_support.h"
 #include "sensors/dataset/dataset.h"
+#include "sensors/dataset/ipin_log.h"
 
 namespace ratslam::fuzz {
 
@@ -36,6 +37,26 @@ inline void CheckWritesAndReadsBack(const Dataset& d) {
       back->compass.size() != d.compass.size() || Readings(*back) != Readings(d)) {
     InvariantFailed("a written data set reads back with other row counts");
   }
+}
+
+// One phone-log input through `read` (strict, then lenient): an error names the file, and an
+// accepted log becomes a data set that writes and reads back.
+template <typename Reader>
+int FuzzPhoneLog(const uint8_t* data, size_t size, Reader read) {
+  const std::string path = WriteScratchFile("log.txt", data, size);
+  for (bool lenient : {false, true}) {
+    PhoneLogOptions options;
+    options.lenient = lenient;
+    StatusOr<Dataset> d = read(path, options);
+    if (!d.ok()) {
+      if (d.status().message().rfind(path, 0) != 0) {
+        InvariantFailed("error does not name the file: " + d.status().message());
+      }
+      continue;
+    }
+    CheckWritesAndReadsBack(*d);
+  }
+  return 0;
 }
 
 }  // namespace ratslam::fuzz

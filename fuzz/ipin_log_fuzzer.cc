@@ -28,19 +28,8 @@ std::vector<std::string> FuzzSeeds() {
 }  // namespace ratslam::fuzz
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  using namespace ratslam;
-  const std::string path = fuzz::WriteScratchFile("log.txt", data, size);
-  for (bool lenient : {false, true}) {
-    PhoneLogOptions options;
-    options.lenient = lenient;
-    StatusOr<Dataset> d = ReadIpinLog(path, options);
-    if (!d.ok()) {
-      if (d.status().message().rfind(path, 0) != 0) {
-        fuzz::InvariantFailed("error does not name the file: " + d.status().message());
-      }
-      continue;
-    }
-    fuzz::CheckWritesAndReadsBack(*d);
-  }
-  return 0;
+  return ratslam::fuzz::FuzzPhoneLog(
+      data, size, [](const std::string& path, const ratslam::PhoneLogOptions& options) {
+        return ratslam::ReadIpinLog(path, options);
+      });
 }
