@@ -10,7 +10,6 @@
 
 #include <chrono>
 #include <filesystem>
-#include <fstream>
 #include <random>
 #include <string>
 #include <thread>
@@ -18,9 +17,9 @@
 
 #include "apps/demo_config.h"
 #include "common/scratch_dir.h"
-#include "common/text_file.h"
 #include "fusion/io/map_file.h"
 #include "sensors/dataset/synthetic_dataset.h"
+#include "tests/run_ratslam.h"
 
 extern char** environ;
 
@@ -28,11 +27,7 @@ namespace ratslam {
 namespace {
 namespace fs = std::filesystem;
 
-// The file's bytes; empty when it cannot be read.
-std::string Slurp(const fs::path& p) {
-  StatusOr<std::string> bytes = ReadRegularFile(p.string(), "file", size_t{1} << 30);
-  return bytes.ok() ? *bytes : std::string();
-}
+using e2e::Slurp;
 
 // Starts `ratslam` with `args` (output to /dev/null); returns its pid.
 pid_t Spawn(const std::vector<std::string>& args) {

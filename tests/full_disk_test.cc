@@ -11,26 +11,15 @@
 #include <string>
 
 #include "common/scratch_dir.h"
-#include "common/text_file.h"
 #include "fusion/io/map_file.h"
+#include "tests/run_ratslam.h"
 
 namespace ratslam {
 namespace {
 namespace fs = std::filesystem;
 
-struct Result {
-  int exit_code;
-  std::string err;
-};
-
-Result RunRatslam(const std::string& arguments, const fs::path& scratch) {
-  const fs::path err = scratch / "stderr.txt";
-  const std::string command = std::string(RATSLAM_BINARY) + " " + arguments + " > " +
-                              (scratch / "stdout.txt").string() + " 2> " + err.string();
-  const int status = std::system(command.c_str());
-  StatusOr<std::string> text = ReadRegularFile(err.string(), "stderr", 1 << 20);
-  return {WEXITSTATUS(status), text.ok() ? *text : std::string()};
-}
+using e2e::Result;
+using e2e::RunRatslam;
 
 class FullDiskTest : public ::testing::Test {
  protected:

@@ -12,6 +12,7 @@
 #include "render/image.h"
 #include "render/renderer.h"
 #include "sensors/dataset/synthetic_dataset.h"
+#include "tests/run_ratslam.h"
 
 namespace ratslam {
 namespace {
@@ -21,25 +22,9 @@ const char* const kOutputs[] = {"experiences.csv",  "links.csv",          "traje
                                 "odometry_tum.txt", "experience_map.g2o", "frames.csv",
                                 "config.toml"};
 
-std::string Slurp(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-struct Result {
-  int exit_code;
-  std::string err;
-};
-
-Result RunRatslam(const std::string& arguments, const fs::path& scratch) {
-  const fs::path err = scratch / "stderr.txt";
-  const std::string command = std::string(RATSLAM_BINARY) + " " + arguments + " > " +
-                              (scratch / "stdout.txt").string() + " 2> " + err.string();
-  const int status = std::system(command.c_str());
-  return {WEXITSTATUS(status), Slurp(err)};
-}
+using e2e::Result;
+using e2e::RunRatslam;
+using e2e::Slurp;
 
 nlohmann::json Summary(const fs::path& out) {
   return nlohmann::json::parse(Slurp(out / "summary.json"));

@@ -1,0 +1,40 @@
+// Helpers for the end-to-end tests, which run the `ratslam` program (RATSLAM_BINARY) as a user
+// would and read what it wrote.
+#ifndef RATSLAM_TESTS_RUN_RATSLAM_H_
+#define RATSLAM_TESTS_RUN_RATSLAM_H_
+
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace ratslam::e2e {
+
+// The file's bytes; empty when it cannot be read.
+inline std::string Slurp(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+struct Result {
+  int exit_code;
+  std::string err;  // what it printed on stderr
+};
+
+// Runs `ratslam arguments` with stdout and stderr in files of `scratch`.
+inline Result RunRatslam(const std::string& arguments, const std::filesystem::path& scratch) {
+  const std::filesystem::path err = scratch / "stderr.txt";
+  const std::string command = std::string(RATSLAM_BINARY) + " " + arguments + " > " +
+                              (scratch / "stdout.txt").string() + " 2> " + err.string();
+  const int status = std::system(command.c_str());
+  return {WEXITSTATUS(status), Slurp(err)};
+}
+
+}  // namespace ratslam::e2e
+
+#endif  // RATSLAM_TESTS_RUN_RATSLAM_H_
