@@ -47,19 +47,7 @@ bool FabmapSettings::IsValid(std::string* error) const {
 }
 
 bool FabmapFrontEndOptions::IsValid(std::string* error) const {
-  if (!(match_probability > 0.0 && match_probability <= 1.0)) {
-    if (error) *error = "match_probability: must be in (0, 1]";
-    return false;
-  }
-  if (recency_templates < 0 || !(recency_s >= 0.0) || !(max_wifi_age_s >= 0.0)) {
-    if (error) *error = "recency_templates: must not be negative, nor recency_s and max_wifi_age_s";
-    return false;
-  }
-  if (online_first_scans < 1) {
-    if (error) *error = "online_first_scans: must be at least 1";
-    return false;
-  }
-  return true;
+  return schema::CheckFields(*this, error);
 }
 
 std::string ToString(WifiLearning learning) {
@@ -73,17 +61,11 @@ StatusOr<WifiLearning> WifiLearningFromString(const std::string& name) {
 }
 
 bool FusedOptions::IsValid(std::string* error) const {
-  auto fail = [error](const std::string& message) {
-    if (error) *error = message;
+  if (!schema::CheckFields(*this, error)) return false;
+  if (!use_camera && !use_wifi) {
+    if (error) *error = "use_wifi: at least one of camera and Wi-Fi must be on";
     return false;
-  };
-  if (!use_camera && !use_wifi)
-    return fail("use_wifi: at least one of camera and Wi-Fi must be on");
-  if (recency_templates < 0) return fail("recency_templates: must not be negative");
-  if (!(recency_s >= 0.0) || !std::isfinite(recency_s)) {
-    return fail("recency_s: must be a non-negative number");
   }
-  if (!(max_wifi_age_s >= 0.0)) return fail("max_wifi_age_s: must not be negative");
   return true;
 }
 

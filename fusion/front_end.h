@@ -28,6 +28,7 @@
 #include <optional>
 #include <string>
 
+#include "common/schema.h"
 #include "common/status.h"
 #include "fusion/fabmap/localiser.h"
 #include "fusion/fabmap/visual_model.h"
@@ -53,8 +54,8 @@ struct FrontEndOptions {
   bool IsValid(std::string*) const { return true; }
   template <typename Visitor>
   void VisitFields(Visitor&& v) {
-    v("kind", kind,
-      "front end that decides the active local view: classic_camera, fused or fabmap");
+    v("kind", kind, "front end that decides the active local view: classic_camera, fused or fabmap",
+      schema::Any());
   }
 };
 
@@ -70,15 +71,20 @@ struct FusedOptions {
 
   template <typename Visitor>
   void VisitFields(Visitor&& v) {
-    v("use_camera", use_camera, "use 12x9 camera templates (eq. 7); frames are camera images");
-    v("use_wifi", use_wifi,
-      "use Wi-Fi fingerprints (eqs. 3-6); without a camera, scans are frames");
+    v("use_camera", use_camera, "use 12x9 camera templates (eq. 7); frames are camera images",
+      schema::Any());
+    v("use_wifi", use_wifi, "use Wi-Fi fingerprints (eqs. 3-6); without a camera, scans are frames",
+      schema::Any());
     v("use_compass", use_compass,
-      "store a heading with each template; matches give the relative orientation of eq. 2");
+      "store a heading with each template; matches give the relative orientation of eq. 2",
+      schema::Any());
     v("recency_templates", recency_templates,
-      "k of eqs. 10-11 in templates: newer matches do not count");
-    v("recency_s", recency_s, "k of eqs. 10-11 in seconds: matches newer than this do not count");
-    v("max_wifi_age_s", max_wifi_age_s, "a Wi-Fi scan older than this counts as absent at a frame");
+      "k of eqs. 10-11 in templates: newer matches do not count",
+      schema::Unit("templates").NonNegative());
+    v("recency_s", recency_s, "k of eqs. 10-11 in seconds: matches newer than this do not count",
+      schema::Unit("s").NonNegative());
+    v("max_wifi_age_s", max_wifi_age_s, "a Wi-Fi scan older than this counts as absent at a frame",
+      schema::Unit("s").NonNegative());
   }
 };
 
@@ -104,16 +110,22 @@ struct FabmapFrontEndOptions {
   template <typename Visitor>
   void VisitFields(Visitor&& v) {
     v("match_probability", match_probability,
-      "least FABMAP posterior of the best place for its template to become active");
+      "least FABMAP posterior of the best place for its template to become active",
+      schema::Unit("").Above(0).AtMost(1));
     v("recency_templates", recency_templates,
-      "matches to one of the newest this-many templates re-use it without injection");
-    v("recency_s", recency_s, "so do matches to a template made less than this long ago");
-    v("max_wifi_age_s", max_wifi_age_s, "a Wi-Fi scan older than this counts as absent at a frame");
+      "matches to one of the newest this-many templates re-use it without injection",
+      schema::Unit("templates").NonNegative());
+    v("recency_s", recency_s, "so do matches to a template made less than this long ago",
+      schema::Unit("s").NonNegative());
+    v("max_wifi_age_s", max_wifi_age_s, "a Wi-Fi scan older than this counts as absent at a frame",
+      schema::Unit("s").NonNegative());
     v("wifi_learning", wifi_learning,
       "Wi-Fi words, tree and unknown world from whole_data_set (every scan, future included) or "
-      "online (only the scans seen so far, relearnt as their number doubles)");
+      "online (only the scans seen so far, relearnt as their number doubles)",
+      schema::Any());
     v("online_first_scans", online_first_scans,
-      "online: scans before the first Wi-Fi model (every frame is a new place until then)");
+      "online: scans before the first Wi-Fi model (every frame is a new place until then)",
+      schema::Unit("scans").AtLeast(1));
   }
 };
 

@@ -12,15 +12,7 @@
 namespace ratslam {
 
 bool ExperienceMapOptions::IsValid(std::string* error) const {
-  auto fail = [error](const std::string& message) {
-    if (error) *error = message;
-    return false;
-  };
-  if (relaxation_sweeps < 0) return fail("relaxation_sweeps: must not be negative");
-  if (!(relaxation_correction >= 0.0 && relaxation_correction <= 0.5)) {
-    return fail("relaxation_correction: must be in [0, 0.5]");
-  }
-  return true;
+  return schema::CheckFields(*this, error);
 }
 
 ExperienceMap::ExperienceMap(const ExperienceMapOptions& options) : options_(options) {

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "common/schema.h"
 #include "common/status.h"
 #include "ratslam/pose_cell_network.h"
 
@@ -26,11 +27,13 @@ struct ExperienceMapOptions {
 
   template <typename Visitor>
   void VisitFields(Visitor&& v) {
-    v("relaxation_sweeps", relaxation_sweeps, "relaxation passes over all links after each action");
+    v("relaxation_sweeps", relaxation_sweeps, "relaxation passes over all links after each action",
+      schema::Unit("sweeps").NonNegative());
     v("relaxation_correction", relaxation_correction,
-      "share of a link's error each end absorbs per pass (0.5 satisfies the link exactly)");
+      "share of a link's error each end absorbs per pass (0.5 satisfies the link exactly)",
+      schema::Unit("").Within(0, 0.5));
     v("anchor_first_experience", anchor_first_experience,
-      "keep experience 0 fixed during relaxation");
+      "keep experience 0 fixed during relaxation", schema::Any());
   }
 };
 

@@ -11,28 +11,7 @@
 namespace ratslam {
 
 bool LocalViewOptions::IsValid(std::string* error) const {
-  auto fail = [error](const std::string& message) {
-    if (error) *error = message;
-    return false;
-  };
-  if (!(injection_gain >= 0.0) || !std::isfinite(injection_gain)) {
-    return fail("injection_gain: must be a non-negative number");
-  }
-  if (!(decay_per_match >= 0.0) || !std::isfinite(decay_per_match)) {
-    return fail("decay_per_match: must be a non-negative number");
-  }
-  if (!(decay_restore_per_frame >= 0.0) || !std::isfinite(decay_restore_per_frame)) {
-    return fail("decay_restore_per_frame: must be a non-negative number");
-  }
-  if (!std::isfinite(decay_floor)) return fail("decay_floor: must be a number");
-  if (!(energy_limit > 0.0) || !std::isfinite(energy_limit)) {
-    return fail("energy_limit: must be a positive number");
-  }
-  if (!(energy_decay_rate >= 0.0) || !std::isfinite(energy_decay_rate)) {
-    return fail("energy_decay_rate: must be a non-negative number");
-  }
-  if (skip_recent_templates < 0) return fail("skip_recent_templates: must not be negative");
-  return true;
+  return schema::CheckFields(*this, error);
 }
 
 LocalViewCells::LocalViewCells(const LocalViewOptions& options, int dim_theta_cells)

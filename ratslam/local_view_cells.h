@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "common/schema.h"
 #include "common/status.h"
 #include "ratslam/pose_cell_network.h"
 
@@ -28,16 +29,20 @@ struct LocalViewOptions {
 
   template <typename Visitor>
   void VisitFields(Visitor&& v) {
-    v("injection_gain", injection_gain, "pose-cell energy injected by a rested template match");
-    v("decay_per_match", decay_per_match, "added to a template's decay on each match");
+    v("injection_gain", injection_gain, "pose-cell energy injected by a rested template match",
+      schema::Unit("").NonNegative());
+    v("decay_per_match", decay_per_match, "added to a template's decay on each match",
+      schema::Unit("").NonNegative());
     v("decay_restore_per_frame", decay_restore_per_frame,
-      "removed from every template's decay each view frame");
-    v("decay_floor", decay_floor, "lowest value of a template's decay");
-    v("energy_limit", energy_limit, "E = gain * (limit - exp(rate * decay)) / limit: limit");
+      "removed from every template's decay each view frame", schema::Unit("").NonNegative());
+    v("decay_floor", decay_floor, "lowest value of a template's decay", schema::Unit(""));
+    v("energy_limit", energy_limit, "E = gain * (limit - exp(rate * decay)) / limit: limit",
+      schema::Unit("").Positive());
     v("energy_decay_rate", energy_decay_rate,
-      "E = gain * (limit - exp(rate * decay)) / limit: rate");
+      "E = gain * (limit - exp(rate * decay)) / limit: rate", schema::Unit("").NonNegative());
     v("skip_recent_templates", skip_recent_templates,
-      "matches to this many newest templates inject no energy");
+      "matches to this many newest templates inject no energy",
+      schema::Unit("templates").NonNegative());
   }
 };
 

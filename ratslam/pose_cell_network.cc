@@ -36,35 +36,13 @@ double CircularMean(const std::complex<double>& sum, double size) {
 }  // namespace
 
 bool PoseCellOptions::IsValid(std::string* error) const {
-  auto fail = [error](const std::string& message) {
-    if (error) *error = message;
-    return false;
-  };
-  if (dim_xy_cells < 1) return fail("dim_xy_cells: must be at least 1");
-  if (dim_theta_cells < 1) return fail("dim_theta_cells: must be at least 1");
+  if (!schema::CheckFields(*this, error)) return false;
   // Three buffers of doubles per cell: 2^24 cells need 384 MiB; 2^30 needed 24 GiB and passed.
   if (static_cast<long long>(dim_xy_cells) * dim_xy_cells * dim_theta_cells > kMaxPoseCells) {
-    return fail("dim_xy_cells: grid of dim_xy_cells^2 x dim_theta_cells larger than 2^24 cells");
+    if (error)
+      *error = "dim_xy_cells: grid of dim_xy_cells^2 x dim_theta_cells larger than 2^24 cells";
+    return false;
   }
-  if (!(cell_size_m > 0.0) || !std::isfinite(cell_size_m)) {
-    return fail("cell_size_m: must be a positive number");
-  }
-  if (excitation_size_cells < 1 || excitation_size_cells % 2 == 0) {
-    return fail("excitation_size_cells: must be odd and at least 1");
-  }
-  if (inhibition_size_cells < 1 || inhibition_size_cells % 2 == 0) {
-    return fail("inhibition_size_cells: must be odd and at least 1");
-  }
-  if (!(excitation_variance_cells2 > 0.0) || !std::isfinite(excitation_variance_cells2)) {
-    return fail("excitation_variance_cells2: must be a positive number");
-  }
-  if (!(inhibition_variance_cells2 > 0.0) || !std::isfinite(inhibition_variance_cells2)) {
-    return fail("inhibition_variance_cells2: must be a positive number");
-  }
-  if (!(global_inhibition >= 0.0) || !(global_inhibition < 1.0)) {
-    return fail("global_inhibition: must be in [0, 1)");
-  }
-  if (decode_radius_cells < 0) return fail("decode_radius_cells: must not be negative");
   return true;
 }
 

@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "common/schema.h"
 #include "common/status.h"
 
 namespace ratslam {
@@ -41,19 +42,25 @@ struct PoseCellOptions {
 
   template <typename Visitor>
   void VisitFields(Visitor&& v) {
-    v("dim_xy_cells", dim_xy_cells, "cells along x and along y; the grid wraps");
-    v("dim_theta_cells", dim_theta_cells, "cells around the heading ring");
-    v("cell_size_m", cell_size_m, "metres of travel per x/y cell");
-    v("excitation_size_cells", excitation_size_cells, "width of the excitation kernel (odd)");
+    v("dim_xy_cells", dim_xy_cells, "cells along x and along y; the grid wraps",
+      schema::Unit("cells").AtLeast(1));
+    v("dim_theta_cells", dim_theta_cells, "cells around the heading ring",
+      schema::Unit("cells").AtLeast(1));
+    v("cell_size_m", cell_size_m, "metres of travel per x/y cell", schema::Unit("m").Positive());
+    v("excitation_size_cells", excitation_size_cells, "width of the excitation kernel",
+      schema::Unit("cells").Odd().AtLeast(1));
     v("excitation_variance_cells2", excitation_variance_cells2,
-      "variance of the excitation Gaussian, cells^2");
-    v("inhibition_size_cells", inhibition_size_cells, "width of the local inhibition kernel (odd)");
+      "variance of the excitation Gaussian", schema::Unit("cells^2").Positive());
+    v("inhibition_size_cells", inhibition_size_cells, "width of the local inhibition kernel",
+      schema::Unit("cells").Odd().AtLeast(1));
     v("inhibition_variance_cells2", inhibition_variance_cells2,
-      "variance of the inhibition Gaussian, cells^2");
+      "variance of the inhibition Gaussian", schema::Unit("cells^2").Positive());
     v("global_inhibition", global_inhibition,
-      "activity subtracted from every cell each step, floored at 0");
+      "activity subtracted from every cell each step, floored at 0",
+      schema::Unit("").AtLeast(0).Below(1));
     v("decode_radius_cells", decode_radius_cells,
-      "half-width of the window around the peak used for the population-vector pose");
+      "half-width of the window around the peak used for the population-vector pose",
+      schema::Unit("cells").NonNegative());
   }
 };
 

@@ -6,13 +6,7 @@
 
 namespace ratslam {
 
-bool ActionOptions::IsValid(std::string* error) const {
-  if (!(match_distance_cells > 0.0) || !std::isfinite(match_distance_cells)) {
-    if (error) *error = "match_distance_cells: must be a positive number";
-    return false;
-  }
-  return true;
-}
+bool ActionOptions::IsValid(std::string* error) const { return schema::CheckFields(*this, error); }
 
 bool RatslamOptions::IsValid(std::string* error) const {
   std::string inner;

@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 
+#include "common/schema.h"
 #include "common/status.h"
 #include "ratslam/experience_map.h"
 #include "ratslam/local_view_cells.h"
@@ -27,11 +28,13 @@ struct ActionOptions {
   template <typename Visitor>
   void VisitFields(Visitor&& v) {
     v("match_distance_cells", match_distance_cells,
-      "pose-cell distance within which an experience of the current template is re-used");
+      "pose-cell distance within which an experience of the current template is re-used",
+      schema::Unit("cells").Positive());
     v("refuse_ambiguous_links", refuse_ambiguous_links,
-      "make no link when several experiences are within match_distance_cells");
+      "make no link when several experiences are within match_distance_cells", schema::Any());
     v("match_heading", match_heading,
-      "include pose-cell theta in that distance; false suits an absolute compass heading");
+      "include pose-cell theta in that distance; false suits an absolute compass heading",
+      schema::Any());
   }
 };
 

@@ -144,33 +144,14 @@ bool ClassicCameraOptions::IsValid(std::string* error) const {
     if (error) *error = message;
     return false;
   };
-  if (crop_left_px < 0) return fail("crop_left_px: must not be negative");
-  if (crop_top_px < 0) return fail("crop_top_px: must not be negative");
+  if (!schema::CheckFields(*this, error)) return false;
   if (crop_right_px != -1 && crop_right_px <= crop_left_px) {
     return fail("crop_right_px: must be -1 or greater than crop_left_px");
   }
   if (crop_bottom_px != -1 && crop_bottom_px <= crop_top_px) {
     return fail("crop_bottom_px: must be -1 or greater than crop_top_px");
   }
-  if (template_width_px < 1 || template_width_px > 4096) {
-    return fail("template_width_px: must be in [1, 4096]");
-  }
-  if (template_height_px < 1 || template_height_px > 4096) {
-    return fail("template_height_px: must be in [1, 4096]");
-  }
-  if (shift_px < 0 || shift_px >= template_width_px) {
-    return fail("shift_px: must be in [0, template_width_px)");
-  }
-  if (shift_step_px < 1) return fail("shift_step_px: must be at least 1");
-  if (!(match_threshold >= 0.0 && match_threshold <= 1.0)) {
-    return fail("match_threshold: must be in [0, 1]");
-  }
-  if (!(global_normalisation_mean >= 0.0 && global_normalisation_mean <= 1.0)) {
-    return fail("global_normalisation_mean: must be in [0, 1]");
-  }
-  if (patch_normalisation_radius_px < 0) {
-    return fail("patch_normalisation_radius_px: must not be negative");
-  }
+  if (shift_px >= template_width_px) return fail("shift_px: must be less than template_width_px");
   return true;
 }
 

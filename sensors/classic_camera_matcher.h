@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "common/schema.h"
 #include "common/status.h"
 #include "ratslam/local_view_cells.h"
 
@@ -45,21 +46,31 @@ struct ClassicCameraOptions {
 
   template <typename Visitor>
   void VisitFields(Visitor&& v) {
-    v("crop_left_px", crop_left_px, "first image column used");
-    v("crop_right_px", crop_right_px, "one past the last image column used; -1 for the width");
-    v("crop_top_px", crop_top_px, "first image row used");
-    v("crop_bottom_px", crop_bottom_px, "one past the last image row used; -1 for the height");
-    v("template_width_px", template_width_px, "template columns (block-mean down-sampling)");
-    v("template_height_px", template_height_px, "template rows");
-    v("shift_px", shift_px, "templates are compared at column offsets -shift_px..+shift_px");
-    v("shift_step_px", shift_step_px, "step between compared column offsets");
+    v("crop_left_px", crop_left_px, "first image column used", schema::Unit("px").NonNegative());
+    v("crop_right_px", crop_right_px, "one past the last image column used; -1 for the width",
+      schema::Unit("px").AtLeast(-1));
+    v("crop_top_px", crop_top_px, "first image row used", schema::Unit("px").NonNegative());
+    v("crop_bottom_px", crop_bottom_px, "one past the last image row used; -1 for the height",
+      schema::Unit("px").AtLeast(-1));
+    v("template_width_px", template_width_px, "template columns (block-mean down-sampling)",
+      schema::Unit("px").Within(1, 4096));
+    v("template_height_px", template_height_px, "template rows",
+      schema::Unit("px").Within(1, 4096));
+    v("shift_px", shift_px, "templates are compared at column offsets -shift_px..+shift_px",
+      schema::Unit("px").NonNegative());
+    v("shift_step_px", shift_step_px, "step between compared column offsets",
+      schema::Unit("px").AtLeast(1));
     v("match_threshold", match_threshold,
-      "largest mean absolute difference (intensities 0..1) that counts as a match");
+      "largest mean absolute difference (intensities 0..1) that counts as a match",
+      schema::Unit("").Within(0, 1));
     v("global_normalisation_mean", global_normalisation_mean,
-      "scale each template to this mean intensity; 0 switches it off");
+      "scale each template to this mean intensity; 0 switches it off",
+      schema::Unit("").Within(0, 1));
     v("patch_normalisation_radius_px", patch_normalisation_radius_px,
-      "radius of the local contrast normalisation patch; 0 switches it off");
-    v("panoramic", panoramic, "the image spans 360 degrees: shifts wrap and give a heading change");
+      "radius of the local contrast normalisation patch; 0 switches it off",
+      schema::Unit("px").NonNegative());
+    v("panoramic", panoramic, "the image spans 360 degrees: shifts wrap and give a heading change",
+      schema::Any());
   }
 };
 

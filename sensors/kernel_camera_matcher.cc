@@ -6,23 +6,7 @@
 namespace ratslam {
 
 bool KernelCameraOptions::IsValid(std::string* error) const {
-  auto fail = [error](const std::string& message) {
-    if (error) *error = message;
-    return false;
-  };
-  if (template_width_px < 1 || template_width_px > 1024) {
-    return fail("template_width_px: must be in [1, 1024]");
-  }
-  if (template_height_px < 1 || template_height_px > 1024) {
-    return fail("template_height_px: must be in [1, 1024]");
-  }
-  if (!(kernel_sigma > 0.0) || !std::isfinite(kernel_sigma)) {
-    return fail("kernel_sigma: must be a positive number");
-  }
-  if (!(match_threshold >= 0.0 && match_threshold <= 1.0)) {
-    return fail("match_threshold: must be in [0, 1]");
-  }
-  return true;
+  return schema::CheckFields(*this, error);
 }
 
 KernelCameraMatcher::KernelCameraMatcher(const KernelCameraOptions& options) : options_(options) {

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "common/schema.h"
 #include "common/status.h"
 #include "sensors/classic_camera_matcher.h"
 
@@ -28,13 +29,18 @@ struct KernelCameraOptions {
 
   template <typename Visitor>
   void VisitFields(Visitor&& v) {
-    v("template_width_px", template_width_px, "template columns (paper: 12)");
-    v("template_height_px", template_height_px, "template rows (paper: 9)");
+    v("template_width_px", template_width_px, "template columns (paper: 12)",
+      schema::Unit("px").Within(1, 1024));
+    v("template_height_px", template_height_px, "template rows (paper: 9)",
+      schema::Unit("px").Within(1, 1024));
     v("kernel_sigma", kernel_sigma,
-      "sigma_camera of eq. 7 on the 0..1 intensity scale (paper: 2.0)");
+      "sigma_camera of eq. 7 on the 0..1 intensity scale (paper: 2.0)",
+      schema::Unit("").Positive());
     v("match_threshold", match_threshold,
-      "t_camera: smallest similarity c(j) that is a match (paper: 0.96)");
-    v("subtract_mean", subtract_mean, "remove each template's mean intensity before comparing");
+      "t_camera: smallest similarity c(j) that is a match (paper: 0.96)",
+      schema::Unit("").Within(0, 1));
+    v("subtract_mean", subtract_mean, "remove each template's mean intensity before comparing",
+      schema::Any());
   }
 };
 

@@ -11,16 +11,11 @@ bool PdrOptions::IsValid(std::string* error) const {
     if (error) *error = message;
     return false;
   };
-  if (!(smoothing_s >= 0.0)) return fail("smoothing_s: must not be negative");
+  if (!schema::CheckFields(*this, error)) return false;
   if (!(baseline_s > smoothing_s)) return fail("baseline_s: must exceed smoothing_s");
-  if (!(peak_threshold_m_s2 > 0.0)) return fail("peak_threshold_m_s2: must be positive");
-  if (!(min_step_interval_s > 0.0)) return fail("min_step_interval_s: must be positive");
   if (!(max_step_interval_s > min_step_interval_s)) {
     return fail("max_step_interval_s: must exceed min_step_interval_s");
   }
-  if (!(weinberg_k > 0.0)) return fail("weinberg_k: must be positive");
-  if (!(fixed_step_length_m >= 0.0)) return fail("fixed_step_length_m: must not be negative");
-  if (!std::isfinite(heading_offset_rad)) return fail("heading_offset_rad: must be a number");
   return true;
 }
 

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "common/schema.h"
+
 namespace ratslam {
 
 struct PdrOptions {
@@ -24,15 +26,22 @@ struct PdrOptions {
 
   template <typename Visitor>
   void VisitFields(Visitor&& v) {
-    v("smoothing_s", smoothing_s, "time constant of the accelerometer magnitude low-pass, s");
-    v("baseline_s", baseline_s, "time constant of the slow baseline (the phone's gravity), s");
+    v("smoothing_s", smoothing_s, "time constant of the accelerometer magnitude low-pass, s",
+      schema::Unit("s").NonNegative());
+    v("baseline_s", baseline_s, "time constant of the slow baseline (the phone's gravity), s",
+      schema::Unit("s").Positive());
     v("peak_threshold_m_s2", peak_threshold_m_s2,
-      "a step peak rises this far above the baseline, m/s^2");
-    v("min_step_interval_s", min_step_interval_s, "steps closer in time than this are one step, s");
-    v("max_step_interval_s", max_step_interval_s, "longest gap between steps of one walk, s");
-    v("weinberg_k", weinberg_k, "K of the Weinberg step length L = K (a_max - a_min)^(1/4)");
-    v("fixed_step_length_m", fixed_step_length_m, "> 0: every step has this length instead");
-    v("heading_offset_rad", heading_offset_rad, "walking direction minus phone heading, rad");
+      "a step peak rises this far above the baseline, m/s^2", schema::Unit("m/s^2").Positive());
+    v("min_step_interval_s", min_step_interval_s, "steps closer in time than this are one step, s",
+      schema::Unit("s").Positive());
+    v("max_step_interval_s", max_step_interval_s, "longest gap between steps of one walk, s",
+      schema::Unit("s").Positive());
+    v("weinberg_k", weinberg_k, "K of the Weinberg step length L = K (a_max - a_min)^(1/4)",
+      schema::Unit("").Positive());
+    v("fixed_step_length_m", fixed_step_length_m, "> 0: every step has this length instead",
+      schema::Unit("m").NonNegative());
+    v("heading_offset_rad", heading_offset_rad, "walking direction minus phone heading, rad",
+      schema::Unit("rad"));
   }
 };
 

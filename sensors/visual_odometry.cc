@@ -7,20 +7,10 @@
 namespace ratslam {
 
 bool VisualOdometryOptions::IsValid(std::string* error) const {
-  auto fail = [error](const std::string& message) {
-    if (error) *error = message;
-    return false;
-  };
-  if (!(speed_m_per_s >= 0.0) || !std::isfinite(speed_m_per_s)) {
-    return fail("speed_m_per_s: must be a non-negative number");
-  }
-  if (!(field_of_view_rad > 0.0 && field_of_view_rad <= 2 * M_PI)) {
-    return fail("field_of_view_rad: must be in (0, 2 pi]");
-  }
-  if (max_shift_px < 1) return fail("max_shift_px: must be at least 1");
-  if (crop_top_px < 0) return fail("crop_top_px: must not be negative");
+  if (!schema::CheckFields(*this, error)) return false;
   if (crop_bottom_px != -1 && crop_bottom_px <= crop_top_px) {
-    return fail("crop_bottom_px: must be -1 or greater than crop_top_px");
+    if (error) *error = "crop_bottom_px: must be -1 or greater than crop_top_px";
+    return false;
   }
   return true;
 }

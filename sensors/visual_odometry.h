@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "common/schema.h"
 #include "common/status.h"
 #include "sensors/classic_camera_matcher.h"
 
@@ -26,12 +27,18 @@ struct VisualOdometryOptions {
 
   template <typename Visitor>
   void VisitFields(Visitor&& v) {
-    v("enabled", enabled, "replace the data set's odometry by visual odometry from its images");
-    v("speed_m_per_s", speed_m_per_s, "constant forward speed assumed, m/s");
-    v("field_of_view_rad", field_of_view_rad, "horizontal field of view of the camera, rad");
-    v("max_shift_px", max_shift_px, "largest column shift searched between consecutive frames, px");
-    v("crop_top_px", crop_top_px, "first image row of the intensity profile");
-    v("crop_bottom_px", crop_bottom_px, "one past the last row of the profile; -1 for the height");
+    v("enabled", enabled, "replace the data set's odometry by visual odometry from its images",
+      schema::Any());
+    v("speed_m_per_s", speed_m_per_s, "constant forward speed assumed, m/s",
+      schema::Unit("m/s").NonNegative());
+    v("field_of_view_rad", field_of_view_rad, "horizontal field of view of the camera, rad",
+      schema::Unit("rad").Positive().AtMost(2 * M_PI));
+    v("max_shift_px", max_shift_px, "largest column shift searched between consecutive frames, px",
+      schema::Unit("px").AtLeast(1));
+    v("crop_top_px", crop_top_px, "first image row of the intensity profile",
+      schema::Unit("px").NonNegative());
+    v("crop_bottom_px", crop_bottom_px, "one past the last row of the profile; -1 for the height",
+      schema::Unit("px").AtLeast(-1));
   }
 };
 

@@ -8,22 +8,7 @@
 namespace ratslam {
 
 bool WifiMatcherOptions::IsValid(std::string* error) const {
-  auto fail = [error](const std::string& message) {
-    if (error) *error = message;
-    return false;
-  };
-  if (!(kernel_variance_dbm2 > 0.0) || !std::isfinite(kernel_variance_dbm2)) {
-    return fail("kernel_variance_dbm2: must be a positive number");
-  }
-  if (!std::isfinite(penalty_floor_dbm)) return fail("penalty_floor_dbm: must be a number");
-  if (!(penalty_per_dbm >= 0.0) || !std::isfinite(penalty_per_dbm)) {
-    return fail("penalty_per_dbm: must be a non-negative number");
-  }
-  if (!(match_threshold >= 0.0 && match_threshold <= 1.0)) {
-    return fail("match_threshold: must be in [0, 1]");
-  }
-  if (!std::isfinite(min_rssi_dbm)) return fail("min_rssi_dbm: must be a number");
-  return true;
+  return schema::CheckFields(*this, error);
 }
 
 WifiFingerprintMatcher::WifiFingerprintMatcher(const WifiMatcherOptions& options)

@@ -20,6 +20,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "common/schema.h"
 #include "common/status.h"
 
 namespace ratslam {
@@ -36,13 +37,16 @@ struct WifiMatcherOptions {
   template <typename Visitor>
   void VisitFields(Visitor&& v) {
     v("kernel_variance_dbm2", kernel_variance_dbm2,
-      "sigma^2 of the Gaussian kernels of eqs. 3-5, dBm^2 (paper: 20)");
+      "sigma^2 of the Gaussian kernels of eqs. 3-5, dBm^2 (paper: 20)",
+      schema::Unit("dBm^2").Positive());
     v("penalty_floor_dbm", penalty_floor_dbm,
-      "extra or missing APs at or below this RSSI carry no penalty");
+      "extra or missing APs at or below this RSSI carry no penalty", schema::Unit("dBm"));
     v("penalty_per_dbm", penalty_per_dbm,
-      "penalty P(s) = penalty_per_dbm * max(0, s - penalty_floor_dbm) for eqs. 4-5");
-    v("match_threshold", match_threshold, "t_wifi: smallest weight w (eq. 6) that is a match");
-    v("min_rssi_dbm", min_rssi_dbm, "readings weaker than this are ignored");
+      "penalty P(s) = penalty_per_dbm * max(0, s - penalty_floor_dbm) for eqs. 4-5",
+      schema::Unit("1/dBm").NonNegative());
+    v("match_threshold", match_threshold, "t_wifi: smallest weight w (eq. 6) that is a match",
+      schema::Unit("").Within(0, 1));
+    v("min_rssi_dbm", min_rssi_dbm, "readings weaker than this are ignored", schema::Unit("dBm"));
   }
 };
 

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include "sim/propagation.h"
@@ -271,6 +272,64 @@ TEST(WorldTest, StepBudgetHoldsWithoutASessionGap) {
   const Status status = world.Validate();
   ASSERT_FALSE(status.ok());
   EXPECT_NE(status.message().find("ten million"), std::string::npos) << status.message();
+}
+
+}  // namespace
+}  // namespace ratslam::sim
+
+namespace ratslam::sim {
+namespace {
+
+// Every key a world table declares (world.h) is named in that table's row of configs/README.md,
+// and each rule holds for the built-in worlds.
+TEST(WorldSchemaTest, ReadmeNamesEveryWorldKeyAndBuiltInWorldsKeepTheRules) {
+  std::ifstream in(std::string(RATSLAM_SOURCE_DIR) + "/configs/README.md");
+  ASSERT_TRUE(in);
+  std::map<std::string, std::string> rows;  // "[camera]" or "[[walls]]" -> its README row
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("| `[", 0) != 0) continue;
+    rows[line.substr(3, line.find('`', 3) - 3)] = line;
+  }
+  auto documented = [&](const std::string& table, auto item) {
+    ASSERT_TRUE(rows.count(table)) << table << " has no row in configs/README.md";
+    item.VisitFields([&](const char* key, auto&, const char*, const schema::Rule&) {
+      EXPECT_NE(rows[table].find("`" + std::string(key) + "`"), std::string::npos)
+          << table << " " << key << " is not in configs/README.md";
+    });
+  };
+  documented("[[walls]]", Wall());
+  documented("[[access_points]]", AccessPoint());
+  documented("[[disturbances]]", Disturbance());
+  documented("[[people]]", Person());
+  documented("[[routes]]", Route());
+  documented("[[sessions]]", Session());
+  documented("[camera]", CameraSettings());
+  documented("[wifi]", WifiSettings());
+  documented("[compass]", CompassSettings());
+  documented("[odometry]", OdometrySettings());
+  documented("[motion]", MotionSettings());
+  for (const std::string& name : BuiltInWorldNames()) {
+    StatusOr<World> world = BuiltInWorld(name);
+    ASSERT_TRUE(world.ok()) << name << ": " << world.status().message();
+    EXPECT_TRUE(world->Validate().ok()) << name;
+  }
+}
+
+// A rule broken in a world file is reported with its line and a dotted key that names the item.
+TEST(WorldSchemaTest, RuleErrorsNameLineAndItem) {
+  const std::string walls =
+      "[[walls]]\nfrom = [0, 0]\nto = [1, 0]\n[[walls]]\nfrom = [0, 0]\nto = [0, 1]\nfloor = "
+      "5000\n";
+  StatusOr<World> w = ParseWorld(walls, "w.toml");
+  ASSERT_FALSE(w.ok());
+  EXPECT_EQ(w.status().message(), "w.toml:7: walls[1].floor: must be in [-1000, 1000]");
+  StatusOr<World> c = ParseWorld("[camera]\nrate_hz = 0\n", "w.toml");
+  ASSERT_FALSE(c.ok());
+  EXPECT_EQ(c.status().message(), "w.toml:2: camera.rate_hz: must be in (0, 100]");
+  World programmatic = *BuiltInWorld("office");
+  programmatic.wifi.miss_probability = 1.0;
+  EXPECT_EQ(programmatic.Validate().message(), "world: wifi.miss_probability: must be in [0, 1)");
 }
 
 }  // namespace

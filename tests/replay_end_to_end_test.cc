@@ -382,7 +382,7 @@ TEST_F(ReplayEndToEndTest, PrintConfigFailsWithLineNumber) {
   std::ofstream(bad) << "[pose_cells]\n\ndim_theta_cells = \"many\"\n";
   const Result r = RunRatslam("print-config --config " + bad.string(), root_);
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_NE(r.err.find("bad2.toml:3: [pose_cells] dim_theta_cells: expected an integer"),
+  EXPECT_NE(r.err.find("bad2.toml:3: pose_cells.dim_theta_cells: expected an integer"),
             std::string::npos)
       << r.err;
 }

@@ -29,19 +29,7 @@ StatusOr<SplitUnit> SplitUnitFromString(const std::string& name) {
 }
 
 bool EvaluationOptions::IsValid(std::string* error) const {
-  if (!(map_fraction > 0.0 && map_fraction < 1.0)) {
-    if (error) *error = "map_fraction: must be in (0, 1)";
-    return false;
-  }
-  if (!(frame_spacing_m > 0.0)) {
-    if (error) *error = "frame_spacing_m: must be positive";
-    return false;
-  }
-  if (!(image_wifi_max_gap_s >= 0.0)) {
-    if (error) *error = "image_wifi_max_gap_s: must be non-negative";
-    return false;
-  }
-  return true;
+  return schema::CheckFields(*this, error);
 }
 
 SplitNodes SplitEvaluationNodes(const std::vector<EvaluationNode>& nodes,

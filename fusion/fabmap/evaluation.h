@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "common/schema.h"
 #include "common/status.h"
 #include "sensors/dataset/dataset.h"
 
@@ -44,12 +45,16 @@ struct EvaluationOptions {
   void VisitFields(Visitor&& v) {
     v("split", split,
       "one data set for map and queries: split by node, session, or first_session (map = the "
-      "first session, queries = the others)");
-    v("map_fraction", map_fraction, "share of nodes (or sessions) in the map; the rest query");
+      "first session, queries = the others)",
+      schema::Any());
+    v("map_fraction", map_fraction, "share of nodes (or sessions) in the map; the rest query",
+      schema::Unit("").Above(0).Below(1));
     v("frame_spacing_m", frame_spacing_m,
-      "image folders have no positions: frame i is at i * this along its floor");
+      "image folders have no positions: frame i is at i * this along its floor",
+      schema::Unit("m").Positive());
     v("image_wifi_max_gap_s", image_wifi_max_gap_s,
-      "an image is paired with a Wi-Fi scan at most this far in time");
+      "an image is paired with a Wi-Fi scan at most this far in time",
+      schema::Unit("s").NonNegative());
   }
 };
 

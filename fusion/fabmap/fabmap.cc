@@ -8,12 +8,9 @@
 namespace ratslam::fabmap {
 
 bool DetectorModel::IsValid(std::string* error) const {
-  if (!(p_observed_given_exists > 0.0 && p_observed_given_exists < 1.0)) {
-    if (error) *error = "p_observed_given_exists: must be in (0, 1)";
-    return false;
-  }
-  if (!(p_observed_given_absent >= 0.0 && p_observed_given_absent < p_observed_given_exists)) {
-    if (error) *error = "p_observed_given_absent: must be in [0, p_observed_given_exists)";
+  if (!schema::CheckFields(*this, error)) return false;
+  if (!(p_observed_given_absent < p_observed_given_exists)) {
+    if (error) *error = "p_observed_given_absent: must be below p_observed_given_exists";
     return false;
   }
   return true;
@@ -30,17 +27,7 @@ StatusOr<UnknownWorld> UnknownWorldFromString(const std::string& name) {
                        "' (expected mean_field or sampled)");
 }
 
-bool FabmapOptions::IsValid(std::string* error) const {
-  if (!(p_new_place > 0.0 && p_new_place < 1.0)) {
-    if (error) *error = "p_new_place: must be in (0, 1)";
-    return false;
-  }
-  if (!(sample_pseudo_count > 0.0) || !std::isfinite(sample_pseudo_count)) {
-    if (error) *error = "sample_pseudo_count: must be positive and finite";
-    return false;
-  }
-  return true;
-}
+bool FabmapOptions::IsValid(std::string* error) const { return schema::CheckFields(*this, error); }
 
 namespace {
 

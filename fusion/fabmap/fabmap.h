@@ -32,6 +32,7 @@
 #include <string>
 #include <vector>
 
+#include "common/schema.h"
 #include "common/status.h"
 #include "fusion/fabmap/chow_liu.h"
 
@@ -45,9 +46,11 @@ struct DetectorModel {
   template <typename Visitor>
   void VisitFields(Visitor&& v) {
     v("p_observed_given_exists", p_observed_given_exists,
-      "detector model PzGe: p(word seen given it exists at the place)");
+      "detector model PzGe: p(word seen given it exists at the place)",
+      schema::Unit("").Above(0).Below(1));
     v("p_observed_given_absent", p_observed_given_absent,
-      "detector model PzGNe: p(word seen given it is absent at the place)");
+      "detector model PzGNe: p(word seen given it is absent at the place)",
+      schema::Unit("").AtLeast(0).Below(1));
   }
 };
 
@@ -70,11 +73,14 @@ struct FabmapOptions {
   bool IsValid(std::string* error) const;
   template <typename Visitor>
   void VisitFields(Visitor&& v) {
-    v("p_new_place", p_new_place, "prior of the unknown world (eq. 3)");
+    v("p_new_place", p_new_place, "prior of the unknown world (eq. 3)",
+      schema::Unit("").Above(0).Below(1));
     v("unknown_world", unknown_world,
-      "p(Z|unknown place): mean_field (stays calibrated) or sampled (the paper's eq. 3)");
+      "p(Z|unknown place): mean_field (stays calibrated) or sampled (the paper's eq. 3)",
+      schema::Any());
     v("sample_pseudo_count", sample_pseudo_count,
-      "pseudo-count smoothing the unknown-world samples' word marginals");
+      "pseudo-count smoothing the unknown-world samples' word marginals",
+      schema::Unit("").Positive());
   }
 };
 

@@ -36,20 +36,7 @@ bool UsesVision(FabmapMode mode) { return mode != FabmapMode::kWifi; }
 bool UsesWifi(FabmapMode mode) { return mode != FabmapMode::kVision; }
 
 bool LocaliserOptions::IsValid(std::string* error) const {
-  if (max_candidates < 1) {
-    if (error) *error = "max_candidates: must be at least 1";
-    return false;
-  }
-  if (!(candidate_log_margin >= 0.0)) {
-    if (error) *error = "candidate_log_margin: must be non-negative";
-    return false;
-  }
-  if (!(wifi_tree_min_distance_m >= 0.0) || !(wifi_tree_min_interval_s >= 0.0)) {
-    if (error)
-      *error = "wifi_tree_min_distance_m: must be non-negative, as must wifi_tree_min_interval_s";
-    return false;
-  }
-  return true;
+  return schema::CheckFields(*this, error);
 }
 
 Observation Localiser::WifiWords(const Query& query) const {

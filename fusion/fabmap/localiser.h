@@ -25,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "common/schema.h"
 #include "common/status.h"
 #include "fusion/fabmap/chow_liu.h"
 #include "fusion/fabmap/fabmap.h"
@@ -49,14 +50,18 @@ struct LocaliserOptions {
   bool IsValid(std::string* error) const;
   template <typename Visitor>
   void VisitFields(Visitor&& v) {
-    v("mode", mode, "vision, wifi, early, late, wifi_guided or wifi_check (paper section 4)");
-    v("max_candidates", max_candidates, "Wi-Fi candidates at most, for sequential fusion");
+    v("mode", mode, "vision, wifi, early, late, wifi_guided or wifi_check (paper section 4)",
+      schema::Any());
+    v("max_candidates", max_candidates, "Wi-Fi candidates at most, for sequential fusion",
+      schema::Unit("places").AtLeast(1));
     v("candidate_log_margin", candidate_log_margin,
-      "a place within this many nats of the best Wi-Fi likelihood is a candidate");
+      "a place within this many nats of the best Wi-Fi likelihood is a candidate",
+      schema::Unit("nats").NonNegative());
     v("wifi_tree_min_distance_m", wifi_tree_min_distance_m,
-      "Wi-Fi tree: a scan is used only this far (travel) from the previously used one");
+      "Wi-Fi tree: a scan is used only this far (travel) from the previously used one",
+      schema::Unit("m").NonNegative());
     v("wifi_tree_min_interval_s", wifi_tree_min_interval_s,
-      "Wi-Fi tree: and only this long after it");
+      "Wi-Fi tree: and only this long after it", schema::Unit("s").NonNegative());
   }
 };
 

@@ -13,11 +13,7 @@
 namespace ratslam::fabmap {
 
 bool VisualModelOptions::IsValid(std::string* error) const {
-  if (training_image_step < 1) {
-    if (error) *error = "training_image_step: must be at least 1";
-    return false;
-  }
-  return true;
+  return schema::CheckFields(*this, error);
 }
 
 StatusOr<std::vector<std::string>> ListImages(const std::string& folder) {

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "common/schema.h"
 #include "common/status.h"
 #include "fusion/fabmap/localiser.h"
 #include "fusion/fabmap/vocabulary.h"
@@ -23,10 +24,12 @@ struct VisualModelOptions {
   bool IsValid(std::string* error) const;
   template <typename Visitor>
   void VisitFields(Visitor&& v) {
-    v("file", file, "saved visual model (vocabulary, tree, samples); empty: train one");
+    v("file", file, "saved visual model (vocabulary, tree, samples); empty: train one",
+      schema::Any());
     v("training_images", training_images,
-      "folder of training images (searched recursively), used when file is empty");
-    v("training_image_step", training_image_step, "every n-th training image is used");
+      "folder of training images (searched recursively), used when file is empty", schema::Any());
+    v("training_image_step", training_image_step, "every n-th training image is used",
+      schema::Unit("images").AtLeast(1));
   }
 };
 

@@ -21,32 +21,10 @@ StatusOr<DescriptorKind> DescriptorKindFromString(const std::string& name) {
   return Status::Error("unknown descriptor '" + name + "' (expected orb or sift)");
 }
 
-bool FeatureOptions::IsValid(std::string* error) const {
-  if (max_features < 1) {
-    if (error) *error = "max_features: must be at least 1";
-    return false;
-  }
-  if (fast_threshold < 1 || fast_threshold > 255) {
-    if (error) *error = "fast_threshold: must be in 1..255";
-    return false;
-  }
-  return true;
-}
+bool FeatureOptions::IsValid(std::string* error) const { return schema::CheckFields(*this, error); }
 
 bool VocabularyOptions::IsValid(std::string* error) const {
-  if (words < 1) {
-    if (error) *error = "words: must be at least 1";
-    return false;
-  }
-  if (iterations < 1) {
-    if (error) *error = "iterations: must be at least 1";
-    return false;
-  }
-  if (max_descriptors < 1) {
-    if (error) *error = "max_descriptors: must be at least 1";
-    return false;
-  }
-  return true;
+  return schema::CheckFields(*this, error);
 }
 
 Status DescriptorSet::Append(const DescriptorSet& other) {

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "common/schema.h"
 #include "common/status.h"
 #include "fusion/fabmap/chow_liu.h"
 #include "sensors/dataset/image_loader.h"
@@ -31,9 +32,11 @@ struct FeatureOptions {
   bool IsValid(std::string* error) const;
   template <typename Visitor>
   void VisitFields(Visitor&& v) {
-    v("descriptor", descriptor, "orb (FAST + ORB, binary) or sift (float)");
-    v("max_features", max_features, "strongest features kept per image");
-    v("fast_threshold", fast_threshold, "FAST corner threshold (orb only)");
+    v("descriptor", descriptor, "orb (FAST + ORB, binary) or sift (float)", schema::Any());
+    v("max_features", max_features, "strongest features kept per image",
+      schema::Unit("features").AtLeast(1));
+    v("fast_threshold", fast_threshold, "FAST corner threshold (orb only)",
+      schema::Unit("").Within(1, 255));
   }
 };
 
@@ -61,10 +64,11 @@ struct VocabularyOptions {
   bool IsValid(std::string* error) const;
   template <typename Visitor>
   void VisitFields(Visitor&& v) {
-    v("words", words, "visual vocabulary size");
-    v("iterations", iterations, "clustering iterations");
-    v("seed", seed, "seed of the initial centres");
-    v("max_descriptors", max_descriptors, "a seeded subsample of descriptors above this count");
+    v("words", words, "visual vocabulary size", schema::Unit("words").AtLeast(1));
+    v("iterations", iterations, "clustering iterations", schema::Unit("").AtLeast(1));
+    v("seed", seed, "seed of the initial centres", schema::Any());
+    v("max_descriptors", max_descriptors, "a seeded subsample of descriptors above this count",
+      schema::Unit("descriptors").AtLeast(1));
   }
 };
 

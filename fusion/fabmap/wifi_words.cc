@@ -19,12 +19,8 @@ StatusOr<WifiEncoding> WifiEncodingFromString(const std::string& name) {
 }
 
 bool WifiWordOptions::IsValid(std::string* error) const {
-  if (bins < 1 || bins > 256) {
-    if (error) *error = "bins: must be in 1..256";
-    return false;
-  }
-  if (!(min_rssi_dbm < max_rssi_dbm) || !std::isfinite(min_rssi_dbm) ||
-      !std::isfinite(max_rssi_dbm)) {
+  if (!schema::CheckFields(*this, error)) return false;
+  if (!(min_rssi_dbm < max_rssi_dbm)) {
     if (error) *error = "min_rssi_dbm: must be below max_rssi_dbm";
     return false;
   }
@@ -32,15 +28,7 @@ bool WifiWordOptions::IsValid(std::string* error) const {
 }
 
 bool VirtualSampleOptions::IsValid(std::string* error) const {
-  if (samples < 1) {
-    if (error) *error = "samples: must be at least 1";
-    return false;
-  }
-  if (!(p_known >= 0.0 && p_known <= 1.0)) {
-    if (error) *error = "p_known: must be in [0, 1]";
-    return false;
-  }
-  return true;
+  return schema::CheckFields(*this, error);
 }
 
 void WifiVocabulary::AddAccessPoints(const std::vector<WifiReading>& readings) {

@@ -19,6 +19,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "common/schema.h"
 #include "common/status.h"
 #include "fusion/fabmap/chow_liu.h"
 #include "sensors/dataset/dataset.h"
@@ -38,10 +39,12 @@ struct WifiWordOptions {
   bool IsValid(std::string* error) const;
   template <typename Visitor>
   void VisitFields(Visitor&& v) {
-    v("bins", bins, "b: words per access point (1 = presence only)");
-    v("encoding", encoding, "exclusive (one bin set) or incremental (all bins up to the level)");
-    v("min_rssi_dbm", min_rssi_dbm, "usable RSSI range ]min, max], dBm");
-    v("max_rssi_dbm", max_rssi_dbm, "usable RSSI range ]min, max], dBm");
+    v("bins", bins, "b: words per access point (1 = presence only)",
+      schema::Unit("words").Within(1, 256));
+    v("encoding", encoding, "exclusive (one bin set) or incremental (all bins up to the level)",
+      schema::Any());
+    v("min_rssi_dbm", min_rssi_dbm, "usable RSSI range ]min, max], dBm", schema::Unit("dBm"));
+    v("max_rssi_dbm", max_rssi_dbm, "usable RSSI range ]min, max], dBm", schema::Unit("dBm"));
   }
 };
 
@@ -82,11 +85,13 @@ struct VirtualSampleOptions {
   bool IsValid(std::string* error) const;
   template <typename Visitor>
   void VisitFields(Visitor&& v) {
-    v("samples", samples, "n_s: virtual Wi-Fi samples for the unknown world (section 3.3)");
-    v("p_known", p_known, "chance that a simulated access point is a known one");
-    v("seed", seed, "seed of the virtual samples");
+    v("samples", samples, "n_s: virtual Wi-Fi samples for the unknown world (section 3.3)",
+      schema::Unit("scans").AtLeast(1));
+    v("p_known", p_known, "chance that a simulated access point is a known one",
+      schema::Unit("").Within(0, 1));
+    v("seed", seed, "seed of the virtual samples", schema::Any());
     v("use_exploration_scans", use_exploration_scans,
-      "the unknown world is the exploration scans themselves, not virtual samples");
+      "the unknown world is the exploration scans themselves, not virtual samples", schema::Any());
   }
 };
 

@@ -10,164 +10,44 @@
 #include <map>
 #include <set>
 #include <sstream>
-#include <type_traits>
 
 #include "common/text_file.h"
-#include "common/toml_string.h"
+#include "common/toml_binder.h"
 
 namespace ratslam {
 namespace {
 
 constexpr size_t kMaxConfigBytes = 1 << 20;  // a config is a few kB; a megabyte is not a config
 
-std::string Location(const std::string& source, const toml::node* node) {
-  return source + ":" + (node ? std::to_string(node->source().begin.line) : std::string("?"));
-}
+using schema::TomlWhere;
 
-// Reads the fields of one options struct from a TOML table.
-class SectionReader {
- public:
-  SectionReader(const toml::table& table, std::string section, std::string source)
-      : table_(table), section_(std::move(section)), source_(std::move(source)) {}
+}  // namespace
+}  // namespace ratslam
 
-  template <typename T>
-  void operator()(const char* key, T& field, const char* /*doc*/) {
-    if (!status_.ok()) return;
-    const toml::node* node = table_.get(key);
-    if (!node) return;
-    used_.insert(key);
-    Status s = Assign(*node, field);
-    if (!s.ok()) {
-      status_ = Status::Error(Location(source_, node) + ": [" + section_ + "] " + key + ": " +
-                              s.message());
-    }
-  }
-
-  Status Finish() const {
-    if (!status_.ok()) return status_;
-    for (const auto& [key, node] : table_) {
-      if (!used_.count(std::string(key.str()))) {
-        return Status::Error(Location(source_, &node) + ": unknown key '" + std::string(key.str()) +
-                             "' in [" + section_ + "]");
-      }
-    }
-    return Status::Ok();
-  }
-
- private:
-  static Status Assign(const toml::node& node, int& field) {
-    const auto* v = node.as_integer();
-    if (!v) return Status::Error("expected an integer");
-    const int64_t value = v->get();
-    if (value < std::numeric_limits<int>::min() || value > std::numeric_limits<int>::max()) {
-      return Status::Error("integer out of range");
-    }
-    field = static_cast<int>(value);
-    return Status::Ok();
-  }
-  static Status Assign(const toml::node& node, double& field) {
-    if (const auto* f = node.as_floating_point()) {
-      if (!std::isfinite(f->get())) return Status::Error("must be a finite number");
-      field = f->get();
-    } else if (const auto* i = node.as_integer()) {
-      field = static_cast<double>(i->get());
-    } else {
-      return Status::Error("expected a number");
-    }
-    return Status::Ok();
-  }
-  static Status Assign(const toml::node& node, bool& field) {
-    const auto* b = node.as_boolean();
-    if (!b) return Status::Error("expected true or false");
-    field = b->get();
-    return Status::Ok();
-  }
-  static Status Assign(const toml::node& node, uint64_t& field) {
-    const auto* v = node.as_integer();
-    if (!v) return Status::Error("expected an integer");
-    if (v->get() < 0) return Status::Error("must not be negative");
-    field = static_cast<uint64_t>(v->get());
-    return Status::Ok();
-  }
-  static Status Assign(const toml::node& node, std::string& field) {
-    const auto* s = node.as_string();
-    if (!s) return Status::Error("expected a string");
-    field = s->get();
-    return Status::Ok();
-  }
-  template <typename Enum, typename Parse>
-  static Status AssignEnum(const toml::node& node, Enum& field, Parse parse) {
-    const auto* s = node.as_string();
-    if (!s) return Status::Error("expected a string");
-    auto value = parse(s->get());
-    if (!value.ok()) return value.status();
-    field = value.value();
-    return Status::Ok();
-  }
-  static Status Assign(const toml::node& node, fabmap::FabmapMode& field) {
-    return AssignEnum(node, field, fabmap::FabmapModeFromString);
-  }
-  static Status Assign(const toml::node& node, fabmap::UnknownWorld& field) {
-    return AssignEnum(node, field, fabmap::UnknownWorldFromString);
-  }
-  static Status Assign(const toml::node& node, fabmap::DescriptorKind& field) {
-    return AssignEnum(node, field, fabmap::DescriptorKindFromString);
-  }
-  static Status Assign(const toml::node& node, fabmap::WifiEncoding& field) {
-    return AssignEnum(node, field, fabmap::WifiEncodingFromString);
-  }
-  static Status Assign(const toml::node& node, fabmap::SplitUnit& field) {
-    return AssignEnum(node, field, fabmap::SplitUnitFromString);
-  }
-  static Status Assign(const toml::node& node, WifiLearning& field) {
-    return AssignEnum(node, field, WifiLearningFromString);
-  }
-  static Status Assign(const toml::node& node, FrontEndKind& field) {
-    const auto* s = node.as_string();
-    if (!s) return Status::Error("expected a string");
-    StatusOr<FrontEndKind> kind = FrontEndKindFromString(s->get());
-    if (!kind.ok()) return kind.status();
-    field = kind.value();
-    return Status::Ok();
-  }
-
-  const toml::table& table_;
-  std::string section_;
-  std::string source_;
-  std::set<std::string> used_;
-  Status status_;
+// The enums of the configuration, read and printed by their names.
+namespace ratslam::schema {
+template <>
+struct TomlCodec<fabmap::FabmapMode> : EnumCodec<fabmap::FabmapMode, fabmap::FabmapModeFromString> {
 };
+template <>
+struct TomlCodec<fabmap::UnknownWorld>
+    : EnumCodec<fabmap::UnknownWorld, fabmap::UnknownWorldFromString> {};
+template <>
+struct TomlCodec<fabmap::DescriptorKind>
+    : EnumCodec<fabmap::DescriptorKind, fabmap::DescriptorKindFromString> {};
+template <>
+struct TomlCodec<fabmap::WifiEncoding>
+    : EnumCodec<fabmap::WifiEncoding, fabmap::WifiEncodingFromString> {};
+template <>
+struct TomlCodec<fabmap::SplitUnit> : EnumCodec<fabmap::SplitUnit, fabmap::SplitUnitFromString> {};
+template <>
+struct TomlCodec<WifiLearning> : EnumCodec<WifiLearning, WifiLearningFromString> {};
+template <>
+struct TomlCodec<FrontEndKind> : EnumCodec<FrontEndKind, FrontEndKindFromString> {};
+}  // namespace ratslam::schema
 
-std::string FormatDouble(double value) {
-  char buffer[64];
-  const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
-  std::string text(buffer, result.ptr);
-  if (text.find_first_of(".eEn") == std::string::npos) text += ".0";  // keep it a TOML float
-  return text;
-}
-
-class SectionPrinter {
- public:
-  SectionPrinter(std::ostringstream& out, bool comments) : out_(out), comments_(comments) {}
-  template <typename T>
-  void operator()(const char* key, T& field, const char* doc) {
-    if (comments_) out_ << "# " << doc << "\n";
-    out_ << key << " = " << Format(field) << "\n";
-  }
-
- private:
-  static std::string Format(int v) { return std::to_string(v); }
-  static std::string Format(double v) { return FormatDouble(v); }
-  static std::string Format(bool v) { return v ? "true" : "false"; }
-  static std::string Format(uint64_t v) { return std::to_string(v); }
-  static std::string Format(const std::string& v) { return TomlQuoted(v); }
-  template <typename Enum>
-  static std::string Format(Enum v) requires std::is_enum_v<Enum> {
-    return Format(ToString(v));
-  }
-  std::ostringstream& out_;
-  bool comments_;
-};
+namespace ratslam {
+namespace {
 
 // Line of `section.key` in the parsed file, for validity errors found after reading.
 std::string LocateField(const toml::table& root, const std::string& source,
@@ -180,19 +60,15 @@ std::string LocateField(const toml::table& root, const std::string& source,
   const toml::table* table = root[section].as_table();
   if (!table) return source;
   const toml::node* node = table->get(key);
-  return Location(source, node ? node : table);
+  return TomlWhere(source, node ? node : table);
 }
 
 }  // namespace
 
 StatusOr<PipelineOptions> ParseConfig(const std::string& text, const std::string& source_name) {
-  toml::table root;
-  try {
-    root = toml::parse(text, source_name);
-  } catch (const toml::parse_error& e) {
-    return Status::Error(source_name + ":" + std::to_string(e.source().begin.line) + ": " +
-                         std::string(e.description()));
-  }
+  StatusOr<toml::table> parsed = schema::ParseToml(text, source_name);
+  if (!parsed.ok()) return parsed.status();
+  const toml::table& root = *parsed;
   PipelineOptions options;
   std::set<std::string> sections;
   Status status;
@@ -203,18 +79,20 @@ StatusOr<PipelineOptions> ParseConfig(const std::string& text, const std::string
     if (!node) return;
     const toml::table* table = node->as_table();
     if (!table) {
-      status = Status::Error(Location(source_name, node) + ": [" + name + "] must be a table");
+      status = Status::Error(TomlWhere(source_name, node) + ": [" + name + "] must be a table");
       return;
     }
-    SectionReader reader(*table, name, source_name);
-    section.VisitFields(reader);
-    status = reader.Finish();
+    schema::TableBinder binder(*table, "[" + std::string(name) + "]", std::string(name) + ".",
+                               source_name);
+    section.VisitFields(binder);
+    status = binder.Finish();
   });
   if (!status.ok()) return status;
   for (const auto& [key, node] : root) {
-    if (!sections.count(std::string(key.str()))) {
-      return Status::Error(Location(source_name, &node) + ": unknown section '" +
-                           std::string(key.str()) + "'");
+    const std::string name(key.str());
+    if (!sections.count(name)) {
+      return Status::Error(TomlWhere(source_name, &node) + ": unknown section '" + name + "'" +
+                           schema::DidYouMean(name, sections));
     }
   }
   std::string error;
@@ -238,7 +116,7 @@ std::string PrintConfig(const PipelineOptions& options, bool comments) {
     if (!first) out << "\n";
     first = false;
     out << "[" << name << "]\n";
-    SectionPrinter printer(out, comments);
+    schema::TablePrinter printer(out, comments);
     section.VisitFields(printer);
   });
   return out.str();

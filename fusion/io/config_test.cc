@@ -46,18 +46,23 @@ TEST(ConfigTest, ReadsValuesAndAcceptsIntegersForReals) {
 
 TEST(ConfigTest, UnknownKeyNamesLine) {
   EXPECT_EQ(ErrorOf("[pose_cells]\ndim_xy_cells = 30\ndim_xy_cell = 3\n"),
-            "c.toml:3: unknown key 'dim_xy_cell' in [pose_cells]");
+            "c.toml:3: unknown key 'dim_xy_cell' in [pose_cells] (did you mean 'dim_xy_cells'?)");
+  // Nothing close: no suggestion.
+  EXPECT_EQ(ErrorOf("[pose_cells]\nbanana = 3\n"),
+            "c.toml:2: unknown key 'banana' in [pose_cells]");
 }
 
 TEST(ConfigTest, UnknownSectionNamesLine) {
-  EXPECT_EQ(ErrorOf("\n[posecells]\nx = 1\n"), "c.toml:2: unknown section 'posecells'");
+  EXPECT_EQ(ErrorOf("\n[posecells]\nx = 1\n"),
+            "c.toml:2: unknown section 'posecells' (did you mean 'pose_cells'?)");
+  EXPECT_EQ(ErrorOf("[zebra]\nx = 1\n"), "c.toml:1: unknown section 'zebra'");
 }
 
 TEST(ConfigTest, WrongTypeNamesLineAndKey) {
   EXPECT_EQ(ErrorOf("[experience_map]\n\nrelaxation_sweeps = 2.5\n"),
-            "c.toml:3: [experience_map] relaxation_sweeps: expected an integer");
+            "c.toml:3: experience_map.relaxation_sweeps: expected an integer");
   EXPECT_EQ(ErrorOf("[camera]\npanoramic = 1\n"),
-            "c.toml:2: [camera] panoramic: expected true or false");
+            "c.toml:2: camera.panoramic: expected true or false");
 }
 
 TEST(ConfigTest, OutOfRangeValueNamesLine) {

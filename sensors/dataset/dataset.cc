@@ -12,7 +12,7 @@
 #include "common/circular.h"
 #include "common/file_util.h"
 #include "common/text_file.h"
-#include "common/toml_string.h"
+#include "common/toml_binder.h"
 #include "sensors/dataset/csv.h"
 
 namespace ratslam {
@@ -20,6 +20,41 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr int kFormatVersion = 1;
+
+// The manifest's keys, bound by the common TOML binder (common/toml_binder.h). Streams are
+// optional except odometry; a stream that is named must be a path inside the data-set folder.
+struct ManifestStreams {
+  std::string odometry, images, image_folder, ground_truth, wifi, compass;
+
+  template <typename V>
+  void VisitFields(V&& v) {
+    const schema::Rule file = schema::Any().RelativePath();
+    v("odometry", odometry, "odometry CSV: time_s, forward_speed_m_per_s, turn_rate_rad_per_s",
+      file);
+    v("images", images, "image list CSV: time_s, file", file);
+    v("image_folder", image_folder, "folder the image list's files are in", file);
+    v("ground_truth", ground_truth, "ground truth CSV: time_s, x_m, y_m, theta_rad, floor", file);
+    v("wifi", wifi, "Wi-Fi CSV: time_s, bssid, rssi_dbm", file);
+    v("compass", compass, "compass CSV: time_s, heading_rad", file);
+  }
+};
+
+struct Manifest {
+  std::string format;
+  int format_version = 0;
+  std::string name;
+  std::vector<double> session_start_times_s;
+
+  template <typename V>
+  void VisitFields(V&& v) {
+    v("format", format, "always \"ratslam-replay\"", schema::Any());
+    v("format_version", format_version, "version of this format", schema::Any());
+    v("name", name, "the data set's name (default: its folder's)", schema::Any());
+    v("session_start_times_s", session_start_times_s,
+      "times at which the sessions of a multi-session data set start",
+      schema::Unit("s").NonNegative().Increasing());
+  }
+};
 
 // Fails when a time is negative or goes backwards between consecutive rows.
 Status CheckTimeOrder(const CsvTable& table, size_t row, double previous, double current) {
@@ -148,80 +183,50 @@ StatusOr<Dataset> ReadDataset(const std::string& folder) {
   if (!fs::exists(manifest_path)) return Status::Error(manifest_path + ": missing manifest");
   StatusOr<std::string> manifest_text = ReadRegularFile(manifest_path, "manifest", 1 << 20);
   if (!manifest_text.ok()) return manifest_text.status();
-  toml::table manifest;
-  try {
-    manifest = toml::parse(*manifest_text, manifest_path);
-  } catch (const toml::parse_error& e) {
-    return Status::Error(manifest_path + ":" + std::to_string(e.source().begin.line) + ": " +
-                         std::string(e.description()));
+  StatusOr<toml::table> parsed = schema::ParseToml(*manifest_text, manifest_path);
+  if (!parsed.ok()) return parsed.status();
+  Manifest manifest;
+  ManifestStreams streams;
+  schema::TableBinder top(*parsed, "the manifest", "", manifest_path);
+  manifest.VisitFields(top);
+  const toml::table* streams_table = top.Table("streams");
+  RATSLAM_RETURN_IF_ERROR(top.Finish());
+  if (manifest.format != "ratslam-replay") {
+    return Status::Error(schema::TomlWhere(manifest_path, parsed->get("format")) +
+                         ": format must be \"ratslam-replay\"");
   }
-  auto error_at = [&](const toml::node* node, const std::string& message) {
-    const int line = node ? static_cast<int>(node->source().begin.line) : 0;
-    return Status::Error(manifest_path + ":" + std::to_string(line) + ": " + message);
-  };
+  if (manifest.format_version != kFormatVersion) {
+    return Status::Error(schema::TomlWhere(manifest_path, parsed->get("format_version")) +
+                         ": unsupported format_version (this program reads " +
+                         std::to_string(kFormatVersion) + ")");
+  }
+  if (!streams_table) return Status::Error(manifest_path + ": missing [streams] table");
+  schema::TableBinder stream_binder(*streams_table, "[streams]", "streams.", manifest_path);
+  streams.VisitFields(stream_binder);
+  RATSLAM_RETURN_IF_ERROR(stream_binder.Finish());
+  if (streams.odometry.empty()) {
+    return Status::Error(schema::TomlWhere(manifest_path, streams_table) +
+                         ": streams.odometry is required");
+  }
   Dataset d;
   d.folder = folder;
-  static const std::vector<std::string> kTopKeys = {"format", "format_version", "name", "streams",
-                                                    "session_start_times_s"};
-  static const std::vector<std::string> kStreams = {"odometry",     "images", "image_folder",
-                                                    "ground_truth", "wifi",   "compass"};
-  for (const auto& [key, node] : manifest) {
-    if (std::find(kTopKeys.begin(), kTopKeys.end(), key.str()) == kTopKeys.end()) {
-      return error_at(&node, "unknown key '" + std::string(key.str()) + "'");
-    }
-  }
-  if (manifest["format"].value_or(std::string()) != "ratslam-replay") {
-    return error_at(manifest.get("format"), "format must be \"ratslam-replay\"");
-  }
-  if (manifest["format_version"].value_or(0) != kFormatVersion) {
-    return error_at(
-        manifest.get("format_version"),
-        "unsupported format_version (this program reads " + std::to_string(kFormatVersion) + ")");
-  }
-  d.name = manifest["name"].value_or(fs::path(folder).filename().string());
-  if (const toml::node* starts = manifest.get("session_start_times_s")) {
-    const toml::array* list = starts->as_array();
-    if (!list) return error_at(starts, "session_start_times_s must be a list of times");
-    for (const auto& t : *list) {
-      const std::optional<double> v = t.value<double>();
-      if (!v || !std::isfinite(*v) ||
-          (!d.session_start_times_s.empty() && *v < d.session_start_times_s.back())) {
-        return error_at(&t, "session_start_times_s must be increasing finite times");
-      }
-      d.session_start_times_s.push_back(*v);
-    }
-  }
-  const toml::table* streams = manifest["streams"].as_table();
-  if (!streams) return error_at(nullptr, "missing [streams] table");
-  std::map<std::string, std::string> files;
-  for (const auto& [key, node] : *streams) {
-    if (std::find(kStreams.begin(), kStreams.end(), key.str()) == kStreams.end()) {
-      return error_at(&node, "unknown stream '" + std::string(key.str()) + "'");
-    }
-    if (!node.is_string()) return error_at(&node, std::string(key.str()) + " must be a string");
-    const std::string file = *node.value<std::string>();
-    // Streams live inside the data-set folder: no absolute paths, no way out through "..".
-    const fs::path relative(file);
-    if (file.empty() || relative.is_absolute() ||
-        std::any_of(relative.begin(), relative.end(),
-                    [](const fs::path& p) { return p == ".."; })) {
-      return error_at(
-          &node, std::string(key.str()) + " must be a relative path inside the data-set folder");
-    }
-    files[std::string(key.str())] = file;
-  }
-  if (!files.count("odometry")) return error_at(streams, "streams.odometry is required");
-  if (files.count("image_folder")) d.image_folder = files["image_folder"];
+  d.name = parsed->contains("name") ? manifest.name : fs::path(folder).filename().string();
+  d.session_start_times_s = manifest.session_start_times_s;
+  if (!streams.image_folder.empty()) d.image_folder = streams.image_folder;
+  const std::map<std::string, std::string> files = {{"odometry", streams.odometry},
+                                                    {"images", streams.images},
+                                                    {"ground_truth", streams.ground_truth},
+                                                    {"wifi", streams.wifi},
+                                                    {"compass", streams.compass}};
   auto path_of = [&](const std::string& stream) {
-    return (fs::path(folder) / files[stream]).string();
+    return (fs::path(folder) / files.at(stream)).string();
   };
+  auto named = [&](const std::string& stream) { return !files.at(stream).empty(); };
   RATSLAM_RETURN_IF_ERROR(ReadOdometry(path_of("odometry"), &d));
-  if (files.count("images")) RATSLAM_RETURN_IF_ERROR(ReadImages(path_of("images"), &d));
-  if (files.count("ground_truth")) {
-    RATSLAM_RETURN_IF_ERROR(ReadGroundTruth(path_of("ground_truth"), &d));
-  }
-  if (files.count("wifi")) RATSLAM_RETURN_IF_ERROR(ReadWifi(path_of("wifi"), &d));
-  if (files.count("compass")) RATSLAM_RETURN_IF_ERROR(ReadCompass(path_of("compass"), &d));
+  if (named("images")) RATSLAM_RETURN_IF_ERROR(ReadImages(path_of("images"), &d));
+  if (named("ground_truth")) RATSLAM_RETURN_IF_ERROR(ReadGroundTruth(path_of("ground_truth"), &d));
+  if (named("wifi")) RATSLAM_RETURN_IF_ERROR(ReadWifi(path_of("wifi"), &d));
+  if (named("compass")) RATSLAM_RETURN_IF_ERROR(ReadCompass(path_of("compass"), &d));
   return d;
 }
 

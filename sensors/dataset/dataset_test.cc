@@ -107,7 +107,35 @@ TEST_F(DatasetTest, MissingStreamFileAndUnknownManifestKey) {
         "format = \"ratslam-replay\"\nformat_version = 1\n[streams]\nodometry = \"odometry.csv\"\n"
         "odometer = \"x.csv\"\n");
   const std::string error = ReadError();
-  EXPECT_NE(error.find("manifest.toml:5: unknown stream 'odometer'"), std::string::npos) << error;
+  EXPECT_NE(
+      error.find("manifest.toml:5: unknown key 'odometer' in [streams] (did you mean 'odometry'?)"),
+      std::string::npos)
+      << error;
+}
+
+// The manifest goes through the same binder as configs and worlds: every error names the line and
+// the key, in the same words.
+TEST_F(DatasetTest, ManifestErrorsNameLineAndKey) {
+  const std::string head = "format = \"ratslam-replay\"\nformat_version = 1\n";
+  const std::string streams = "[streams]\nodometry = \"odometry.csv\"\n";
+  Write("manifest.toml", head + "session_start_times_s = [0.0, 10.0, 5.0]\n" + streams);
+  EXPECT_NE(ReadError().find("manifest.toml:3: session_start_times_s: must be increasing"),
+            std::string::npos)
+      << ReadError();
+  Write("manifest.toml", head + "session_start_times_s = [-1.0]\n" + streams);
+  EXPECT_NE(ReadError().find("manifest.toml:3: session_start_times_s: element 0: must be zero or "
+                             "more"),
+            std::string::npos)
+      << ReadError();
+  Write("manifest.toml", head + "name = 3\n" + streams);
+  EXPECT_NE(ReadError().find("manifest.toml:3: name: expected a string"), std::string::npos)
+      << ReadError();
+  Write("manifest.toml", "format = \"ratslam-replay\"\nformat_version = 2\n" + streams);
+  EXPECT_NE(ReadError().find("manifest.toml:2: unsupported format_version"), std::string::npos)
+      << ReadError();
+  Write("manifest.toml", head + "[streams]\nwifi = \"wifi.csv\"\n");
+  EXPECT_NE(ReadError().find("manifest.toml:3: streams.odometry is required"), std::string::npos)
+      << ReadError();
 }
 
 // A manifest is untrusted: streams must be regular files inside the data-set folder. These once
@@ -116,11 +144,12 @@ TEST_F(DatasetTest, StreamsOutsideTheFolderOrNotRegularFilesAreRefused) {
   const std::string head =
       "format = \"ratslam-replay\"\nformat_version = 1\n[streams]\nodometry = ";
   Write("manifest.toml", head + "\"/dev/zero\"\n");
-  EXPECT_NE(ReadError().find("must be a relative path inside the data-set folder"),
+  EXPECT_NE(ReadError().find("streams.odometry: must be a relative path inside the folder"),
             std::string::npos);
   Write("manifest.toml", head + "\"../../etc/passwd\"\n");
   const std::string escape = ReadError();
-  EXPECT_NE(escape.find("manifest.toml:4: odometry must be a relative path"), std::string::npos)
+  EXPECT_NE(escape.find("manifest.toml:4: streams.odometry: must be a relative path"),
+            std::string::npos)
       << escape;
   EXPECT_EQ(escape.find("root"), std::string::npos) << escape;
   fs::create_symlink("/dev/zero", folder_ / "zero.csv");
