@@ -61,56 +61,6 @@ bool ParseDouble(const std::string& text, double* value) {
 
 }  // namespace
 
-Status OpenPhoneLog(const std::string& path, const PhoneLogOptions& options, std::ifstream* in) {
-  std::string pdr_error;
-  if (!options.pdr.IsValid(&pdr_error)) return Status::Error("pdr." + pdr_error);
-  return OpenRegularFile(path, "log file", in);
-}
-
-Status ReadPhoneLogLine(std::istream& in, const std::string& path, int number, std::string* line,
-                        bool* more) {
-  const LineResult result = ReadLine(in, line);
-  *more = result != LineResult::kEnd;
-  if (result == LineResult::kTooLong) {
-    return Status::Error(path + ":" + std::to_string(number + 1) + ": line longer than " +
-                         std::to_string(kMaxLineBytes) + " bytes");
-  }
-  return Status::Ok();
-}
-
-Dataset AssemblePhoneDataset(PhoneLogStreams streams, const std::string& name,
-                             const PhoneLogOptions& options, double start_time_s,
-                             PhoneLogReport* report) {
-  auto by_time = [](const auto& a, const auto& b) { return a.time_s < b.time_s; };
-  std::stable_sort(streams.accelerometer.begin(), streams.accelerometer.end(), by_time);
-  std::stable_sort(streams.headings.begin(), streams.headings.end(), by_time);
-  std::stable_sort(streams.ground_truth.begin(), streams.ground_truth.end(), by_time);
-  Dataset d;
-  d.name = name;
-  const std::vector<Step> steps =
-      PedestrianDeadReckoning(streams.accelerometer, streams.headings, options.pdr);
-  if (report) report->steps = steps.size();
-  d.odometry = StepsToOdometry(steps, start_time_s);
-  for (auto& [time, readings] : streams.scans) d.wifi.push_back({time, std::move(readings)});
-  double last_compass = -std::numeric_limits<double>::infinity();
-  for (const HeadingSample& h : streams.headings) {
-    if (h.time_s - last_compass >= 1.0 / options.compass_rate_hz) {
-      d.compass.push_back({h.time_s, h.heading_rad});
-      last_compass = h.time_s;
-    }
-  }
-  d.ground_truth = std::move(streams.ground_truth);
-  // Heading of the ground truth: the direction of travel towards the next point (the last point
-  // keeps the direction from its predecessor).
-  for (size_t i = 0; i < d.ground_truth.size(); ++i) {
-    const size_t from = i + 1 < d.ground_truth.size() ? i : (i > 0 ? i - 1 : i);
-    const size_t to = i + 1 < d.ground_truth.size() ? i + 1 : i;
-    d.ground_truth[i].theta_rad = std::atan2(d.ground_truth[to].y_m - d.ground_truth[from].y_m,
-                                             d.ground_truth[to].x_m - d.ground_truth[from].x_m);
-  }
-  return d;
-}
-
 void GeoToLocal(const GeoReference& reference, double latitude_deg, double longitude_deg,
                 double* x_m, double* y_m) {
   const double to_rad = std::numbers::pi / 180.0;
@@ -119,25 +69,10 @@ void GeoToLocal(const GeoReference& reference, double latitude_deg, double longi
   *y_m = kEarthRadiusM * (latitude_deg - reference.latitude_deg) * to_rad;
 }
 
-std::vector<OdometryRow> StepsToOdometry(const std::vector<Step>& steps, double start_time_s) {
-  std::vector<OdometryRow> rows;
-  rows.push_back({start_time_s, 0.0, 0.0});
-  double previous_time = start_time_s;
-  double previous_heading = steps.empty() ? 0.0 : steps.front().heading_rad;
-  for (const Step& s : steps) {
-    const double dt = s.time_s - previous_time;
-    if (dt <= 0.0) continue;  // a step at the start time carries no usable interval
-    rows.push_back({s.time_s, s.length_m / dt, WrapAngle(s.heading_rad - previous_heading) / dt});
-    previous_time = s.time_s;
-    previous_heading = s.heading_rad;
-  }
-  return rows;
-}
-
-StatusOr<Dataset> ReadIpinLog(const std::string& path, const PhoneLogOptions& options,
-                              PhoneLogReport* report) {
+StatusOr<PhoneLog> ParseIpinLog(const std::string& path, const PhoneLogOptions& options,
+                                PhoneLogReport* report) {
   std::ifstream in;
-  RATSLAM_RETURN_IF_ERROR(OpenPhoneLog(path, options, &in));
+  RATSLAM_RETURN_IF_ERROR(OpenPhoneLog(path, &in));
   PhoneLogReport local_report;
   PhoneLogReport& r = report ? *report : local_report;
   r = PhoneLogReport();
@@ -244,9 +179,7 @@ StatusOr<Dataset> ReadIpinLog(const std::string& path, const PhoneLogOptions& op
       streams.ground_truth.push_back(row);
     }
   }
-  Dataset d = AssemblePhoneDataset(std::move(streams), std::filesystem::path(path).stem().string(),
-                                   options, first_time, &r);
-  return d;
+  return PhoneLog{std::filesystem::path(path).stem().string(), first_time, std::move(streams)};
 }
 
 }  // namespace ratslam

@@ -137,5 +137,51 @@ TEST(IpinLogTest, RealLogDeadReckoningDistanceMatchesGroundTruth) {
   EXPECT_NEAR(walked / truth, 1.0, 0.25) << "walked " << walked << " m, truth " << truth << " m";
 }
 
+// Parsing runs no dead reckoning: one parsed log becomes data sets under two PDR settings
+// without being read again, and the parse keeps every raw sample.
+TEST(IpinLogTest, ParsedLogIsReckonedAfterwardsUnderAnySettings) {
+  const fs::path log = fs::path(RATSLAM_SHARED_DATA_DIR) / "ipin2023-t3" /
+                       "IPIN2023_T3_TrainingTrial01_repetition01.txt";
+  if (!fs::exists(log)) GTEST_SKIP() << "missing " << log;
+  StatusOr<PhoneLog> parsed = ParseIpinLog(log.string(), {});
+  ASSERT_TRUE(parsed.ok()) << parsed.status().message();
+  EXPECT_GT(parsed->streams.accelerometer.size(), 1000u);
+  EXPECT_GT(parsed->streams.headings.size(), 1000u);
+  PhoneLogOptions fixed;
+  fixed.pdr.fixed_step_length_m = 0.5;
+  PhoneLogReport weinberg_report, fixed_report;
+  StatusOr<Dataset> weinberg = PhoneLogToDataset(*parsed, {}, &weinberg_report);
+  StatusOr<Dataset> constant = PhoneLogToDataset(*parsed, fixed, &fixed_report);
+  ASSERT_TRUE(weinberg.ok() && constant.ok());
+  // The same steps are detected; with a fixed length the distance is exactly 0.5 m per step.
+  EXPECT_EQ(weinberg_report.steps, fixed_report.steps);
+  ASSERT_GT(fixed_report.steps, 20u);
+  double walked = 0.0;
+  for (size_t i = 1; i < constant->odometry.size(); ++i) {
+    walked += constant->odometry[i].forward_speed_m_per_s *
+              (constant->odometry[i].time_s - constant->odometry[i - 1].time_s);
+  }
+  EXPECT_NEAR(walked, 0.5 * static_cast<double>(constant->odometry.size() - 1), 1e-9);
+  // The one-call reader is exactly the two steps.
+  StatusOr<Dataset> direct = ReadIpinLog(log.string(), {});
+  ASSERT_TRUE(direct.ok());
+  ASSERT_EQ(direct->odometry.size(), weinberg->odometry.size());
+  for (size_t i = 0; i < direct->odometry.size(); ++i) {
+    EXPECT_EQ(direct->odometry[i].forward_speed_m_per_s,
+              weinberg->odometry[i].forward_speed_m_per_s);
+  }
+}
+
+TEST(IpinLogTest, BadDeadReckoningOptionsFailBeforeTheFileIsRead) {
+  PhoneLogOptions bad;
+  bad.pdr.baseline_s = 0.0;
+  const std::string message = ReadIpinLog("/nonexistent.txt", bad).status().message();
+  EXPECT_EQ(message.rfind("pdr.", 0), 0u) << message;
+  bad = PhoneLogOptions();
+  bad.compass_rate_hz = 0.0;
+  EXPECT_EQ(ReadIpinLog("/nonexistent.txt", bad).status().message(),
+            "compass_rate_hz: must be positive");
+}
+
 }  // namespace
 }  // namespace ratslam

@@ -56,10 +56,10 @@ double HeadingFromRotationVector(double x, double y, double z) {
   return std::atan2(north, east);
 }
 
-StatusOr<Dataset> ReadMicrosoftLog(const std::string& path, const PhoneLogOptions& options,
-                                   PhoneLogReport* report, double max_wifi_staleness_s) {
+StatusOr<PhoneLog> ParseMicrosoftLog(const std::string& path, const PhoneLogOptions& options,
+                                     PhoneLogReport* report, double max_wifi_staleness_s) {
   std::ifstream in;
-  RATSLAM_RETURN_IF_ERROR(OpenPhoneLog(path, options, &in));
+  RATSLAM_RETURN_IF_ERROR(OpenPhoneLog(path, &in));
   PhoneLogReport local_report;
   PhoneLogReport& r = report ? *report : local_report;
   r = PhoneLogReport();
@@ -159,9 +159,7 @@ StatusOr<Dataset> ReadMicrosoftLog(const std::string& path, const PhoneLogOption
   if (in.bad()) return Status::Error(path + ": read error");
   if (std::isnan(start_ms)) return Status::Error(path + ": no data lines (not a Microsoft walk?)");
   for (GroundTruthRow& w : waypoints) w.floor = floor;  // FloorName may follow the first lines
-  Dataset d = AssemblePhoneDataset(std::move(streams), std::filesystem::path(path).stem().string(),
-                                   options, 0.0, &r);
-  return d;
+  return PhoneLog{std::filesystem::path(path).stem().string(), 0.0, std::move(streams)};
 }
 
 }  // namespace ratslam

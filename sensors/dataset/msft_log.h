@@ -2,10 +2,10 @@
 // `#` header lines, then tab-separated `unix_ms TYPE values...`. Used: TYPE_WIFI (ssid, bssid,
 // rssi, frequency, last_seen_ms; readings with one timestamp form one scan; readings last seen
 // more than max_wifi_staleness_s before the scan are Android's cached results and are dropped),
-// TYPE_ACCELEROMETER (for dead reckoning), TYPE_ROTATION_VECTOR (the phone's heading: where its
-// y axis points in the East-North-Up frame), TYPE_WAYPOINT (ground truth in metres). The floor
-// comes from the header's FloorName (B1 = -1, F1 = 0, F2 = 1, ...). Times are seconds since the
-// header's startTime (or the first line). Other types are skipped.
+// TYPE_ACCELEROMETER (for dead reckoning, run after parsing), TYPE_ROTATION_VECTOR (the phone's
+// heading: where its y axis points in the East-North-Up frame), TYPE_WAYPOINT (ground truth in
+// metres). The floor comes from the header's FloorName (B1 = -1, F1 = 0, F2 = 1, ...). Times are
+// seconds since the header's startTime (or the first line). Other types are skipped.
 #ifndef RATSLAM_SENSORS_DATASET_MSFT_LOG_H_
 #define RATSLAM_SENSORS_DATASET_MSFT_LOG_H_
 
@@ -13,7 +13,7 @@
 
 #include "common/status.h"
 #include "sensors/dataset/dataset.h"
-#include "sensors/dataset/ipin_log.h"
+#include "sensors/dataset/phone_log.h"
 
 namespace ratslam {
 
@@ -24,6 +24,11 @@ std::optional<int> FloorFromName(const std::string& name);
 // (x, y, z: the vector part of the unit quaternion from device to East-North-Up).
 double HeadingFromRotationVector(double x, double y, double z);
 
+// Parses one walk into its raw streams (no dead reckoning); errors name the file and line.
+StatusOr<PhoneLog> ParseMicrosoftLog(const std::string& path, const PhoneLogOptions& options,
+                                     PhoneLogReport* report = nullptr,
+                                     double max_wifi_staleness_s = 10.0);
+// ParseMicrosoftLog, then PhoneLogToDataset (phone_log.h): the walk as a replay data set.
 StatusOr<Dataset> ReadMicrosoftLog(const std::string& path, const PhoneLogOptions& options,
                                    PhoneLogReport* report = nullptr,
                                    double max_wifi_staleness_s = 10.0);
