@@ -251,19 +251,19 @@ std::unique_ptr<FrontEnd> MakeFabmapFrontEnd(const FabmapSettings& settings,
 }  // namespace front_end_internal
 
 StatusOr<std::shared_ptr<const FabmapResources>> PrepareFabmapResources(
-    const FrontEndSettings& settings, const Dataset& dataset, ImageLoader& images) {
+    const FrontEndSettings& settings, const Dataset& dataset,
+    std::optional<fabmap::TrainedVisualModel> visual) {
   const FabmapSettings& f = settings.fabmap;
   std::string error;
   if (!f.IsValid(&error)) return Status::Error("FABMAP settings: " + error);
   auto resources = std::make_shared<FabmapResources>();
   const fabmap::FabmapMode mode = f.localiser.localiser.mode;
   if (fabmap::UsesVision(mode)) {
-    auto model = fabmap::LoadOrTrainVisualModel(f.visual_model, f.features, f.vocabulary,
-                                                f.localiser.chow_liu, images, nullptr);
-    if (!model.ok()) {
-      return model.status().WithContext("FABMAP mode " + fabmap::ToString(mode));
+    if (!visual) {
+      return Status::Error("FABMAP mode " + fabmap::ToString(mode) +
+                           " needs a visual model ([visual_model] file or training_images)");
     }
-    resources->visual = *std::move(model);
+    resources->visual = std::move(visual);
   }
   fabmap::WifiExploration exploration;
   if (fabmap::UsesWifi(mode)) {

@@ -192,12 +192,13 @@ struct FrontEndSettings {
   FabmapSettings fabmap;
 };
 
-// The FABMAP front end's models for `dataset`: the visual model (loaded, or trained from
-// [visual_model] training_images) when the mode uses vision, and the Wi-Fi words and tree from
-// an exploration of every scan (with odometry travel) when it uses Wi-Fi. Fails on a bad file
-// or an unusable mode.
+// The FABMAP front end's models for `dataset`: `visual` (required when the mode uses vision;
+// fusion/io/visual_model_file.h loads or trains it) and the Wi-Fi words and tree from an
+// exploration of every scan (with odometry travel) when the mode uses Wi-Fi. Reads no file.
+// Fails on invalid settings, a missing visual model or an unusable mode.
 StatusOr<std::shared_ptr<const FabmapResources>> PrepareFabmapResources(
-    const FrontEndSettings& settings, const Dataset& dataset, ImageLoader& images);
+    const FrontEndSettings& settings, const Dataset& dataset,
+    std::optional<fabmap::TrainedVisualModel> visual);
 
 // `fabmap` is required by the kFabmap front end (it throws std::invalid_argument without it,
 // like the pipeline does for invalid options).

@@ -161,8 +161,7 @@ TEST(FabmapFrontEndTest, SecondLapRecognisesTheFirstLapsPlaces) {
       x_of_scan.push_back(2.0 * i);
     }
   }
-  FileImageLoader images;
-  const auto resources = PrepareFabmapResources(settings, data, images);
+  const auto resources = PrepareFabmapResources(settings, data, std::nullopt);
   ASSERT_TRUE(resources.ok()) << resources.status().message();
   std::unique_ptr<FrontEnd> a = CreateFrontEnd(settings, *resources);
   EXPECT_FALSE(a->WantsImages());
@@ -203,8 +202,7 @@ TEST(FabmapFrontEndTest, VisionWithoutAModelIsAClearError) {
   FrontEndSettings settings;
   settings.front_end.kind = FrontEndKind::kFabmap;
   settings.fabmap.localiser.localiser.mode = fabmap::FabmapMode::kVision;
-  FileImageLoader images;
-  const auto resources = PrepareFabmapResources(settings, Dataset{}, images);
+  const auto resources = PrepareFabmapResources(settings, Dataset{}, std::nullopt);
   ASSERT_FALSE(resources.ok());
   EXPECT_NE(resources.status().message().find("visual_model"), std::string::npos);
 }

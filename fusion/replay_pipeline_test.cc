@@ -248,7 +248,7 @@ std::vector<FrameRecord> FabmapFrames(const Dataset& data, WifiLearning learning
                                       std::optional<FabmapLearningReport>* report = nullptr) {
   NoImages images;
   const PipelineOptions options = FabmapWifiOptions(learning);
-  auto resources = PrepareFabmapResources(options.sensors, data, images);
+  auto resources = PrepareFabmapResources(options.sensors, data, std::nullopt);
   EXPECT_TRUE(resources.ok()) << resources.status().message();
   ReplayPipeline pipeline(options, data, &images, *resources);
   EXPECT_TRUE(pipeline.Run({}).ok());
@@ -312,7 +312,7 @@ TEST(ReplayPipelineTest, StopAndResumeEqualsOneRunForOnlineFabmapLearning) {
   const Dataset data = ApLoop();
   NoImages images;
   const PipelineOptions options = FabmapWifiOptions(WifiLearning::kOnline);
-  auto resources = PrepareFabmapResources(options.sensors, data, images);
+  auto resources = PrepareFabmapResources(options.sensors, data, std::nullopt);
   ASSERT_TRUE(resources.ok());
   ReplayPipeline whole(options, data, &images, *resources);
   ASSERT_TRUE(whole.Run({}).ok());

@@ -99,7 +99,7 @@ struct Setup {
     options = {classic, fused, fabmap_wifi};
     for (const PipelineOptions& o : options) {
       fabmap.push_back(o.sensors.front_end.kind == FrontEndKind::kFabmap
-                           ? PrepareFabmapResources(o.sensors, dataset, images).value()
+                           ? PrepareFabmapResources(o.sensors, dataset, std::nullopt).value()
                            : nullptr);
     }
   }

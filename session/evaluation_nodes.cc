@@ -7,7 +7,7 @@
 #include <limits>
 #include <system_error>
 
-#include "fusion/fabmap/visual_model.h"
+#include "fusion/io/visual_model_file.h"
 #include "sensors/dataset/dataset_loader.h"
 #include "sensors/dataset/ujiindoorloc.h"
 
@@ -41,7 +41,7 @@ StatusOr<std::vector<EvaluationNode>> ImageFolderNodes(const std::string& path,
   if (floors.empty()) floors.push_back(path);
   std::vector<EvaluationNode> nodes;
   for (size_t f = 0; f < floors.size(); ++f) {
-    auto images = fabmap::ListImages(floors[f]);
+    auto images = ListImages(floors[f]);
     if (!images.ok()) return images.status();
     const int floor = FloorOfFolder(fs::path(floors[f]).filename().string(), static_cast<int>(f));
     for (size_t i = 0; i < images->size(); ++i) {

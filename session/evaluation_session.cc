@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "fusion/io/config.h"
+#include "fusion/io/visual_model_file.h"
 #include "session/evaluation_nodes.h"
 
 namespace ratslam {
@@ -99,11 +100,11 @@ Status EvaluationSession::Prepare() {
   const FabmapSettings& settings = options_.pipeline.sensors.fabmap;
   const bool vision = fabmap::UsesVision(mode());
   if (vision) {
-    auto model = fabmap::LoadOrTrainVisualModel(
-        settings.visual_model, settings.features, settings.vocabulary, settings.localiser.chow_liu,
-        *images_, [this](size_t done, size_t total) {
-          progress_->Update({"training images", done, total});
-        });
+    auto model = LoadOrTrainVisualModel(settings.visual_model, settings.features,
+                                        settings.vocabulary, settings.localiser.chow_liu, *images_,
+                                        [this](size_t done, size_t total) {
+                                          progress_->Update({"training images", done, total});
+                                        });
     if (!model.ok()) return model.status();
     progress_->Finish();
     visual_ = *std::move(model);

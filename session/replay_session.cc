@@ -5,6 +5,7 @@
 
 #include "fusion/io/config.h"
 #include "fusion/io/map_file.h"
+#include "fusion/io/visual_model_file.h"
 #include "sensors/dataset/dataset_loader.h"
 #include "sensors/dataset/visual_odometry_source.h"
 
@@ -74,7 +75,7 @@ Status ReplaySession::Prepare() {
   if (!dataset_) return Status::Error("replay session: Prepare before Load");
   std::shared_ptr<const FabmapResources> fabmap;
   if (options_.pipeline.sensors.front_end.kind == FrontEndKind::kFabmap) {
-    auto prepared = PrepareFabmapResources(options_.pipeline.sensors, *dataset_, *env_.images);
+    auto prepared = LoadFabmapResources(options_.pipeline.sensors, *dataset_, *env_.images);
     if (!prepared.ok()) return prepared.status().WithContext("FABMAP front end");
     fabmap = *prepared;
   }

@@ -1,39 +1,13 @@
 #include "fusion/fabmap/visual_model.h"
 
-#include <algorithm>
 #include <cmath>
-#include <filesystem>
-#include <fstream>
-#include <sstream>
-#include <system_error>
 
 #include "common/byte_buffer.h"
-#include "common/text_file.h"
 
 namespace ratslam::fabmap {
 
 bool VisualModelOptions::IsValid(std::string* error) const {
   return schema::CheckFields(*this, error);
-}
-
-StatusOr<std::vector<std::string>> ListImages(const std::string& folder) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  if (!fs::is_directory(folder, ec)) return Status::Error(folder + ": not a folder of images");
-  std::vector<std::string> images;
-  for (auto it = fs::recursive_directory_iterator(folder, ec);
-       !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
-    if (!it->is_regular_file(ec)) continue;
-    std::string ext = it->path().extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(),
-                   [](unsigned char c) { return std::tolower(c); });
-    if (ext == ".jpg" || ext == ".jpeg" || ext == ".png" || ext == ".pgm") {
-      images.push_back(it->path().string());
-    }
-  }
-  if (ec) return Status::Error(folder + ": " + ec.message());
-  std::sort(images.begin(), images.end());
-  return images;
 }
 
 StatusOr<TrainedVisualModel> TrainVisualModel(const std::vector<std::string>& images,
@@ -65,25 +39,6 @@ StatusOr<TrainedVisualModel> TrainVisualModel(const std::vector<std::string>& im
   if (!tree.ok()) return tree.status();
   trained.model.tree = *std::move(tree);
   return trained;
-}
-
-StatusOr<TrainedVisualModel> LoadOrTrainVisualModel(
-    const VisualModelOptions& options, const FeatureOptions& features,
-    const VocabularyOptions& vocabulary, const ChowLiuOptions& chow_liu, ImageLoader& loader,
-    const std::function<void(size_t, size_t)>& progress) {
-  if (!options.file.empty()) {
-    StatusOr<std::string> bytes = ReadRegularFile(options.file, "visual model", size_t{1} << 34);
-    if (!bytes.ok()) return bytes.status();
-    return DecodeVisualModel(*bytes, options.file);
-  }
-  if (options.training_images.empty()) {
-    return Status::Error("[visual_model] needs file or training_images");
-  }
-  auto all = ListImages(options.training_images);
-  if (!all.ok()) return all.status();
-  std::vector<std::string> chosen;
-  for (size_t i = 0; i < all->size(); i += options.training_image_step) chosen.push_back((*all)[i]);
-  return TrainVisualModel(chosen, features, vocabulary, chow_liu, loader, progress);
 }
 
 StatusOr<Observation> ImageWords(const TrainedVisualModel& model, const GrayImage& image) {

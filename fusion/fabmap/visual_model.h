@@ -39,22 +39,13 @@ struct TrainedVisualModel {
   VisualModel model;  // tree and unknown-world samples (the training observations)
 };
 
-// Sorted image files under `folder`, recursively.
-StatusOr<std::vector<std::string>> ListImages(const std::string& folder);
-
-// Trains on `images`; `progress` (optional) gets (done, total) per image.
+// Trains on `images` (read through `loader`); `progress` (optional) gets (done, total) per
+// image. Loading a saved model or listing a folder is fusion/io/visual_model_file.h's job.
 StatusOr<TrainedVisualModel> TrainVisualModel(const std::vector<std::string>& images,
                                               const FeatureOptions& features,
                                               const VocabularyOptions& vocabulary,
                                               const ChowLiuOptions& chow_liu, ImageLoader& loader,
                                               const std::function<void(size_t, size_t)>& progress);
-
-// The model `options` names: read from `file`, or trained on every training_image_step-th image
-// under `training_images`.
-StatusOr<TrainedVisualModel> LoadOrTrainVisualModel(
-    const VisualModelOptions& options, const FeatureOptions& features,
-    const VocabularyOptions& vocabulary, const ChowLiuOptions& chow_liu, ImageLoader& loader,
-    const std::function<void(size_t, size_t)>& progress);
 
 // Visual words of one image.
 StatusOr<Observation> ImageWords(const TrainedVisualModel& model, const GrayImage& image);
