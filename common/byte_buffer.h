@@ -14,6 +14,7 @@
 #include <cstring>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <type_traits>
 #include <vector>
 
@@ -66,8 +67,9 @@ class ByteWriter {
 
 class ByteReader {
  public:
-  // `context` starts every error message.
-  ByteReader(const std::string& bytes, std::string context)
+  // Reads `bytes` in place (no copy; they must outlive the reader). `context` starts every
+  // error message.
+  ByteReader(std::string_view bytes, std::string context)
       : bytes_(bytes), context_(std::move(context)) {}
   template <ByteNumber T>
   bool Pod(T* value) {
@@ -140,7 +142,7 @@ class ByteReader {
     if (bytes_.size() - pos_ < n) return Fail("unexpected end of file (truncated?)");
     return true;
   }
-  const std::string& bytes_;
+  std::string_view bytes_;
   std::string context_;
   size_t pos_ = 0;
   std::string error_;

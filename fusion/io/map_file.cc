@@ -37,8 +37,8 @@ StatusOr<MapFile> DecodeMapFile(const std::string& bytes, const std::string& sou
   if (bytes.size() < sizeof kMagic || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0) {
     return Status::Error(source + ": not a RatSLAM map file");
   }
-  const std::string body = bytes.substr(sizeof kMagic);
-  ByteReader r(body, source + ": corrupt map file");
+  // The body is read in place: a copy would double the memory a large map needs.
+  ByteReader r(std::string_view(bytes).substr(sizeof kMagic), source + ": corrupt map file");
   uint32_t version = 0;
   MapFile map;
   if (!r.Pod(&version)) return Status::Error(r.error());
