@@ -106,6 +106,7 @@ inline std::optional<PipelineOptions> LoadOptions(const Arguments& args,
 int RenderCommand(int argc, char** argv);
 int EvaluateCommand(int argc, char** argv);
 int SimulateCommand(int argc, char** argv);
+int SweepCommand(int argc, char** argv);
 // Simulates `world` into the replay data set `out` (with world.toml, simulation.json and
 // ground_truth.png); `dataset` receives it.
 namespace sim {

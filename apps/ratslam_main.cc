@@ -82,7 +82,10 @@ const char kUsage[] =
     "  ratslam simulate --world NAME|FILE --out D [--seed S] [--quiet]\n"
     "      Simulates a world (built in: office, circular, day_night, aliased_floors,\n"
     "      apartment; or a world TOML file) into the replay data set D, with world.toml,\n"
-    "      simulation.json and ground_truth.png.\n";
+    "      simulation.json and ground_truth.png.\n"
+    "  ratslam sweep plan S --out DIR | run DIR [--jobs N] | task DIR [--index I] | collect DIR\n"
+    "      Parameter sweeps (configs/README.md, \"Sweeps\"): plan a sweep file into DIR, run its\n"
+    "      tasks as separate processes (resumable), run one task of a cluster array, collect.\n";
 
 struct ReplayRequest {
   ReplaySessionOptions session;
@@ -364,6 +367,7 @@ int Dispatch(int argc, char** argv) {
   if (command == "render") return RenderCommand(argc, argv);
   if (command == "evaluate") return EvaluateCommand(argc, argv);
   if (command == "simulate") return SimulateCommand(argc, argv);
+  if (command == "sweep") return SweepCommand(argc, argv);
   if (command == "import") return ImportCommand(argc, argv);
   if (command == "--help" || command == "help" || command == "-h") {
     std::cout << kUsage;

@@ -66,10 +66,15 @@ std::string LocateField(const toml::table& root, const std::string& source,
 }  // namespace
 
 StatusOr<PipelineOptions> ParseConfig(const std::string& text, const std::string& source_name) {
+  return ParseConfigOnto(text, source_name, PipelineOptions());
+}
+
+StatusOr<PipelineOptions> ParseConfigOnto(const std::string& text, const std::string& source_name,
+                                          const PipelineOptions& base) {
   StatusOr<toml::table> parsed = schema::ParseToml(text, source_name);
   if (!parsed.ok()) return parsed.status();
   const toml::table& root = *parsed;
-  PipelineOptions options;
+  PipelineOptions options = base;
   std::set<std::string> sections;
   Status status;
   options.VisitSections([&](const char* name, auto& section) {

@@ -15,6 +15,10 @@ namespace ratslam {
 // Parses TOML text; `source_name` is used in error messages ("file:line: ...").
 StatusOr<PipelineOptions> ParseConfig(const std::string& text, const std::string& source_name);
 StatusOr<PipelineOptions> LoadConfigFile(const std::string& path);
+// ParseConfig starting from `base` instead of the defaults: the keys in `text` override it (a
+// sweep's parameters over its base configuration). The result is validated as a whole.
+StatusOr<PipelineOptions> ParseConfigOnto(const std::string& text, const std::string& source_name,
+                                          const PipelineOptions& base);
 
 // The resolved configuration as TOML, every key present; with `comments`, each key is preceded
 // by its documentation line. ParseConfig(PrintConfig(x)) == x.

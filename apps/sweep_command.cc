@@ -1,0 +1,169 @@
+// `ratslam sweep plan|run|task|collect`: the command-line face of ratslam::sweep.
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+#include <string>
+
+#include "apps/cli.h"
+#include "sweep/sweep.h"
+
+namespace ratslam {
+namespace {
+
+const char kSweepUsage[] =
+    "usage:\n"
+    "  ratslam sweep plan SWEEP.toml --out DIR   expand the sweep into DIR's task table\n"
+    "  ratslam sweep run DIR [--jobs N]          run every pending task, N at a time\n"
+    "  ratslam sweep task DIR [--index I]        run one task (I from SLURM_ARRAY_TASK_ID,\n"
+    "                                            PBS_ARRAY_INDEX or SGE_TASK_ID when absent)\n"
+    "  ratslam sweep collect DIR                 results.csv/json, points.csv, best.toml\n";
+
+std::atomic<bool> g_sweep_stop{false};
+extern "C" void OnSweepSignal(int) { g_sweep_stop.store(true); }
+
+// The ratslam executable running now: sweeps start their tasks with the same program.
+std::string ThisProgram() {
+  char buffer[4096];
+  const ssize_t n = readlink("/proc/self/exe", buffer, sizeof buffer - 1);
+  return n > 0 ? std::string(buffer, static_cast<size_t>(n)) : std::string("ratslam");
+}
+
+// One line per change: done of total, failures and running tasks, elapsed time and ETA.
+class SweepProgress : public ProgressSink {
+ public:
+  explicit SweepProgress(bool quiet) : quiet_(quiet), start_(std::chrono::steady_clock::now()) {}
+  void Update(const ProgressUpdate& p) override {
+    if (quiet_ || p.total == 0) return;
+    const double elapsed =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    const uint64_t fresh = p.done - std::min(p.done, first_done_);
+    if (!started_) {
+      started_ = true;
+      first_done_ = p.done;
+    }
+    const std::string eta =
+        p.done >= p.total ? Duration(0.0)
+        : fresh > 0
+            ? Duration(elapsed / static_cast<double>(fresh) * static_cast<double>(p.total - p.done))
+            : std::string(1, '?');
+    std::fprintf(stderr, "%s: %llu/%llu, %s elapsed, ETA %s\n", p.phase.c_str(),
+                 static_cast<unsigned long long>(p.done), static_cast<unsigned long long>(p.total),
+                 Duration(elapsed).c_str(), eta.c_str());
+  }
+
+ private:
+  static std::string Duration(double s) {
+    const long total = static_cast<long>(s + 0.5);
+    char buffer[32];
+    if (total >= 3600) {
+      std::snprintf(buffer, sizeof buffer, "%ldh%02ldm", total / 3600, total / 60 % 60);
+    } else {
+      std::snprintf(buffer, sizeof buffer, "%ldm%02lds", total / 60, total % 60);
+    }
+    return buffer;
+  }
+  bool quiet_;
+  std::chrono::steady_clock::time_point start_;
+  bool started_ = false;
+  uint64_t first_done_ = 0;
+};
+
+int Fail(const Status& s) {
+  std::cerr << "ratslam sweep: " << s.message() << "\n";
+  return kExitError;
+}
+
+}  // namespace
+
+int SweepCommand(int argc, char** argv) {
+  const std::string action = argc > 2 ? argv[2] : "";
+  auto args = ParseArguments(argc, argv, 3, {"--out", "--jobs", "--index"});
+  if (!args || args->positional.size() != 1 ||
+      (action != "plan" && action != "run" && action != "task" && action != "collect")) {
+    std::cerr << kSweepUsage;
+    return kExitUsage;
+  }
+  const std::string& target = args->positional[0];
+  if (action == "plan") {
+    if (!args->values.count("--out")) {
+      std::cerr << kSweepUsage;
+      return kExitUsage;
+    }
+    StatusOr<sweep::SweepSpec> spec = sweep::LoadSweepFile(target);
+    if (!spec.ok()) return Fail(spec.status());
+    StatusOr<sweep::Plan> plan = sweep::MakePlan(*spec);
+    if (!plan.ok()) return Fail(plan.status());
+    Status written = sweep::WritePlan(*plan, args->values["--out"]);
+    if (!written.ok()) return Fail(written);
+    std::cout << plan->tasks.size() << " tasks (" << plan->points << " points x "
+              << spec->datasets.size() << " data sets) in " << args->values["--out"] << "\n";
+    return kExitOk;
+  }
+  if (action == "run") {
+    sweep::RunOptions options;
+    options.program = ThisProgram();
+    if (args->values.count("--jobs")) {
+      auto jobs = ParseInteger("--jobs", args->values["--jobs"], 1, 1024);
+      if (!jobs) return kExitUsage;
+      options.jobs = static_cast<int>(*jobs);
+    }
+    SweepProgress progress(args->quiet);
+    options.progress = &progress;
+    options.stop_requested = &g_sweep_stop;
+    std::signal(SIGINT, OnSweepSignal);
+    std::signal(SIGTERM, OnSweepSignal);
+    StatusOr<sweep::RunReport> report = sweep::RunSweep(target, options);
+    std::signal(SIGINT, SIG_DFL);
+    std::signal(SIGTERM, SIG_DFL);
+    if (!report.ok()) return Fail(report.status());
+    std::cout << report->done << " run, " << report->skipped << " already done, " << report->failed
+              << " failed, " << report->pending << " pending\n";
+    if (report->pending > 0) return kExitInterrupted;
+    return report->failed > 0 ? kExitError : kExitOk;
+  }
+  if (action == "task") {
+    int64_t index = -1;
+    if (args->values.count("--index")) {
+      auto i = ParseInteger("--index", args->values["--index"], 0, 1 << 30);
+      if (!i) return kExitUsage;
+      index = *i;
+    } else {
+      for (const char* variable : {"SLURM_ARRAY_TASK_ID", "PBS_ARRAY_INDEX", "SGE_TASK_ID"}) {
+        const char* value = std::getenv(variable);
+        if (!value) continue;
+        auto i = ParseInteger(variable, value, 0, 1 << 30);
+        if (!i) return kExitUsage;
+        index = *i;
+        break;
+      }
+      if (index < 0) {
+        std::cerr << "ratslam sweep task: no --index and no scheduler array index in the "
+                     "environment\n";
+        return kExitUsage;
+      }
+    }
+    StatusOr<sweep::TaskOutcome> outcome =
+        sweep::RunTask(target, static_cast<int>(index), ThisProgram());
+    if (!outcome.ok()) return Fail(outcome.status());
+    std::cout << "task " << index << ": " << outcome->status
+              << (outcome->error.empty() ? "" : " (" + outcome->error + ")") << "\n";
+    return outcome->status == "ok" ? kExitOk : kExitError;
+  }
+  StatusOr<sweep::CollectReport> report = sweep::Collect(target);
+  if (!report.ok()) return Fail(report.status());
+  std::cout << report->ok << " ok, " << report->failed << " failed, " << report->pending
+            << " pending";
+  if (report->best_point) {
+    std::cout << "; best point " << *report->best_point << " (objective " << report->best_objective
+              << "), written to " << target << "/best.toml";
+  }
+  std::cout << "\n";
+  return kExitOk;
+}
+
+}  // namespace ratslam

@@ -1,0 +1,397 @@
+#include "sweep/sweep.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+
+#include "common/scratch_dir.h"
+#include "fusion/io/config.h"
+#include "sensors/dataset/dataset.h"
+
+namespace ratslam::sweep {
+namespace {
+namespace fs = std::filesystem;
+
+const ScratchDir& Scratch() {
+  static const ScratchDir dir("ratslam_sweep_test");
+  return dir;
+}
+
+std::string Write(const std::string& name, const std::string& text) {
+  const fs::path path = Scratch().path() / name;
+  fs::create_directories(path.parent_path());
+  std::ofstream(path) << text;
+  return path.string();
+}
+
+// A 40 m square walked twice at 1 m/s, with four access points heard by distance and ground
+// truth: a Wi-Fi-only replay of it takes milliseconds.
+std::string SquareWalk(const std::string& name, double noise_dbm) {
+  Dataset d;
+  d.name = name;
+  const double side = 10.0;
+  double x = 0.0, y = 0.0, heading = 0.0;
+  const double aps[4][2] = {{0, 0}, {10, 0}, {10, 10}, {0, 10}};
+  for (int t = 0; t <= 80; ++t) {
+    const bool corner = t > 0 && t % 10 == 0;
+    d.odometry.push_back({static_cast<double>(t), 1.0, corner ? M_PI / 2 : 0.0});
+    d.ground_truth.push_back({static_cast<double>(t), x, y, heading, 0});
+    if (t % 2 == 0) {
+      WifiScan scan;
+      scan.time_s = t + 0.5;
+      for (int a = 0; a < 4; ++a) {
+        const double dist = std::hypot(x - aps[a][0], y - aps[a][1]) + 1.0;
+        const double wobble = noise_dbm * std::sin(7.0 * t + a);
+        scan.readings.push_back(
+            {"ap" + std::to_string(a), -40.0 - 20.0 * std::log10(dist) + wobble});
+      }
+      d.wifi.push_back(scan);
+    }
+    x += std::cos(heading);
+    y += std::sin(heading);
+    if (corner) heading += M_PI / 2;
+    (void)side;
+  }
+  const std::string folder = (Scratch().path() / "data" / name).string();
+  EXPECT_TRUE(WriteDataset(d, folder).ok());
+  return folder;
+}
+
+const char kBase[] = R"([front_end]
+kind = "fused"
+[fused]
+use_camera = false
+use_wifi = true
+use_compass = false
+recency_s = 10.0
+[pose_cells]
+cell_size_m = 1.0
+)";
+
+std::string SweepFile(const std::string& name, const std::string& body) {
+  Write("base.toml", kBase);
+  return Write(name,
+               "[sweep]\nbase_config = \"base.toml\"\nobjective = \"map_ate_m\"\n"
+               "metrics = [\"templates\", \"match_rate_within_m.5\"]\n" +
+                   body);
+}
+
+TEST(SweepPlanTest, GridExpandsEveryCombinationInAStableOrder) {
+  SquareWalk("a", 0.0);
+  SquareWalk("b", 1.0);
+  const std::string path = SweepFile("grid.toml", R"(
+[[datasets]]
+glob = "data/*"
+[parameters]
+"wifi.match_threshold" = {linear = [0.2, 0.6, 3]}
+"fused.recency_templates" = [0, 5]
+)");
+  StatusOr<SweepSpec> spec = LoadSweepFile(path);
+  ASSERT_TRUE(spec.ok()) << spec.status().message();
+  ASSERT_EQ(spec->datasets.size(), 2u);  // the glob: one data set per match, sorted
+  EXPECT_EQ(fs::path(spec->datasets[0][0]).filename(), "a");
+  StatusOr<Plan> plan = MakePlan(*spec);
+  ASSERT_TRUE(plan.ok()) << plan.status().message();
+  EXPECT_EQ(plan->points, 6);
+  ASSERT_EQ(plan->tasks.size(), 12u);
+  // Parameters in key order (fused before wifi); point-major, data sets inside.
+  EXPECT_EQ(plan->tasks[0].overrides,
+            (std::vector<std::pair<std::string, std::string>>{{"fused.recency_templates", "0"},
+                                                              {"wifi.match_threshold", "0.2"}}));
+  EXPECT_EQ(plan->tasks[1].dataset, 1);
+  EXPECT_EQ(plan->tasks[1].point, 0);
+  EXPECT_EQ(plan->tasks[3].overrides[1].second, "0.4");
+  EXPECT_EQ(plan->tasks[11].overrides,
+            (std::vector<std::pair<std::string, std::string>>{{"fused.recency_templates", "5"},
+                                                              {"wifi.match_threshold", "0.6"}}));
+  StatusOr<PipelineOptions> config = TaskConfig(*plan, plan->tasks[11]);
+  ASSERT_TRUE(config.ok());
+  EXPECT_EQ(config->sensors.fused.recency_templates, 5);
+  EXPECT_EQ(config->sensors.wifi.match_threshold, 0.6);
+  EXPECT_EQ(config->sensors.fused.recency_s, 10.0);  // from the base configuration
+  // Re-planning into the same folder is allowed and changes nothing; another plan is refused.
+  const std::string dir = (Scratch().path() / "plan-grid").string();
+  ASSERT_TRUE(WritePlan(*plan, dir).ok());
+  ASSERT_TRUE(WritePlan(*MakePlan(*LoadSweepFile(path)), dir).ok());
+  StatusOr<Plan> read = ReadPlan(dir);
+  ASSERT_TRUE(read.ok()) << read.status().message();
+  EXPECT_EQ(read->tasks.size(), 12u);
+  EXPECT_EQ(read->tasks[7].overrides, plan->tasks[7].overrides);
+  Plan other = *plan;
+  other.tasks.pop_back();
+  EXPECT_FALSE(WritePlan(other, dir).ok());
+}
+
+TEST(SweepPlanTest, RangesAndSeededRandomDraws) {
+  SquareWalk("a", 0.0);
+  const std::string grid = SweepFile("ranges.toml", R"(
+[[datasets]]
+data = ["data/a"]
+[parameters]
+"wifi.kernel_variance_dbm2" = {log = [1, 100, 3]}
+"local_view.skip_recent_templates" = {linear = [0, 5, 4]}
+)");
+  StatusOr<Plan> plan = MakePlan(*LoadSweepFile(grid));
+  ASSERT_TRUE(plan.ok()) << plan.status().message();
+  // Integer ends give integers: log 1, 10, 100; linear 0, 5/3, 10/3, 5 rounded to 0, 2, 3, 5.
+  EXPECT_EQ(plan->spec.parameters[0].values, (std::vector<std::string>{"0", "2", "3", "5"}));
+  EXPECT_EQ(plan->spec.parameters[1].values, (std::vector<std::string>{"1", "10", "100"}));
+  EXPECT_EQ(plan->points, 12);
+
+  auto random_plan = [&](int seed) {
+    const std::string path = SweepFile(
+        "random.toml", "method = \"random\"\nsamples = 20\nseed = " + std::to_string(seed) + R"(
+[[datasets]]
+data = ["data/a"]
+[parameters]
+"wifi.match_threshold" = {uniform = [0.1, 0.5]}
+"fused.recency_s" = {log_uniform = [1, 100]}
+"fused.recency_templates" = [0, 3]
+)");
+    return MakePlan(*LoadSweepFile(path));
+  };
+  StatusOr<Plan> a = random_plan(7), b = random_plan(7), c = random_plan(8);
+  ASSERT_TRUE(a.ok()) << a.status().message();
+  ASSERT_EQ(a->tasks.size(), 20u);
+  std::set<std::string> distinct;
+  for (size_t i = 0; i < a->tasks.size(); ++i) {
+    EXPECT_EQ(a->tasks[i].overrides, b->tasks[i].overrides);  // same seed, same draws
+    const double threshold = std::stod(a->tasks[i].overrides[2].second);
+    const double recency = std::stod(a->tasks[i].overrides[0].second);
+    EXPECT_GE(threshold, 0.1);
+    EXPECT_LE(threshold, 0.5);
+    EXPECT_GE(recency, 1.0);
+    EXPECT_LE(recency, 100.0);
+    distinct.insert(a->tasks[i].overrides[2].second);
+  }
+  EXPECT_EQ(distinct.size(), 20u);
+  EXPECT_NE(a->tasks[0].overrides, c->tasks[0].overrides);  // another seed, other draws
+}
+
+TEST(SweepPlanTest, BadKeysAndValuesNameTheSweepFileLine) {
+  SquareWalk("a", 0.0);
+  auto error = [&](const std::string& parameters) {
+    const std::string path =
+        SweepFile("bad.toml", "[[datasets]]\ndata = [\"data/a\"]\n[parameters]\n" + parameters);
+    StatusOr<SweepSpec> spec = LoadSweepFile(path);
+    if (!spec.ok()) return spec.status().message();
+    StatusOr<Plan> plan = MakePlan(*spec);
+    return plan.ok() ? std::string() : plan.status().message();
+  };
+  const std::string prefix = (Scratch().path() / "bad.toml").string() + ":";
+  // Lines: 1-4 [sweep], 5-6 [[datasets]], 7 [parameters], 8 the first parameter.
+  EXPECT_EQ(error("\"wifi.match_treshold\" = [0.2]\n"),
+            prefix +
+                "8: parameter 'wifi.match_treshold' = 0.2: unknown key 'match_treshold' in "
+                "[wifi] (did you mean 'match_threshold'?)");
+  EXPECT_EQ(error("\"fused.recency_s\" = [1.0]\n\"wifi.match_threshold\" = [0.5, 1.5]\n"),
+            prefix +
+                "9: parameter 'wifi.match_threshold' = 1.5: wifi.match_threshold: must be in "
+                "[0, 1]");
+  EXPECT_EQ(error("\"pose_cells.dim_xy_cells\" = [2.5]\n"),
+            prefix +
+                "8: parameter 'pose_cells.dim_xy_cells' = 2.5: pose_cells.dim_xy_cells: "
+                "expected an integer");
+  EXPECT_NE(
+      error("\"wifi.match_threshold\" = {uniform = [0.1, 0.2]}\n").find("method = \"random\""),
+      std::string::npos);
+  // Each value alone is valid; a relation between two swept keys fails in one combination.
+  const std::string relation =
+      error("\"pdr.smoothing_s\" = [0.1, 1.5]\n\"pdr.baseline_s\" = [1.0, 3.0]\n");
+  EXPECT_NE(relation.find(": point 1 (pdr.baseline_s = 1.0, pdr.smoothing_s = 1.5): "
+                          "pdr.baseline_s: must exceed smoothing_s"),
+            std::string::npos)
+      << relation;
+}
+
+// A fake worker: crashes for data set "crash", hangs for "hang", and runs the real program
+// otherwise; every start is appended to a log so that repeats can be counted.
+std::string FakeProgram(const std::string& log) {
+  const std::string path = Write("fake_ratslam.sh", "#!/bin/sh\necho \"$*\" >> " + log +
+                                                        "\ncase \"$*\" in\n"
+                                                        "  */crash\\ *) kill -SEGV $$ ;;\n"
+                                                        "  */hang\\ *) sleep 60 ;;\n"
+                                                        "esac\nexec " RATSLAM_PROGRAM " \"$@\"\n");
+  fs::permissions(path, fs::perms::owner_all);
+  return path;
+}
+
+int Starts(const std::string& log, const std::string& run_folder) {
+  std::ifstream in(log);
+  std::string line;
+  int n = 0;
+  while (std::getline(in, line)) n += line.find("--out " + run_folder) != std::string::npos;
+  return n;
+}
+
+TEST(SweepRunTest, FailuresAreRecordedWhileTheOthersFinishAndCollectRanksPoints) {
+  SquareWalk("a", 0.0);
+  SquareWalk("b", 1.5);
+  fs::create_directories(Scratch().path() / "broken" / "crash");
+  fs::create_directories(Scratch().path() / "broken" / "hang");
+  fs::create_directories(Scratch().path() / "broken" / "nomanifest");
+  const std::string path = SweepFile("run.toml", R"(timeout_s = 3
+[[datasets]]
+data = ["data/a"]
+[[datasets]]
+data = ["data/b"]
+[parameters]
+"wifi.match_threshold" = [0.3, 0.99]
+)");
+  StatusOr<Plan> plan = MakePlan(*LoadSweepFile(path));
+  ASSERT_TRUE(plan.ok()) << plan.status().message();
+  // Three broken tasks beside the four good ones.
+  for (const char* broken : {"crash", "hang", "nomanifest"}) {
+    plan->spec.datasets.push_back({(Scratch().path() / "broken" / broken).string()});
+    Task t;
+    t.index = static_cast<int>(plan->tasks.size());
+    t.point = 0;
+    t.dataset = static_cast<int>(plan->spec.datasets.size()) - 1;
+    t.overrides = plan->tasks[0].overrides;
+    plan->tasks.push_back(t);
+  }
+  const std::string dir = (Scratch().path() / "sweep-run").string();
+  ASSERT_TRUE(WritePlan(*plan, dir).ok());
+  const std::string log = (Scratch().path() / "starts.log").string();
+  RunOptions options;
+  options.program = FakeProgram(log);
+  options.jobs = 3;
+  StatusOr<RunReport> report = RunSweep(dir, options);
+  ASSERT_TRUE(report.ok()) << report.status().message();
+  EXPECT_EQ(report->done, 7);
+  EXPECT_EQ(report->failed, 3);
+  StatusOr<std::vector<TaskOutcome>> outcomes = ReadOutcomes(dir);
+  ASSERT_TRUE(outcomes.ok());
+  for (int i = 0; i < 4; ++i) EXPECT_EQ((*outcomes)[i].status, "ok") << (*outcomes)[i].error;
+  EXPECT_EQ((*outcomes)[4].status, "failed");
+  EXPECT_EQ((*outcomes)[4].exit_code, 128 + SIGSEGV);
+  EXPECT_EQ((*outcomes)[5].status, "timeout");
+  EXPECT_LT((*outcomes)[5].wall_s, 10.0);
+  EXPECT_EQ((*outcomes)[6].status, "failed");
+  EXPECT_NE((*outcomes)[6].error.find("manifest"), std::string::npos) << (*outcomes)[6].error;
+  // Small run folders: the summary, config and trajectory stay, the rest is gone.
+  const fs::path run0 = fs::path(dir) / "runs" / "00000";
+  EXPECT_TRUE(fs::exists(run0 / "summary.json"));
+  EXPECT_TRUE(fs::exists(run0 / "trajectory_tum.txt"));
+  EXPECT_FALSE(fs::exists(run0 / "frames.csv"));
+
+  // Running again repeats nothing.
+  StatusOr<RunReport> again = RunSweep(dir, options);
+  ASSERT_TRUE(again.ok());
+  EXPECT_EQ(again->done, 0);
+  EXPECT_EQ(again->skipped, 7);
+  EXPECT_EQ(Starts(log, (fs::path(dir) / "runs").string()), 7);
+
+  StatusOr<CollectReport> collected = Collect(dir);
+  ASSERT_TRUE(collected.ok()) << collected.status().message();
+  EXPECT_EQ(collected->ok, 4);
+  EXPECT_EQ(collected->failed, 3);
+  // Point 0 has failed runs, so it is not ranked: point 1 is the best.
+  ASSERT_TRUE(collected->best_point.has_value());
+  EXPECT_EQ(*collected->best_point, 1);
+  // The objective is the mean of point 1's two runs, read independently from their summaries.
+  double sum = 0.0;
+  for (int i : {2, 3}) {
+    std::ifstream in(fs::path(dir) / "runs" / ("0000" + std::to_string(i)) / "summary.json");
+    sum += nlohmann::json::parse(in).at("map_ate_m").get<double>();
+  }
+  EXPECT_DOUBLE_EQ(collected->best_objective, sum / 2);
+  StatusOr<PipelineOptions> best = LoadConfigFile((fs::path(dir) / "best.toml").string());
+  ASSERT_TRUE(best.ok()) << best.status().message();
+  EXPECT_EQ(best->sensors.wifi.match_threshold, 0.99);
+  EXPECT_EQ(best->sensors.fused.recency_s, 10.0);
+  std::ifstream csv(fs::path(dir) / "results.csv");
+  std::string header, line;
+  std::getline(csv, header);
+  EXPECT_EQ(header,
+            "index,point,dataset,status,exit_code,wall_s,wifi.match_threshold,map_ate_m,templates,"
+            "match_rate_within_m.5,error");
+  int rows = 0;
+  while (std::getline(csv, line)) ++rows;
+  EXPECT_EQ(rows, 7);
+}
+
+TEST(SweepRunTest, AStoppedSweepResumesWithoutRepeatingOrLosingRuns) {
+  SquareWalk("a", 0.0);
+  const std::string path = SweepFile("resume.toml", R"(
+[[datasets]]
+data = ["data/a"]
+[parameters]
+"wifi.match_threshold" = {linear = [0.1, 0.9, 9]}
+)");
+  StatusOr<Plan> plan = MakePlan(*LoadSweepFile(path));
+  ASSERT_TRUE(plan.ok());
+  const std::string dir = (Scratch().path() / "sweep-resume").string();
+  ASSERT_TRUE(WritePlan(*plan, dir).ok());
+  const std::string log = (Scratch().path() / "resume.log").string();
+  // Stop once three runs have ended (as Ctrl-C would): running ones end unrecorded.
+  std::atomic<bool> stop{false};
+  struct StopAfter : ProgressSink {
+    std::atomic<bool>* stop;
+    void Update(const ProgressUpdate& u) override {
+      if (u.done >= 3) stop->store(true);
+    }
+  } stopper;
+  stopper.stop = &stop;
+  RunOptions options;
+  options.program = FakeProgram(log);
+  options.jobs = 2;
+  options.progress = &stopper;
+  options.stop_requested = &stop;
+  StatusOr<RunReport> first = RunSweep(dir, options);
+  ASSERT_TRUE(first.ok());
+  EXPECT_GE(first->done, 3);
+  EXPECT_LT(first->done, 9);
+  EXPECT_GT(first->pending, 0);
+  std::set<int> ended;
+  const StatusOr<std::vector<TaskOutcome>> after_stop = ReadOutcomes(dir);
+  ASSERT_TRUE(after_stop.ok());
+  for (const TaskOutcome& o : *after_stop) {
+    if (o.status != "pending") ended.insert(o.index);
+  }
+  options.progress = nullptr;
+  stop.store(false);
+  std::ofstream(log, std::ios::trunc).close();
+  StatusOr<RunReport> second = RunSweep(dir, options);
+  ASSERT_TRUE(second.ok());
+  EXPECT_EQ(second->skipped, static_cast<int>(ended.size()));
+  EXPECT_EQ(second->done + second->skipped, 9);
+  const StatusOr<std::vector<TaskOutcome>> at_end = ReadOutcomes(dir);
+  ASSERT_TRUE(at_end.ok());
+  for (const TaskOutcome& o : *at_end) EXPECT_EQ(o.status, "ok") << o.index << ": " << o.error;
+  // No run that had ended was started again; each pending one exactly once.
+  char name[16];
+  for (int i = 0; i < 9; ++i) {
+    std::snprintf(name, sizeof name, "%05d", i);
+    EXPECT_EQ(Starts(log, (fs::path(dir) / "runs" / name).string() + " "), ended.count(i) ? 0 : 1)
+        << i;
+  }
+}
+
+TEST(SweepRunTest, OneTaskByIndexAsAnArrayJobRunsIt) {
+  SquareWalk("a", 0.0);
+  const std::string path = SweepFile("task.toml", R"(
+[[datasets]]
+data = ["data/a"]
+[parameters]
+"wifi.match_threshold" = [0.2, 0.4]
+)");
+  const std::string dir = (Scratch().path() / "sweep-task").string();
+  ASSERT_TRUE(WritePlan(*MakePlan(*LoadSweepFile(path)), dir).ok());
+  StatusOr<TaskOutcome> one = RunTask(dir, 1, RATSLAM_PROGRAM);
+  ASSERT_TRUE(one.ok()) << one.status().message();
+  EXPECT_EQ(one->status, "ok");
+  EXPECT_FALSE(RunTask(dir, 2, RATSLAM_PROGRAM).ok());  // no such task
+  StatusOr<std::vector<TaskOutcome>> outcomes = ReadOutcomes(dir);
+  EXPECT_EQ((*outcomes)[0].status, "pending");
+  EXPECT_EQ((*outcomes)[1].status, "ok");
+}
+
+}  // namespace
+}  // namespace ratslam::sweep
