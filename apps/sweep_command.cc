@@ -6,8 +6,10 @@
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <iostream>
 #include <string>
+#include <vector>
 
 #include "apps/cli.h"
 #include "sweep/sweep.h"
@@ -21,7 +23,11 @@ const char kSweepUsage[] =
     "  ratslam sweep run DIR [--jobs N]          run every pending task, N at a time\n"
     "  ratslam sweep task DIR [--index I]        run one task (I from SLURM_ARRAY_TASK_ID,\n"
     "                                            PBS_ARRAY_INDEX or SGE_TASK_ID when absent)\n"
-    "  ratslam sweep collect DIR                 results.csv/json, points.csv, best.toml\n";
+    "  ratslam sweep collect DIR                 results.csv/json, points.csv, best.toml\n"
+    "  ratslam sweep submit DIR --slurm [--partition P] [--time T] [--mem M]\n"
+    "                 [--max-parallel K] [--chunk C] [--sbatch-arg A ...] [--dry-run]\n"
+    "      a Slurm job array over the pending tasks (C tasks per element) and a collect job\n"
+    "      after it (afterany); --dry-run writes and prints the scripts without submitting\n";
 
 std::atomic<bool> g_sweep_stop{false};
 extern "C" void OnSweepSignal(int) { g_sweep_stop.store(true); }
@@ -33,27 +39,41 @@ std::string ThisProgram() {
   return n > 0 ? std::string(buffer, static_cast<size_t>(n)) : std::string("ratslam");
 }
 
-// One line per change: done of total, failures and running tasks, elapsed time and ETA.
+// Done of total, failures and running tasks, elapsed time and ETA: redrawn in place on a
+// terminal, else a line per percent of the tasks (and for every failure).
 class SweepProgress : public ProgressSink {
  public:
-  explicit SweepProgress(bool quiet) : quiet_(quiet), start_(std::chrono::steady_clock::now()) {}
+  explicit SweepProgress(bool quiet)
+      : quiet_(quiet), terminal_(isatty(STDERR_FILENO)), start_(std::chrono::steady_clock::now()) {}
   void Update(const ProgressUpdate& p) override {
     if (quiet_ || p.total == 0) return;
+    if (!started_) {
+      started_ = true;
+      first_done_ = p.done;  // tasks finished by earlier runs do not count for the ETA
+    }
+    const uint64_t percent = p.done * 100 / p.total;
+    const bool new_failure =
+        p.phase.substr(0, p.phase.find(',')) != last_phase_.substr(0, last_phase_.find(','));
+    if (!terminal_ && percent == last_percent_ && !new_failure) return;
+    last_percent_ = percent;
+    last_phase_ = p.phase;
     const double elapsed =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
     const uint64_t fresh = p.done - std::min(p.done, first_done_);
-    if (!started_) {
-      started_ = true;
-      first_done_ = p.done;
-    }
     const std::string eta =
         p.done >= p.total ? Duration(0.0)
         : fresh > 0
             ? Duration(elapsed / static_cast<double>(fresh) * static_cast<double>(p.total - p.done))
             : std::string(1, '?');
-    std::fprintf(stderr, "%s: %llu/%llu, %s elapsed, ETA %s\n", p.phase.c_str(),
-                 static_cast<unsigned long long>(p.done), static_cast<unsigned long long>(p.total),
-                 Duration(elapsed).c_str(), eta.c_str());
+    std::fprintf(stderr, "%s%s: %llu/%llu, %s elapsed, ETA %s%s", terminal_ ? "\r" : "",
+                 p.phase.c_str(), static_cast<unsigned long long>(p.done),
+                 static_cast<unsigned long long>(p.total), Duration(elapsed).c_str(), eta.c_str(),
+                 terminal_ ? "   " : "\n");
+    drew_ = terminal_;
+  }
+  void Finish() override {
+    if (drew_) std::fprintf(stderr, "\n");
+    drew_ = false;
   }
 
  private:
@@ -68,9 +88,13 @@ class SweepProgress : public ProgressSink {
     return buffer;
   }
   bool quiet_;
+  bool terminal_;
   std::chrono::steady_clock::time_point start_;
   bool started_ = false;
+  bool drew_ = false;
   uint64_t first_done_ = 0;
+  uint64_t last_percent_ = 101;
+  std::string last_phase_;
 };
 
 int Fail(const Status& s) {
@@ -82,9 +106,29 @@ int Fail(const Status& s) {
 
 int SweepCommand(int argc, char** argv) {
   const std::string action = argc > 2 ? argv[2] : "";
-  auto args = ParseArguments(argc, argv, 3, {"--out", "--jobs", "--index"});
+  // Bare flags of `submit`, taken out before the common parser sees them.
+  bool slurm = false, dry_run = false;
+  std::vector<char*> kept;
+  for (int i = 0; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (i >= 3 && a == "--slurm") {
+      slurm = true;
+    } else if (i >= 3 && a == "--dry-run") {
+      dry_run = true;
+    } else {
+      kept.push_back(argv[i]);
+    }
+  }
+  if ((slurm || dry_run) && action != "submit") {
+    std::cerr << kSweepUsage;
+    return kExitUsage;
+  }
+  auto args = ParseArguments(static_cast<int>(kept.size()), kept.data(), 3,
+                             {"--out", "--jobs", "--index", "--chunk", "--partition", "--time",
+                              "--mem", "--max-parallel", "--sbatch-arg"});
   if (!args || args->positional.size() != 1 ||
-      (action != "plan" && action != "run" && action != "task" && action != "collect")) {
+      (action != "plan" && action != "run" && action != "task" && action != "collect" &&
+       action != "submit")) {
     std::cerr << kSweepUsage;
     return kExitUsage;
   }
@@ -147,12 +191,59 @@ int SweepCommand(int argc, char** argv) {
         return kExitUsage;
       }
     }
-    StatusOr<sweep::TaskOutcome> outcome =
-        sweep::RunTask(target, static_cast<int>(index), ThisProgram());
-    if (!outcome.ok()) return Fail(outcome.status());
-    std::cout << "task " << index << ": " << outcome->status
-              << (outcome->error.empty() ? "" : " (" + outcome->error + ")") << "\n";
-    return outcome->status == "ok" ? kExitOk : kExitError;
+    int64_t chunk = 1;
+    if (args->values.count("--chunk")) {
+      auto c = ParseInteger("--chunk", args->values["--chunk"], 1, 1 << 20);
+      if (!c) return kExitUsage;
+      chunk = *c;
+    }
+    StatusOr<std::vector<sweep::TaskOutcome>> outcomes = sweep::RunTasks(
+        target, static_cast<int>(index * chunk), static_cast<int>(chunk), ThisProgram());
+    if (!outcomes.ok()) return Fail(outcomes.status());
+    bool all_ok = true;
+    for (const sweep::TaskOutcome& o : *outcomes) {
+      std::cout << "task " << o.index << ": " << o.status
+                << (o.error.empty() ? "" : " (" + o.error + ")") << "\n";
+      all_ok = all_ok && o.status == "ok";
+    }
+    return all_ok ? kExitOk : kExitError;
+  }
+  if (action == "submit") {
+    if (!slurm) {
+      std::cerr << "ratslam sweep submit: only --slurm is supported (see configs/README.md for a "
+                   "GNU parallel recipe)\n";
+      return kExitUsage;
+    }
+    sweep::SlurmOptions options;
+    options.program = ThisProgram();
+    options.partition = args->values["--partition"];
+    options.time = args->values["--time"];
+    options.mem = args->values["--mem"];
+    options.sbatch_args = args->all["--sbatch-arg"];
+    if (args->values.count("--max-parallel")) {
+      auto k = ParseInteger("--max-parallel", args->values["--max-parallel"], 1, 1 << 20);
+      if (!k) return kExitUsage;
+      options.max_parallel = static_cast<int>(*k);
+    }
+    if (args->values.count("--chunk")) {
+      auto c = ParseInteger("--chunk", args->values["--chunk"], 1, 1 << 20);
+      if (!c) return kExitUsage;
+      options.chunk = static_cast<int>(*c);
+    }
+    StatusOr<sweep::SlurmJobs> jobs = sweep::WriteSlurmScripts(target, options);
+    if (!jobs.ok()) return Fail(jobs.status());
+    if (dry_run) {
+      for (const std::string& script : {jobs->array_script, jobs->collect_script}) {
+        std::ifstream in(script);
+        std::cout << "# " << script << "\n" << in.rdbuf() << "\n";
+      }
+      return kExitOk;
+    }
+    Status submitted = sweep::SubmitSlurm(&*jobs);
+    if (!submitted.ok()) return Fail(submitted);
+    std::cout << "array job " << jobs->array_job << " (--array=" << jobs->array_spec
+              << "), collect job " << jobs->collect_job << "\n";
+    return kExitOk;
   }
   StatusOr<sweep::CollectReport> report = sweep::Collect(target);
   if (!report.ok()) return Fail(report.status());

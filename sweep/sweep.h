@@ -104,6 +104,31 @@ StatusOr<RunReport> RunSweep(const std::string& dir, const RunOptions& options);
 // Runs one task (what a cluster array job calls); a task already ended is not run again.
 StatusOr<TaskOutcome> RunTask(const std::string& dir, int index, const std::string& program);
 
+// Runs tasks [first, first + count) of the plan one after another (an array job's share when a
+// sweep has more tasks than the cluster allows array elements); the outcome of each.
+StatusOr<std::vector<TaskOutcome>> RunTasks(const std::string& dir, int first, int count,
+                                            const std::string& program);
+
+// A Slurm job array over a plan's pending tasks, and a collect job that runs after it whatever
+// its tasks' outcome (afterany).
+struct SlurmOptions {
+  std::string program;  // the ratslam executable the jobs run (an absolute path)
+  std::string partition, time, mem;
+  int max_parallel = 0;                  // array tasks at once (%K); 0: no limit
+  int chunk = 1;                         // plan tasks per array element
+  std::vector<std::string> sbatch_args;  // extra "#SBATCH" lines, e.g. "--account=x"
+};
+struct SlurmJobs {
+  std::string array_script, collect_script;  // paths, in DIR/slurm/
+  std::string array_spec;                    // the --array value, e.g. "0-9,12%2"
+  std::string array_job, collect_job;        // job ids once submitted
+};
+// Writes DIR/slurm/array.sh and DIR/slurm/collect.sh (logs go to DIR/slurm/logs/). Fails when
+// nothing is pending.
+StatusOr<SlurmJobs> WriteSlurmScripts(const std::string& dir, const SlurmOptions& options);
+// Submits both scripts with sbatch (on PATH) and fills in the job ids.
+Status SubmitSlurm(SlurmJobs* jobs);
+
 // The recorded outcome of every task (pending ones included).
 StatusOr<std::vector<TaskOutcome>> ReadOutcomes(const std::string& dir);
 

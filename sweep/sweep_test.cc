@@ -393,5 +393,39 @@ data = ["data/a"]
   EXPECT_EQ((*outcomes)[1].status, "ok");
 }
 
+// The Slurm scripts cover only what is pending, in ranges, with the parallel limit.
+TEST(SweepSlurmTest, ArrayCoversPendingTasksInRanges) {
+  SquareWalk("a", 0.0);
+  const std::string path = SweepFile("slurm.toml", R"(
+[[datasets]]
+data = ["data/a"]
+[parameters]
+"wifi.match_threshold" = [0.1, 0.2, 0.3, 0.4, 0.5]
+)");
+  const std::string dir = (Scratch().path() / "sweep-slurm").string();
+  ASSERT_TRUE(WritePlan(*MakePlan(*LoadSweepFile(path)), dir).ok());
+  ASSERT_TRUE(RunTasks(dir, 1, 2, RATSLAM_PROGRAM).ok());  // tasks 1 and 2 done
+  SlurmOptions options;
+  options.program = "/opt/it's here/ratslam";
+  options.max_parallel = 2;
+  options.time = "00:10:00";
+  options.sbatch_args = {"--account=lab"};
+  StatusOr<SlurmJobs> jobs = WriteSlurmScripts(dir, options);
+  ASSERT_TRUE(jobs.ok()) << jobs.status().message();
+  EXPECT_EQ(jobs->array_spec, "0,3-4%2");
+  std::ifstream in(jobs->array_script);
+  const std::string script((std::istreambuf_iterator<char>(in)), {});
+  EXPECT_NE(script.find("#SBATCH --array=0,3-4%2\n"), std::string::npos) << script;
+  EXPECT_NE(script.find("#SBATCH --time=00:10:00\n#SBATCH --account=lab\n"), std::string::npos);
+  EXPECT_NE(script.find("exec '/opt/it'\\''s here/ratslam' sweep task '"), std::string::npos)
+      << script;
+  options.chunk = 2;  // elements 0 (tasks 0-1), 1 (2-3), 2 (4): 1 and 2 hold pending tasks too
+  jobs = WriteSlurmScripts(dir, options);
+  ASSERT_TRUE(jobs.ok());
+  EXPECT_EQ(jobs->array_spec, "0-2%2");
+  ASSERT_TRUE(RunTasks(dir, 0, 5, RATSLAM_PROGRAM).ok());
+  EXPECT_FALSE(WriteSlurmScripts(dir, options).ok());  // nothing pending
+}
+
 }  // namespace
 }  // namespace ratslam::sweep
