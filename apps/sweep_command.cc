@@ -249,6 +249,7 @@ int SweepCommand(int argc, char** argv) {
   if (!report.ok()) return Fail(report.status());
   std::cout << report->ok << " ok, " << report->failed << " failed, " << report->pending
             << " pending";
+  if (report->eliminated > 0) std::cout << ", " << report->eliminated << " eliminated";
   if (report->best_point) {
     std::cout << "; best point " << *report->best_point << " (objective " << report->best_objective
               << "), written to " << target << "/best.toml";

@@ -48,6 +48,8 @@ struct SweepSettings {
   std::string goal = "minimize";
   double timeout_s = 0.0;
   std::string keep = "small";
+  std::string search = "all";
+  double halving_rate = 3.0;
 
   template <typename V>
   void VisitFields(V&& v) {
@@ -62,6 +64,10 @@ struct SweepSettings {
     v("goal", goal, "minimize or maximize", schema::Any());
     v("timeout_s", timeout_s, "per run; 0: none", schema::Unit("s").NonNegative());
     v("keep", keep, "small (summary, config, trajectory) or all (every output)", schema::Any());
+    v("search", search, "all tasks, or halving (successive halving over the data sets)",
+      schema::Any());
+    v("halving_rate", halving_rate, "halving: the share kept is 1/rate, data sets grow by rate",
+      schema::Unit("").AtLeast(2).AtMost(100));
   }
 };
 
@@ -211,13 +217,21 @@ json SpecToJson(const SweepSpec& s) {
                           {"hi", p.hi},
                           {"line", p.line}});
   }
-  return {{"source", s.source},       {"base_config", s.base_config_text},
-          {"datasets", s.datasets},   {"parameters", parameters},
-          {"method", s.method},       {"samples", s.samples},
-          {"seed", s.seed},           {"metrics", s.metrics},
-          {"objective", s.objective}, {"aggregate", s.aggregate},
-          {"goal", s.goal},           {"timeout_s", s.timeout_s},
-          {"keep_all", s.keep_all}};
+  return {{"source", s.source},
+          {"base_config", s.base_config_text},
+          {"datasets", s.datasets},
+          {"parameters", parameters},
+          {"method", s.method},
+          {"samples", s.samples},
+          {"seed", s.seed},
+          {"metrics", s.metrics},
+          {"objective", s.objective},
+          {"aggregate", s.aggregate},
+          {"goal", s.goal},
+          {"timeout_s", s.timeout_s},
+          {"keep_all", s.keep_all},
+          {"search", s.search},
+          {"halving_rate", s.halving_rate}};
 }
 
 SweepSpec SpecFromJson(const json& j) {
@@ -245,6 +259,8 @@ SweepSpec SpecFromJson(const json& j) {
   s.goal = j.at("goal").get<std::string>();
   s.timeout_s = j.at("timeout_s").get<double>();
   s.keep_all = j.at("keep_all").get<bool>();
+  s.search = j.at("search").get<std::string>();
+  s.halving_rate = j.at("halving_rate").get<double>();
   return s;
 }
 
@@ -302,6 +318,11 @@ StatusOr<SweepSpec> LoadSweepFile(const std::string& path) {
   if (settings.keep != "small" && settings.keep != "all") {
     return fail_at("keep", "must be small or all");
   }
+  if (settings.search != "all" && settings.search != "halving") {
+    return fail_at("search", "must be all or halving");
+  }
+  spec.search = settings.search;
+  spec.halving_rate = settings.halving_rate;
   spec.method = settings.method;
   spec.samples = settings.samples;
   spec.seed = settings.seed;
@@ -646,37 +667,30 @@ StatusOr<std::vector<TaskOutcome>> ReadOutcomes(const std::string& dir) {
   return out;
 }
 
-StatusOr<RunReport> RunSweep(const std::string& dir, const RunOptions& options) {
-  StatusOr<Plan> plan = ReadPlan(dir);
-  if (!plan.ok()) return plan.status();
-  RunReport report;
-  std::vector<int> queue;
-  for (const Task& t : plan->tasks) {
-    StatusOr<TaskOutcome> o = ReadOutcome(dir, t.index);
-    if (!o.ok()) return o.status();
-    if (o->status == "pending") {
-      queue.push_back(t.index);
-    } else {
-      ++report.skipped;
-      if (o->status != "ok") ++report.failed;
-    }
-  }
-  const int total = static_cast<int>(plan->tasks.size());
+// The objective of a run, when it succeeded and its summary has it (defined with Collect).
+std::optional<double> RunObjective(const Plan& plan, const std::string& dir, int index);
+
+namespace {
+
+// Runs the tasks of `queue` (all pending), options.jobs at a time, adding to `report`; `total`
+// and `finished_before` only feed the progress line.
+Status RunQueue(const Plan& plan, const std::string& dir, const std::vector<int>& queue,
+                const RunOptions& options, int total, RunReport* report) {
   std::vector<Running> running;
   size_t next = 0;
   auto stopping = [&] { return options.stop_requested && options.stop_requested->load(); };
   auto show = [&] {
     if (!options.progress) return;
-    options.progress->Update({"sweep (" + std::to_string(report.failed) + " failed, " +
+    options.progress->Update({"sweep (" + std::to_string(report->failed) + " failed, " +
                                   std::to_string(running.size()) + " running)",
-                              static_cast<uint64_t>(report.done + report.skipped),
+                              static_cast<uint64_t>(report->done + report->skipped),
                               static_cast<uint64_t>(total)});
   };
   Status error;
   while (error.ok() && ((next < queue.size() && !stopping()) || !running.empty())) {
     while (error.ok() && !stopping() && next < queue.size() &&
            static_cast<int>(running.size()) < std::max(1, options.jobs)) {
-      StatusOr<Running> r = Start(*plan, dir, queue[next++], options.program);
+      StatusOr<Running> r = Start(plan, dir, queue[next++], options.program);
       if (!r.ok()) {
         error = r.status();
         break;
@@ -691,7 +705,7 @@ StatusOr<RunReport> RunSweep(const std::string& dir, const RunOptions& options) 
       const pid_t done = waitpid(r.pid, &wait_status, WNOHANG);
       const double age =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - r.start).count();
-      const bool timed_out = plan->spec.timeout_s > 0.0 && age > plan->spec.timeout_s;
+      const bool timed_out = plan.spec.timeout_s > 0.0 && age > plan.spec.timeout_s;
       if (done == 0 && (timed_out || stopping())) {
         kill(-r.pid, timed_out ? SIGKILL : SIGTERM);
         waitpid(r.pid, &wait_status, 0);
@@ -700,13 +714,13 @@ StatusOr<RunReport> RunSweep(const std::string& dir, const RunOptions& options) 
         continue;
       }
       if (!timed_out && (stopping() || Interrupted(wait_status))) {
-        ++report.pending;  // unrecorded: it runs again next time
+        ++report->pending;  // unrecorded: it runs again next time
       } else {
         TaskOutcome outcome;
-        Status s = Finish(*plan, dir, r, wait_status, timed_out, &outcome);
+        Status s = Finish(plan, dir, r, wait_status, timed_out, &outcome);
         if (!s.ok() && error.ok()) error = s;
-        ++report.done;
-        if (outcome.status != "ok") ++report.failed;
+        ++report->done;
+        if (outcome.status != "ok") ++report->failed;
       }
       running.erase(running.begin() + static_cast<std::ptrdiff_t>(i));
       changed = true;
@@ -718,10 +732,126 @@ StatusOr<RunReport> RunSweep(const std::string& dir, const RunOptions& options) 
     kill(-r.pid, SIGTERM);
     int wait_status = 0;
     waitpid(r.pid, &wait_status, 0);
+    ++report->pending;
   }
-  report.pending += static_cast<int>(queue.size() - next);
+  report->pending += static_cast<int>(queue.size() - next);
+  return error;
+}
+
+// Successive halving (Jamieson and Talwalkar 2016) over data sets: every point runs on a few
+// data sets, the best 1/rate of the points go on to rate times as many, until the survivors
+// have run on all of them. Data sets enter in a seeded random order. Deterministic given the
+// runs' results, so a resumed sweep makes the same decisions. Writes DIR/search.json.
+Status RunHalving(const Plan& plan, const std::string& dir, const RunOptions& options,
+                  RunReport* report) {
+  const SweepSpec& spec = plan.spec;
+  const int datasets = static_cast<int>(spec.datasets.size());
+  const double rate = spec.halving_rate;
+  std::vector<int> order(datasets);
+  for (int d = 0; d < datasets; ++d) order[d] = d;
+  Random random(spec.seed ^ 0x5eedULL);
+  for (int i = datasets - 1; i > 0; --i) {
+    std::swap(order[i], order[random.NextU64() % static_cast<uint64_t>(i + 1)]);
+  }
+  // Halvings: as many as the points need, but no more than the data sets allow.
+  const int halvings = std::max(
+      0, std::min(static_cast<int>(
+                      std::ceil(std::log(std::max(1, plan.points)) / std::log(rate) - 1e-9)),
+                  static_cast<int>(std::floor(std::log(datasets) / std::log(rate) + 1e-9))));
+  int used = std::max(1, static_cast<int>(std::ceil(datasets / std::pow(rate, halvings))));
+  std::vector<int> survivors(plan.points);
+  for (int p = 0; p < plan.points; ++p) survivors[p] = p;
+  std::map<std::pair<int, int>, int> task_of;  // (point, data set) -> task
+  for (const Task& t : plan.tasks) task_of[{t.point, t.dataset}] = t.index;
+  const bool minimize = spec.goal == "minimize";
+  json rounds = json::array();
+  int planned_runs = 0;
+  while (true) {
+    std::vector<int> queue;
+    for (int p : survivors) {
+      for (int k = 0; k < used; ++k) {
+        const int index = task_of.at({p, order[k]});
+        StatusOr<TaskOutcome> o = ReadOutcome(dir, index);
+        if (!o.ok()) return o.status();
+        if (o->status == "pending") queue.push_back(index);
+      }
+    }
+    std::sort(queue.begin(), queue.end());
+    planned_runs += static_cast<int>(queue.size());
+    RATSLAM_RETURN_IF_ERROR(
+        RunQueue(plan, dir, queue, options, static_cast<int>(plan.tasks.size()), report));
+    if (report->pending > 0) return Status::Ok();  // stopped: the next run resumes this round
+    // Each survivor's objective over the data sets used so far; a failed run ranks it last.
+    std::vector<std::pair<double, int>> ranked;
+    for (int p : survivors) {
+      double sum = 0.0, worst = minimize ? -1e300 : 1e300;
+      bool failed = false;
+      for (int k = 0; k < used; ++k) {
+        const std::optional<double> v = RunObjective(plan, dir, task_of.at({p, order[k]}));
+        if (!v) {
+          failed = true;
+          break;
+        }
+        sum += *v;
+        worst = minimize ? std::max(worst, *v) : std::min(worst, *v);
+      }
+      double value = spec.aggregate == "mean" ? sum / used : worst;
+      if (failed) value = minimize ? 1e300 : -1e300;
+      ranked.emplace_back(minimize ? value : -value, p);  // ascending is best first
+    }
+    std::sort(ranked.begin(), ranked.end());
+    json round = {{"datasets", used}, {"points", survivors}, {"runs", queue.size()}};
+    if (used >= datasets) {
+      rounds.push_back(round);
+      break;
+    }
+    const size_t keep =
+        std::max<size_t>(1, static_cast<size_t>(std::ceil(survivors.size() / rate)));
+    survivors.clear();
+    for (size_t i = 0; i < keep && i < ranked.size(); ++i) survivors.push_back(ranked[i].second);
+    std::sort(survivors.begin(), survivors.end());
+    round["kept"] = survivors;
+    rounds.push_back(round);
+    used = std::min(datasets, static_cast<int>(std::ceil(used * rate)));
+  }
+  const json search = {{"search", "halving"},           {"rate", rate},
+                       {"dataset_order", order},        {"rounds", rounds},
+                       {"finalists", survivors},        {"runs", planned_runs},
+                       {"grid_runs", plan.tasks.size()}};
+  return WriteFileAtomically((fs::path(dir) / "search.json").string(), search.dump(1) + "\n");
+}
+
+}  // namespace
+
+StatusOr<RunReport> RunSweep(const std::string& dir, const RunOptions& options) {
+  StatusOr<Plan> plan = ReadPlan(dir);
+  if (!plan.ok()) return plan.status();
+  RunReport report;
+  Status status;
+  if (plan->spec.search == "halving") {
+    for (const Task& t : plan->tasks) {
+      StatusOr<TaskOutcome> o = ReadOutcome(dir, t.index);
+      if (!o.ok()) return o.status();
+      if (o->status != "pending") ++report.skipped;
+      if (o->status != "pending" && o->status != "ok") ++report.failed;
+    }
+    status = RunHalving(*plan, dir, options, &report);
+  } else {
+    std::vector<int> queue;
+    for (const Task& t : plan->tasks) {
+      StatusOr<TaskOutcome> o = ReadOutcome(dir, t.index);
+      if (!o.ok()) return o.status();
+      if (o->status == "pending") {
+        queue.push_back(t.index);
+      } else {
+        ++report.skipped;
+        if (o->status != "ok") ++report.failed;
+      }
+    }
+    status = RunQueue(*plan, dir, queue, options, static_cast<int>(plan->tasks.size()), &report);
+  }
   if (options.progress) options.progress->Finish();
-  if (!error.ok()) return error;
+  if (!status.ok()) return status;
   return report;
 }
 
@@ -914,6 +1044,19 @@ std::optional<double> Metric(const json& summary, const std::string& dotted) {
   return node->get<double>();
 }
 
+}  // namespace
+
+std::optional<double> RunObjective(const Plan& plan, const std::string& dir, int index) {
+  StatusOr<TaskOutcome> o = ReadOutcome(dir, index);
+  if (!o.ok() || o->status != "ok") return std::nullopt;
+  StatusOr<std::string> text =
+      ReadRegularFile(RunFolder(dir, index) + "/summary.json", "run summary", size_t{1} << 26);
+  if (!text.ok()) return std::nullopt;
+  return Metric(json::parse(*text, nullptr, false), plan.spec.objective);
+}
+
+namespace {
+
 std::string Format(std::optional<double> v) { return v ? schema::TomlNumber(*v) : std::string(); }
 
 }  // namespace
@@ -923,6 +1066,9 @@ StatusOr<CollectReport> Collect(const std::string& dir) {
   if (!plan.ok()) return plan.status();
   const SweepSpec& spec = plan->spec;
   CollectReport report;
+  // After a finished successive halving, a task that never ran belongs to an eliminated point.
+  bool halving_done = false;
+  if (fs::exists(fs::path(dir) / "search.json")) halving_done = true;
   std::string csv = "index,point,dataset,status,exit_code,wall_s";
   for (const Parameter& p : spec.parameters) {
     csv += ',';
@@ -945,6 +1091,9 @@ StatusOr<CollectReport> Collect(const std::string& dir) {
       StatusOr<std::string> text = ReadRegularFile(RunFolder(dir, t.index) + "/summary.json",
                                                    "run summary", size_t{1} << 26);
       if (text.ok()) summary = json::parse(*text, nullptr, false);
+    } else if (o->status == "pending" && halving_done) {
+      o->status = "eliminated";
+      ++report.eliminated;
     } else if (o->status == "pending") {
       ++report.pending;
     } else {

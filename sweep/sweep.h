@@ -42,6 +42,10 @@ struct SweepSpec {
   std::string method = "grid";  // grid: every combination; random: `samples` seeded draws
   int samples = 0;
   uint64_t seed = 1;
+  // Which tasks run: all, or successive halving over the data sets (the best 1/halving_rate of
+  // the points go on to halving_rate times as many data sets; DIR/search.json says which).
+  std::string search = "all";
+  double halving_rate = 3.0;
   std::vector<std::string> metrics;  // dotted keys into summary.json ("map_ate_m", ...)
   std::string objective;             // one of the metrics
   std::string aggregate = "mean";    // over the data sets: mean or worst
@@ -134,6 +138,7 @@ StatusOr<std::vector<TaskOutcome>> ReadOutcomes(const std::string& dir);
 
 struct CollectReport {
   int ok = 0, failed = 0, pending = 0;
+  int eliminated = 0;  // never run: their point was dropped by successive halving
   std::optional<int> best_point;
   double best_objective = 0.0;
 };

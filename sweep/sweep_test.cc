@@ -427,5 +427,59 @@ data = ["data/a"]
   EXPECT_FALSE(WriteSlurmScripts(dir, options).ok());  // nothing pending
 }
 
+// Successive halving on a synthetic objective with a known optimum: the fake worker scores
+// (match_threshold - 0.37)^2 plus a per-data-set offset, so point 10 (threshold 10/27) is best.
+TEST(SweepHalvingTest, FindsTheKnownOptimumWithAThirdOfTheGridsRuns) {
+  std::string data;
+  for (int d = 0; d < 9; ++d) {
+    const std::string name = std::string(1, 'd') + std::to_string(d);
+    fs::create_directories(Scratch().path() / "halving" / name);
+    data += "[[datasets]]\ndata = [\"halving/d";
+    data += std::to_string(d);
+    data += "\"]\n";
+  }
+  const std::string worker = Write("fake_objective.sh", R"(#!/bin/sh
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --config) config=$2; shift ;;
+    --data) data=$2; shift ;;
+    --out) out=$2; shift ;;
+  esac
+  shift
+done
+x=$(awk -F' = ' '/^\[/ {s=$0} s=="[wifi]" && $1=="match_threshold" {print $2}' "$config")
+d=${data##*/d}
+awk -v x="$x" -v d="$d" 'BEGIN { printf "{\"map_ate_m\": %.12f}\n", (x-0.37)^2 + 0.01*d + 0.0001*((d*7)%3)*x }' > "$out/summary.json"
+)");
+  fs::permissions(worker, fs::perms::owner_all);
+  const std::string path =
+      SweepFile("halving.toml", "search = \"halving\"\nhalving_rate = 3\n" + data +
+                                    "[parameters]\n\"wifi.match_threshold\" = "
+                                    "{linear = [0.0, 1.0, 28]}\n");
+  const std::string dir = (Scratch().path() / "sweep-halving").string();
+  StatusOr<Plan> plan = MakePlan(*LoadSweepFile(path));
+  ASSERT_TRUE(plan.ok()) << plan.status().message();
+  ASSERT_EQ(plan->tasks.size(), 28u * 9u);
+  ASSERT_TRUE(WritePlan(*plan, dir).ok());
+  RunOptions options;
+  options.program = worker;
+  options.jobs = 2;
+  StatusOr<RunReport> report = RunSweep(dir, options);
+  ASSERT_TRUE(report.ok()) << report.status().message();
+  // 28 points on 1 data set, the best 10 on 3, the best 4 on all 9: 28 + 20 + 24 runs.
+  EXPECT_EQ(report->done, 72);
+  EXPECT_LE(report->done * 3, static_cast<int>(plan->tasks.size()));
+  StatusOr<CollectReport> collected = Collect(dir);
+  ASSERT_TRUE(collected.ok()) << collected.status().message();
+  EXPECT_EQ(collected->ok, 72);
+  EXPECT_EQ(collected->eliminated, 28 * 9 - 72);
+  ASSERT_TRUE(collected->best_point.has_value());
+  EXPECT_EQ(*collected->best_point, 10);
+  // Resuming a finished halving runs nothing.
+  StatusOr<RunReport> again = RunSweep(dir, options);
+  ASSERT_TRUE(again.ok());
+  EXPECT_EQ(again->done, 0);
+}
+
 }  // namespace
 }  // namespace ratslam::sweep
