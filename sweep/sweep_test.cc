@@ -481,5 +481,22 @@ awk -v x="$x" -v d="$d" 'BEGIN { printf "{\"map_ate_m\": %.12f}\n", (x-0.37)^2 +
   EXPECT_EQ(again->done, 0);
 }
 
+// The shipped sweep files plan (every value valid for the configuration they vary).
+TEST(SweepPlanTest, ShippedSweepFilesPlan) {
+  const fs::path data = fs::path(RATSLAM_SHARED_DATA_DIR) / "ipin2023-t3";
+  if (!fs::exists(data)) GTEST_SKIP() << "missing " << data;
+  const fs::path sweeps = fs::path(RATSLAM_SOURCE_DIR) / "configs" / "sweeps";
+  const std::map<std::string, size_t> expected = {{"ipin2023-wifi-compass.toml", 2160},
+                                                  {"ipin2023-wifi-compass-halving.toml", 2160},
+                                                  {"ipin2023-wifi-compass-holdout.toml", 11}};
+  for (const auto& [name, tasks] : expected) {
+    StatusOr<SweepSpec> spec = LoadSweepFile((sweeps / name).string());
+    ASSERT_TRUE(spec.ok()) << spec.status().message();
+    StatusOr<Plan> plan = MakePlan(*spec);
+    ASSERT_TRUE(plan.ok()) << plan.status().message();
+    EXPECT_EQ(plan->tasks.size(), tasks) << name;
+  }
+}
+
 }  // namespace
 }  // namespace ratslam::sweep
