@@ -6,13 +6,16 @@
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <string>
 #include <vector>
 
 #include "apps/cli.h"
+#include "render/renderer.h"
 #include "sweep/sweep.h"
+#include "viewer/sweep_figures.h"
 
 namespace ratslam {
 namespace {
@@ -96,6 +99,39 @@ class SweepProgress : public ProgressSink {
   uint64_t last_percent_ = 101;
   std::string last_phase_;
 };
+
+// The sweep's figures from its collected points, into DIR/plots/.
+Status DrawSweepPlots(const std::string& dir, const sweep::CollectReport& report) {
+  StatusOr<sweep::Plan> plan = sweep::ReadPlan(dir);
+  if (!plan.ok()) return plan.status();
+  SweepFigureData data;
+  data.title = std::filesystem::path(plan->spec.source).filename().string();
+  data.objective = plan->spec.aggregate + " " + plan->spec.objective;
+  data.minimize = plan->spec.goal == "minimize";
+  for (const sweep::Parameter& p : plan->spec.parameters) data.keys.push_back(p.key);
+  for (const sweep::PointSummary& p : report.points) {
+    SweepFigurePoint point;
+    for (const auto& [key, value] : p.overrides) point.values.push_back(value);
+    point.objective = p.objective;
+    point.mean_wall_s = p.mean_wall_s;
+    if (report.best_point && *report.best_point == p.point) {
+      data.best = static_cast<int>(data.points.size());
+    }
+    data.points.push_back(point);
+  }
+  const std::string plots = dir + "/plots";
+  std::error_code ec;
+  std::filesystem::create_directories(plots, ec);
+  if (ec) return Status::Error(plots + ": cannot create folder: " + ec.message());
+  if (!data.keys.empty()) {
+    RATSLAM_RETURN_IF_ERROR(
+        RenderToPng(SweepParameterScene(data), plots + "/objective_by_parameter.png"));
+  }
+  if (data.keys.size() >= 2) {
+    RATSLAM_RETURN_IF_ERROR(RenderToPng(SweepHeatmapScene(data, 0, 1), plots + "/heatmap.png"));
+  }
+  return RenderToPng(SweepParetoScene(data), plots + "/pareto.png");
+}
 
 int Fail(const Status& s) {
   std::cerr << "ratslam sweep: " << s.message() << "\n";
@@ -247,6 +283,7 @@ int SweepCommand(int argc, char** argv) {
   }
   StatusOr<sweep::CollectReport> report = sweep::Collect(target);
   if (!report.ok()) return Fail(report.status());
+  if (Status drawn = DrawSweepPlots(target, *report); !drawn.ok()) return Fail(drawn);
   std::cout << report->ok << " ok, " << report->failed << " failed, " << report->pending
             << " pending";
   if (report->eliminated > 0) std::cout << ", " << report->eliminated << " eliminated";

@@ -259,8 +259,8 @@ SweepSpec SpecFromJson(const json& j) {
   s.goal = j.at("goal").get<std::string>();
   s.timeout_s = j.at("timeout_s").get<double>();
   s.keep_all = j.at("keep_all").get<bool>();
-  s.search = j.at("search").get<std::string>();
-  s.halving_rate = j.at("halving_rate").get<double>();
+  s.search = j.value("search", std::string("all"));  // added after the first plans
+  s.halving_rate = j.value("halving_rate", 3.0);
   return s;
 }
 
@@ -1082,6 +1082,7 @@ StatusOr<CollectReport> Collect(const std::string& dir) {
   json runs = json::array();
   // Per point: the objective of each data set (nullopt when its run did not succeed).
   std::vector<std::vector<std::optional<double>>> objectives(plan->points);
+  std::vector<std::pair<double, int>> wall(plan->points);  // sum of wall times, runs
   for (const Task& t : plan->tasks) {
     StatusOr<TaskOutcome> o = ReadOutcome(dir, t.index);
     if (!o.ok()) return o.status();
@@ -1119,6 +1120,10 @@ StatusOr<CollectReport> Collect(const std::string& dir) {
     csv += CsvField(o->error) + "\n";
     objectives[t.point].push_back(o->status == "ok" ? Metric(summary, spec.objective)
                                                     : std::nullopt);
+    if (o->status == "ok" || o->status == "failed" || o->status == "timeout") {
+      wall[t.point].first += o->wall_s;
+      ++wall[t.point].second;
+    }
     runs.push_back({{"index", t.index},
                     {"point", t.point},
                     {"data", spec.datasets[t.dataset]},
@@ -1158,6 +1163,8 @@ StatusOr<CollectReport> Collect(const std::string& dir) {
     if (ok > 0 && spec.aggregate == "mean") aggregate /= ok;
     // A point with a failed or missing run is not ranked.
     const std::optional<double> ranked = complete ? std::optional<double>(aggregate) : std::nullopt;
+    report.points.push_back(
+        {p, overrides[p], ranked, wall[p].second ? wall[p].first / wall[p].second : 0.0, ok});
     points_csv += std::to_string(p);
     for (const auto& [key, value] : overrides[p]) {
       points_csv += ',';

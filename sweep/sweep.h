@@ -136,7 +136,17 @@ Status SubmitSlurm(SlurmJobs* jobs);
 // The recorded outcome of every task (pending ones included).
 StatusOr<std::vector<TaskOutcome>> ReadOutcomes(const std::string& dir);
 
+// One parameter combination as collected.
+struct PointSummary {
+  int point = 0;
+  std::vector<std::pair<std::string, std::string>> overrides;
+  std::optional<double> objective;  // aggregated; none unless every run of the point succeeded
+  double mean_wall_s = 0.0;         // over its runs that ended
+  int runs_ok = 0;
+};
+
 struct CollectReport {
+  std::vector<PointSummary> points;
   int ok = 0, failed = 0, pending = 0;
   int eliminated = 0;  // never run: their point was dropped by successive halving
   std::optional<int> best_point;

@@ -1,0 +1,255 @@
+#include "viewer/sweep_figures.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "viewer/figures.h"
+
+namespace ratslam {
+namespace {
+
+constexpr Rgba kInk{30, 30, 30, 255};
+constexpr Rgba kGrid{225, 225, 225, 255};
+constexpr Rgba kDot{70, 110, 170, 200};
+constexpr Rgba kBest{215, 40, 40, 255};
+
+std::optional<double> AsNumber(const std::string& text) {
+  double v = 0.0;
+  const auto r = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (r.ec != std::errc() || r.ptr != text.data() + text.size()) return std::nullopt;
+  return v;
+}
+
+std::string Short(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.4g", v);
+  return text;
+}
+
+// Where a parameter's values go along an axis of unit length: numbers linearly, anything else
+// (or a single number) evenly in order of first appearance.
+class ValueAxis {
+ public:
+  explicit ValueAxis(const std::vector<std::string>& values) {
+    for (const std::string& v : values) {
+      if (std::find(distinct_.begin(), distinct_.end(), v) == distinct_.end()) {
+        distinct_.push_back(v);
+      }
+    }
+    numeric_ = distinct_.size() > 1;
+    for (const std::string& v : distinct_) {
+      const std::optional<double> x = AsNumber(v);
+      if (!x) {
+        numeric_ = false;
+        break;
+      }
+      lo_ = std::min(lo_, *x);
+      hi_ = std::max(hi_, *x);
+    }
+    if (numeric_ && !(hi_ > lo_)) numeric_ = false;
+    if (!numeric_) {
+      std::sort(distinct_.begin(), distinct_.end(), [](const std::string& a, const std::string& b) {
+        const auto x = AsNumber(a), y = AsNumber(b);
+        return x && y ? *x < *y : a < b;
+      });
+    }
+  }
+  double operator()(const std::string& v) const {
+    if (numeric_) return 0.05 + 0.9 * (*AsNumber(v) - lo_) / (hi_ - lo_);
+    const auto it = std::find(distinct_.begin(), distinct_.end(), v);
+    return (static_cast<double>(it - distinct_.begin()) + 0.5) / distinct_.size();
+  }
+  const std::vector<std::string>& distinct() const { return distinct_; }
+
+ private:
+  std::vector<std::string> distinct_;
+  bool numeric_ = false;
+  double lo_ = std::numeric_limits<double>::infinity();
+  double hi_ = -std::numeric_limits<double>::infinity();
+};
+
+struct Range {
+  double lo = 0.0, hi = 1.0;
+  double Fraction(double v) const { return (v - lo) / (hi - lo); }
+};
+
+Range ObjectiveRange(const SweepFigureData& data) {
+  Range r{std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
+  for (const SweepFigurePoint& p : data.points) {
+    if (!p.objective) continue;
+    r.lo = std::min(r.lo, *p.objective);
+    r.hi = std::max(r.hi, *p.objective);
+  }
+  if (!std::isfinite(r.lo)) return {0.0, 1.0};
+  const double pad = r.hi > r.lo ? 0.05 * (r.hi - r.lo) : std::max(1e-9, 0.05 * std::abs(r.lo));
+  return {r.lo - pad, r.hi + pad};
+}
+
+// A left axis with ticks for `range` over a panel.
+void ValueTicks(Scene& scene, const Range& range, float left, float top, float width,
+                float height) {
+  const double step = NiceStep(range.hi - range.lo, 5);
+  for (double v = std::ceil(range.lo / step) * step; v <= range.hi; v += step) {
+    const float y = top + height * static_cast<float>(1.0 - range.Fraction(v));
+    scene.Line({left, y}, {left + width, y}, 1.0f, kGrid);
+    scene.Text({left - 8, y + 5}, Short(v), 14, kInk, TextAnchor::kRight);
+  }
+  scene.Line({left, top + height}, {left + width, top + height}, 1.5f, kInk);
+  scene.Line({left, top}, {left, top + height}, 1.5f, kInk);
+}
+
+std::string Goal(const SweepFigureData& data) {
+  return data.objective + (data.minimize ? " (lower is better)" : " (higher is better)");
+}
+
+}  // namespace
+
+Scene SweepParameterScene(const SweepFigureData& data) {
+  const int panels = std::max<int>(1, static_cast<int>(data.keys.size()));
+  const int columns = std::min(panels, 3);
+  const int rows = (panels + columns - 1) / columns;
+  const float panel_w = 380, panel_h = 280, left0 = 90, top0 = 90, gap_x = 110, gap_y = 110;
+  Scene scene(static_cast<int>(left0 + columns * (panel_w + gap_x)),
+              static_cast<int>(top0 + rows * (panel_h + gap_y)), Rgba{255, 255, 255, 255});
+  scene.Text({20, 32}, data.title, 20, kInk);
+  scene.Text({20, 58}, Goal(data) + " of each point; the best in red", 15, kInk);
+  const Range range = ObjectiveRange(data);
+  for (int k = 0; k < static_cast<int>(data.keys.size()); ++k) {
+    const float left = left0 + (k % columns) * (panel_w + gap_x);
+    const float top = top0 + (k / columns) * (panel_h + gap_y);
+    std::vector<std::string> values;
+    for (const SweepFigurePoint& p : data.points) values.push_back(p.values.at(k));
+    const ValueAxis axis(values);
+    ValueTicks(scene, range, left, top, panel_w, panel_h);
+    const auto& distinct = axis.distinct();
+    const size_t every = std::max<size_t>(1, distinct.size() / 8);
+    for (size_t i = 0; i < distinct.size(); i += every) {
+      const float x = left + panel_w * static_cast<float>(axis(distinct[i]));
+      scene.Line({x, top + panel_h}, {x, top + panel_h + 5}, 1.0f, kInk);
+      scene.Text({x, top + panel_h + 22}, distinct[i], 13, kInk, TextAnchor::kCenter);
+    }
+    scene.Text({left + panel_w / 2, top + panel_h + 48}, data.keys[k], 15, kInk,
+               TextAnchor::kCenter);
+    auto at = [&](const SweepFigurePoint& p) {
+      return ScenePoint{left + panel_w * static_cast<float>(axis(p.values[k])),
+                        top + panel_h * static_cast<float>(1.0 - range.Fraction(*p.objective))};
+    };
+    for (const SweepFigurePoint& p : data.points) {
+      if (p.objective) scene.Disc(at(p), 3.5f, kDot);
+    }
+    if (data.best) scene.Disc(at(data.points[*data.best]), 6.0f, kBest);
+  }
+  return scene;
+}
+
+Scene SweepHeatmapScene(const SweepFigureData& data, int a, int b) {
+  std::vector<std::string> xs, ys;
+  for (const SweepFigurePoint& p : data.points) {
+    xs.push_back(p.values.at(a));
+    ys.push_back(p.values.at(b));
+  }
+  const ValueAxis x_axis(xs), y_axis(ys);
+  const auto& columns = x_axis.distinct();
+  const auto& rows = y_axis.distinct();
+  const float cell_w = std::max(60.0f, 560.0f / columns.size());
+  const float cell_h = std::max(34.0f, 380.0f / rows.size());
+  const float left = 150, top = 120;
+  const float width = cell_w * columns.size(), height = cell_h * rows.size();
+  Scene scene(std::max(760, static_cast<int>(left + width + 60)),
+              static_cast<int>(top + height + 90),
+              Rgba{255, 255, 255, 255});
+  scene.Text({20, 32}, data.title, 20, kInk);
+  scene.Text({20, 58}, "best " + Goal(data) + " over the other parameters", 15, kInk);
+  const Range range = ObjectiveRange(data);
+  for (size_t c = 0; c < columns.size(); ++c) {
+    for (size_t r = 0; r < rows.size(); ++r) {
+      std::optional<double> best;
+      for (const SweepFigurePoint& p : data.points) {
+        if (!p.objective || p.values[a] != columns[c] || p.values[b] != rows[r]) continue;
+        if (!best || (data.minimize ? *p.objective < *best : *p.objective > *best)) {
+          best = p.objective;
+        }
+      }
+      const float cx = left + cell_w * c, cy = top + height - cell_h * (r + 1);
+      if (!best) {
+        scene.Rect(cx + 1, cy + 1, cell_w - 2, cell_h - 2, kGrid);
+        continue;
+      }
+      // Dark is good whichever the goal.
+      double t = range.Fraction(*best);
+      if (!data.minimize) t = 1.0 - t;
+      scene.Rect(cx + 1, cy + 1, cell_w - 2, cell_h - 2, SequentialColor(1.0 - t));
+      scene.Text({cx + cell_w / 2, cy + cell_h / 2 + 5}, Short(*best), 13,
+                 t < 0.5 ? kInk : Rgba{255, 255, 255, 255}, TextAnchor::kCenter);
+    }
+  }
+  for (size_t c = 0; c < columns.size(); ++c) {
+    scene.Text({left + cell_w * (c + 0.5f), top + height + 22}, columns[c], 13, kInk,
+               TextAnchor::kCenter);
+  }
+  for (size_t r = 0; r < rows.size(); ++r) {
+    scene.Text({left - 10, top + height - cell_h * (r + 0.5f) + 5}, rows[r], 13, kInk,
+               TextAnchor::kRight);
+  }
+  scene.Text({left + width / 2, top + height + 50}, data.keys[a], 15, kInk, TextAnchor::kCenter);
+  scene.Text({20, top - 16}, data.keys[b], 15, kInk);
+  return scene;
+}
+
+Scene SweepParetoScene(const SweepFigureData& data) {
+  const float left = 100, top = 90, width = 700, height = 420;
+  Scene scene(static_cast<int>(left + width + 60), static_cast<int>(top + height + 90),
+              Rgba{255, 255, 255, 255});
+  scene.Text({20, 32}, data.title, 20, kInk);
+  scene.Text({20, 58}, Goal(data) + " against run time; the Pareto front in red", 15, kInk);
+  const Range y = ObjectiveRange(data);
+  Range x{std::numeric_limits<double>::infinity(), 0.0};
+  for (const SweepFigurePoint& p : data.points) {
+    if (!p.objective) continue;
+    x.lo = std::min(x.lo, p.mean_wall_s);
+    x.hi = std::max(x.hi, p.mean_wall_s);
+  }
+  if (!std::isfinite(x.lo)) x = {0.0, 1.0};
+  const double pad = x.hi > x.lo ? 0.05 * (x.hi - x.lo) : std::max(1e-3, 0.05 * x.lo);
+  x = {std::max(0.0, x.lo - pad), x.hi + pad};
+  ValueTicks(scene, y, left, top, width, height);
+  const double step = NiceStep(x.hi - x.lo, 6);
+  for (double v = std::ceil(x.lo / step) * step; v <= x.hi; v += step) {
+    const float px = left + width * static_cast<float>(x.Fraction(v));
+    scene.Line({px, top}, {px, top + height}, 1.0f, kGrid);
+    scene.Text({px, top + height + 22}, Short(v), 14, kInk, TextAnchor::kCenter);
+  }
+  scene.Text({left + width / 2, top + height + 50}, "mean wall time per run (s)", 15, kInk,
+             TextAnchor::kCenter);
+  auto at = [&](const SweepFigurePoint& p) {
+    return ScenePoint{left + width * static_cast<float>(x.Fraction(p.mean_wall_s)),
+                      top + height * static_cast<float>(1.0 - y.Fraction(*p.objective))};
+  };
+  std::vector<const SweepFigurePoint*> ranked;
+  for (const SweepFigurePoint& p : data.points) {
+    if (!p.objective) continue;
+    ranked.push_back(&p);
+    scene.Disc(at(p), 3.5f, kDot);
+  }
+  // The front: by time, each point better than every faster one.
+  std::sort(ranked.begin(), ranked.end(),
+            [&](const SweepFigurePoint* a, const SweepFigurePoint* b) {
+              if (a->mean_wall_s != b->mean_wall_s) return a->mean_wall_s < b->mean_wall_s;
+              return data.minimize ? *a->objective < *b->objective : *a->objective > *b->objective;
+            });
+  std::vector<ScenePoint> front;
+  std::optional<double> best;
+  for (const auto* p : ranked) {
+    if (best && !(data.minimize ? *p->objective < *best : *p->objective > *best)) continue;
+    best = p->objective;
+    front.push_back(at(*p));
+    scene.Disc(front.back(), 5.0f, kBest);
+  }
+  if (front.size() > 1) scene.Polyline(front, 2.0f, kBest);
+  return scene;
+}
+
+}  // namespace ratslam

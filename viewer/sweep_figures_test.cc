@@ -1,0 +1,48 @@
+#include "viewer/sweep_figures.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+namespace ratslam {
+namespace {
+
+bool HasText(const Scene& scene, const std::string& text) {
+  return std::any_of(scene.texts().begin(), scene.texts().end(),
+                     [&](const SceneText& t) { return t.text == text; });
+}
+
+// Two parameters of two values each, and a third that the heat map takes the best over.
+SweepFigureData Example() {
+  SweepFigureData d;
+  d.title = "t";
+  d.objective = "ate";
+  d.keys = {"a", "b", "c"};
+  d.points = {{{"1", "x", "0"}, 4.0, 1.0},
+              {{"1", "x", "1"}, 3.0, 2.0},
+              {{"2", "x", "0"}, 2.5, 1.0},
+              {{"1", "y", "0"}, 7.0, 1.0},
+              {{"2", "y", "0"}, std::nullopt, 1.0}};
+  d.best = 2;
+  return d;
+}
+
+TEST(SweepFiguresTest, HeatmapCellsHoldTheBestOverTheOtherParameters) {
+  const Scene scene = SweepHeatmapScene(Example(), 0, 1);
+  EXPECT_TRUE(HasText(scene, "3"));    // a=1, b=x: min(4, 3)
+  EXPECT_TRUE(HasText(scene, "2.5"));  // a=2, b=x
+  EXPECT_TRUE(HasText(scene, "7"));    // a=1, b=y
+  EXPECT_FALSE(HasText(scene, "4"));   // beaten in its cell
+  SweepFigureData maximise = Example();
+  maximise.minimize = false;
+  EXPECT_TRUE(HasText(SweepHeatmapScene(maximise, 0, 1), "4"));
+}
+
+TEST(SweepFiguresTest, EveryParameterGetsAPanelWithItsValues) {
+  const Scene scene = SweepParameterScene(Example());
+  for (const char* text : {"a", "b", "c", "x", "y"}) EXPECT_TRUE(HasText(scene, text)) << text;
+  EXPECT_GT(scene.triangles().size(), 0u);
+}
+
+}  // namespace
+}  // namespace ratslam
