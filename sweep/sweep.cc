@@ -39,6 +39,7 @@ constexpr size_t kMaxSweepBytes = 1 << 20;
 // The [sweep] table's own keys, bound like every other TOML table.
 struct SweepSettings {
   std::string base_config;
+  std::string command = "replay";
   std::string method = "grid";
   int samples = 0;
   uint64_t seed = 1;
@@ -55,10 +56,12 @@ struct SweepSettings {
   void VisitFields(V&& v) {
     v("base_config", base_config, "configuration the parameters vary; empty: the defaults",
       schema::Any());
+    v("command", command, "replay, or evaluate (the FABMAP benchmark)", schema::Any());
     v("method", method, "grid (every combination) or random (seeded draws)", schema::Any());
     v("samples", samples, "random: number of draws", schema::Unit("runs").NonNegative());
     v("seed", seed, "random: seed of the draws", schema::Any());
-    v("metrics", metrics, "dotted keys of summary.json collected from every run", schema::Any());
+    v("metrics", metrics, "dotted keys of summary.json (evaluation.json) collected from every run",
+      schema::Any());
     v("objective", objective, "the metric the sweep optimises", schema::Any().NotEmpty());
     v("aggregate", aggregate, "over the data sets: mean or worst", schema::Any());
     v("goal", goal, "minimize or maximize", schema::Any());
@@ -192,6 +195,11 @@ std::string WithoutLocation(const std::string& message, const std::string& sourc
   return colon == std::string::npos ? message : message.substr(colon + 2);
 }
 
+// Where a run's metrics are: replay's summary or the benchmark's evaluation.
+std::string MetricsFile(const SweepSpec& spec) {
+  return spec.command == "evaluate" ? "evaluation.json" : "summary.json";
+}
+
 std::string RunFolder(const std::string& dir, int index) {
   char name[16];
   std::snprintf(name, sizeof name, "%05d", index);
@@ -218,6 +226,7 @@ json SpecToJson(const SweepSpec& s) {
                           {"line", p.line}});
   }
   return {{"source", s.source},
+          {"command", s.command},
           {"base_config", s.base_config_text},
           {"datasets", s.datasets},
           {"parameters", parameters},
@@ -238,6 +247,7 @@ SweepSpec SpecFromJson(const json& j) {
   SweepSpec s;
   s.source = j.at("source").get<std::string>();
   s.base_config_text = j.at("base_config").get<std::string>();
+  s.command = j.value("command", std::string("replay"));
   s.datasets = j.at("datasets").get<std::vector<std::vector<std::string>>>();
   for (const json& p : j.at("parameters")) {
     Parameter q;
@@ -303,6 +313,10 @@ StatusOr<SweepSpec> LoadSweepFile(const std::string& path) {
     return Status::Error(schema::TomlWhere(path, sweep_table.get(key)) + ": sweep." + key + ": " +
                          message);
   };
+  if (settings.command != "replay" && settings.command != "evaluate") {
+    return fail_at("command", "must be replay or evaluate");
+  }
+  spec.command = settings.command;
   if (settings.method != "grid" && settings.method != "random") {
     return fail_at("method", "must be grid or random");
   }
@@ -376,6 +390,14 @@ StatusOr<SweepSpec> LoadSweepFile(const std::string& path) {
     spec.datasets.push_back(sessions);
   }
   if (spec.datasets.empty()) return Status::Error(path + ": no [[datasets]]");
+  if (spec.command == "evaluate") {
+    for (const auto& d : spec.datasets) {
+      if (d.size() > 2) {
+        return Status::Error(path + ": evaluate takes data = [map] or [map, query], not " +
+                             std::to_string(d.size()) + " data sets");
+      }
+    }
+  }
   if (const toml::table* parameters = top.Table("parameters")) {
     for (const auto& [key, node] : *parameters) {
       StatusOr<Parameter> p = ReadParameter(std::string(key.str()), node, path);
@@ -582,10 +604,15 @@ StatusOr<Running> Start(const Plan& plan, const std::string& dir, int index,
   if (!config.ok()) return config.status();
   const std::string config_path = folder + "/config.toml";
   RATSLAM_RETURN_IF_ERROR(WriteFileAtomically(config_path, PrintConfig(*config)));
-  std::vector<std::string> args = {program, "replay", "--config", config_path};
-  for (const std::string& d : plan.spec.datasets[task.dataset]) {
-    args.push_back("--data");
-    args.push_back(d);
+  std::vector<std::string> args = {program, plan.spec.command, "--config", config_path};
+  const std::vector<std::string>& data = plan.spec.datasets[task.dataset];
+  if (plan.spec.command == "evaluate") {
+    args.insert(args.end(), {"--map", data.front(), "--query", data.back()});
+  } else {
+    for (const std::string& d : data) {
+      args.push_back("--data");
+      args.push_back(d);
+    }
   }
   args.insert(args.end(), {"--out", folder, "--quiet"});
   std::vector<char*> argv;
@@ -630,8 +657,8 @@ Status Finish(const Plan& plan, const std::string& dir, const Running& r, int wa
     outcome->error = std::string("killed by signal ") + strsignal(WTERMSIG(wait_status));
   }
   if (!plan.spec.keep_all && outcome->status == "ok") {
-    static const std::set<std::string> kKept = {"summary.json", "config.toml", "trajectory_tum.txt",
-                                                "stderr.txt"};
+    static const std::set<std::string> kKept = {"summary.json", "evaluation.json", "config.toml",
+                                                "trajectory_tum.txt", "stderr.txt"};
     std::error_code ec;
     for (const auto& entry : fs::directory_iterator(folder, ec)) {
       if (!kKept.count(entry.path().filename().string())) fs::remove_all(entry.path(), ec);
@@ -1049,8 +1076,8 @@ std::optional<double> Metric(const json& summary, const std::string& dotted) {
 std::optional<double> RunObjective(const Plan& plan, const std::string& dir, int index) {
   StatusOr<TaskOutcome> o = ReadOutcome(dir, index);
   if (!o.ok() || o->status != "ok") return std::nullopt;
-  StatusOr<std::string> text =
-      ReadRegularFile(RunFolder(dir, index) + "/summary.json", "run summary", size_t{1} << 26);
+  StatusOr<std::string> text = ReadRegularFile(RunFolder(dir, index) + "/" + MetricsFile(plan.spec),
+                                               "run metrics", size_t{1} << 26);
   if (!text.ok()) return std::nullopt;
   return Metric(json::parse(*text, nullptr, false), plan.spec.objective);
 }
@@ -1089,8 +1116,8 @@ StatusOr<CollectReport> Collect(const std::string& dir) {
     json summary;
     if (o->status == "ok") {
       ++report.ok;
-      StatusOr<std::string> text = ReadRegularFile(RunFolder(dir, t.index) + "/summary.json",
-                                                   "run summary", size_t{1} << 26);
+      StatusOr<std::string> text = ReadRegularFile(
+          RunFolder(dir, t.index) + "/" + MetricsFile(spec), "run metrics", size_t{1} << 26);
       if (text.ok()) summary = json::parse(*text, nullptr, false);
     } else if (o->status == "pending" && halving_done) {
       o->status = "eliminated";

@@ -35,8 +35,11 @@ struct Parameter {
 };
 
 struct SweepSpec {
-  std::string source;                              // the sweep file, for messages
-  std::string base_config_text;                    // resolved base configuration (TOML)
+  std::string source;            // the sweep file, for messages
+  std::string base_config_text;  // resolved base configuration (TOML)
+  // replay (metrics from summary.json) or evaluate (the FABMAP benchmark: each data-set entry
+  // is [map] or [map, query]; metrics from evaluation.json).
+  std::string command = "replay";
   std::vector<std::vector<std::string>> datasets;  // each run replays one entry (its sessions)
   std::vector<Parameter> parameters;
   std::string method = "grid";  // grid: every combination; random: `samples` seeded draws

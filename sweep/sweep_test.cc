@@ -498,5 +498,37 @@ TEST(SweepPlanTest, ShippedSweepFilesPlan) {
   }
 }
 
+// command = "evaluate" runs the FABMAP benchmark per task and reads evaluation.json.
+TEST(SweepRunTest, EvaluateSweepsReadTheBenchmarksMetrics) {
+  const fs::path site = fs::path(RATSLAM_SHARED_DATA_DIR) / "msft-ilc20-site1";
+  if (!fs::exists(site)) GTEST_SKIP() << "missing " << site;
+  const std::string path =
+      Write("evaluate.toml",
+            "[sweep]\ncommand = \"evaluate\"\nbase_config = \"" + std::string(RATSLAM_SOURCE_DIR) +
+                "/configs/msft-ilc20-wifi-b8.toml\"\n"
+                "objective = \"correct_within_m.5\"\n"
+                "goal = \"maximize\"\n[[datasets]]\ndata = [\"" +
+                site.string() + "\"]\n[parameters]\n\"wifi_words.bins\" = [1, 8]\n");
+  const std::string dir = (Scratch().path() / "sweep-evaluate").string();
+  StatusOr<Plan> plan = MakePlan(*LoadSweepFile(path));
+  ASSERT_TRUE(plan.ok()) << plan.status().message();
+  ASSERT_TRUE(WritePlan(*plan, dir).ok());
+  RunOptions options;
+  options.program = RATSLAM_PROGRAM;
+  options.jobs = 2;
+  StatusOr<RunReport> report = RunSweep(dir, options);
+  ASSERT_TRUE(report.ok()) << report.status().message();
+  StatusOr<CollectReport> collected = Collect(dir);
+  ASSERT_TRUE(collected.ok());
+  ASSERT_EQ(collected->ok, 2);
+  ASSERT_EQ(collected->points.size(), 2u);
+  for (const PointSummary& p : collected->points) {
+    ASSERT_TRUE(p.objective.has_value());
+    EXPECT_GT(*p.objective, 0.0);
+    EXPECT_LE(*p.objective, 1.0);
+  }
+  EXPECT_TRUE(fs::exists(fs::path(dir) / "runs" / "00000" / "evaluation.json"));
+}
+
 }  // namespace
 }  // namespace ratslam::sweep
