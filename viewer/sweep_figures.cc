@@ -159,8 +159,7 @@ Scene SweepHeatmapScene(const SweepFigureData& data, int a, int b) {
   const float left = 150, top = 120;
   const float width = cell_w * columns.size(), height = cell_h * rows.size();
   Scene scene(std::max(760, static_cast<int>(left + width + 60)),
-              static_cast<int>(top + height + 90),
-              Rgba{255, 255, 255, 255});
+              static_cast<int>(top + height + 90), Rgba{255, 255, 255, 255});
   scene.Text({20, 32}, data.title, 20, kInk);
   scene.Text({20, 58}, "best " + Goal(data) + " over the other parameters", 15, kInk);
   const Range range = ObjectiveRange(data);
