@@ -52,47 +52,72 @@ constexpr uint32_t kModelMagic = 0x4d565252;  // "RRVM"
 constexpr uint32_t kModelVersion = 1;
 }  // namespace
 
+namespace {
+
+// The file, field by field in file order: Describe below both writes and reads it (the archives
+// of common/byte_buffer.h), so the two cannot disagree.
+struct VisualModelFile {
+  uint32_t magic = kModelMagic;
+  uint32_t version = kModelVersion;
+  uint8_t descriptor = 0;  // 0 ORB, 1 SIFT
+  int32_t max_features = 0;
+  int32_t fast_threshold = 0;
+  std::string vocabulary;  // Vocabulary::Encode's bytes
+  ChowLiuTree tree;
+  std::vector<Observation> samples;
+};
+
+}  // namespace
+}  // namespace ratslam::fabmap
+
+namespace ratslam {
+// Found by the archives (namespace ratslam) for the unknown-world samples.
+template <typename A>
+bool Describe(A& a, fabmap::Observation& o) {
+  return a(o);
+}
+template <typename A>
+bool Describe(A& a, fabmap::VisualModelFile& f) {
+  return a(f.magic) && a.Check(f.magic == fabmap::kModelMagic, "not a visual model file") &&
+         a(f.version) && a.Check(f.version == fabmap::kModelVersion, "unsupported version") &&
+         a(f.descriptor) && a.Check(f.descriptor <= 1, "unknown descriptor") && a(f.max_features) &&
+         a(f.fast_threshold) && a(f.vocabulary) && a(f.tree.parent) && a(f.tree.marginal) &&
+         a(f.tree.on_given_parent_on) && a(f.tree.on_given_parent_off) && a.Objects(f.samples, 8);
+}
+}  // namespace ratslam
+
+namespace ratslam::fabmap {
+
 std::string EncodeVisualModel(const TrainedVisualModel& m) {
+  VisualModelFile file;
+  file.descriptor = m.features.descriptor == DescriptorKind::kOrb ? 0 : 1;
+  file.max_features = m.features.max_features;
+  file.fast_threshold = m.features.fast_threshold;
+  file.vocabulary = m.vocabulary.Encode();
+  file.tree = m.model.tree;
+  file.samples = m.model.samples;
   ByteWriter w;
-  w.Pod(kModelMagic);
-  w.Pod(kModelVersion);
-  w.Pod<uint8_t>(m.features.descriptor == DescriptorKind::kOrb ? 0 : 1);
-  w.Pod<int32_t>(m.features.max_features);
-  w.Pod<int32_t>(m.features.fast_threshold);
-  w.String(m.vocabulary.Encode());
-  const ChowLiuTree& t = m.model.tree;
-  w.PodVector(t.parent);
-  w.PodVector(t.marginal);
-  w.PodVector(t.on_given_parent_on);
-  w.PodVector(t.on_given_parent_off);
-  w.Count(m.model.samples.size());
-  for (const Observation& o : m.model.samples) w.PodVector(o);
+  EncodeArchive archive(w, kModelVersion);
+  Describe(archive, file);
   return std::move(w.bytes());
 }
 
 StatusOr<TrainedVisualModel> DecodeVisualModel(const std::string& bytes,
                                                const std::string& source) {
   ByteReader r(bytes, source);
-  uint32_t magic = 0, version = 0;
-  uint8_t kind = 0;
-  std::string vocabulary_bytes;
-  TrainedVisualModel m;
-  ChowLiuTree& t = m.model.tree;
-  size_t samples = 0;
-  bool ok = r.Pod(&magic) && (magic == kModelMagic || r.Fail("not a visual model file")) &&
-            r.Pod(&version) && (version == kModelVersion || r.Fail("unsupported version")) &&
-            r.Pod(&kind) && (kind <= 1 || r.Fail("unknown descriptor")) &&
-            r.Pod(&m.features.max_features) && r.Pod(&m.features.fast_threshold) &&
-            r.String(&vocabulary_bytes) && r.PodVector(&t.parent) && r.PodVector(&t.marginal) &&
-            r.PodVector(&t.on_given_parent_on) && r.PodVector(&t.on_given_parent_off) &&
-            r.Count(8, &samples);
-  for (size_t i = 0; ok && i < samples; ++i) {
-    Observation o;
-    ok = r.PodVector(&o);
-    m.model.samples.push_back(std::move(o));
+  VisualModelFile file;
+  DecodeArchive archive(r, kModelVersion);
+  if (!(Describe(archive, file) && (r.AtEnd() || r.Fail("trailing bytes")))) {
+    return Status::Error(r.error());
   }
-  if (!(ok && (r.AtEnd() || r.Fail("trailing bytes")))) return Status::Error(r.error());
-  m.features.descriptor = kind == 0 ? DescriptorKind::kOrb : DescriptorKind::kSift;
+  TrainedVisualModel m;
+  m.features.descriptor = file.descriptor == 0 ? DescriptorKind::kOrb : DescriptorKind::kSift;
+  m.features.max_features = file.max_features;
+  m.features.fast_threshold = file.fast_threshold;
+  m.model.tree = std::move(file.tree);
+  m.model.samples = std::move(file.samples);
+  ChowLiuTree& t = m.model.tree;
+  const std::string vocabulary_bytes = std::move(file.vocabulary);
   std::string error;
   if (!m.features.IsValid(&error)) return Status::Error(source + ": " + error);
   auto v = Vocabulary::Decode(vocabulary_bytes, source + " (vocabulary)");
