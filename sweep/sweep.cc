@@ -591,11 +591,27 @@ StatusOr<TaskOutcome> ReadOutcome(const std::string& dir, int index) {
   return o;
 }
 
+// A run left behind by a killed sweep runner: its process group is still alive and its command
+// line names this folder. Ended before the folder is reused.
+void EndOrphan(const std::string& folder) {
+  std::ifstream in(folder + "/pid");
+  pid_t pid = 0;
+  if (!(in >> pid) || pid <= 1) return;
+  std::ifstream cmdline("/proc/" + std::to_string(pid) + "/cmdline");
+  const std::string command((std::istreambuf_iterator<char>(cmdline)), {});
+  if (command.find(folder) == std::string::npos) return;  // gone, or the pid was reused
+  kill(-pid, SIGKILL);
+  for (int i = 0; i < 500 && kill(pid, 0) == 0; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+}
+
 // Starts task `index` as `program replay ...` in its own process group.
 StatusOr<Running> Start(const Plan& plan, const std::string& dir, int index,
                         const std::string& program) {
   const Task& task = plan.tasks.at(index);
   const std::string folder = RunFolder(dir, index);
+  EndOrphan(folder);
   std::error_code ec;
   fs::remove_all(folder, ec);  // a run that never ended starts again from nothing
   fs::create_directories(folder, ec);
@@ -637,6 +653,9 @@ StatusOr<Running> Start(const Plan& plan, const std::string& dir, int index,
   posix_spawn_file_actions_destroy(&actions);
   posix_spawnattr_destroy(&attributes);
   if (rc != 0) return Status::Error(program + ": cannot start: " + std::strerror(rc));
+  // Who writes into the folder, so that a sweep resumed after its runner was killed can end the
+  // run that was left behind instead of racing it.
+  std::ofstream(folder + "/pid") << r.pid << "\n";
   return r;
 }
 
@@ -657,8 +676,9 @@ Status Finish(const Plan& plan, const std::string& dir, const Running& r, int wa
     outcome->error = std::string("killed by signal ") + strsignal(WTERMSIG(wait_status));
   }
   if (!plan.spec.keep_all && outcome->status == "ok") {
-    static const std::set<std::string> kKept = {"summary.json", "evaluation.json", "config.toml",
-                                                "trajectory_tum.txt", "stderr.txt"};
+    static const std::set<std::string> kKept = {"summary.json", "evaluation.json",
+                                                "config.toml",  "trajectory_tum.txt",
+                                                "stderr.txt",   "pid"};
     std::error_code ec;
     for (const auto& entry : fs::directory_iterator(folder, ec)) {
       if (!kKept.count(entry.path().filename().string())) fs::remove_all(entry.path(), ec);

@@ -1,6 +1,10 @@
 #include "sweep/sweep.h"
 
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -13,6 +17,8 @@
 #include "common/scratch_dir.h"
 #include "fusion/io/config.h"
 #include "sensors/dataset/dataset.h"
+
+extern char** environ;
 
 namespace ratslam::sweep {
 namespace {
@@ -528,6 +534,57 @@ TEST(SweepRunTest, EvaluateSweepsReadTheBenchmarksMetrics) {
     EXPECT_LE(*p.objective, 1.0);
   }
   EXPECT_TRUE(fs::exists(fs::path(dir) / "runs" / "00000" / "evaluation.json"));
+}
+
+// The runner itself killed (SIGKILL, no chance to clean up) half-way: the same command resumes,
+// repeats no run that had ended, and ends any run the dead runner left behind.
+TEST(SweepRunTest, AKilledRunnerResumesWithoutRepeatingOrLosingRuns) {
+  SquareWalk("a", 0.0);
+  const std::string path = SweepFile("kill.toml", R"(
+[[datasets]]
+data = ["data/a"]
+[parameters]
+"wifi.match_threshold" = {linear = [0.1, 0.9, 12]}
+)");
+  const std::string dir = (Scratch().path() / "sweep-kill").string();
+  ASSERT_TRUE(WritePlan(*MakePlan(*LoadSweepFile(path)), dir).ok());
+  std::string program = RATSLAM_PROGRAM, run = "run", folder = dir, jobs = "--jobs", two = "2",
+              quiet = "--quiet", sweep = "sweep";
+  char* argv[] = {program.data(), sweep.data(), run.data(),   folder.data(),
+                  jobs.data(),    two.data(),   quiet.data(), nullptr};
+  pid_t runner = -1;
+  ASSERT_EQ(posix_spawn(&runner, program.c_str(), nullptr, nullptr, argv, environ), 0);
+  auto ended = [&] {
+    std::set<int> out;
+    StatusOr<std::vector<TaskOutcome>> outcomes = ReadOutcomes(dir);
+    for (const TaskOutcome& o : *outcomes) {
+      if (o.status != "pending") out.insert(o.index);
+    }
+    return out;
+  };
+  for (int i = 0; i < 3000 && ended().size() < 4; ++i) usleep(10000);
+  kill(runner, SIGKILL);
+  int status = 0;
+  waitpid(runner, &status, 0);
+  const std::set<int> before = ended();
+  ASSERT_GE(before.size(), 4u);
+  ASSERT_LT(before.size(), 12u) << "the sweep finished before it could be killed";
+  const std::string log = (Scratch().path() / "kill.log").string();
+  RunOptions options;
+  options.program = FakeProgram(log);
+  options.jobs = 2;
+  StatusOr<RunReport> resumed = RunSweep(dir, options);
+  ASSERT_TRUE(resumed.ok()) << resumed.status().message();
+  EXPECT_EQ(resumed->skipped, static_cast<int>(before.size()));
+  EXPECT_EQ(resumed->done, 12 - static_cast<int>(before.size()));
+  char name[16];
+  for (int i = 0; i < 12; ++i) {
+    std::snprintf(name, sizeof name, "%05d", i);
+    EXPECT_EQ(Starts(log, (fs::path(dir) / "runs" / name).string() + " "), before.count(i) ? 0 : 1)
+        << i;
+  }
+  const StatusOr<std::vector<TaskOutcome>> at_end = ReadOutcomes(dir);
+  for (const TaskOutcome& o : *at_end) EXPECT_EQ(o.status, "ok") << o.index << ": " << o.error;
 }
 
 }  // namespace
