@@ -8,7 +8,9 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -35,6 +37,121 @@ namespace {
 
 constexpr int kPlanVersion = 1;
 constexpr size_t kMaxSweepBytes = 1 << 20;
+
+// An objective: a metric, or an arithmetic expression of metrics ("map_ate_m + 0.05 * templates")
+// with + - * /, parentheses, unary minus and numbers. Kept as reverse Polish notation.
+class Expression {
+ public:
+  static StatusOr<Expression> Parse(const std::string& text) {
+    Expression e;
+    e.text_ = text;
+    size_t pos = 0;
+    if (!e.Sum(&pos) || (e.Skip(&pos), pos != text.size())) {
+      return Status::Error("cannot read the objective '" + text + "' near character " +
+                           std::to_string(pos + 1));
+    }
+    return e;
+  }
+  // The metrics it reads, in order of first use.
+  std::vector<std::string> Metrics() const {
+    std::vector<std::string> out;
+    for (const Token& t : rpn_) {
+      if (t.kind == 'm' && std::find(out.begin(), out.end(), t.name) == out.end()) {
+        out.push_back(t.name);
+      }
+    }
+    return out;
+  }
+  template <typename Lookup>
+  std::optional<double> Evaluate(Lookup&& lookup) const {
+    std::vector<double> stack;
+    for (const Token& t : rpn_) {
+      if (t.kind == 'n') {
+        stack.push_back(t.value);
+      } else if (t.kind == 'm') {
+        const std::optional<double> v = lookup(t.name);
+        if (!v) return std::nullopt;
+        stack.push_back(*v);
+      } else if (t.kind == '~') {
+        stack.back() = -stack.back();
+      } else {
+        const double b = stack.back();
+        stack.pop_back();
+        double& a = stack.back();
+        a = t.kind == '+' ? a + b : t.kind == '-' ? a - b : t.kind == '*' ? a * b : a / b;
+      }
+    }
+    if (stack.size() != 1 || !std::isfinite(stack.back())) return std::nullopt;
+    return stack.back();
+  }
+
+ private:
+  struct Token {
+    char kind;  // n number, m metric, ~ negation, or the operator
+    double value = 0.0;
+    std::string name;
+  };
+  void Skip(size_t* pos) const {
+    while (*pos < text_.size() && text_[*pos] == ' ') ++*pos;
+  }
+  bool Sum(size_t* pos) {
+    if (!Product(pos)) return false;
+    for (Skip(pos); *pos < text_.size() && (text_[*pos] == '+' || text_[*pos] == '-'); Skip(pos)) {
+      const char op = text_[(*pos)++];
+      if (!Product(pos)) return false;
+      rpn_.push_back({op, 0.0, {}});
+    }
+    return true;
+  }
+  bool Product(size_t* pos) {
+    if (!Factor(pos)) return false;
+    for (Skip(pos); *pos < text_.size() && (text_[*pos] == '*' || text_[*pos] == '/'); Skip(pos)) {
+      const char op = text_[(*pos)++];
+      if (!Factor(pos)) return false;
+      rpn_.push_back({op, 0.0, {}});
+    }
+    return true;
+  }
+  bool Factor(size_t* pos) {
+    Skip(pos);
+    if (*pos >= text_.size()) return false;
+    const char c = text_[*pos];
+    if (c == '-') {
+      ++*pos;
+      if (!Factor(pos)) return false;
+      rpn_.push_back({'~', 0.0, {}});
+      return true;
+    }
+    if (c == '(') {
+      ++*pos;
+      if (!Sum(pos)) return false;
+      Skip(pos);
+      if (*pos >= text_.size() || text_[*pos] != ')') return false;
+      ++*pos;
+      return true;
+    }
+    if (std::isdigit(static_cast<unsigned char>(c)) || c == '.') {
+      double v = 0.0;
+      const auto r = std::from_chars(text_.data() + *pos, text_.data() + text_.size(), v);
+      if (r.ec != std::errc()) return false;
+      *pos = static_cast<size_t>(r.ptr - text_.data());
+      rpn_.push_back({'n', v, {}});
+      return true;
+    }
+    if (std::isalpha(static_cast<unsigned char>(c)) || c == '_') {
+      const size_t start = *pos;
+      while (*pos < text_.size() && (std::isalnum(static_cast<unsigned char>(text_[*pos])) ||
+                                     text_[*pos] == '_' || text_[*pos] == '.')) {
+        ++*pos;
+      }
+      rpn_.push_back({'m', 0.0, text_.substr(start, *pos - start)});
+      return true;
+    }
+    return false;
+  }
+  std::string text_;
+  std::vector<Token> rpn_;
+};
 
 // The [sweep] table's own keys, bound like every other TOML table.
 struct SweepSettings {
@@ -341,10 +458,16 @@ StatusOr<SweepSpec> LoadSweepFile(const std::string& path) {
   spec.samples = settings.samples;
   spec.seed = settings.seed;
   spec.metrics = settings.metrics;
-  if (std::find(spec.metrics.begin(), spec.metrics.end(), settings.objective) ==
-      spec.metrics.end()) {
-    spec.metrics.insert(spec.metrics.begin(), settings.objective);
+  StatusOr<Expression> objective = Expression::Parse(settings.objective);
+  if (!objective.ok()) return fail_at("objective", objective.status().message());
+  // The objective's metrics first, then the others asked for.
+  std::vector<std::string> metrics;
+  for (const std::string& m : objective->Metrics()) {
+    if (std::find(spec.metrics.begin(), spec.metrics.end(), m) == spec.metrics.end()) {
+      metrics.push_back(m);
+    }
   }
+  spec.metrics.insert(spec.metrics.begin(), metrics.begin(), metrics.end());
   spec.objective = settings.objective;
   spec.aggregate = settings.aggregate;
   spec.goal = settings.goal;
@@ -559,6 +682,7 @@ namespace {
 struct Running {
   int index = 0;
   pid_t pid = -1;
+  std::string program;
   std::chrono::steady_clock::time_point start;
 };
 
@@ -585,6 +709,8 @@ StatusOr<TaskOutcome> ReadOutcome(const std::string& dir, int index) {
     o.exit_code = j.at("exit_code").get<int>();
     o.wall_s = j.at("wall_s").get<double>();
     o.error = j.at("error").get<std::string>();
+    o.program = j.value("program", std::string());
+    o.host = j.value("host", std::string());
   } catch (const json::exception& e) {
     return Status::Error(path + ": " + e.what());
   }
@@ -648,6 +774,7 @@ StatusOr<Running> Start(const Plan& plan, const std::string& dir, int index,
   posix_spawnattr_setpgroup(&attributes, 0);  // its own group: a terminal's Ctrl-C is ours
   Running r;
   r.index = index;
+  r.program = program;
   r.start = std::chrono::steady_clock::now();
   const int rc = posix_spawn(&r.pid, program.c_str(), &actions, &attributes, argv.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
@@ -684,10 +811,13 @@ Status Finish(const Plan& plan, const std::string& dir, const Running& r, int wa
       if (!kKept.count(entry.path().filename().string())) fs::remove_all(entry.path(), ec);
     }
   }
-  const json status = {{"status", outcome->status},
-                       {"exit_code", outcome->exit_code},
-                       {"wall_s", outcome->wall_s},
-                       {"error", outcome->error}};
+  char host[256] = "";
+  gethostname(host, sizeof host - 1);
+  outcome->program = r.program;
+  outcome->host = host;
+  const json status = {{"status", outcome->status},   {"exit_code", outcome->exit_code},
+                       {"wall_s", outcome->wall_s},   {"error", outcome->error},
+                       {"program", outcome->program}, {"host", outcome->host}};
   return WriteFileAtomically(folder + "/status.json", status.dump(1) + "\n");
 }
 
@@ -1091,6 +1221,13 @@ std::optional<double> Metric(const json& summary, const std::string& dotted) {
   return node->get<double>();
 }
 
+// The objective (a metric or an expression of metrics) of one run's summary.
+std::optional<double> ObjectiveOf(const json& summary, const std::string& objective) {
+  StatusOr<Expression> e = Expression::Parse(objective);
+  if (!e.ok()) return std::nullopt;
+  return e->Evaluate([&](const std::string& name) { return Metric(summary, name); });
+}
+
 }  // namespace
 
 std::optional<double> RunObjective(const Plan& plan, const std::string& dir, int index) {
@@ -1099,7 +1236,7 @@ std::optional<double> RunObjective(const Plan& plan, const std::string& dir, int
   StatusOr<std::string> text = ReadRegularFile(RunFolder(dir, index) + "/" + MetricsFile(plan.spec),
                                                "run metrics", size_t{1} << 26);
   if (!text.ok()) return std::nullopt;
-  return Metric(json::parse(*text, nullptr, false), plan.spec.objective);
+  return ObjectiveOf(json::parse(*text, nullptr, false), plan.spec.objective);
 }
 
 namespace {
@@ -1165,22 +1302,28 @@ StatusOr<CollectReport> Collect(const std::string& dir) {
     }
     csv += ',';
     csv += CsvField(o->error) + "\n";
-    objectives[t.point].push_back(o->status == "ok" ? Metric(summary, spec.objective)
+    objectives[t.point].push_back(o->status == "ok" ? ObjectiveOf(summary, spec.objective)
                                                     : std::nullopt);
     if (o->status == "ok" || o->status == "failed" || o->status == "timeout") {
       wall[t.point].first += o->wall_s;
       ++wall[t.point].second;
     }
-    runs.push_back({{"index", t.index},
-                    {"point", t.point},
-                    {"data", spec.datasets[t.dataset]},
-                    {"parameters", parameters},
-                    {"metrics", metrics},
-                    {"status", o->status},
-                    {"exit_code", o->exit_code},
-                    {"wall_s", o->wall_s},
-                    {"error", o->error},
-                    {"folder", RunFolder(dir, t.index)}});
+    runs.push_back(
+        {{"index", t.index},
+         {"point", t.point},
+         {"data", spec.datasets[t.dataset]},
+         {"parameters", parameters},
+         {"metrics", metrics},
+         {"status", o->status},
+         {"exit_code", o->exit_code},
+         {"wall_s", o->wall_s},
+         {"error", o->error},
+         {"program", o->program},
+         {"host", o->host},
+         {"config_fingerprint", summary.is_object() && summary.contains("config_fingerprint")
+                                    ? summary["config_fingerprint"]
+                                    : json()},
+         {"folder", RunFolder(dir, t.index)}});
   }
   const bool minimize = spec.goal == "minimize";
   std::string points_csv = "point";

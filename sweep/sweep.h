@@ -91,6 +91,9 @@ struct TaskOutcome {
   int exit_code = 0;   // the run's exit status, or 128 + signal
   double wall_s = 0.0;
   std::string error;  // last line the run wrote to stderr, when it failed
+  // Provenance: the program that ran the task and the machine it ran on.
+  std::string program;
+  std::string host;
 };
 
 struct RunOptions {

@@ -587,5 +587,41 @@ data = ["data/a"]
   for (const TaskOutcome& o : *at_end) EXPECT_EQ(o.status, "ok") << o.index << ": " << o.error;
 }
 
+// An objective may be an expression of metrics; each run's value is computed from its summary.
+TEST(SweepRunTest, ObjectiveExpressionsCombineMetrics) {
+  SquareWalk("a", 0.0);
+  Write("base.toml", kBase);
+  const std::string path = Write("expression.toml", R"([sweep]
+base_config = "base.toml"
+objective = "(map_ate_m + 0.5 * templates) / 2 - -1"
+[[datasets]]
+data = ["data/a"]
+[parameters]
+"wifi.match_threshold" = [0.2, 0.6]
+)");
+  StatusOr<SweepSpec> spec = LoadSweepFile(path);
+  ASSERT_TRUE(spec.ok()) << spec.status().message();
+  EXPECT_EQ(spec->metrics, (std::vector<std::string>{"map_ate_m", "templates"}));
+  const std::string dir = (Scratch().path() / "sweep-expression").string();
+  ASSERT_TRUE(WritePlan(*MakePlan(*spec), dir).ok());
+  RunOptions options;
+  options.program = RATSLAM_PROGRAM;
+  ASSERT_TRUE(RunSweep(dir, options).ok());
+  StatusOr<CollectReport> collected = Collect(dir);
+  ASSERT_TRUE(collected.ok());
+  for (const PointSummary& p : collected->points) {
+    std::ifstream in(fs::path(dir) / "runs" / ("0000" + std::to_string(p.point)) / "summary.json");
+    const nlohmann::json summary = nlohmann::json::parse(in);
+    const double expected =
+        (summary.at("map_ate_m").get<double>() + 0.5 * summary.at("templates").get<double>()) / 2 +
+        1;
+    ASSERT_TRUE(p.objective.has_value());
+    EXPECT_DOUBLE_EQ(*p.objective, expected);
+  }
+  const std::string bad = Write("bad-expression.toml", "[sweep]\nobjective = \"map_ate_m +\"\n");
+  EXPECT_EQ(LoadSweepFile(bad).status().message(),
+            bad + ":2: sweep.objective: cannot read the objective 'map_ate_m +' near character 12");
+}
+
 }  // namespace
 }  // namespace ratslam::sweep
