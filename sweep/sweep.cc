@@ -555,6 +555,16 @@ StatusOr<Plan> MakePlan(const SweepSpec& spec) {
       }
     }
   }
+  // Counted before anything is built: more than 10^6 runs is not a sweep this tool can hold.
+  double runs = spec.method == "grid" ? 1.0 : static_cast<double>(spec.samples);
+  for (const Parameter& p : spec.parameters) {
+    if (spec.method == "grid") runs *= static_cast<double>(p.values.size());
+  }
+  runs *= static_cast<double>(spec.datasets.size());
+  if (runs > 1e6) {
+    return Status::Error(spec.source + ": " + schema::TomlNumber(runs) +
+                         " runs; a sweep plans at most 10^6");
+  }
   std::vector<std::vector<std::pair<std::string, std::string>>> points;
   if (spec.method == "grid") {
     points.push_back({});
@@ -567,7 +577,6 @@ StatusOr<Plan> MakePlan(const SweepSpec& spec) {
         }
       }
       points = std::move(next);
-      if (points.size() > 1000000) return Status::Error(spec.source + ": more than 10^6 points");
     }
   } else {
     Random random(spec.seed);
@@ -850,7 +859,7 @@ std::optional<double> RunObjective(const Plan& plan, const std::string& dir, int
 namespace {
 
 // Runs the tasks of `queue` (all pending), options.jobs at a time, adding to `report`; `total`
-// and `finished_before` only feed the progress line.
+// only feeds the progress line.
 Status RunQueue(const Plan& plan, const std::string& dir, const std::vector<int>& queue,
                 const RunOptions& options, int total, RunReport* report) {
   std::vector<Running> running;
@@ -1041,27 +1050,13 @@ StatusOr<TaskOutcome> RunTask(const std::string& dir, int index, const std::stri
   }
   StatusOr<TaskOutcome> recorded = ReadOutcome(dir, index);
   if (!recorded.ok() || recorded->status != "pending") return recorded;
-  StatusOr<Running> r = Start(*plan, dir, index, program);
-  if (!r.ok()) return r.status();
-  int wait_status = 0;
-  bool timed_out = false;
-  while (waitpid(r->pid, &wait_status, WNOHANG) == 0) {
-    const double age =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - r->start).count();
-    if (plan->spec.timeout_s > 0.0 && age > plan->spec.timeout_s) {
-      timed_out = true;
-      kill(-r->pid, SIGKILL);
-      waitpid(r->pid, &wait_status, 0);
-      break;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
-  TaskOutcome outcome;
-  outcome.index = index;
-  outcome.status = "pending";
-  if (!timed_out && Interrupted(wait_status)) return outcome;
-  RATSLAM_RETURN_IF_ERROR(Finish(*plan, dir, *r, wait_status, timed_out, &outcome));
-  return outcome;
+  // The same runner as a whole sweep's, with a queue of one: timeout, interruption and the
+  // recorded outcome behave alike.
+  RunOptions options;
+  options.program = program;
+  RunReport report;
+  RATSLAM_RETURN_IF_ERROR(RunQueue(*plan, dir, {index}, options, 1, &report));
+  return ReadOutcome(dir, index);
 }
 
 StatusOr<std::vector<TaskOutcome>> RunTasks(const std::string& dir, int first, int count,
@@ -1251,8 +1246,7 @@ StatusOr<CollectReport> Collect(const std::string& dir) {
   const SweepSpec& spec = plan->spec;
   CollectReport report;
   // After a finished successive halving, a task that never ran belongs to an eliminated point.
-  bool halving_done = false;
-  if (fs::exists(fs::path(dir) / "search.json")) halving_done = true;
+  const bool halving_done = fs::exists(fs::path(dir) / "search.json");
   std::string csv = "index,point,dataset,status,exit_code,wall_s";
   for (const Parameter& p : spec.parameters) {
     csv += ',';

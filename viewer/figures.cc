@@ -13,8 +13,6 @@ namespace ratslam {
 namespace {
 
 constexpr Rgba kWhite{255, 255, 255, 255};
-constexpr Rgba kInk{30, 30, 30, 255};
-constexpr Rgba kGrid{225, 225, 225, 255};
 constexpr Rgba kLoopClosure{220, 50, 32, 255};
 constexpr Rgba kGroundTruth{160, 160, 160, 200};
 

@@ -17,6 +17,10 @@
 
 namespace ratslam {
 
+// The figures' ink (text, axes) and grid lines, shared so that every figure looks alike.
+inline constexpr Rgba kInk{30, 30, 30, 255};
+inline constexpr Rgba kGrid{225, 225, 225, 255};
+
 // A perceptual sequential colour map for t in [0, 1] (dark blue, teal, green, yellow).
 Rgba SequentialColor(double t);
 // Distinct colours for categories (sessions, floors).

@@ -7,11 +7,6 @@
 
 namespace ratslam {
 
-namespace {
-constexpr Rgba kInk{30, 30, 30, 255};
-constexpr Rgba kGrid{225, 225, 225, 255};
-}  // namespace
-
 Scene LocalisationCurvesScene(const std::vector<LocalisationCurve>& curves,
                               const std::string& title, double max_distance_m) {
   const float panel_w = 560, panel_h = 400, left0 = 90, top = 80, gap = 130;

@@ -11,8 +11,6 @@
 namespace ratslam {
 namespace {
 
-constexpr Rgba kInk{30, 30, 30, 255};
-constexpr Rgba kGrid{225, 225, 225, 255};
 constexpr Rgba kDot{70, 110, 170, 200};
 constexpr Rgba kBest{215, 40, 40, 255};
 
