@@ -20,13 +20,14 @@ glob = "$data/*.txt"
 TOML
 median() { sort -g | awk '{v[NR] = $1} END {print (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2}'; }
 now() { date +%s.%N; }
+calc() { awk "BEGIN { printf \"%.4g\", $1 }"; }  # no bc on a fresh machine
 sweep_times=() bare_times=()
 for ((r = 0; r < repeats; r++)); do
   rm -rf "$work/s" "$work/bare"
   "$program" sweep plan "$work/sweep.toml" --out "$work/s" >/dev/null
   start=$(now)
   "$program" sweep run "$work/s" --jobs 1 --quiet >/dev/null
-  sweep_times+=("$(echo "$(now) - $start" | bc)")
+  sweep_times+=("$(calc "$(now) - $start")")
   mkdir -p "$work/bare"
   start=$(now)
   i=0
@@ -35,12 +36,12 @@ for ((r = 0; r < repeats; r++)); do
       --out "$work/bare/$i" --quiet >/dev/null 2>&1
     i=$((i + 1))
   done
-  bare_times+=("$(echo "$(now) - $start" | bc)")
+  bare_times+=("$(calc "$(now) - $start")")
 done
 runs=$(ls "$data"/*.txt | wc -l)
 s=$(printf '%s\n' "${sweep_times[@]}" | median)
 b=$(printf '%s\n' "${bare_times[@]}" | median)
 echo "runs per repeat: $runs; repeats: $repeats"
-echo "sweep run --jobs 1: median $s s ($(echo "scale=3; $s / $runs" | bc) s per run)"
-echo "bare replay loop:   median $b s ($(echo "scale=3; $b / $runs" | bc) s per run)"
-echo "overhead: $(echo "scale=4; ($s / $b - 1) * 100" | bc) %"
+echo "sweep run --jobs 1: median $s s ($(calc "$s / $runs") s per run)"
+echo "bare replay loop:   median $b s ($(calc "$b / $runs") s per run)"
+echo "overhead: $(calc "($s / $b - 1) * 100") %"

@@ -19,7 +19,7 @@ shared=$root/../shared/data
 bash scripts/setup.sh clang-14 libfuzzer-14-dev
 
 harnesses=(config_fuzzer ini_fuzzer map_file_fuzzer visual_model_fuzzer dataset_fuzzer
-           ipin_log_fuzzer msft_log_fuzzer ujiindoorloc_fuzzer world_fuzzer)
+           ipin_log_fuzzer msft_log_fuzzer ujiindoorloc_fuzzer world_fuzzer sweep_file_fuzzer)
 if (($#)); then harnesses=("$@"); fi
 
 generator=()
@@ -46,6 +46,7 @@ for h in "${harnesses[@]}"; do
   fi
 done
 [[ -d $build/corpus/config_fuzzer ]] && cp configs/*.toml "$build/corpus/config_fuzzer/" 2>/dev/null || true
+[[ -d $build/corpus/sweep_file_fuzzer ]] && cp configs/sweeps/*.toml "$build/corpus/sweep_file_fuzzer/" 2>/dev/null || true
 for f in "$shared"/ipin2023-t3/*TrainingTrial0[12]_repetition01.txt; do
   [[ -d $build/corpus/ipin_log_fuzzer ]] && excerpt ipin_log_fuzzer "$f" 400
 done

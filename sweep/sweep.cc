@@ -607,7 +607,8 @@ StatusOr<Plan> MakePlan(const SweepSpec& spec) {
       plan.tasks.push_back(t);
     }
     // The whole combination (relations between keys, e.g. min < max) once per point.
-    StatusOr<PipelineOptions> all = TaskConfig(plan, plan.tasks.back());
+    StatusOr<PipelineOptions> all =
+        ParseConfigOnto(OverrideText(points[i]), spec.source, *base);  // base parsed once
     if (!all.ok()) {
       std::string values;
       for (const auto& [key, value] : points[i])
