@@ -68,20 +68,22 @@ export build seconds
 echo "fuzz: ${#harnesses[@]} harnesses, ${seconds} s each, two at a time"
 printf '%s\n' "${harnesses[@]}" | xargs -P 2 -I{} bash -c 'run_one {}'
 
+# The table goes to the summary file first and is shown after: a status set inside a pipeline
+# (`{ ... } | tee`) would be lost with its subshell, and a finding would not fail the script.
 status=0
-{
-  printf '%-22s %12s %8s %8s %s\n' harness executions cov ft findings
-  for h in "${harnesses[@]}"; do
-    log=$build/logs/$h.log
-    runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo 0)
-    cov=$(grep -o 'cov: [0-9]*' "$log" | tail -n 1 | grep -o '[0-9]*' || echo 0)
-    ft=$(grep -o 'ft: [0-9]*' "$log" | tail -n 1 | grep -o '[0-9]*' || echo 0)
-    # Crashes, timeouts, leaks and out-of-memory inputs; slow units are only reported.
-    found=$(find "$build/findings/$h" -type f ! -name 'slow-unit-*' | wc -l)
-    printf '%-22s %12s %8s %8s %s\n' "$h" "${runs:-0}" "${cov:-0}" "${ft:-0}" "$found"
-    if ((found > 0)) || ! grep -q 'Done [0-9]* runs' "$log"; then status=1; fi
-  done
-} | tee "$build/fuzz-summary.txt"
+printf '%-22s %12s %8s %8s %s\n' harness executions cov ft findings >"$build/fuzz-summary.txt"
+for h in "${harnesses[@]}"; do
+  log=$build/logs/$h.log
+  runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo 0)
+  cov=$(grep -o 'cov: [0-9]*' "$log" | tail -n 1 | grep -o '[0-9]*' || echo 0)
+  ft=$(grep -o 'ft: [0-9]*' "$log" | tail -n 1 | grep -o '[0-9]*' || echo 0)
+  # Crashes, timeouts, leaks and out-of-memory inputs; slow units are only reported.
+  found=$(find "$build/findings/$h" -type f ! -name 'slow-unit-*' | wc -l)
+  printf '%-22s %12s %8s %8s %s\n' "$h" "${runs:-0}" "${cov:-0}" "${ft:-0}" "$found" \
+    >>"$build/fuzz-summary.txt"
+  if ((found > 0)) || ! grep -q 'Done [0-9]* runs' "$log"; then status=1; fi
+done
+cat "$build/fuzz-summary.txt"
 if ((status)); then
   echo "fuzz: a harness crashed or stopped early; logs in $build/logs, inputs in $build/findings" >&2
   for h in "${harnesses[@]}"; do

@@ -272,6 +272,10 @@ Status WriteDataset(const Dataset& d, const std::string& folder) {
   }
   std::string ground_truth = "time_s,x_m,y_m,theta_rad,floor\n";
   for (const GroundTruthRow& r : d.ground_truth) {
+    if (std::abs(r.floor) > 1000) {
+      return Status::Error(folder + ": ground-truth floor " + std::to_string(r.floor) +
+                           " is not writable (at most 1000 floors either way)");
+    }
     ground_truth += num(r.time_s, "ground-truth time") + ',' + num(r.x_m, "ground-truth x") + ',' +
                     num(r.y_m, "ground-truth y") + ',' + num(r.theta_rad, "ground-truth heading") +
                     ',' + std::to_string(r.floor) + '\n';

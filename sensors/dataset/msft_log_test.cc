@@ -87,6 +87,8 @@ TEST(MicrosoftLogTest, FloorNamesAndRotationVectors) {
   EXPECT_EQ(FloorFromName("B1"), -1);
   EXPECT_EQ(FloorFromName("F1"), 0);
   EXPECT_EQ(FloorFromName("F4"), 3);
+  EXPECT_EQ(FloorFromName("B1000"), -1000);
+  EXPECT_EQ(FloorFromName("B9496900"), std::nullopt);  // found by the fuzzer: not a floor
   EXPECT_FALSE(FloorFromName("L1").has_value());
   EXPECT_FALSE(FloorFromName("F").has_value());
   // Rotated 90 degrees counter-clockwise about up: the y axis points west.
