@@ -30,6 +30,23 @@ inline double WrapAngle(double angle_rad) {
   return CircularDifference(angle_rad, 0.0, 2.0 * std::numbers::pi);
 }
 
+// WrapAngle, bit for bit, without fmod for angles in [-3 pi, 3 pi) (a sum or difference of two
+// wrapped angles): fmod is exact, so one conditional subtraction or addition of 2 pi performs the
+// same operations (Sterbenz: y - 2 pi is exact for y in [2 pi, 4 pi)). Hot loops use it.
+inline double WrapAngleNear(double angle_rad) {
+  constexpr double kPi = std::numbers::pi;
+  constexpr double kTwoPi = 2.0 * std::numbers::pi;
+  double y = angle_rad + kPi;
+  if (!(y > -kTwoPi && y < 2.0 * kTwoPi)) return WrapAngle(angle_rad);  // also NaN
+  if (y >= kTwoPi) {
+    y -= kTwoPi;
+  } else if (y < 0.0) {
+    y += kTwoPi;
+  }
+  if (y >= kTwoPi) y = 0.0;
+  return y - kPi;
+}
+
 }  // namespace ratslam
 
 #endif  // RATSLAM_COMMON_CIRCULAR_H_

@@ -3,6 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
+#include <random>
+
+#include "common/circular.h"
 
 namespace ratslam {
 namespace {
@@ -32,6 +36,39 @@ TEST(AlignRigid2DTest, RmseOfKnownResidual) {
   EXPECT_NEAR(a->rmse_m, 1.0, 1e-12);
   EXPECT_FALSE(AlignRigid2D({{0, 0}}, {{0, 0}}).has_value());
   EXPECT_FALSE(AlignRigid2D({{0, 0}, {1, 1}}, {{0, 0}}).has_value());
+}
+
+}  // namespace
+}  // namespace ratslam
+
+namespace ratslam {
+namespace {
+
+// WrapAngleNear must be WrapAngle bit for bit: the hot loops use it, the rest WrapAngle. The
+// oracle is fmod-based; the inputs cover the fast range, its edges and beyond.
+TEST(WrapAngleNearTest, EqualsWrapAngleBitForBit) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> wide(-12.0, 12.0);
+  std::vector<double> inputs = {0.0,
+                                -0.0,
+                                M_PI,
+                                -M_PI,
+                                2 * M_PI,
+                                -2 * M_PI,
+                                3 * M_PI,
+                                -3 * M_PI,
+                                1e-300,
+                                -1e-300,
+                                1e9,
+                                -1e9,
+                                std::nextafter(3 * M_PI, 0.0)};
+  for (int i = 0; i < 1000000; ++i) inputs.push_back(wide(rng));
+  for (double x : inputs) {
+    const double a = WrapAngle(x);
+    const double b = WrapAngleNear(x);
+    ASSERT_EQ(std::memcmp(&a, &b, sizeof a), 0) << std::hexfloat << x << " -> " << a << " vs " << b;
+  }
+  EXPECT_TRUE(std::isnan(WrapAngleNear(std::nan(""))));
 }
 
 }  // namespace

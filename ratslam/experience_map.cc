@@ -1,8 +1,10 @@
 #include "ratslam/experience_map.h"
 
+#include <algorithm>
 #include <boost/graph/adjacency_list.hpp>
 #include <boost/graph/dijkstra_shortest_paths.hpp>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <stdexcept>
 
@@ -10,6 +12,16 @@
 #include "common/geometry.h"
 
 namespace ratslam {
+
+std::string ToString(RelaxationScheme scheme) {
+  return scheme == RelaxationScheme::kFull ? "full" : "incremental";
+}
+
+StatusOr<RelaxationScheme> RelaxationSchemeFromString(const std::string& name) {
+  if (name == "full") return RelaxationScheme::kFull;
+  if (name == "incremental") return RelaxationScheme::kIncremental;
+  return Status::Error("unknown relaxation scheme \"" + name + "\" (full, incremental)");
+}
 
 bool ExperienceMapOptions::IsValid(std::string* error) const {
   return schema::CheckFields(*this, error);
@@ -55,6 +67,12 @@ void ExperienceMap::AddLink(uint32_t from, uint32_t to, double time_s,
   state_.experiences[from].link_ids.push_back(link.id);
   state_.experiences[to].link_ids.push_back(link.id);
   state_.links.push_back(link);
+  link_cos_.push_back(std::cos(link.heading_rad));
+  link_sin_.push_back(std::sin(link.heading_rad));
+  // The newest id: the region stays ascending.
+  const bool incremental = options_.relaxation_scheme == RelaxationScheme::kIncremental;
+  if (incremental) state_.relaxation_pending_links.push_back(link.id);
+  in_region_.push_back(incremental ? 1 : 0);
 }
 
 uint32_t ExperienceMap::CreateExperience(uint32_t template_id, const PoseCellPosition& pose_cells,
@@ -114,30 +132,150 @@ StatusOr<bool> ExperienceMap::LinkTo(uint32_t id, double time_s,
 }
 
 void ExperienceMap::Relax() {
+  if (options_.relaxation_scheme == RelaxationScheme::kFull) {
+    RelaxFull();
+  } else {
+    RelaxIncremental();
+  }
+}
+
+ExperienceMap::EndMotion ExperienceMap::UpdateLink(const Link& l, double cos_direction,
+                                                   double sin_direction) {
   const double c = options_.relaxation_correction;
-  std::vector<Experience>& ex = state_.experiences;
+  Experience& a = state_.experiences[l.from];
+  Experience& b = state_.experiences[l.to];
+  // Where the link says b should be, seen from a.
+  const double px = a.x_m + l.distance_m * cos_direction;
+  const double py = a.y_m + l.distance_m * sin_direction;
+  const double ex_m = b.x_m - px;
+  const double ey_m = b.y_m - py;
+  const double et = WrapAngleNear(b.theta_rad - (a.theta_rad + l.facing_rad));
+  const bool a_fixed = options_.anchor_first_experience && l.from == 0;
+  const bool b_fixed = options_.anchor_first_experience && l.to == 0;
+  const double moved_m = (std::abs(ex_m) + std::abs(ey_m)) * c;
+  const double moved_rad = std::abs(et) * c;
+  EndMotion motion{0.0, 0.0, 0.0, 0.0};
+  if (!a_fixed) {
+    a.x_m += ex_m * c;
+    a.y_m += ey_m * c;
+    a.theta_rad = WrapAngleNear(a.theta_rad + et * c);
+    motion.a_m = moved_m;
+    motion.a_rad = moved_rad;
+  }
+  if (!b_fixed) {
+    b.x_m -= ex_m * c;
+    b.y_m -= ey_m * c;
+    b.theta_rad = WrapAngleNear(b.theta_rad - et * c);
+    motion.b_m = moved_m;
+    motion.b_rad = moved_rad;
+  }
+  return motion;
+}
+
+void ExperienceMap::RelaxFull() {
+  // OpenRatSLAM's scheme, bit for bit as before the incremental one existed (WrapAngleNear equals
+  // WrapAngle): the reference the incremental scheme is measured against.
+  for (uint32_t l : state_.relaxation_pending_links) in_region_[l] = 0;
+  state_.relaxation_pending_links.clear();
+  const std::vector<Experience>& ex = state_.experiences;
   for (int sweep = 0; sweep < options_.relaxation_sweeps; ++sweep) {
     for (const Link& l : state_.links) {
-      Experience& a = ex[l.from];
-      Experience& b = ex[l.to];
-      // Where the link says b should be, seen from a.
-      const double px = a.x_m + l.distance_m * std::cos(a.theta_rad + l.heading_rad);
-      const double py = a.y_m + l.distance_m * std::sin(a.theta_rad + l.heading_rad);
-      const double ex_m = b.x_m - px;
-      const double ey_m = b.y_m - py;
-      const double et = WrapAngle(b.theta_rad - (a.theta_rad + l.facing_rad));
-      const bool a_fixed = options_.anchor_first_experience && l.from == 0;
-      const bool b_fixed = options_.anchor_first_experience && l.to == 0;
-      if (!a_fixed) {
-        a.x_m += ex_m * c;
-        a.y_m += ey_m * c;
-        a.theta_rad = WrapAngle(a.theta_rad + et * c);
+      const double direction = ex[l.from].theta_rad + l.heading_rad;
+      UpdateLink(l, std::cos(direction), std::sin(direction));
+    }
+    link_updates_ += state_.links.size();
+  }
+}
+
+void ExperienceMap::Touch(uint32_t id) {
+  if (touched_pass_[id] == pass_) return;
+  touched_pass_[id] = pass_;
+  const Experience& e = state_.experiences[id];
+  pass_start_[id] = {e.x_m, e.y_m, e.theta_rad};
+  touched_.push_back(id);
+  experience_cos_[id] = std::cos(e.theta_rad);
+  experience_sin_[id] = std::sin(e.theta_rad);
+}
+
+bool ExperienceMap::GrowRegion(uint32_t id, uint32_t above) {
+  bool grown = false;
+  for (uint32_t k : state_.experiences[id].link_ids) {
+    if (k < above || in_region_[k]) continue;
+    in_region_[k] = 1;
+    grown_.push_back(k);
+    grown = true;
+    if (queued_pass_[k] != pass_) {  // a link above the current one: still in this pass
+      queued_pass_[k] = pass_;
+      queue_.push_back(k);
+      std::push_heap(queue_.begin(), queue_.end(), std::greater<>());
+    }
+  }
+  return grown;
+}
+
+void ExperienceMap::RelaxIncremental() {
+  const size_t n = state_.experiences.size();
+  const size_t n_links = state_.links.size();
+  touched_pass_.resize(n, 0);
+  pass_start_.resize(n);
+  experience_cos_.resize(n);
+  experience_sin_.resize(n);
+  queued_pass_.resize(n_links, 0);
+  const double tolerance_m = options_.relaxation_tolerance_m;
+  const double tolerance_rad = options_.relaxation_tolerance_rad;
+  std::vector<uint32_t>& region = state_.relaxation_pending_links;
+  for (int sweep = 0; sweep < options_.relaxation_sweeps && !region.empty(); ++sweep) {
+    ++pass_;
+    // Ascending ids form a min-heap already; links join while the pass runs.
+    queue_.assign(region.begin(), region.end());
+    for (uint32_t l : queue_) queued_pass_[l] = pass_;
+    touched_.clear();
+    grown_.clear();
+    bool grown = false;
+    while (!queue_.empty()) {
+      std::pop_heap(queue_.begin(), queue_.end(), std::greater<>());
+      const uint32_t l = queue_.back();
+      queue_.pop_back();
+      const Link& link = state_.links[l];
+      Touch(link.from);
+      Touch(link.to);
+      const double ca = experience_cos_[link.from], sa = experience_sin_[link.from];
+      const EndMotion motion = UpdateLink(link, ca * link_cos_[l] - sa * link_sin_[l],
+                                          sa * link_cos_[l] + ca * link_sin_[l]);
+      ++link_updates_;
+      // A large step of an end reaches its links further on in this same pass, as in a full
+      // pass; links before it join when the pass has moved the end.
+      if (motion.a_m > tolerance_m || motion.a_rad > tolerance_rad) {
+        grown |= GrowRegion(link.from, l + 1);
       }
-      if (!b_fixed) {
-        b.x_m -= ex_m * c;
-        b.y_m -= ey_m * c;
-        b.theta_rad = WrapAngle(b.theta_rad - et * c);
+      if (motion.b_m > tolerance_m || motion.b_rad > tolerance_rad) {
+        grown |= GrowRegion(link.to, l + 1);
       }
+    }
+    // Single updates in an inconsistent loop swing back and forth for ever (cyclic projections
+    // reach a limit cycle), but the poses at the end of a pass over a fixed set of links
+    // converge. So the region only grows, by the links of experiences the pass moved on net,
+    // and is done when a pass moves nothing on net by more than the tolerances.
+    bool settled = true;
+    for (uint32_t id : touched_) {
+      const Experience& e = state_.experiences[id];
+      const Pose2& start = pass_start_[id];
+      if (std::abs(e.x_m - start.x_m) + std::abs(e.y_m - start.y_m) > tolerance_m ||
+          std::abs(WrapAngleNear(e.theta_rad - start.theta_rad)) > tolerance_rad) {
+        settled = false;
+        grown |= GrowRegion(id, 0);
+      }
+    }
+    if (settled && !grown) {
+      for (uint32_t l : region) in_region_[l] = 0;
+      region.clear();
+      break;
+    }
+    if (!grown_.empty()) {
+      const size_t old_size = region.size();
+      region.insert(region.end(), grown_.begin(), grown_.end());
+      std::sort(region.begin() + old_size, region.end());
+      std::inplace_merge(region.begin(), region.begin() + old_size, region.end());
     }
   }
 }
@@ -197,11 +335,25 @@ Status ExperienceMap::SetState(State state) {
     }
   }
   if (state.current && *state.current >= n) return fail("current experience does not exist");
+  for (size_t i = 0; i < state.relaxation_pending_links.size(); ++i) {
+    const uint32_t l = state.relaxation_pending_links[i];
+    if (l >= n_links || (i > 0 && l <= state.relaxation_pending_links[i - 1])) {
+      return fail("links being relaxed are not ascending link ids");
+    }
+  }
   if (!finite(state.offset.forward_m) || !finite(state.offset.left_m) ||
       !finite(state.offset.facing_rad) || !finite(state.offset_start_time_s)) {
     return fail("offset since the current experience is not finite");
   }
   state_ = std::move(state);
+  link_cos_.resize(n_links);
+  link_sin_.resize(n_links);
+  in_region_.assign(n_links, 0);
+  for (uint32_t l : state_.relaxation_pending_links) in_region_[l] = 1;
+  for (size_t i = 0; i < n_links; ++i) {
+    link_cos_[i] = std::cos(state_.links[i].heading_rad);
+    link_sin_[i] = std::sin(state_.links[i].heading_rad);
+  }
   return Status::Ok();
 }
 

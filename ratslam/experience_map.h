@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "common/geometry.h"
 #include "common/schema.h"
 #include "common/status.h"
 #include "ratslam/pose_cell_network.h"
@@ -18,22 +19,52 @@ namespace ratslam {
 // values, like non-finite ones, mean a corrupt file (data times are at most epoch seconds).
 inline constexpr double kMaxCoordinate = 1e12;
 
+// Which links a relaxation pass visits.
+//  - kFull: every link, in link order, `relaxation_sweeps` times after each action (OpenRatSLAM's
+//    scheme, Milford and Wyeth 2008; cost grows with the map).
+//  - kIncremental: the same Gauss-Seidel passes in link order over a region of links that grows
+//    from each new link: by the later links of an experience that one update moved by more than
+//    the tolerances (the reach of a full pass), and by all links of an experience that a whole
+//    pass moved on net by more. The region is relaxed, over as many actions as it takes, until a
+//    pass moves nothing on net, then dropped. Net movement, because single updates in an
+//    inconsistent loop swing for ever (cyclic projections reach a limit cycle) while the poses
+//    after a pass over a fixed set of links converge. A frame that only extends the map costs
+//    one link update; a loop closure costs passes over the loop and a fringe around it. The
+//    rotation of each experience is read once per pass (sin/cos per experience, not per link).
+enum class RelaxationScheme { kFull, kIncremental };
+std::string ToString(RelaxationScheme scheme);
+StatusOr<RelaxationScheme> RelaxationSchemeFromString(const std::string& name);
+
 struct ExperienceMapOptions {
-  int relaxation_sweeps = 10;            // relaxation passes over all links after each action
+  int relaxation_sweeps = 10;            // relaxation passes after each action
   double relaxation_correction = 0.5;    // share of a link's error each end absorbs per pass
   bool anchor_first_experience = false;  // keep experience 0 fixed during relaxation
+  RelaxationScheme relaxation_scheme = RelaxationScheme::kIncremental;  // see RelaxationScheme
+  double relaxation_tolerance_m = 1e-4;    // kIncremental: movement that grows the region
+  double relaxation_tolerance_rad = 1e-5;  // kIncremental: rotation that grows the region
 
   bool IsValid(std::string* error) const;
 
   template <typename Visitor>
   void VisitFields(Visitor&& v) {
-    v("relaxation_sweeps", relaxation_sweeps, "relaxation passes over all links after each action",
+    v("relaxation_sweeps", relaxation_sweeps,
+      "relaxation passes after each action (over every link, or the links that need it)",
       schema::Unit("sweeps").NonNegative());
     v("relaxation_correction", relaxation_correction,
       "share of a link's error each end absorbs per pass (0.5 satisfies the link exactly)",
       schema::Unit("").Within(0, 0.5));
     v("anchor_first_experience", anchor_first_experience,
       "keep experience 0 fixed during relaxation", schema::Any());
+    v("relaxation_scheme", relaxation_scheme,
+      "full (every link in every pass, as OpenRatSLAM) or incremental (only links whose ends "
+      "moved)",
+      schema::Any());
+    v("relaxation_tolerance_m", relaxation_tolerance_m,
+      "incremental: movement of an experience that adds its links to the relaxed region",
+      schema::Unit("m").Positive());
+    v("relaxation_tolerance_rad", relaxation_tolerance_rad,
+      "incremental: rotation of an experience that adds its links to the relaxed region",
+      schema::Unit("rad").Positive());
   }
 };
 
@@ -75,6 +106,9 @@ class ExperienceMap {
     std::optional<uint32_t> current;  // none before the first experience
     LocalOffset offset;               // since `current` (or since the origin)
     double offset_start_time_s = 0.0;
+    // Incremental relaxation's region, the links still being relaxed (ascending ids); empty
+    // when settled. Saved so that a resumed run relaxes as an uninterrupted one.
+    std::vector<uint32_t> relaxation_pending_links;
   };
 
   // `options` must be valid; throws std::invalid_argument otherwise.
@@ -97,8 +131,10 @@ class ExperienceMap {
   StatusOr<bool> LinkTo(uint32_t id, double time_s,
                         std::optional<double> compass_heading_rad = std::nullopt);
 
-  // `relaxation_sweeps` passes of relaxation over every link.
+  // `relaxation_sweeps` passes of relaxation (see RelaxationScheme).
   void Relax();
+  // Link updates made by Relax since construction (not saved): a measure of relaxation cost.
+  uint64_t relaxation_link_updates() const { return link_updates_; }
 
   // The pose of the current experience composed with the offset since it.
   void CurrentPose(double* x_m, double* y_m, double* theta_rad) const;
@@ -123,8 +159,34 @@ class ExperienceMap {
   void AddLink(uint32_t from, uint32_t to, double time_s, std::optional<double> facing_override,
                bool loop_closure);
 
+  void RelaxFull();
+  void RelaxIncremental();
+  // Moves both ends of link `l` towards agreement, given the cosine and sine of the link's
+  // direction (from's rotation plus heading_rad). Returns the movement of each end: metres
+  // (|dx| + |dy|) and radians.
+  struct EndMotion {
+    double a_m, a_rad, b_m, b_rad;
+  };
+  EndMotion UpdateLink(const Link& l, double cos_direction, double sin_direction);
+  // Records experience `id`'s pose and rotation's cos and sin when first touched in a pass.
+  void Touch(uint32_t id);
+  // Adds `id`'s links with ids from `above` that are not in the region yet to it (and to this
+  // pass when still ahead). Returns true when the region grew.
+  bool GrowRegion(uint32_t id, uint32_t above);
+
   ExperienceMapOptions options_;
   State state_;
+  // Scratch, rebuilt from state_: per link cos and sin of heading_rad; per experience the pass
+  // it was first touched in, its pose then and its rotation's cos and sin; per link the pass it
+  // was queued in (this pass, the next).
+  std::vector<double> link_cos_, link_sin_;
+  std::vector<double> experience_cos_, experience_sin_;
+  std::vector<Pose2> pass_start_;
+  std::vector<uint64_t> touched_pass_, queued_pass_;
+  std::vector<uint32_t> queue_, grown_, touched_;
+  std::vector<char> in_region_;  // per link: in relaxation_pending_links
+  uint64_t pass_ = 0;
+  uint64_t link_updates_ = 0;
 };
 
 }  // namespace ratslam

@@ -2,8 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
+
+#include "common/circular.h"
+#include "common/geometry.h"
 
 namespace ratslam {
 namespace {
@@ -142,6 +146,184 @@ TEST(ExperienceMapCompassTest, NewLinksTakeCompassFacing) {
   map.Integrate(1.0, 0.9);  // odometric turn 0.9 rad; compass says 0.3 rad
   map.CreateExperience(1, {}, 1.0, 0.8);
   EXPECT_NEAR(map.links().back().facing_rad, 0.3, 1e-12);
+}
+
+}  // namespace
+}  // namespace ratslam
+
+namespace ratslam {
+namespace {
+
+// The full scheme as first written (std::cos/sin per link, fmod-based WrapAngle): the full scheme
+// must stay equal to it bit for bit.
+void ReferenceFullRelax(std::vector<Experience>& ex, const std::vector<Link>& links, int sweeps,
+                        double c) {
+  for (int sweep = 0; sweep < sweeps; ++sweep) {
+    for (const Link& l : links) {
+      Experience& a = ex[l.from];
+      Experience& b = ex[l.to];
+      const double px = a.x_m + l.distance_m * std::cos(a.theta_rad + l.heading_rad);
+      const double py = a.y_m + l.distance_m * std::sin(a.theta_rad + l.heading_rad);
+      const double ex_m = b.x_m - px, ey_m = b.y_m - py;
+      const double et = WrapAngle(b.theta_rad - (a.theta_rad + l.facing_rad));
+      a.x_m += ex_m * c;
+      a.y_m += ey_m * c;
+      a.theta_rad = WrapAngle(a.theta_rad + et * c);
+      b.x_m -= ex_m * c;
+      b.y_m -= ey_m * c;
+      b.theta_rad = WrapAngle(b.theta_rad - et * c);
+    }
+  }
+}
+
+ExperienceMapOptions Scheme(RelaxationScheme scheme) {
+  ExperienceMapOptions o;
+  o.relaxation_scheme = scheme;
+  return o;
+}
+
+// A long route: a chain with a spurious turn, closing back onto experience `i - 60` every 40.
+ExperienceMap DriveLongRoute(const ExperienceMapOptions& options, int n) {
+  ExperienceMap map(options);
+  for (int i = 0; i < n; ++i) {
+    map.Integrate(1.0, 0.11);
+    map.CreateExperience(i, {}, i);
+    map.Relax();
+    if (i >= 60 && i % 40 == 0) {
+      EXPECT_TRUE(map.LinkTo(static_cast<uint32_t>(i - 60), i).ok());
+      map.Relax();
+    }
+  }
+  return map;
+}
+
+// Laps of a 20 m x 10 m rectangle with places every metre, odometry 3 % long with 0.02 rad of
+// spurious turn per metre: the first lap creates an experience per place, later laps link to
+// them, relaxing after every action. Returns the map error against the true places (RMSE after
+// rigid alignment) and counts link updates.
+double LapsMapError(RelaxationScheme scheme, int laps, uint64_t* link_updates) {
+  ExperienceMap map(Scheme(scheme));
+  std::vector<Point2> truth;
+  for (int s = 0; s < 60; ++s) {
+    if (s < 20)
+      truth.push_back({double(s), 0.0});
+    else if (s < 30)
+      truth.push_back({20.0, double(s - 20)});
+    else if (s < 50)
+      truth.push_back({double(50 - s), 10.0});
+    else
+      truth.push_back({0.0, double(60 - s)});
+  }
+  for (int lap = 0; lap < laps; ++lap) {
+    for (int s = 0; s < 60; ++s) {
+      if (lap == 0) {
+        map.CreateExperience(s, {}, s);
+      } else {
+        EXPECT_TRUE(map.LinkTo(s, 60.0 * lap + s).ok());
+      }
+      map.Relax();
+      const bool corner = s == 19 || s == 29 || s == 49 || s == 59;
+      map.Integrate(1.03, 0.02 + (corner ? kPi / 2 : 0.0));
+    }
+  }
+  std::vector<Point2> estimate;
+  for (const Experience& e : map.experiences()) estimate.push_back({e.x_m, e.y_m});
+  *link_updates = map.relaxation_link_updates();
+  return AlignRigid2D(estimate, truth)->rmse_m;
+}
+
+TEST(RelaxationSchemeTest, IncrementalIsAsAccurateAsFullForAFractionOfTheWork) {
+  uint64_t full_updates = 0, incremental_updates = 0, none = 0;
+  const double dead_reckoning = LapsMapError(RelaxationScheme::kFull, 1, &none);
+  const double full = LapsMapError(RelaxationScheme::kFull, 6, &full_updates);
+  const double incremental = LapsMapError(RelaxationScheme::kIncremental, 6, &incremental_updates);
+  // Relaxation pays: the laps' links take most of the drift out (checked for both schemes).
+  EXPECT_LT(full, 0.5 * dead_reckoning) << full << " vs " << dead_reckoning;
+  EXPECT_LE(incremental, 1.02 * full + 1e-3) << incremental << " vs " << full;
+  EXPECT_LT(incremental_updates * 5, full_updates) << incremental_updates << " vs " << full_updates;
+}
+
+TEST(RelaxationSchemeTest, FullSchemeEqualsTheOriginalBitForBit) {
+  ExperienceMap map = DriveBiasedSquare(Scheme(RelaxationScheme::kFull));
+  ASSERT_TRUE(map.LinkTo(0, 40.0).ok());
+  std::vector<Experience> reference = map.experiences();
+  for (int i = 0; i < 7; ++i) {
+    map.Relax();
+    ReferenceFullRelax(reference, map.links(), 10, 0.5);
+  }
+  for (size_t i = 0; i < reference.size(); ++i) {
+    ASSERT_EQ(map.experience(i).x_m, reference[i].x_m) << i;
+    ASSERT_EQ(map.experience(i).y_m, reference[i].y_m) << i;
+    ASSERT_EQ(map.experience(i).theta_rad, reference[i].theta_rad) << i;
+  }
+}
+
+TEST(RelaxationSchemeTest, IncrementalSettlesAndThenDoesNothing) {
+  ExperienceMap map = DriveLongRoute(Scheme(RelaxationScheme::kIncremental), 400);
+  for (int i = 0; i < 2000 && !map.state().relaxation_pending_links.empty(); ++i) map.Relax();
+  EXPECT_TRUE(map.state().relaxation_pending_links.empty());
+  const std::vector<Experience> settled = map.experiences();
+  const uint64_t before = map.relaxation_link_updates();
+  map.Relax();
+  EXPECT_EQ(map.relaxation_link_updates(), before);
+  EXPECT_EQ(map.experience(123).x_m, settled[123].x_m);
+}
+
+TEST(RelaxationSchemeTest, ExtendingAConvergedMapCostsOneLinkUpdate) {
+  ExperienceMap map = DriveLongRoute(Scheme(RelaxationScheme::kIncremental), 200);
+  for (int i = 0; i < 2000 && !map.state().relaxation_pending_links.empty(); ++i) map.Relax();
+  ASSERT_TRUE(map.state().relaxation_pending_links.empty());
+  const uint64_t before = map.relaxation_link_updates();
+  map.Relax();  // nothing changed
+  EXPECT_EQ(map.relaxation_link_updates(), before);
+  for (int i = 0; i < 50; ++i) {
+    map.Integrate(1.0, 0.11);
+    map.CreateExperience(1000 + i, {}, 1000.0 + i);
+    map.Relax();
+  }
+  EXPECT_EQ(map.relaxation_link_updates(), before + 50);
+}
+
+TEST(RelaxationSchemeTest, ResumedStateRelaxesAsTheUninterruptedMap) {
+  const ExperienceMapOptions options = Scheme(RelaxationScheme::kIncremental);
+  ExperienceMap whole = DriveBiasedSquare(options);
+  ASSERT_TRUE(whole.LinkTo(0, 40.0).ok());
+  whole.Relax();  // leaves work pending: ten passes do not settle a 40-link loop
+  ASSERT_FALSE(whole.state().relaxation_pending_links.empty());
+  ExperienceMap resumed(options);
+  ASSERT_TRUE(resumed.SetState(whole.state()).ok());
+  for (int i = 0; i < 5; ++i) {
+    whole.Relax();
+    resumed.Relax();
+  }
+  for (size_t i = 0; i < whole.num_experiences(); ++i) {
+    ASSERT_EQ(whole.experience(i).x_m, resumed.experience(i).x_m) << i;
+    ASSERT_EQ(whole.experience(i).theta_rad, resumed.experience(i).theta_rad) << i;
+  }
+  EXPECT_EQ(whole.state().relaxation_pending_links, resumed.state().relaxation_pending_links);
+}
+
+TEST(RelaxationSchemeTest, SetStateRefusesInconsistentRelaxationWork) {
+  ExperienceMap map = DriveBiasedSquare(Scheme(RelaxationScheme::kIncremental));
+  const ExperienceMap::State good = map.state();
+  auto refused = [&](auto&& edit) {
+    ExperienceMap::State s = good;
+    edit(s);
+    ExperienceMap target({});
+    return !target.SetState(s).ok();
+  };
+  EXPECT_TRUE(refused([](auto& s) { s.relaxation_pending_links = {3, 2}; }));
+  EXPECT_TRUE(refused([](auto& s) { s.relaxation_pending_links = {1, 1}; }));
+  EXPECT_TRUE(refused([](auto& s) { s.relaxation_pending_links = {uint32_t(s.links.size())}; }));
+  ExperienceMap target({});
+  EXPECT_TRUE(target.SetState(good).ok());
+}
+
+TEST(RelaxationSchemeTest, SchemeNamesRoundTrip) {
+  for (RelaxationScheme s : {RelaxationScheme::kFull, RelaxationScheme::kIncremental}) {
+    EXPECT_EQ(RelaxationSchemeFromString(ToString(s)).value(), s);
+  }
+  EXPECT_FALSE(RelaxationSchemeFromString("fast").ok());
 }
 
 }  // namespace

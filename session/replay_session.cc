@@ -16,7 +16,7 @@ namespace {
 // error names every key that differs; format 2 maps hold a fingerprint, compared as it was then.
 Status CheckSameConfiguration(const MapFile& map, const PipelineOptions& now) {
   if (!map.config.empty()) {
-    StatusOr<PipelineOptions> before = ParseConfig(map.config, "the map's configuration");
+    StatusOr<PipelineOptions> before = ParseMapConfig(map.config, map.format_version);
     if (!before.ok()) return before.status();
     const std::vector<std::string> differences = ConfigDifferences(*before, now);
     if (differences.empty()) return Status::Ok();

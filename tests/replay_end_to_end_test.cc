@@ -30,6 +30,18 @@ nlohmann::json Summary(const fs::path& out) {
   return nlohmann::json::parse(Slurp(out / "summary.json"));
 }
 
+// Writes `config` to `out` with relaxation_scheme = "full": maps of format 3 and older were made
+// with full relaxation and resume only under it.
+std::string WithFullRelaxation(const std::string& config, const fs::path& out) {
+  std::string text = Slurp(config);
+  const std::string key = "relaxation_scheme = \"incremental\"";
+  const size_t at = text.find(key);
+  if (at == std::string::npos) return "";
+  text.replace(at, key.size(), "relaxation_scheme = \"full\"");
+  std::ofstream(out) << text;
+  return out.string();
+}
+
 class ReplayEndToEndTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -163,10 +175,24 @@ TEST_F(ReplayEndToEndTest, MapFromThePreviousReleaseResumesToTheSameRun) {
   const fs::path whole = root_ / "whole_v2", rest = root_ / "rest_v2";
   const std::string fixture =
       (fs::path(RATSLAM_SOURCE_DIR) / "tests" / "data" / "map-v2-synthetic.map").string();
-  ASSERT_EQ(RunRatslam(ReplayArgs(whole), root_).exit_code, 0);
-  const Result r = RunRatslam(ReplayArgs(rest) + " --load-map " + fixture, root_);
+  const std::string config = WithFullRelaxation(config_, root_ / "synthetic-full.toml");
+  ASSERT_FALSE(config.empty());
+  auto args = [&](const fs::path& out) {
+    return "replay --quiet --config " + config + " --data " + (root_ / "data").string() +
+           " --out " + out.string();
+  };
+  ASSERT_EQ(RunRatslam(args(whole), root_).exit_code, 0);
+  const Result r = RunRatslam(args(rest) + " --load-map " + fixture, root_);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   ExpectSameRun(whole, rest);
+  // Under today's default scheme the old map is refused, naming the key.
+  const Result refused =
+      RunRatslam(ReplayArgs(root_ / "v2_incremental") + " --load-map " + fixture, root_);
+  EXPECT_EQ(refused.exit_code, 1);
+  EXPECT_NE(refused.err.find("experience_map.relaxation_scheme is \"incremental\", but maps of "
+                             "format 2 were made with \"full\""),
+            std::string::npos)
+      << refused.err;
 }
 
 // A key added after format 2 must be at its default to resume a format-2 map (which was made
@@ -236,9 +262,12 @@ TEST_F(SimulatedSaveResumeTest, FusedFrontEnd) {
 }
 
 TEST_F(SimulatedSaveResumeTest, FusedFrontEndFromAMapOfThePreviousRelease) {
-  // Made with `ratslam replay --config configs/demo.toml --until 200 --save-map` by format 2.
-  const std::string config = (fs::path(RATSLAM_SOURCE_DIR) / "configs" / "demo.toml").string();
+  // Made with `ratslam replay --config configs/demo.toml --until 200 --save-map` by format 2,
+  // which relaxed every link.
   const fs::path& dir = root_->path();
+  const std::string config = WithFullRelaxation(
+      (fs::path(RATSLAM_SOURCE_DIR) / "configs" / "demo.toml").string(), dir / "demo-full.toml");
+  ASSERT_FALSE(config.empty());
   const fs::path whole = dir / "v2_whole", rest = dir / "v2_rest";
   ASSERT_EQ(RunRatslam(Args(config, whole), dir).exit_code, 0);
   const Result r = RunRatslam(

@@ -43,6 +43,8 @@ struct TomlCodec<fabmap::SplitUnit> : EnumCodec<fabmap::SplitUnit, fabmap::Split
 template <>
 struct TomlCodec<WifiLearning> : EnumCodec<WifiLearning, WifiLearningFromString> {};
 template <>
+struct TomlCodec<RelaxationScheme> : EnumCodec<RelaxationScheme, RelaxationSchemeFromString> {};
+template <>
 struct TomlCodec<FrontEndKind> : EnumCodec<FrontEndKind, FrontEndKindFromString> {};
 }  // namespace ratslam::schema
 
@@ -157,14 +159,19 @@ std::vector<std::pair<std::string, std::string>> KeyedLines(const std::string& p
 }
 
 // Keys added to the configuration after each map format version (the map fingerprint of that
-// version was taken without them).
+// version was taken without them), with the value (as printed) the older program behaved as when
+// that is not the new default.
 struct AddedKey {
   uint32_t after_version;
   const char* key;
+  const char* value_then = nullptr;
 };
 constexpr AddedKey kKeysAddedAfter[] = {
     {2, "fabmap_front_end.wifi_learning"},
     {2, "fabmap_front_end.online_first_scans"},
+    {3, "experience_map.relaxation_scheme", "\"full\""},
+    {3, "experience_map.relaxation_tolerance_m"},
+    {3, "experience_map.relaxation_tolerance_rad"},
 };
 
 }  // namespace
@@ -194,10 +201,12 @@ StatusOr<uint64_t> FingerprintAsOfMapVersion(const PipelineOptions& options, uin
   for (const AddedKey& added : kKeysAddedAfter) {
     if (map_version > added.after_version) continue;
     for (size_t i = 0; i < lines.size(); ++i) {
-      if (lines[i].first == added.key && lines[i].second != defaults[i].second) {
+      if (lines[i].first != added.key) continue;
+      const std::string then = added.value_then ? added.value_then : defaults[i].second;
+      if (lines[i].second != then) {
         return Status::Error(std::string(added.key) + " is " + lines[i].second +
                              ", but maps of format " + std::to_string(map_version) +
-                             " were made with its default " + defaults[i].second);
+                             " were made with " + then);
       }
     }
     dropped.insert(added.key);
@@ -214,12 +223,29 @@ StatusOr<uint64_t> FingerprintAsOfMapVersion(const PipelineOptions& options, uin
   return Fnv1a(kept);
 }
 
+StatusOr<PipelineOptions> ParseMapConfig(const std::string& text, uint32_t map_version) {
+  std::string then;
+  for (const AddedKey& added : kKeysAddedAfter) {
+    if (map_version > added.after_version || !added.value_then) continue;
+    const std::string_view key = added.key;
+    const size_t dot = key.find('.');
+    then.append("[").append(key.substr(0, dot)).append("]\n");
+    then.append(key.substr(dot + 1)).append(" = ").append(added.value_then).append("\n");
+  }
+  StatusOr<PipelineOptions> base = ParseConfigOnto(
+      then, "format " + std::to_string(map_version) + " defaults", PipelineOptions());
+  if (!base.ok()) return base.status();
+  return ParseConfigOnto(text, "the map's configuration", *base);
+}
+
 StatusOr<ImportedConfig> ImportOpenRatslamIni(const std::string& path) {
   StatusOr<std::string> text = ReadRegularFile(path, "INI file", kMaxConfigBytes);
   if (!text.ok()) return text.status();
   std::istringstream in(*text);
   ImportedConfig imported;
   PipelineOptions& o = imported.options;
+  // OpenRatSLAM relaxes every link exp_loops times after each action.
+  o.ratslam.experience_map.relaxation_scheme = RelaxationScheme::kFull;
   using Setter = std::function<Status(double)>;
   auto whole = [](int& field) {
     return [&field](double v) {

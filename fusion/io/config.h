@@ -35,8 +35,12 @@ std::vector<std::string> ConfigDifferences(const PipelineOptions& before,
 
 // The fingerprint a map of format `map_version` holds for `options`: the configuration printed
 // without the keys added since that version. Fails, naming the key, when one of those keys is
-// not at its default (the old program could not have made that map).
+// not at the value the old program behaved as (its default, or e.g. relaxation_scheme "full").
 StatusOr<uint64_t> FingerprintAsOfMapVersion(const PipelineOptions& options, uint32_t map_version);
+
+// Reads the configuration a map of format `map_version` carries: keys added after that version
+// are absent from it and take the value the old program behaved as, not today's default.
+StatusOr<PipelineOptions> ParseMapConfig(const std::string& text, uint32_t map_version);
 
 struct ImportedConfig {
   PipelineOptions options;

@@ -18,8 +18,8 @@ constexpr char kMagic[8] = {'R', 'S', 'L', 'M', 'A', 'P', '\0', '\1'};
 // The version written, and the oldest one read. A field added in a new version is listed in
 // state_schema.h as `(a.version() < N || a(field))`, so older files load with its default.
 // Version 2 is the first release with save and resume (tests/data/map-v2-*.map must load);
-// version 3 adds the resolved configuration.
-constexpr uint32_t kVersion = 3;
+// version 3 adds the resolved configuration, version 4 incremental relaxation's pending work.
+constexpr uint32_t kVersion = 4;
 constexpr uint32_t kOldestVersion = 2;
 
 }  // namespace

@@ -105,7 +105,7 @@ constexpr size_t MemberCount() {
 // Counts the fields a Describe function lists (nested objects count once, as one member).
 class CountingArchive {
  public:
-  uint32_t version() const { return 3; }
+  uint32_t version() const { return 4; }  // the version written
   template <typename T>
   bool operator()(T&) {
     ++count;
@@ -151,7 +151,7 @@ TEST(MapFileTest, SchemaListsEveryMemberOfEverySavedStruct) {
   ExpectSchemaComplete<LocalViewCells::State>("LocalViewCells::State", 2);
   ExpectSchemaComplete<Experience>("Experience", 9);
   ExpectSchemaComplete<Link>("Link", 8);
-  ExpectSchemaComplete<ExperienceMap::State>("ExperienceMap::State", 5);
+  ExpectSchemaComplete<ExperienceMap::State>("ExperienceMap::State", 6);
   ExpectSchemaComplete<Ratslam::Counters>("Ratslam::Counters", 5);
   ExpectSchemaComplete<Ratslam::State>("Ratslam::State", 6);
   ExpectSchemaComplete<TrajectoryRecord>("TrajectoryRecord", 6);

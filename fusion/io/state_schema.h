@@ -59,7 +59,8 @@ bool Describe(A& a, Link& l) {
 template <typename A>
 bool Describe(A& a, ExperienceMap::State& s) {
   return a.Objects(s.experiences, 81) && a.Objects(s.links, 45) && a(s.current) &&
-         a.Object(s.offset) && a(s.offset_start_time_s);
+         a.Object(s.offset) && a(s.offset_start_time_s) &&
+         (a.version() < 4 || a(s.relaxation_pending_links));
 }
 
 template <typename A>
