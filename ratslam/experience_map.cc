@@ -72,7 +72,10 @@ void ExperienceMap::AddLink(uint32_t from, uint32_t to, double time_s,
   // The newest id: the region stays ascending.
   const bool incremental = options_.relaxation_scheme == RelaxationScheme::kIncremental;
   if (incremental) state_.relaxation_pending_links.push_back(link.id);
-  in_region_.push_back(incremental ? 1 : 0);
+  in_region_.push_back(0);
+  outside_region_[from] += 1;
+  outside_region_[to] += 1;
+  if (incremental) SetInRegion(link.id, true);
 }
 
 uint32_t ExperienceMap::CreateExperience(uint32_t template_id, const PoseCellPosition& pose_cells,
@@ -85,6 +88,7 @@ uint32_t ExperienceMap::CreateExperience(uint32_t template_id, const PoseCellPos
   e.time_s = time_s;
   e.compass_heading_rad = compass_heading_rad;
   state_.experiences.push_back(e);
+  outside_region_.push_back(0);
   if (state_.current) {
     const Experience& from = state_.experiences[*state_.current];
     std::optional<double> facing;
@@ -175,7 +179,7 @@ ExperienceMap::EndMotion ExperienceMap::UpdateLink(const Link& l, double cos_dir
 void ExperienceMap::RelaxFull() {
   // OpenRatSLAM's scheme, bit for bit as before the incremental one existed (WrapAngleNear equals
   // WrapAngle): the reference the incremental scheme is measured against.
-  for (uint32_t l : state_.relaxation_pending_links) in_region_[l] = 0;
+  for (uint32_t l : state_.relaxation_pending_links) SetInRegion(l, false);
   state_.relaxation_pending_links.clear();
   const std::vector<Experience>& ex = state_.experiences;
   for (int sweep = 0; sweep < options_.relaxation_sweeps; ++sweep) {
@@ -193,21 +197,27 @@ void ExperienceMap::Touch(uint32_t id) {
   const Experience& e = state_.experiences[id];
   pass_start_[id] = {e.x_m, e.y_m, e.theta_rad};
   touched_.push_back(id);
-  experience_cos_[id] = std::cos(e.theta_rad);
-  experience_sin_[id] = std::sin(e.theta_rad);
+  ::sincos(e.theta_rad, &experience_sin_[id], &experience_cos_[id]);  // glibc: both at once
 }
 
-bool ExperienceMap::GrowRegion(uint32_t id, uint32_t above) {
+void ExperienceMap::SetInRegion(uint32_t l, bool in) {
+  in_region_[l] = in ? 1 : 0;
+  const int change = in ? -1 : 1;
+  outside_region_[state_.links[l].from] += change;
+  outside_region_[state_.links[l].to] += change;
+}
+
+bool ExperienceMap::GrowRegion(uint32_t id, uint32_t above, bool this_pass) {
+  if (outside_region_[id] == 0) return false;  // the common case once a region is large
   bool grown = false;
   for (uint32_t k : state_.experiences[id].link_ids) {
     if (k < above || in_region_[k]) continue;
-    in_region_[k] = 1;
+    SetInRegion(k, true);
     grown_.push_back(k);
     grown = true;
-    if (queued_pass_[k] != pass_) {  // a link above the current one: still in this pass
-      queued_pass_[k] = pass_;
-      queue_.push_back(k);
-      std::push_heap(queue_.begin(), queue_.end(), std::greater<>());
+    if (this_pass) {
+      ahead_.push_back(k);
+      std::push_heap(ahead_.begin(), ahead_.end(), std::greater<>());
     }
   }
   return grown;
@@ -215,27 +225,31 @@ bool ExperienceMap::GrowRegion(uint32_t id, uint32_t above) {
 
 void ExperienceMap::RelaxIncremental() {
   const size_t n = state_.experiences.size();
-  const size_t n_links = state_.links.size();
   touched_pass_.resize(n, 0);
   pass_start_.resize(n);
   experience_cos_.resize(n);
   experience_sin_.resize(n);
-  queued_pass_.resize(n_links, 0);
   const double tolerance_m = options_.relaxation_tolerance_m;
   const double tolerance_rad = options_.relaxation_tolerance_rad;
   std::vector<uint32_t>& region = state_.relaxation_pending_links;
   for (int sweep = 0; sweep < options_.relaxation_sweeps && !region.empty(); ++sweep) {
     ++pass_;
-    // Ascending ids form a min-heap already; links join while the pass runs.
-    queue_.assign(region.begin(), region.end());
-    for (uint32_t l : queue_) queued_pass_[l] = pass_;
     touched_.clear();
     grown_.clear();
+    ahead_.clear();
     bool grown = false;
-    while (!queue_.empty()) {
-      std::pop_heap(queue_.begin(), queue_.end(), std::greater<>());
-      const uint32_t l = queue_.back();
-      queue_.pop_back();
+    // The region in ascending order, merged with the links that join it during the pass (all
+    // above the link being updated, kept in a min-heap).
+    size_t next = 0;
+    while (next < region.size() || !ahead_.empty()) {
+      uint32_t l;
+      if (!ahead_.empty() && (next == region.size() || ahead_.front() < region[next])) {
+        std::pop_heap(ahead_.begin(), ahead_.end(), std::greater<>());
+        l = ahead_.back();
+        ahead_.pop_back();
+      } else {
+        l = region[next++];
+      }
       const Link& link = state_.links[l];
       Touch(link.from);
       Touch(link.to);
@@ -246,10 +260,10 @@ void ExperienceMap::RelaxIncremental() {
       // A large step of an end reaches its links further on in this same pass, as in a full
       // pass; links before it join when the pass has moved the end.
       if (motion.a_m > tolerance_m || motion.a_rad > tolerance_rad) {
-        grown |= GrowRegion(link.from, l + 1);
+        grown |= GrowRegion(link.from, l + 1, true);
       }
       if (motion.b_m > tolerance_m || motion.b_rad > tolerance_rad) {
-        grown |= GrowRegion(link.to, l + 1);
+        grown |= GrowRegion(link.to, l + 1, true);
       }
     }
     // Single updates in an inconsistent loop swing back and forth for ever (cyclic projections
@@ -263,11 +277,11 @@ void ExperienceMap::RelaxIncremental() {
       if (std::abs(e.x_m - start.x_m) + std::abs(e.y_m - start.y_m) > tolerance_m ||
           std::abs(WrapAngleNear(e.theta_rad - start.theta_rad)) > tolerance_rad) {
         settled = false;
-        grown |= GrowRegion(id, 0);
+        grown |= GrowRegion(id, 0, false);
       }
     }
     if (settled && !grown) {
-      for (uint32_t l : region) in_region_[l] = 0;
+      for (uint32_t l : region) SetInRegion(l, false);
       region.clear();
       break;
     }
@@ -349,7 +363,12 @@ Status ExperienceMap::SetState(State state) {
   link_cos_.resize(n_links);
   link_sin_.resize(n_links);
   in_region_.assign(n_links, 0);
-  for (uint32_t l : state_.relaxation_pending_links) in_region_[l] = 1;
+  outside_region_.assign(n, 0);
+  for (const Link& l : state_.links) {
+    outside_region_[l.from] += 1;
+    outside_region_[l.to] += 1;
+  }
+  for (uint32_t l : state_.relaxation_pending_links) SetInRegion(l, true);
   for (size_t i = 0; i < n_links; ++i) {
     link_cos_[i] = std::cos(state_.links[i].heading_rad);
     link_sin_[i] = std::sin(state_.links[i].heading_rad);

@@ -170,21 +170,23 @@ class ExperienceMap {
   EndMotion UpdateLink(const Link& l, double cos_direction, double sin_direction);
   // Records experience `id`'s pose and rotation's cos and sin when first touched in a pass.
   void Touch(uint32_t id);
-  // Adds `id`'s links with ids from `above` that are not in the region yet to it (and to this
-  // pass when still ahead). Returns true when the region grew.
-  bool GrowRegion(uint32_t id, uint32_t above);
+  // Adds `id`'s links with ids from `above` that are not in the region yet to it (and, with
+  // `this_pass`, to the links still ahead in this pass). Returns true when the region grew.
+  bool GrowRegion(uint32_t id, uint32_t above, bool this_pass);
 
   ExperienceMapOptions options_;
   State state_;
   // Scratch, rebuilt from state_: per link cos and sin of heading_rad; per experience the pass
-  // it was first touched in, its pose then and its rotation's cos and sin; per link the pass it
-  // was queued in (this pass, the next).
+  // it was first touched in, its pose then and its rotation's cos and sin; links joining the
+  // region (ahead_: still in this pass).
   std::vector<double> link_cos_, link_sin_;
   std::vector<double> experience_cos_, experience_sin_;
   std::vector<Pose2> pass_start_;
-  std::vector<uint64_t> touched_pass_, queued_pass_;
-  std::vector<uint32_t> queue_, grown_, touched_;
-  std::vector<char> in_region_;  // per link: in relaxation_pending_links
+  std::vector<uint64_t> touched_pass_;
+  std::vector<uint32_t> ahead_, grown_, touched_;
+  std::vector<char> in_region_;      // per link: in relaxation_pending_links
+  std::vector<int> outside_region_;  // per experience: its links not in the region
+  void SetInRegion(uint32_t l, bool in);
   uint64_t pass_ = 0;
   uint64_t link_updates_ = 0;
 };

@@ -1,0 +1,115 @@
+// End-to-end replay in the library of the built-in synthetic camera loop driven ten times
+// (`ratslam synthesize --laps 10`: 12k frames) with configs/synthetic.toml, images decoded once
+// before timing. Three relaxation settings in the same run: the full scheme (OpenRatSLAM's, the
+// baseline), the incremental scheme (the default), and no relaxation at all (the cost of
+// everything else: the difference to it is what relaxation costs).
+#include <benchmark/benchmark.h>
+
+#include <map>
+#include <memory>
+
+#include "common/scratch_dir.h"
+#include "fusion/io/config.h"
+#include "fusion/replay_pipeline.h"
+#include "sensors/dataset/synthetic_dataset.h"
+
+namespace ratslam {
+namespace {
+
+class MemoryImages : public ImageLoader {
+ public:
+  StatusOr<GrayImage> Load(const std::string& path) override {
+    auto it = images_.find(path);
+    if (it == images_.end()) return Status::Error("not preloaded: " + path);
+    return it->second;
+  }
+  std::map<std::string, GrayImage> images_;
+};
+
+struct Workload {
+  ScratchDir folder{"replay_benchmark"};
+  Dataset dataset;
+  MemoryImages images;
+  PipelineOptions options;
+  std::string error;
+};
+
+Workload* GetWorkload() {
+  static Workload* w = [] {
+    auto* w = new Workload;
+    SyntheticOptions synthetic;
+    synthetic.laps = 10;
+    StatusOr<Dataset> d = WriteSyntheticDataset(synthetic, (w->folder.path() / "d").string());
+    StatusOr<PipelineOptions> o =
+        LoadConfigFile(std::string(RATSLAM_SOURCE_DIR) + "/configs/synthetic.toml");
+    if (!d.ok() || !o.ok()) {
+      w->error = !d.ok() ? d.status().message() : o.status().message();
+      return w;
+    }
+    w->dataset = std::move(*d);
+    w->options = *o;
+    FileImageLoader files;
+    for (const ImageRow& row : w->dataset.images) {
+      const std::string path = w->dataset.ImagePath(row);
+      StatusOr<GrayImage> image = files.Load(path);
+      if (!image.ok()) {
+        w->error = image.status().message();
+        return w;
+      }
+      w->images.images_[path] = std::move(*image);
+    }
+    return w;
+  }();
+  return w;
+}
+
+// Argument: 0 full relaxation, 1 incremental, 2 none.
+void BM_SyntheticReplay(benchmark::State& state) {
+  Workload* w = GetWorkload();
+  if (!w->error.empty()) {
+    state.SkipWithError(w->error.c_str());
+    return;
+  }
+  PipelineOptions options = w->options;
+  ExperienceMapOptions& map = options.ratslam.experience_map;
+  map.relaxation_scheme =
+      state.range(0) == 0 ? RelaxationScheme::kFull : RelaxationScheme::kIncremental;
+  if (state.range(0) == 2) map.relaxation_sweeps = 0;
+  uint64_t frames = 0, link_updates = 0;
+  size_t templates = 0, experiences = 0, links = 0;
+  for (auto _ : state) {
+    ReplayPipeline pipeline(options, w->dataset, &w->images);
+    const Status s = pipeline.Run({});
+    if (!s.ok()) {
+      state.SkipWithError(s.message().c_str());
+      return;
+    }
+    frames = pipeline.state().frames.size();
+    const Ratslam& slam = pipeline.slam();
+    templates = slam.local_view().size();
+    experiences = slam.experience_map().num_experiences();
+    links = slam.experience_map().num_links();
+    link_updates = slam.experience_map().relaxation_link_updates();
+  }
+  state.counters["frames"] = static_cast<double>(frames);
+  state.counters["templates"] = static_cast<double>(templates);
+  state.counters["experiences"] = static_cast<double>(experiences);
+  state.counters["links"] = static_cast<double>(links);
+  state.counters["link_updates_per_frame"] =
+      static_cast<double>(link_updates) / static_cast<double>(frames);
+  // Time per frame (shown in seconds with a prefix): the inverse rate of frames.
+  state.counters["time_per_frame"] = benchmark::Counter(
+      static_cast<double>(frames),
+      benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_SyntheticReplay)
+    ->ArgName("scheme_full0_incremental1_none2")
+    ->Arg(0)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace ratslam
+
+BENCHMARK_MAIN();
