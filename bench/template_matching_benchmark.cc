@@ -1,12 +1,18 @@
 // Classic camera template matching: one query against N stored 60x10 templates, shifts +-5.
 // Baseline: the straightforward comparison on floating-point templates.
+// BM_SyntheticRouteViews: real views, the built-in synthetic loop (configs/synthetic.toml's
+// crop), the first laps stored and the last lap's views as queries, Compare (with the exact
+// column-sum bound) against the full scan of every template (Differences) in the same run.
 #include <benchmark/benchmark.h>
 
 #include <cmath>
 #include <vector>
 
 #include "common/random.h"
+#include "common/scratch_dir.h"
 #include "sensors/classic_camera_matcher.h"
+#include "sensors/dataset/image_loader.h"
+#include "sensors/dataset/synthetic_dataset.h"
 
 namespace ratslam {
 namespace {
@@ -73,6 +79,60 @@ BENCHMARK(BM_ClassicTemplateMatchingFloatBaseline)
     ->Arg(1000)
     ->Arg(10000)
     ->Unit(benchmark::kMillisecond);
+
+// Argument: 0 Compare with the bound, 1 the full scan. Laps: 6 (5 stored, 1 queried).
+void BM_SyntheticRouteViews(benchmark::State& state) {
+  static const auto* data = [] {
+    auto* d = new std::pair<std::vector<std::vector<uint8_t>>, ClassicCameraOptions>();
+    ClassicCameraOptions& options = d->second;
+    options.crop_top_px = 8;
+    options.crop_bottom_px = 32;
+    ScratchDir folder("template_benchmark");
+    SyntheticOptions synthetic;
+    synthetic.laps = 6;
+    StatusOr<Dataset> dataset = WriteSyntheticDataset(synthetic, (folder.path() / "d").string());
+    if (!dataset.ok()) return d;
+    ClassicCameraMatcher matcher(options);
+    FileImageLoader loader;
+    for (const ImageRow& row : dataset->images) {
+      StatusOr<GrayImage> image = loader.Load(dataset->ImagePath(row));
+      if (!image.ok()) return d;
+      d->first.push_back(
+          matcher.MakeTemplate({image->width, image->height, image->width, image->pixels.data()})
+              .value());
+    }
+    return d;
+  }();
+  if (data->first.empty()) {
+    state.SkipWithError("could not make the synthetic views");
+    return;
+  }
+  const std::vector<std::vector<uint8_t>>& views = data->first;
+  ClassicCameraMatcher matcher(data->second);
+  const size_t stored = views.size() * 5 / 6;
+  for (size_t i = 0; i < stored; ++i) matcher.Add(views[i]);
+  size_t next = stored;
+  for (auto _ : state) {
+    const std::vector<uint8_t>& query = views[next];
+    next = next + 1 < views.size() ? next + 1 : stored;
+    if (state.range(0) == 0) {
+      benchmark::DoNotOptimize(matcher.Compare(query));
+    } else {
+      benchmark::DoNotOptimize(matcher.Differences(query));
+    }
+  }
+  state.counters["templates"] = static_cast<double>(stored);
+  if (state.range(0) == 0) {
+    state.counters["full_comparisons_per_query"] =
+        static_cast<double>(matcher.full_comparisons()) / static_cast<double>(state.iterations());
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(stored));
+}
+BENCHMARK(BM_SyntheticRouteViews)
+    ->ArgName("full_scan")
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace ratslam

@@ -20,6 +20,11 @@ struct ClassicCameraMatcher::PreparedQuery {
   std::vector<uint8_t> rows;   // shifts * height * stride
   std::vector<uint8_t> masks;  // shifts * stride: 0xFF where the offset overlaps
   std::vector<int> overlap_columns;
+  // For the lower bound: per shift the overlapping template columns [first, last) (contiguous:
+  // all of them when panoramic) and the query's column sums they meet (shifts * width).
+  std::vector<int> first_column, last_column;
+  std::vector<int32_t> column_sums;
+  std::vector<int64_t> overlap_sums;  // per shift: the query's sum over the overlap
 };
 
 namespace {
@@ -58,8 +63,41 @@ ClassicCameraMatcher::PreparedQuery Prepare(const std::vector<uint8_t>& query,
       }
     }
     p.overlap_columns.push_back(overlap);
+    p.first_column.push_back(panoramic ? 0 : std::max(0, -s));
+    p.last_column.push_back(panoramic ? width : std::min(width, width - s));
+  }
+  p.column_sums.assign(shifts.size() * width, 0);
+  for (size_t k = 0; k < shifts.size(); ++k) {
+    for (int u = 0; u < width; ++u) {
+      int32_t sum = 0;
+      for (int r = 0; r < height; ++r)
+        sum += p.rows[k * per_shift + static_cast<size_t>(r) * stride + u];
+      p.column_sums[k * width + u] = sum;
+    }
+    int64_t overlap = 0;
+    for (int u = p.first_column[k]; u < p.last_column[k]; ++u)
+      overlap += p.column_sums[k * width + u];
+    p.overlap_sums.push_back(overlap);
   }
   return p;
+}
+
+// Column sums of a stored template (width values), then their running sums (width + 1).
+void AppendColumnSums(const uint8_t* t, int width, int height, int stride,
+                      std::vector<int32_t>* out) {
+  const size_t start = out->size();
+  for (int u = 0; u < width; ++u) {
+    int32_t sum = 0;
+    for (int r = 0; r < height; ++r) sum += t[static_cast<size_t>(r) * stride + u];
+    out->push_back(sum);
+  }
+  // Exact when width * height * 255 < 2^31 (where the scan uses them); wraps beyond.
+  int64_t running = 0;
+  out->push_back(0);
+  for (int u = 0; u < width; ++u) {
+    running += (*out)[start + u];
+    out->push_back(static_cast<int32_t>(running));
+  }
 }
 
 // Sum of absolute differences between a stored template (masked) and one prepared shift.
@@ -134,6 +172,90 @@ void ForEachTemplate(const uint8_t* base, uint32_t count, size_t bytes_per_templ
       best = std::min(best, sad * scale[k]);
     }
     visit(id, best);
+  }
+}
+
+// The smallest difference over the shifts to one template.
+template <uint32_t (*Sad)(const uint8_t*, const uint8_t*, const uint8_t*, int, int)>
+#if defined(RATSLAM_HAVE_X86_SIMD)
+__attribute__((target("avx2")))
+#endif
+inline double
+TemplateBest(const uint8_t* t, const ClassicCameraMatcher::PreparedQuery& prepared,
+             const std::vector<double>& scale, size_t shifts, int height, int stride) {
+  const size_t per_shift = static_cast<size_t>(height) * stride;
+  double best = std::numeric_limits<double>::infinity();
+  for (size_t k = 0; k < shifts; ++k) {
+    const uint32_t sad = Sad(t, prepared.rows.data() + k * per_shift,
+                             prepared.masks.data() + k * stride, height, stride);
+    best = std::min(best, sad * scale[k]);
+  }
+  return best;
+}
+
+// The best template (first of the smallest difference), skipping every template whose exact
+// lower bound cannot beat the best so far. The bound: per column, |sum of template column -
+// sum of query column| <= the column's sum of absolute differences (triangle inequality), so
+// the bound's sum over the overlap is <= the SAD for each shift, and scaling by the same
+// positive factor keeps the order (rounding is monotone). A template with bound >= best has
+// difference >= best and could not have replaced it: the result equals the full scan's.
+template <uint32_t (*Sad)(const uint8_t*, const uint8_t*, const uint8_t*, int, int),
+          typename Sum>
+#if defined(RATSLAM_HAVE_X86_SIMD)
+__attribute__((target("avx2")))
+#endif
+void BestWithBound(const uint8_t* base, uint32_t count, size_t bytes_per_template,
+                   const int32_t* template_column_sums, int width,
+                   const ClassicCameraMatcher::PreparedQuery& prepared,
+                   const std::vector<double>& scale, size_t shifts, int height, int stride,
+                   TemplateComparison* best, uint64_t* full_comparisons) {
+  for (uint32_t id = 0; id < count; ++id) {
+    const int32_t* columns = template_column_sums + static_cast<size_t>(id) * (2 * width + 1);
+    const int32_t* prefix = columns + width;  // width + 1 running sums of the columns
+    bool may_win = false;
+    for (size_t k = 0; k < shifts && !may_win; ++k) {
+      // First the total over the overlap (|sum of differences| <= sum of |differences|), in
+      // constant time from prefix sums; then the column bound.
+      if constexpr (sizeof(Sum) == 4) {  // running sums are exact only then
+        const int first = prepared.first_column[k], last = prepared.last_column[k];
+        const int64_t total =
+            static_cast<int64_t>(prefix[last]) - prefix[first] - prepared.overlap_sums[k];
+        if (static_cast<double>(total < 0 ? -total : total) * scale[k] >= best->mean_difference) {
+          continue;
+        }
+      }
+      const int32_t* query = prepared.column_sums.data() + k * width;
+      Sum bound = 0;  // vectorises when Sum is 32 bits
+      for (int u = prepared.first_column[k]; u < prepared.last_column[k]; ++u) {
+        bound += static_cast<Sum>(std::abs(columns[u] - query[u]));
+      }
+      may_win = static_cast<double>(bound) * scale[k] < best->mean_difference;
+    }
+    if (!may_win) continue;
+    ++*full_comparisons;
+    const double difference =
+        TemplateBest<Sad>(base + id * bytes_per_template, prepared, scale, shifts, height, stride);
+    if (difference < best->mean_difference) {
+      best->mean_difference = difference;
+      best->template_id = static_cast<int32_t>(id);
+    }
+  }
+}
+
+template <uint32_t (*Sad)(const uint8_t*, const uint8_t*, const uint8_t*, int, int)>
+void BestWithBound(const uint8_t* base, uint32_t count, size_t bytes_per_template,
+                   const int32_t* template_column_sums, int width,
+                   const ClassicCameraMatcher::PreparedQuery& prepared,
+                   const std::vector<double>& scale, size_t shifts, int height, int stride,
+                   TemplateComparison* best, uint64_t* full_comparisons) {
+  // The bound is at most width * height * 255: 32 bits suffice below 8.4 million pixels.
+  const bool fits_32 = static_cast<uint64_t>(width) * height * 255 < (uint64_t{1} << 31);
+  if (fits_32) {
+    BestWithBound<Sad, uint32_t>(base, count, bytes_per_template, template_column_sums, width,
+                                 prepared, scale, shifts, height, stride, best, full_comparisons);
+  } else {
+    BestWithBound<Sad, uint64_t>(base, count, bytes_per_template, template_column_sums, width,
+                                 prepared, scale, shifts, height, stride, best, full_comparisons);
   }
 }
 
@@ -272,14 +394,29 @@ TemplateComparison ClassicCameraMatcher::Compare(const std::vector<uint8_t>& que
   TemplateComparison best;
   if (state_.template_count == 0 || query.size() != bytes_per_template_) return best;
   const PreparedQuery prepared = PrepareQuery(query);
-  VisitTemplates(prepared, [&best](uint32_t id, double difference) {
-    if (difference < best.mean_difference) {
-      best.mean_difference = difference;
-      best.template_id = static_cast<int32_t>(id);
-    }
-  });
-  // The winning shift: recomputed for the winning template only (the first shift attaining it).
   const int h = options_.template_height_px;
+  const int w = options_.template_width_px;
+  std::vector<double> scale(shifts_.size());
+  for (size_t k = 0; k < shifts_.size(); ++k) {
+    scale[k] = 1.0 / (255.0 * h * prepared.overlap_columns[k]);
+  }
+  const uint8_t* base = state_.templates.data();
+  const int32_t* sums = column_sums_.data();
+  [&] {
+#if defined(RATSLAM_HAVE_X86_SIMD)
+    static const bool kAvx2 = __builtin_cpu_supports("avx2");
+    if (kAvx2 && !force_portable_) {
+      BestWithBound<MaskedSadAvx2>(base, state_.template_count, bytes_per_template_, sums, w,
+                                   prepared, scale, shifts_.size(), h, row_stride_, &best,
+                                   &full_comparisons_);
+      return;
+    }
+#endif
+    BestWithBound<MaskedSadPortable>(base, state_.template_count, bytes_per_template_, sums, w,
+                                     prepared, scale, shifts_.size(), h, row_stride_, &best,
+                                     &full_comparisons_);
+  }();
+  // The winning shift: recomputed for the winning template only (the first shift attaining it).
   const uint8_t* t = state_.templates.data() + best.template_id * bytes_per_template_;
   for (size_t k = 0; k < shifts_.size(); ++k) {
     const uint32_t sad = MaskedSadPortable(t, prepared.rows.data() + k * h * row_stride_,
@@ -305,6 +442,8 @@ std::vector<double> ClassicCameraMatcher::Differences(const std::vector<uint8_t>
 
 uint32_t ClassicCameraMatcher::Add(const std::vector<uint8_t>& query) {
   state_.templates.insert(state_.templates.end(), query.begin(), query.end());
+  AppendColumnSums(query.data(), options_.template_width_px, options_.template_height_px,
+                   row_stride_, &column_sums_);
   return state_.template_count++;
 }
 
@@ -334,6 +473,11 @@ Status ClassicCameraMatcher::SetState(State state) {
     return Status::Error("camera matcher state: template bytes do not match the template size");
   }
   state_ = std::move(state);
+  column_sums_.clear();
+  for (uint32_t id = 0; id < state_.template_count; ++id) {
+    AppendColumnSums(state_.templates.data() + id * bytes_per_template_, options_.template_width_px,
+                     options_.template_height_px, row_stride_, &column_sums_);
+  }
   return Status::Ok();
 }
 

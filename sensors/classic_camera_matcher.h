@@ -97,8 +97,13 @@ class ClassicCameraMatcher {
 
   // Builds the template of an image (row-padded 8-bit layout) without storing it.
   StatusOr<std::vector<uint8_t>> MakeTemplate(const GrayImageView& image) const;
-  // Compares a template (from MakeTemplate) with every stored one.
+  // Compares a template (from MakeTemplate) with every stored one. Templates whose exact lower
+  // bound (column sums) cannot beat the best so far are skipped: the result is the full scan's.
   TemplateComparison Compare(const std::vector<uint8_t>& query) const;
+  // Templates Compare has compared in full (not skipped by the bound), since construction.
+  uint64_t full_comparisons() const { return full_comparisons_; }
+  // Tests: use the portable SSE2 kernel even where AVX2 exists.
+  void set_force_portable(bool portable) { force_portable_ = portable; }
   // The smallest mean difference over the shifts to every stored template, by id.
   std::vector<double> Differences(const std::vector<uint8_t>& query) const;
   // Stores a template (from MakeTemplate); returns its id.
@@ -123,6 +128,11 @@ class ClassicCameraMatcher {
   size_t bytes_per_template_;
   std::vector<int> shifts_;
   State state_;
+  // Per stored template: column sums (width) and their running sums (width + 1); rebuilt from
+  // state_.
+  std::vector<int32_t> column_sums_;
+  mutable uint64_t full_comparisons_ = 0;
+  bool force_portable_ = false;
 };
 
 }  // namespace ratslam

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -154,6 +155,103 @@ TEST(ClassicCameraMatcherTest, PatchNormalisationRemovesBrightnessChange) {
   matcher.Add(matcher.MakeTemplate(a.view()).value());
   const TemplateComparison c = matcher.Compare(matcher.MakeTemplate(darker.view()).value());
   EXPECT_LT(c.mean_difference, 0.02);
+}
+
+}  // namespace
+}  // namespace ratslam
+
+namespace ratslam {
+namespace {
+
+// Views along a route: a smooth panorama seen from nearby positions (shifted, brightened,
+// noisy), so that many stored templates are near the query and the bound must decide close
+// calls. Returns row-major images of width x height.
+std::vector<Image> RouteViews(int width, int height, int count, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0.0, 6.0);
+  std::vector<double> world(4 * width);
+  for (size_t i = 0; i < world.size(); ++i) {
+    world[i] = 128 + 60 * std::sin(i * 0.07) + 40 * std::sin(i * 0.31 + 1.0);
+  }
+  std::vector<Image> views;
+  for (int v = 0; v < count; ++v) {
+    Image image{width, height, std::vector<uint8_t>(static_cast<size_t>(width) * height)};
+    const int offset = (v * 7) % (3 * width);
+    const double gain = 0.9 + 0.2 * (v % 5) / 4.0;
+    for (int y = 0; y < height; ++y)
+      for (int x = 0; x < width; ++x) {
+        const double value = world[offset + x] * gain * (0.8 + 0.4 * y / height) + noise(rng);
+        image.pixels[y * width + x] = static_cast<uint8_t>(std::clamp(value, 0.0, 255.0));
+      }
+    views.push_back(image);
+  }
+  return views;
+}
+
+// The full scan as the reference: the first template of the smallest difference (Differences
+// visits every template without the bound).
+void ExpectBoundedScanEqualsFullScan(ClassicCameraOptions options, const std::vector<Image>& stored,
+                                     const std::vector<Image>& queries, bool portable) {
+  ClassicCameraMatcher matcher(options);
+  matcher.set_force_portable(portable);
+  for (const Image& s : stored) matcher.Add(matcher.MakeTemplate(s.view()).value());
+  for (const Image& q : queries) {
+    const std::vector<uint8_t> query = matcher.MakeTemplate(q.view()).value();
+    const std::vector<double> all = matcher.Differences(query);
+    const auto first_min = std::min_element(all.begin(), all.end());  // first of the smallest
+    const TemplateComparison got = matcher.Compare(query);
+    ASSERT_EQ(got.template_id, first_min - all.begin());
+    ASSERT_EQ(got.mean_difference, *first_min);  // bit for bit
+  }
+}
+
+TEST(ClassicCameraBoundTest, BoundedScanEqualsFullScanOnRouteViews) {
+  const std::vector<Image> views = RouteViews(120, 40, 600, 5);
+  const std::vector<Image> stored(views.begin(), views.begin() + 500);
+  const std::vector<Image> queries(views.begin() + 500, views.end());
+  for (bool portable : {false, true}) {
+    for (bool panoramic : {false, true}) {
+      ClassicCameraOptions options;
+      options.panoramic = panoramic;
+      ExpectBoundedScanEqualsFullScan(options, stored, queries, portable);
+      options.shift_step_px = 2;
+      options.template_width_px = 37;  // padding and masks
+      options.template_height_px = 7;
+      options.global_normalisation_mean = 0.5;
+      ExpectBoundedScanEqualsFullScan(options, stored, queries, portable);
+    }
+  }
+}
+
+TEST(ClassicCameraBoundTest, BoundedScanEqualsFullScanOnRandomTemplatesWithTies) {
+  std::vector<Image> stored;
+  for (uint32_t i = 0; i < 300; ++i) stored.push_back(RandomImage(120, 40, 100 + i % 150));
+  std::vector<Image> queries;  // half of them equal to stored images: exact ties at 0
+  for (uint32_t i = 0; i < 40; ++i)
+    queries.push_back(RandomImage(120, 40, i % 2 ? 100 + i : 900 + i));
+  for (bool portable : {false, true}) {
+    ExpectBoundedScanEqualsFullScan({}, stored, queries, portable);
+  }
+}
+
+// Templates of over 8.4 million pixels: the bound no longer fits 32 bits and takes its 64-bit path.
+TEST(ClassicCameraBoundTest, BoundedScanEqualsFullScanOnHugeTemplates) {
+  ClassicCameraOptions options;
+  options.template_width_px = 4096;
+  options.template_height_px = 2060;  // 4096 * 2060 * 255 > 2^31
+  options.shift_px = 1;
+  std::vector<Image> stored;
+  for (uint32_t i = 0; i < 2; ++i) stored.push_back(RandomImage(4096, 2060, 40 + i));
+  ExpectBoundedScanEqualsFullScan(options, stored, {stored[1], RandomImage(4096, 2060, 7)}, false);
+}
+
+TEST(ClassicCameraBoundTest, BoundSkipsMostTemplatesOnRouteViews) {
+  const std::vector<Image> views = RouteViews(120, 40, 600, 6);
+  ClassicCameraMatcher matcher({});
+  for (int i = 0; i < 500; ++i) matcher.Add(matcher.MakeTemplate(views[i].view()).value());
+  for (int i = 500; i < 600; ++i) matcher.Compare(matcher.MakeTemplate(views[i].view()).value());
+  // 100 queries x 500 templates: the bound must leave well under half for the full comparison.
+  EXPECT_LT(matcher.full_comparisons(), 100u * 500u / 2) << matcher.full_comparisons();
 }
 
 }  // namespace
