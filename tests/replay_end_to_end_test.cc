@@ -195,6 +195,32 @@ TEST_F(ReplayEndToEndTest, MapFromThePreviousReleaseResumesToTheSameRun) {
       << refused.err;
 }
 
+// A format-3 map (made by the release before incremental relaxation, with `ratslam replay
+// --config configs/synthetic.toml --until 75 --save-map`) carries its configuration, which names
+// no relaxation scheme: it was made with full relaxation, resumes to the uninterrupted run under
+// it, and under today's default the error names the key and both values.
+TEST_F(ReplayEndToEndTest, FormatThreeMapResumesUnderFullRelaxationOnly) {
+  const fs::path whole = root_ / "whole_v3", rest = root_ / "rest_v3";
+  const std::string fixture =
+      (fs::path(RATSLAM_SOURCE_DIR) / "tests" / "data" / "map-v3-synthetic.map").string();
+  const std::string config = WithFullRelaxation(config_, root_ / "synthetic-full-v3.toml");
+  ASSERT_FALSE(config.empty());
+  auto args = [&](const fs::path& out) {
+    return "replay --quiet --config " + config + " --data " + (root_ / "data").string() +
+           " --out " + out.string();
+  };
+  ASSERT_EQ(RunRatslam(args(whole), root_).exit_code, 0);
+  const Result r = RunRatslam(args(rest) + " --load-map " + fixture, root_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  ExpectSameRun(whole, rest);
+  const Result refused =
+      RunRatslam(ReplayArgs(root_ / "v3_incremental") + " --load-map " + fixture, root_);
+  EXPECT_EQ(refused.exit_code, 1);
+  EXPECT_NE(refused.err.find("experience_map.relaxation_scheme: \"full\" -> \"incremental\""),
+            std::string::npos)
+      << refused.err;
+}
+
 // A key added after format 2 must be at its default to resume a format-2 map (which was made
 // without it); the error names the key.
 TEST_F(ReplayEndToEndTest, MapFromThePreviousReleaseRefusesAKeyItCouldNotHaveUsed) {
