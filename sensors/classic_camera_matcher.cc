@@ -208,8 +208,18 @@ void BestWithBound(const uint8_t* base, uint32_t count, size_t bytes_per_templat
                    const int32_t* template_column_sums, int width,
                    const ClassicCameraMatcher::PreparedQuery& prepared,
                    const std::vector<double>& scale, size_t shifts, int height, int stride,
-                   TemplateComparison* best, uint64_t* full_comparisons) {
+                   int64_t seed, TemplateComparison* best, uint64_t* full_comparisons) {
+  // The seed first (a template likely to be near the best: the bound then skips more), then all
+  // others in id order; among equal differences the lowest id wins, as in the full scan.
+  if (seed >= 0) {
+    ++*full_comparisons;
+    best->mean_difference = TemplateBest<Sad>(base + seed * bytes_per_template, prepared, scale,
+                                              shifts, height, stride);
+    best->template_id = static_cast<int32_t>(seed);
+  }
   for (uint32_t id = 0; id < count; ++id) {
+    if (id == seed) continue;
+    const bool wins_ties = static_cast<int64_t>(id) < best->template_id;
     const int32_t* columns = template_column_sums + static_cast<size_t>(id) * (2 * width + 1);
     const int32_t* prefix = columns + width;  // width + 1 running sums of the columns
     bool may_win = false;
@@ -229,13 +239,14 @@ void BestWithBound(const uint8_t* base, uint32_t count, size_t bytes_per_templat
       for (int u = prepared.first_column[k]; u < prepared.last_column[k]; ++u) {
         bound += static_cast<Sum>(std::abs(columns[u] - query[u]));
       }
-      may_win = static_cast<double>(bound) * scale[k] < best->mean_difference;
+      const double lower = static_cast<double>(bound) * scale[k];
+      may_win = lower < best->mean_difference || (wins_ties && lower == best->mean_difference);
     }
     if (!may_win) continue;
     ++*full_comparisons;
     const double difference =
         TemplateBest<Sad>(base + id * bytes_per_template, prepared, scale, shifts, height, stride);
-    if (difference < best->mean_difference) {
+    if (difference < best->mean_difference || (wins_ties && difference == best->mean_difference)) {
       best->mean_difference = difference;
       best->template_id = static_cast<int32_t>(id);
     }
@@ -247,15 +258,17 @@ void BestWithBound(const uint8_t* base, uint32_t count, size_t bytes_per_templat
                    const int32_t* template_column_sums, int width,
                    const ClassicCameraMatcher::PreparedQuery& prepared,
                    const std::vector<double>& scale, size_t shifts, int height, int stride,
-                   TemplateComparison* best, uint64_t* full_comparisons) {
+                   int64_t seed, TemplateComparison* best, uint64_t* full_comparisons) {
   // The bound is at most width * height * 255: 32 bits suffice below 8.4 million pixels.
   const bool fits_32 = static_cast<uint64_t>(width) * height * 255 < (uint64_t{1} << 31);
   if (fits_32) {
     BestWithBound<Sad, uint32_t>(base, count, bytes_per_template, template_column_sums, width,
-                                 prepared, scale, shifts, height, stride, best, full_comparisons);
+                                 prepared, scale, shifts, height, stride, seed, best,
+                                 full_comparisons);
   } else {
     BestWithBound<Sad, uint64_t>(base, count, bytes_per_template, template_column_sums, width,
-                                 prepared, scale, shifts, height, stride, best, full_comparisons);
+                                 prepared, scale, shifts, height, stride, seed, best,
+                                 full_comparisons);
   }
 }
 
@@ -390,9 +403,11 @@ void ClassicCameraMatcher::VisitTemplates(const PreparedQuery& prepared, Visit&&
                                      scale, shifts_, h, row_stride_, visit);
 }
 
-TemplateComparison ClassicCameraMatcher::Compare(const std::vector<uint8_t>& query) const {
+TemplateComparison ClassicCameraMatcher::Compare(const std::vector<uint8_t>& query,
+                                                 int64_t hint) const {
   TemplateComparison best;
   if (state_.template_count == 0 || query.size() != bytes_per_template_) return best;
+  const int64_t seed = hint >= 0 && hint < state_.template_count ? hint : -1;
   const PreparedQuery prepared = PrepareQuery(query);
   const int h = options_.template_height_px;
   const int w = options_.template_width_px;
@@ -407,13 +422,13 @@ TemplateComparison ClassicCameraMatcher::Compare(const std::vector<uint8_t>& que
     static const bool kAvx2 = __builtin_cpu_supports("avx2");
     if (kAvx2 && !force_portable_) {
       BestWithBound<MaskedSadAvx2>(base, state_.template_count, bytes_per_template_, sums, w,
-                                   prepared, scale, shifts_.size(), h, row_stride_, &best,
+                                   prepared, scale, shifts_.size(), h, row_stride_, seed, &best,
                                    &full_comparisons_);
       return;
     }
 #endif
     BestWithBound<MaskedSadPortable>(base, state_.template_count, bytes_per_template_, sums, w,
-                                     prepared, scale, shifts_.size(), h, row_stride_, &best,
+                                     prepared, scale, shifts_.size(), h, row_stride_, seed, &best,
                                      &full_comparisons_);
   }();
   // The winning shift: recomputed for the winning template only (the first shift attaining it).
@@ -450,7 +465,7 @@ uint32_t ClassicCameraMatcher::Add(const std::vector<uint8_t>& query) {
 StatusOr<ViewDecision> ClassicCameraMatcher::Observe(const GrayImageView& image, double time_s) {
   StatusOr<std::vector<uint8_t>> query = MakeTemplate(image);
   if (!query.ok()) return query.status();
-  const TemplateComparison best = Compare(query.value());
+  const TemplateComparison best = Compare(query.value(), last_template_);
   ViewDecision decision;
   decision.time_s = time_s;
   if (best.template_id >= 0 && best.mean_difference <= options_.match_threshold) {
@@ -465,6 +480,7 @@ StatusOr<ViewDecision> ClassicCameraMatcher::Observe(const GrayImageView& image,
     decision.template_id = Add(query.value());
     decision.is_new = true;
   }
+  last_template_ = decision.template_id;
   return decision;
 }
 
@@ -473,6 +489,7 @@ Status ClassicCameraMatcher::SetState(State state) {
     return Status::Error("camera matcher state: template bytes do not match the template size");
   }
   state_ = std::move(state);
+  last_template_ = -1;
   column_sums_.clear();
   for (uint32_t id = 0; id < state_.template_count; ++id) {
     AppendColumnSums(state_.templates.data() + id * bytes_per_template_, options_.template_width_px,

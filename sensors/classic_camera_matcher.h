@@ -99,7 +99,9 @@ class ClassicCameraMatcher {
   StatusOr<std::vector<uint8_t>> MakeTemplate(const GrayImageView& image) const;
   // Compares a template (from MakeTemplate) with every stored one. Templates whose exact lower
   // bound (column sums) cannot beat the best so far are skipped: the result is the full scan's.
-  TemplateComparison Compare(const std::vector<uint8_t>& query) const;
+  // `hint`, a template likely to be close (Observe passes the last frame's), is compared first
+  // so that the bound skips more; the result does not depend on it.
+  TemplateComparison Compare(const std::vector<uint8_t>& query, int64_t hint = -1) const;
   // Templates Compare has compared in full (not skipped by the bound), since construction.
   uint64_t full_comparisons() const { return full_comparisons_; }
   // Tests: use the portable SSE2 kernel even where AVX2 exists.
@@ -132,6 +134,7 @@ class ClassicCameraMatcher {
   // state_.
   std::vector<int32_t> column_sums_;
   mutable uint64_t full_comparisons_ = 0;
+  int64_t last_template_ = -1;  // Observe's last decision: the next Compare's hint
   bool force_portable_ = false;
 };
 

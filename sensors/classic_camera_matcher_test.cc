@@ -199,9 +199,14 @@ void ExpectBoundedScanEqualsFullScan(ClassicCameraOptions options, const std::ve
     const std::vector<uint8_t> query = matcher.MakeTemplate(q.view()).value();
     const std::vector<double> all = matcher.Differences(query);
     const auto first_min = std::min_element(all.begin(), all.end());  // first of the smallest
-    const TemplateComparison got = matcher.Compare(query);
-    ASSERT_EQ(got.template_id, first_min - all.begin());
-    ASSERT_EQ(got.mean_difference, *first_min);  // bit for bit
+    const int64_t count = matcher.size();
+    // Without a hint, and with hints that are the answer, elsewhere, or out of range.
+    for (int64_t hint :
+         {int64_t{-1}, int64_t{first_min - all.begin()}, int64_t{0}, count - 1, count / 2, count}) {
+      const TemplateComparison got = matcher.Compare(query, hint);
+      ASSERT_EQ(got.template_id, first_min - all.begin()) << "hint " << hint;
+      ASSERT_EQ(got.mean_difference, *first_min) << "hint " << hint;  // bit for bit
+    }
   }
 }
 
