@@ -168,57 +168,50 @@ void ExpectSameRun(const fs::path& a_folder, const fs::path& b_folder) {
   EXPECT_EQ(a, b);
 }
 
-// A map file written by the release before the schema rewrite (format version 2, made with
-// `ratslam replay --config configs/synthetic.toml --until 75 --save-map`) must still load and
-// resume to exactly the uninterrupted run.
-TEST_F(ReplayEndToEndTest, MapFromThePreviousReleaseResumesToTheSameRun) {
-  const fs::path whole = root_ / "whole_v2", rest = root_ / "rest_v2";
+// Resumes the map `fixture` (in tests/data) of an earlier release, made with `ratslam replay
+// --config configs/synthetic.toml --until 75 --save-map`, under full relaxation (which made it)
+// and expects exactly the uninterrupted run; under today's default scheme it must be refused
+// with an error containing `refusal`.
+void ExpectOldMapResumesUnderFullRelaxationOnly(const fs::path& root, const std::string& config,
+                                                const std::string& fixture_name,
+                                                const std::string& refusal) {
+  const std::string tag = fs::path(fixture_name).stem().string();
+  const fs::path whole = root / ("whole_" + tag), rest = root / ("rest_" + tag);
   const std::string fixture =
-      (fs::path(RATSLAM_SOURCE_DIR) / "tests" / "data" / "map-v2-synthetic.map").string();
-  const std::string config = WithFullRelaxation(config_, root_ / "synthetic-full.toml");
-  ASSERT_FALSE(config.empty());
-  auto args = [&](const fs::path& out) {
-    return "replay --quiet --config " + config + " --data " + (root_ / "data").string() +
-           " --out " + out.string();
+      (fs::path(RATSLAM_SOURCE_DIR) / "tests" / "data" / fixture_name).string();
+  const std::string full = WithFullRelaxation(config, root / (tag + "-full.toml"));
+  ASSERT_FALSE(full.empty());
+  auto args = [&](const std::string& c, const fs::path& out) {
+    return "replay --quiet --config " + c + " --data " + (root / "data").string() + " --out " +
+           out.string();
   };
-  ASSERT_EQ(RunRatslam(args(whole), root_).exit_code, 0);
-  const Result r = RunRatslam(args(rest) + " --load-map " + fixture, root_);
+  ASSERT_EQ(RunRatslam(args(full, whole), root).exit_code, 0);
+  const Result r = RunRatslam(args(full, rest) + " --load-map " + fixture, root);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   ExpectSameRun(whole, rest);
-  // Under today's default scheme the old map is refused, naming the key.
   const Result refused =
-      RunRatslam(ReplayArgs(root_ / "v2_incremental") + " --load-map " + fixture, root_);
+      RunRatslam(args(config, root / (tag + "_incremental")) + " --load-map " + fixture, root);
   EXPECT_EQ(refused.exit_code, 1);
-  EXPECT_NE(refused.err.find("experience_map.relaxation_scheme is \"incremental\", but maps of "
-                             "format 2 were made with \"full\""),
-            std::string::npos)
-      << refused.err;
+  EXPECT_NE(refused.err.find(refusal), std::string::npos) << refused.err;
 }
 
-// A format-3 map (made by the release before incremental relaxation, with `ratslam replay
-// --config configs/synthetic.toml --until 75 --save-map`) carries its configuration, which names
-// no relaxation scheme: it was made with full relaxation, resumes to the uninterrupted run under
-// it, and under today's default the error names the key and both values.
+// A map file written by the release before the schema rewrite (format version 2) must still
+// load and resume to exactly the uninterrupted run; it holds only a fingerprint, and the error
+// under the incremental scheme names the key.
+TEST_F(ReplayEndToEndTest, MapFromThePreviousReleaseResumesToTheSameRun) {
+  ExpectOldMapResumesUnderFullRelaxationOnly(
+      root_, config_, "map-v2-synthetic.map",
+      "experience_map.relaxation_scheme is \"incremental\", but maps of format 2 were made with "
+      "\"full\"");
+}
+
+// A format-3 map (made by the release before incremental relaxation) carries its configuration,
+// which names no relaxation scheme: it was made with full relaxation, and the error names the
+// key and both values.
 TEST_F(ReplayEndToEndTest, FormatThreeMapResumesUnderFullRelaxationOnly) {
-  const fs::path whole = root_ / "whole_v3", rest = root_ / "rest_v3";
-  const std::string fixture =
-      (fs::path(RATSLAM_SOURCE_DIR) / "tests" / "data" / "map-v3-synthetic.map").string();
-  const std::string config = WithFullRelaxation(config_, root_ / "synthetic-full-v3.toml");
-  ASSERT_FALSE(config.empty());
-  auto args = [&](const fs::path& out) {
-    return "replay --quiet --config " + config + " --data " + (root_ / "data").string() +
-           " --out " + out.string();
-  };
-  ASSERT_EQ(RunRatslam(args(whole), root_).exit_code, 0);
-  const Result r = RunRatslam(args(rest) + " --load-map " + fixture, root_);
-  ASSERT_EQ(r.exit_code, 0) << r.err;
-  ExpectSameRun(whole, rest);
-  const Result refused =
-      RunRatslam(ReplayArgs(root_ / "v3_incremental") + " --load-map " + fixture, root_);
-  EXPECT_EQ(refused.exit_code, 1);
-  EXPECT_NE(refused.err.find("experience_map.relaxation_scheme: \"full\" -> \"incremental\""),
-            std::string::npos)
-      << refused.err;
+  ExpectOldMapResumesUnderFullRelaxationOnly(
+      root_, config_, "map-v3-synthetic.map",
+      "experience_map.relaxation_scheme: \"full\" -> \"incremental\"");
 }
 
 // A key added after format 2 must be at its default to resume a format-2 map (which was made
