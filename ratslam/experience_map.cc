@@ -72,10 +72,7 @@ void ExperienceMap::AddLink(uint32_t from, uint32_t to, double time_s,
   // The newest id: the region stays ascending.
   const bool incremental = options_.relaxation_scheme == RelaxationScheme::kIncremental;
   if (incremental) state_.relaxation_pending_links.push_back(link.id);
-  in_region_.push_back(0);
-  outside_region_[from] += 1;
-  outside_region_[to] += 1;
-  if (incremental) SetInRegion(link.id, true);
+  in_region_.push_back(incremental ? 1 : 0);
 }
 
 uint32_t ExperienceMap::CreateExperience(uint32_t template_id, const PoseCellPosition& pose_cells,
@@ -88,7 +85,6 @@ uint32_t ExperienceMap::CreateExperience(uint32_t template_id, const PoseCellPos
   e.time_s = time_s;
   e.compass_heading_rad = compass_heading_rad;
   state_.experiences.push_back(e);
-  outside_region_.push_back(0);
   if (state_.current) {
     const Experience& from = state_.experiences[*state_.current];
     std::optional<double> facing;
@@ -179,7 +175,7 @@ ExperienceMap::EndMotion ExperienceMap::UpdateLink(const Link& l, double cos_dir
 void ExperienceMap::RelaxFull() {
   // OpenRatSLAM's scheme, bit for bit as before the incremental one existed (WrapAngleNear equals
   // WrapAngle): the reference the incremental scheme is measured against.
-  for (uint32_t l : state_.relaxation_pending_links) SetInRegion(l, false);
+  for (uint32_t l : state_.relaxation_pending_links) in_region_[l] = 0;
   state_.relaxation_pending_links.clear();
   const std::vector<Experience>& ex = state_.experiences;
   for (int sweep = 0; sweep < options_.relaxation_sweeps; ++sweep) {
@@ -200,19 +196,11 @@ void ExperienceMap::Touch(uint32_t id) {
   ::sincos(e.theta_rad, &experience_sin_[id], &experience_cos_[id]);  // glibc: both at once
 }
 
-void ExperienceMap::SetInRegion(uint32_t l, bool in) {
-  in_region_[l] = in ? 1 : 0;
-  const int change = in ? -1 : 1;
-  outside_region_[state_.links[l].from] += change;
-  outside_region_[state_.links[l].to] += change;
-}
-
 bool ExperienceMap::GrowRegion(uint32_t id, uint32_t above, bool this_pass) {
-  if (outside_region_[id] == 0) return false;  // the common case once a region is large
   bool grown = false;
   for (uint32_t k : state_.experiences[id].link_ids) {
     if (k < above || in_region_[k]) continue;
-    SetInRegion(k, true);
+    in_region_[k] = 1;
     grown_.push_back(k);
     grown = true;
     if (this_pass) {
@@ -281,7 +269,7 @@ void ExperienceMap::RelaxIncremental() {
       }
     }
     if (settled && !grown) {
-      for (uint32_t l : region) SetInRegion(l, false);
+      for (uint32_t l : region) in_region_[l] = 0;
       region.clear();
       break;
     }
@@ -363,12 +351,7 @@ Status ExperienceMap::SetState(State state) {
   link_cos_.resize(n_links);
   link_sin_.resize(n_links);
   in_region_.assign(n_links, 0);
-  outside_region_.assign(n, 0);
-  for (const Link& l : state_.links) {
-    outside_region_[l.from] += 1;
-    outside_region_[l.to] += 1;
-  }
-  for (uint32_t l : state_.relaxation_pending_links) SetInRegion(l, true);
+  for (uint32_t l : state_.relaxation_pending_links) in_region_[l] = 1;
   for (size_t i = 0; i < n_links; ++i) {
     link_cos_[i] = std::cos(state_.links[i].heading_rad);
     link_sin_[i] = std::sin(state_.links[i].heading_rad);

@@ -184,9 +184,7 @@ class ExperienceMap {
   std::vector<Pose2> pass_start_;
   std::vector<uint64_t> touched_pass_;
   std::vector<uint32_t> ahead_, grown_, touched_;
-  std::vector<char> in_region_;      // per link: in relaxation_pending_links
-  std::vector<int> outside_region_;  // per experience: its links not in the region
-  void SetInRegion(uint32_t l, bool in);
+  std::vector<char> in_region_;  // per link: in relaxation_pending_links
   uint64_t pass_ = 0;
   uint64_t link_updates_ = 0;
 };
