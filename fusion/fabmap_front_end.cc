@@ -55,7 +55,7 @@ class FabmapFrontEnd : public FrontEnd {
     return FabmapLearningReport{
         settings_.front_end.wifi_learning,
         online() ? learned_from_ : static_cast<uint64_t>(resources_->scans.scans.size()),
-        online() ? relearnt_ : 1};
+        online() ? relearnt_ : 1, localiser_ ? localiser_->wifi_tree_scans() : 0};
   }
 
   std::string EncodeState() const override {
@@ -268,7 +268,9 @@ StatusOr<std::shared_ptr<const FabmapResources>> PrepareFabmapResources(
   fabmap::WifiExploration exploration;
   if (fabmap::UsesWifi(mode)) {
     // Travel at each scan from the odometry (speed held from one row's time to the next's).
-    double travelled = 0.0, last_time = 0.0;
+    // Without odometry there is no travel (NaN): the Wi-Fi tree is then spaced by time only.
+    double travelled = dataset.odometry.empty() ? std::numeric_limits<double>::quiet_NaN() : 0.0;
+    double last_time = 0.0;
     size_t k = 0;
     for (const WifiScan& scan : dataset.wifi) {
       while (k < dataset.odometry.size() && dataset.odometry[k].time_s <= scan.time_s) {

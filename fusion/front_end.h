@@ -157,6 +157,7 @@ struct FabmapLearningReport {
   WifiLearning wifi_learning = WifiLearning::kWholeDataSet;
   uint64_t wifi_learned_from_scans = 0;  // scans behind the current Wi-Fi model
   uint64_t wifi_relearnt = 0;            // times the model was (re)built during the run
+  uint64_t wifi_tree_scans = 0;          // of the scans, those that learnt the Wi-Fi tree
 };
 
 struct FrameDecision {

@@ -32,7 +32,7 @@ run_all() {  # binary, folder
   "$b" replay --config "$c/sim-fused.toml" --data apt --out sim-fused --quiet >/dev/null 2>&1
   echo "sim-fused $?"
   if [[ -d $data/msft-ilc20-site1 ]]; then
-    "$b" evaluate --config "$c/msft-ilc20-wifi-b8.toml" --map "$data/msft-ilc20-site1" \
+    "$b" evaluate --config "$c/msft-ilc20-wifi.toml" --map "$data/msft-ilc20-site1" \
       --query "$data/msft-ilc20-site1" --out msft --quiet >/dev/null 2>&1; echo "msft $?"
   fi
   cd "$root" || return

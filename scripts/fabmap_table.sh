@@ -34,5 +34,5 @@ PY
   done
   echo
 }
-run_set "UJIIndoorLoc" configs/ujiindoorloc-wifi-b8.toml "$data/ujiindoorloc/trainingData.csv"
-run_set "Microsoft ILC 2.0 site 1" configs/msft-ilc20-wifi-b8.toml "$data/msft-ilc20-site1"
+run_set "UJIIndoorLoc" configs/ujiindoorloc-wifi.toml "$data/ujiindoorloc/trainingData.csv"
+run_set "Microsoft ILC 2.0 site 1" configs/msft-ilc20-wifi.toml "$data/msft-ilc20-site1"

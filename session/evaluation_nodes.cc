@@ -69,6 +69,9 @@ StatusOr<std::vector<EvaluationNode>> UjiNodes(const std::string& path, bool len
     n.floor = s.building * 100 + s.floor;  // another building counts as another floor
     n.time_s = s.time_s;
     n.session = s.user * 100 + s.phone;
+    // Fingerprints are single captures: no travel between rows, so the Wi-Fi tree spaces
+    // them by time only (every map row learns it by default).
+    n.travelled_m = std::numeric_limits<double>::quiet_NaN();
     n.wifi = s.readings;
     nodes.push_back(std::move(n));
   }

@@ -129,6 +129,8 @@ Status EvaluationSession::Prepare() {
   if (!localiser.ok()) return localiser.status();
   localiser_ = *std::move(localiser);
   result_.wifi_words = localiser_->wifi_words();
+  result_.wifi_map_scans = localiser_->wifi_exploration_scans();
+  result_.wifi_tree_scans = localiser_->wifi_tree_scans();
   result_.visual_words = visual_ ? visual_->vocabulary.size() : 0u;
   return Status::Ok();
 }
@@ -171,6 +173,8 @@ Status EvaluationSession::WriteOutputs() {
   j["rejection_rate"] = m.rejection_rate;
   j["floor_mistake_rate"] = m.floor_mistake_rate;
   j["wifi_words"] = result_.wifi_words;
+  j["wifi_map_scans"] = result_.wifi_map_scans;
+  j["wifi_tree_scans"] = result_.wifi_tree_scans;
   j["visual_words"] = result_.visual_words;
   j["query_time_ms"] = result_.query_time_ms;
   result_.wall_time_s = clock_->Seconds() - started_s_;

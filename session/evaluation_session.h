@@ -37,6 +37,8 @@ struct EvaluationResult {
   std::vector<int64_t> matches;  // per query: map index, or -1 for a new place (rejection)
   fabmap::EvaluationMetrics metrics;
   size_t wifi_words = 0, visual_words = 0;
+  size_t wifi_map_scans = 0;   // map scans that define the Wi-Fi words
+  size_t wifi_tree_scans = 0;  // of them, those that learnt the Wi-Fi Chow-Liu tree
   double query_time_ms = 0.0;  // mean per query
   double wall_time_s = 0.0;    // of the whole session so far
   std::string json;            // evaluation.json

@@ -71,6 +71,9 @@ TEST(EvaluationSessionTest, KnownPlacesAreAllFoundAndOutputsWritten) {
   const auto json = nlohmann::json::parse(out.written.at("evaluation.json"));
   EXPECT_EQ(json["queries"], 18);
   EXPECT_EQ(json["correct_within_m"]["2"], 1.0);
+  // Fingerprint rows carry no travel: every map scan learns the Wi-Fi tree (it was 1 of 12).
+  EXPECT_EQ(json["wifi_map_scans"], 12);
+  EXPECT_EQ(json["wifi_tree_scans"], 12);
   EXPECT_TRUE(out.written.count("queries.csv"));
   EXPECT_TRUE(out.written.count("config.toml"));
 }

@@ -511,7 +511,7 @@ TEST(SweepRunTest, EvaluateSweepsReadTheBenchmarksMetrics) {
   const std::string path =
       Write("evaluate.toml",
             "[sweep]\ncommand = \"evaluate\"\nbase_config = \"" + std::string(RATSLAM_SOURCE_DIR) +
-                "/configs/msft-ilc20-wifi-b8.toml\"\n"
+                "/configs/msft-ilc20-wifi.toml\"\n"
                 "objective = \"correct_within_m.5\"\n"
                 "goal = \"maximize\"\n[[datasets]]\ndata = [\"" +
                 site.string() + "\"]\n[parameters]\n\"wifi_words.bins\" = [1, 8]\n");

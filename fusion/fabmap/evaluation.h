@@ -22,7 +22,7 @@ struct EvaluationNode {
   double x_m = 0.0, y_m = 0.0;
   int floor = 0;
   double time_s = 0.0;
-  double travelled_m = 0.0;  // along its session (for the Wi-Fi tree's spacing)
+  double travelled_m = 0.0;  // along its session (Wi-Fi tree spacing); NaN: not recorded
   int session = 0;
   std::string image;                             // image path, if any
   std::optional<std::vector<WifiReading>> wifi;  // scan, if any

@@ -80,6 +80,8 @@ StatusOr<std::unique_ptr<Localiser>> Localiser::Create(const LocaliserSettings& 
                                 settings.localiser.wifi_tree_min_interval_s)) {
     tree_observations.push_back(l->wifi_vocabulary_.Encode(exploration.scans[k]));
   }
+  l->wifi_exploration_scans_ = exploration.scans.size();
+  l->wifi_tree_scans_ = tree_observations.size();
   auto wifi_tree =
       LearnChowLiuTree(tree_observations, l->wifi_vocabulary_.size(), settings.chow_liu);
   if (!wifi_tree.ok()) return wifi_tree.status().WithContext("Wi-Fi Chow-Liu tree");

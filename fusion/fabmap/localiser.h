@@ -87,7 +87,7 @@ struct VisualModel {
 struct MapNode {
   Observation visual;                            // visual words (vision modes)
   std::optional<std::vector<WifiReading>> wifi;  // the node's scan, if any
-  double travelled_m = 0.0;                      // along the exploration, for tree spacing
+  double travelled_m = 0.0;  // along the exploration, for tree spacing (NaN: not recorded)
   double time_s = 0.0;
 };
 
@@ -97,7 +97,7 @@ struct Query {
 };
 
 // Scans of an exploration: they define the Wi-Fi words, tree (spaced by travel and time) and
-// virtual unknown world.
+// virtual unknown world. A NaN travel means the data set has none: spacing is by time only.
 struct WifiExploration {
   std::vector<std::vector<WifiReading>> scans;
   std::vector<double> travelled_m;
@@ -119,6 +119,9 @@ class Localiser {
   Status AddPlace(const Query& place);
   uint32_t places() const { return places_; }
   uint32_t wifi_words() const { return wifi_vocabulary_.size(); }
+  // Scans of the exploration, and how many of them (after spacing) learnt the Wi-Fi tree.
+  size_t wifi_exploration_scans() const { return wifi_exploration_scans_; }
+  size_t wifi_tree_scans() const { return wifi_tree_scans_; }
   // best_place indexes the map nodes; -1 is the new place (a rejection).
   LocalisationResult Localise(const Query& query) const;
   // Wi-Fi candidates for sequential fusion, best first.
@@ -134,6 +137,8 @@ class Localiser {
   LocaliserSettings settings_;
   uint32_t places_ = 0;
   uint32_t visual_words_ = 0;
+  size_t wifi_exploration_scans_ = 0;
+  size_t wifi_tree_scans_ = 0;
   WifiVocabulary wifi_vocabulary_;
   std::optional<FabmapModel> vision_, wifi_, early_;
 };

@@ -138,8 +138,11 @@ std::vector<size_t> SpacedIndices(const std::vector<double>& travelled_m,
     }
     const double moved = travelled_m[i] - travelled_m[kept.back()];
     const double waited = time_s[i] - time_s[kept.back()];
+    // Unknown travel (NaN at either end; fingerprint data sets record none) waives the distance
+    // condition: spacing by travel applies only where travel exists.
+    const bool far_enough = std::isnan(moved) || moved >= min_distance_m;
     // Travel or time going backwards starts a new session: keep its first observation.
-    if (moved < 0.0 || waited < 0.0 || (moved >= min_distance_m && waited >= min_interval_s)) {
+    if (moved < 0.0 || waited < 0.0 || (far_enough && waited >= min_interval_s)) {
       kept.push_back(i);
     }
   }

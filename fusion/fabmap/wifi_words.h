@@ -104,7 +104,8 @@ std::vector<Observation> VirtualWifiSamples(const WifiVocabulary& vocabulary, do
 
 // Indices of observations kept for learning the Wi-Fi tree (section 3.2): each kept one is at
 // least `min_distance_m` of travel and `min_interval_s` after the previously kept one. Travel or
-// time going backwards marks a new session, whose first observation is kept.
+// time going backwards marks a new session, whose first observation is kept. A NaN travel means
+// the data set records none (UJIIndoorLoc rows): only the time condition applies to it.
 std::vector<size_t> SpacedIndices(const std::vector<double>& travelled_m,
                                   const std::vector<double>& time_s, double min_distance_m,
                                   double min_interval_s);

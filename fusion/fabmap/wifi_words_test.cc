@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 namespace ratslam::fabmap {
 namespace {
@@ -92,6 +93,18 @@ TEST(WifiWordsTest, CountStatisticsAndSpacing) {
   // A second session restarts travel and time.
   EXPECT_EQ(SpacedIndices({0, 3, 0, 3}, {0, 20, 0, 20}, 2.0, 10.0),
             (std::vector<size_t>{0, 1, 2, 3}));
+}
+
+// Fingerprint data sets (UJIIndoorLoc rows) record no travel: spacing by travel must not
+// collapse them to their first scan (it did: 1 of 7,974 map rows learnt the tree).
+TEST(WifiWordsTest, SpacingWithoutTravelUsesTimeOnly) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const std::vector<double> none(5, nan);
+  EXPECT_EQ(SpacedIndices(none, {0, 0, 1, 1, 2}, 1.0, 0.0), (std::vector<size_t>{0, 1, 2, 3, 4}));
+  EXPECT_EQ(SpacedIndices(none, {0, 4, 10, 12, 25}, 1.0, 10.0), (std::vector<size_t>{0, 2, 4}));
+  // Travel known for some rows only: the distance applies between rows that both have it.
+  EXPECT_EQ(SpacedIndices({0, 0.5, nan, 0.7, 3}, {0, 1, 2, 3, 4}, 1.0, 0.0),
+            (std::vector<size_t>{0, 2, 3, 4}));
 }
 
 TEST(WifiWordsTest, OptionsAreChecked) {

@@ -120,6 +120,7 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
     j["fabmap_wifi_learning"] = ToString(learning->wifi_learning);
     j["fabmap_wifi_learned_from_scans"] = learning->wifi_learned_from_scans;
     j["fabmap_wifi_models_built"] = learning->wifi_relearnt;
+    j["fabmap_wifi_tree_scans"] = learning->wifi_tree_scans;
   }
   if (dataset.session_start_times_s.size() > 1)
     j["sessions"] = dataset.session_start_times_s.size();
