@@ -76,19 +76,24 @@ int EvaluateCommand(int argc, char** argv) {
   if (Status s = session.WriteOutputs(); !s.ok()) return fail(s);
   const EvaluationResult& r = session.result();
   const fabmap::EvaluationMetrics& m = r.metrics;
-  const Scene figure = LocalisationCurvesScene({{fabmap::ToString(mode), m.errors_m}},
-                                               "FABMAP " + fabmap::ToString(mode) + ": " +
-                                                   std::to_string(m.queries) + " queries, " +
-                                                   std::to_string(r.map.size()) + " mapped places");
+  std::vector<LocalisationCurve> curves = {{fabmap::ToString(mode), m.errors_m}};
+  for (const auto& [name, b] : r.baselines) curves.push_back({"baseline " + name, b.errors_m});
+  const Scene figure = LocalisationCurvesScene(
+      curves, "FABMAP " + fabmap::ToString(mode) + ": " + std::to_string(m.queries) + " queries, " +
+                  std::to_string(r.map.size()) + " mapped places");
   if (Status s = RenderToPng(figure, (*out)->Path("localisation.png")); !s.ok()) return fail(s);
 
-  std::printf("%-10s %6s %6s %6s %6s | %6s %6s %6s %6s | %6s %6s\n", "mode", "c2", "c5", "c10",
+  std::printf("%-12s %6s %6s %6s %6s | %6s %6s %6s %6s | %6s %6s\n", "mode", "c2", "c5", "c10",
               "c20", "m2", "m5", "m10", "m20", "reject", "floor");
-  std::printf("%-10s", fabmap::ToString(mode).c_str());
-  for (double v : m.correct_within) std::printf(" %6.1f", 100 * v);
-  std::printf(" |");
-  for (double v : m.misplaced_beyond) std::printf(" %6.1f", 100 * v);
-  std::printf(" | %6.1f %6.1f\n", 100 * m.rejection_rate, 100 * m.floor_mistake_rate);
+  const auto row = [](const std::string& name, const fabmap::EvaluationMetrics& x) {
+    std::printf("%-12s", name.c_str());
+    for (double v : x.correct_within) std::printf(" %6.1f", 100 * v);
+    std::printf(" |");
+    for (double v : x.misplaced_beyond) std::printf(" %6.1f", 100 * v);
+    std::printf(" | %6.1f %6.1f\n", 100 * x.rejection_rate, 100 * x.floor_mistake_rate);
+  };
+  row(fabmap::ToString(mode), m);
+  for (const auto& [name, b] : r.baselines) row(name, b);
   return kExitOk;
 }
 

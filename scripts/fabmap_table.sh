@@ -21,18 +21,27 @@ run_set() {  # name base-config data-path
       sed -e "s/^bins = .*/bins = $b/" -e "s/^encoding = .*/encoding = \"$enc\"/" "$base" > "$dir/input.toml"
       "$build/apps/ratslam" evaluate --config "$dir/input.toml" --map "$path" --query "$path" \
         --out "$dir" --quiet > /dev/null
-      python3 - "$dir/evaluation.json" "$b" "$enc" <<'PY'
+      row "$dir/evaluation.json" "$b" "$enc"
+    done
+  done
+  # The baselines do not depend on the words: report them once, from the last run.
+  for baseline in knn fingerprint; do
+    row "$dir/evaluation.json" "$baseline" "(baseline)" "$baseline"
+  done
+  echo
+}
+row() {  # evaluation.json, first column, second column, [baseline name]
+  /usr/bin/python3 - "$@" <<'PY'
 import json, sys
 j = json.load(open(sys.argv[1]))
+if len(sys.argv) > 4:
+    j = j["baselines"][sys.argv[4]]
 pct = lambda x: f"{100 * x:.1f}"
 c = [pct(j["correct_within_m"][d]) for d in ("2", "5", "10", "20")]
 m = [pct(j["misplaced_beyond_m"][d]) for d in ("2", "5", "10", "20")]
 print(f"| {sys.argv[2]} | {sys.argv[3]} | " + " | ".join(c + m) +
       f" | {pct(j['rejection_rate'])} | {pct(j['floor_mistake_rate'])} |")
 PY
-    done
-  done
-  echo
 }
 run_set "UJIIndoorLoc" configs/ujiindoorloc-wifi.toml "$data/ujiindoorloc/trainingData.csv"
 run_set "Microsoft ILC 2.0 site 1" configs/msft-ilc20-wifi.toml "$data/msft-ilc20-site1"

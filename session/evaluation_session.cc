@@ -1,5 +1,6 @@
 #include "session/evaluation_session.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -10,6 +11,7 @@
 
 #include "fusion/io/config.h"
 #include "fusion/io/visual_model_file.h"
+#include "session/evaluation_baselines.h"
 #include "session/evaluation_nodes.h"
 
 namespace ratslam {
@@ -22,6 +24,23 @@ std::string Key(double d) {
 }
 
 const std::vector<double> kDistancesM = {2, 5, 10, 20};
+
+// An object keyed by the distances of kDistancesM ("2", "5", ...).
+nlohmann::ordered_json ByDistance(const std::vector<double>& values) {
+  nlohmann::ordered_json o = nlohmann::ordered_json::object();
+  for (size_t k = 0; k < kDistancesM.size() && k < values.size(); ++k) {
+    o[Key(kDistancesM[k])] = values[k];
+  }
+  return o;
+}
+
+// The rates of one method: correct within d, misplaced beyond d, rejections, floor mistakes.
+void AddRates(const fabmap::EvaluationMetrics& m, nlohmann::ordered_json* j) {
+  (*j)["correct_within_m"] = ByDistance(m.correct_within);
+  (*j)["misplaced_beyond_m"] = ByDistance(m.misplaced_beyond);
+  (*j)["rejection_rate"] = m.rejection_rate;
+  (*j)["floor_mistake_rate"] = m.floor_mistake_rate;
+}
 
 }  // namespace
 
@@ -152,6 +171,19 @@ Status EvaluationSession::Localise() {
       1000.0 * (clock_->Seconds() - start) / static_cast<double>(result_.queries.size());
   result_.metrics =
       fabmap::ComputeMetrics(result_.map, result_.queries, result_.matches, kDistancesM);
+  result_.baselines.clear();
+  const bool map_has_wifi = std::any_of(result_.map.begin(), result_.map.end(),
+                                        [](const fabmap::EvaluationNode& n) { return n.wifi; });
+  if (map_has_wifi) {
+    result_.baselines.emplace_back(
+        "knn", fabmap::ComputeMetrics(result_.queries, KnnEstimates(result_.map, result_.queries),
+                                      kDistancesM));
+    const WifiMatcherOptions& wifi = options_.pipeline.sensors.wifi;
+    result_.baselines.emplace_back(
+        "fingerprint", fabmap::ComputeMetrics(
+                           result_.queries,
+                           FingerprintEstimates(result_.map, result_.queries, wifi), kDistancesM));
+  }
   return Status::Ok();
 }
 
@@ -164,14 +196,11 @@ Status EvaluationSession::WriteOutputs() {
   j["config"] = options_.config_path;
   j["map_nodes"] = result_.map.size();
   j["queries"] = m.queries;
-  j["correct_within_m"] = nlohmann::ordered_json::object();
-  j["misplaced_beyond_m"] = nlohmann::ordered_json::object();
-  for (size_t k = 0; k < kDistancesM.size(); ++k) {
-    j["correct_within_m"][Key(kDistancesM[k])] = m.correct_within[k];
-    j["misplaced_beyond_m"][Key(kDistancesM[k])] = m.misplaced_beyond[k];
-  }
-  j["rejection_rate"] = m.rejection_rate;
-  j["floor_mistake_rate"] = m.floor_mistake_rate;
+  AddRates(m, &j);
+  j["nearest_place_within_m"] =
+      ByDistance(fabmap::NearestPlaceWithin(result_.map, result_.queries, kDistancesM));
+  j["baselines"] = nlohmann::ordered_json::object();
+  for (const auto& [name, b] : result_.baselines) AddRates(b, &j["baselines"][name]);
   j["wifi_words"] = result_.wifi_words;
   j["wifi_map_scans"] = result_.wifi_map_scans;
   j["wifi_tree_scans"] = result_.wifi_tree_scans;

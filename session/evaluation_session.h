@@ -10,6 +10,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/clock.h"
@@ -39,7 +40,10 @@ struct EvaluationResult {
   size_t wifi_words = 0, visual_words = 0;
   size_t wifi_map_scans = 0;   // map scans that define the Wi-Fi words
   size_t wifi_tree_scans = 0;  // of them, those that learnt the Wi-Fi Chow-Liu tree
-  double query_time_ms = 0.0;  // mean per query
+  // The Wi-Fi baselines on the same map and queries (evaluation_baselines.h), by name ("knn",
+  // "fingerprint"); empty when the map has no scan.
+  std::vector<std::pair<std::string, fabmap::EvaluationMetrics>> baselines;
+  double query_time_ms = 0.0;  // mean per query (FABMAP)
   double wall_time_s = 0.0;    // of the whole session so far
   std::string json;            // evaluation.json
 };

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <map>
 #include <system_error>
 
 namespace ratslam::fabmap {
@@ -65,6 +66,18 @@ EvaluationMetrics ComputeMetrics(const std::vector<EvaluationNode>& map,
                                  const std::vector<EvaluationNode>& queries,
                                  const std::vector<int64_t>& matches,
                                  const std::vector<double>& distances_m) {
+  std::vector<Estimate> estimates(queries.size());
+  for (size_t i = 0; i < queries.size() && i < matches.size(); ++i) {
+    const int64_t match = matches[i];
+    if (match < 0 || static_cast<size_t>(match) >= map.size()) continue;
+    estimates[i] = {true, map[match].x_m, map[match].y_m, map[match].floor};
+  }
+  return ComputeMetrics(queries, estimates, distances_m);
+}
+
+EvaluationMetrics ComputeMetrics(const std::vector<EvaluationNode>& queries,
+                                 const std::vector<Estimate>& estimates,
+                                 const std::vector<double>& distances_m) {
   EvaluationMetrics m;
   m.queries = queries.size();
   m.distances_m = distances_m;
@@ -72,15 +85,15 @@ EvaluationMetrics ComputeMetrics(const std::vector<EvaluationNode>& map,
   m.misplaced_beyond.assign(distances_m.size(), 0.0);
   size_t rejected = 0, floor_mistakes = 0;
   for (size_t i = 0; i < queries.size(); ++i) {
-    const int64_t match = i < matches.size() ? matches[i] : -1;
+    const Estimate e = i < estimates.size() ? estimates[i] : Estimate{};
     double error = std::numeric_limits<double>::quiet_NaN();
-    if (match < 0 || static_cast<size_t>(match) >= map.size()) {
+    if (!e.located) {
       ++rejected;
-    } else if (map[match].floor != queries[i].floor) {
+    } else if (e.floor != queries[i].floor) {
       ++floor_mistakes;
       error = std::numeric_limits<double>::infinity();
     } else {
-      error = std::hypot(map[match].x_m - queries[i].x_m, map[match].y_m - queries[i].y_m);
+      error = std::hypot(e.x_m - queries[i].x_m, e.y_m - queries[i].y_m);
     }
     m.errors_m.push_back(error);
     for (size_t k = 0; k < distances_m.size(); ++k) {
@@ -96,6 +109,33 @@ EvaluationMetrics ComputeMetrics(const std::vector<EvaluationNode>& map,
     m.floor_mistake_rate = floor_mistakes / n;
   }
   return m;
+}
+
+std::vector<double> NearestPlaceWithin(const std::vector<EvaluationNode>& map,
+                                       const std::vector<EvaluationNode>& queries,
+                                       const std::vector<double>& distances_m) {
+  std::vector<double> within(distances_m.size(), 0.0);
+  if (queries.empty()) return within;
+  // Map places by floor, sorted by x, so each query scans only the x window of the largest d.
+  std::map<int, std::vector<std::pair<double, double>>> by_floor;
+  for (const EvaluationNode& n : map) by_floor[n.floor].push_back({n.x_m, n.y_m});
+  for (auto& [floor, places] : by_floor) std::sort(places.begin(), places.end());
+  const double reach =
+      distances_m.empty() ? 0.0 : *std::max_element(distances_m.begin(), distances_m.end());
+  for (const EvaluationNode& q : queries) {
+    const auto it = by_floor.find(q.floor);
+    if (it == by_floor.end()) continue;
+    const auto& places = it->second;
+    double best = std::numeric_limits<double>::infinity();
+    auto p = std::lower_bound(places.begin(), places.end(),
+                              std::make_pair(q.x_m - reach, -std::numeric_limits<double>::max()));
+    for (; p != places.end() && p->first <= q.x_m + reach; ++p) {
+      best = std::min(best, std::hypot(p->first - q.x_m, p->second - q.y_m));
+    }
+    for (size_t k = 0; k < distances_m.size(); ++k) within[k] += best <= distances_m[k];
+  }
+  for (double& w : within) w /= static_cast<double>(queries.size());
+  return within;
 }
 
 }  // namespace ratslam::fabmap

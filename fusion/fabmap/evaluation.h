@@ -86,6 +86,24 @@ EvaluationMetrics ComputeMetrics(const std::vector<EvaluationNode>& map,
                                  const std::vector<int64_t>& matches,
                                  const std::vector<double>& distances_m);
 
+// For each d, the share of queries with a map place on their floor within d of them: what a
+// localiser that answers with map places could reach at best (unmapped places lower it).
+std::vector<double> NearestPlaceWithin(const std::vector<EvaluationNode>& map,
+                                       const std::vector<EvaluationNode>& queries,
+                                       const std::vector<double>& distances_m);
+
+// A localiser's answer to a query as a position: a map place's, or any position (k-NN averages
+// its neighbours), or none (a rejection).
+struct Estimate {
+  bool located = false;
+  double x_m = 0.0, y_m = 0.0;
+  int floor = 0;
+};
+// The same metrics from positions; `estimates[i]` answers query i (missing: a rejection).
+EvaluationMetrics ComputeMetrics(const std::vector<EvaluationNode>& queries,
+                                 const std::vector<Estimate>& estimates,
+                                 const std::vector<double>& distances_m);
+
 }  // namespace ratslam::fabmap
 
 #endif  // RATSLAM_FUSION_FABMAP_EVALUATION_H_

@@ -42,6 +42,40 @@ TEST(EvaluationTest, MetricsOnAHandBuiltCase) {
   EXPECT_TRUE(std::isnan(m.errors_m[3]));
 }
 
+// Estimates off the map's places (k-NN averages) count by their own position.
+TEST(EvaluationTest, MetricsOfPositionEstimates) {
+  const std::vector<EvaluationNode> queries = {At(0, 0, 0), At(0, 0, 0), At(0, 0, 1)};
+  const std::vector<Estimate> estimates = {{true, 3, 4, 0}, {}, {true, 0, 0, 0}};
+  const EvaluationMetrics m = ComputeMetrics(queries, estimates, {2, 5});
+  EXPECT_DOUBLE_EQ(m.errors_m[0], 5.0);
+  EXPECT_DOUBLE_EQ(m.correct_within[0], 0.0);
+  EXPECT_DOUBLE_EQ(m.correct_within[1], 1.0 / 3);  // 5 <= 5
+  EXPECT_DOUBLE_EQ(m.rejection_rate, 1.0 / 3);
+  EXPECT_DOUBLE_EQ(m.floor_mistake_rate, 1.0 / 3);
+}
+
+// The reachable share: a map place on the query's floor within d, brute force on a grid.
+TEST(EvaluationTest, NearestPlaceWithinAgreesWithBruteForce) {
+  std::vector<EvaluationNode> map, queries;
+  for (int i = 0; i < 30; ++i) map.push_back(At((i * 7) % 23, (i * 5) % 17, i % 2));
+  for (int i = 0; i < 50; ++i) queries.push_back(At((i * 3) % 29 - 2.5, (i * 11) % 19, i % 3));
+  const std::vector<double> d = {1, 2, 5, 10};
+  const std::vector<double> got = NearestPlaceWithin(map, queries, d);
+  for (size_t k = 0; k < d.size(); ++k) {
+    int near = 0;
+    for (const auto& q : queries) {
+      bool any = false;
+      for (const auto& p : map) {
+        any |= p.floor == q.floor && std::hypot(p.x_m - q.x_m, p.y_m - q.y_m) <= d[k];
+      }
+      near += any;
+    }
+    EXPECT_DOUBLE_EQ(got[k], near / 50.0) << d[k];
+  }
+  EXPECT_LT(got[0], got[3]);  // the case is not trivial
+  EXPECT_LT(got[3], 1.0);     // floor 2 has no map place
+}
+
 TEST(EvaluationTest, InterleavedSplitKeepsTheFraction) {
   const auto split = InterleavedSplit(10, 0.4);
   int in_map = 0;
