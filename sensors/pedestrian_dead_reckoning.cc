@@ -68,13 +68,34 @@ std::vector<double> DetectSteps(const std::vector<AccelerometerSample>& samples,
   return steps;
 }
 
+double OrientationSteadiness(const std::vector<AccelerometerSample>& samples, double time_s,
+                             double window_s) {
+  const auto by_time = [](const AccelerometerSample& s, double t) { return s.time_s < t; };
+  auto it = std::lower_bound(samples.begin(), samples.end(), time_s - 0.5 * window_s, by_time);
+  double x = 0.0, y = 0.0, z = 0.0, lengths = 0.0;
+  for (; it != samples.end() && it->time_s <= time_s + 0.5 * window_s; ++it) {
+    x += it->x;
+    y += it->y;
+    z += it->z;
+    lengths += std::hypot(it->x, it->y, it->z);
+  }
+  return lengths > 0.0 ? std::hypot(x, y, z) / lengths : 1.0;
+}
+
 std::vector<Step> PedestrianDeadReckoning(const std::vector<AccelerometerSample>& accelerometer,
                                           const std::vector<HeadingSample>& headings,
-                                          const PdrOptions& options) {
+                                          const PdrOptions& options, PdrReport* report) {
   std::vector<double> swings;
   const std::vector<double> times = DetectSteps(accelerometer, options, &swings);
   std::vector<Step> steps;
+  if (report) *report = PdrReport{times.size(), 0};
   for (size_t i = 0; i < times.size(); ++i) {
+    if (options.min_orientation_steadiness > 0.0 &&
+        OrientationSteadiness(accelerometer, times[i], options.orientation_window_s) <
+            options.min_orientation_steadiness) {
+      if (report) ++report->steps_not_walking;
+      continue;
+    }
     Step step;
     step.time_s = times[i];
     step.length_m = options.fixed_step_length_m > 0.0

@@ -6,6 +6,9 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "apps/demo_config.h"
 #include "common/scratch_dir.h"
@@ -30,14 +33,21 @@ nlohmann::json Summary(const fs::path& out) {
   return nlohmann::json::parse(Slurp(out / "summary.json"));
 }
 
-// Writes `config` to `out` with relaxation_scheme = "full": maps of format 3 and older were made
-// with full relaxation and resume only under it.
-std::string WithFullRelaxation(const std::string& config, const fs::path& out) {
+// Writes `config` (a full printed config) to `out` as map format `format` was made: full
+// relaxation (formats 2-3) and no PDR orientation test (formats 2-4). Such maps resume only
+// under those values. Empty when a key is missing.
+std::string AsMadeByFormat(int format, const std::string& config, const fs::path& out) {
   std::string text = Slurp(config);
-  const std::string key = "relaxation_scheme = \"incremental\"";
-  const size_t at = text.find(key);
-  if (at == std::string::npos) return "";
-  text.replace(at, key.size(), "relaxation_scheme = \"full\"");
+  std::vector<std::pair<std::string, std::string>> changes = {
+      {"min_orientation_steadiness = 0.85", "min_orientation_steadiness = 0.0"}};
+  if (format <= 3) {
+    changes.push_back({"relaxation_scheme = \"incremental\"", "relaxation_scheme = \"full\""});
+  }
+  for (const auto& [now, then] : changes) {
+    const size_t at = text.find(now);
+    if (at == std::string::npos) return "";
+    text.replace(at, now.size(), then);
+  }
   std::ofstream(out) << text;
   return out.string();
 }
@@ -169,28 +179,28 @@ void ExpectSameRun(const fs::path& a_folder, const fs::path& b_folder) {
 }
 
 // Resumes the map `fixture` (in tests/data) of an earlier release, made with `ratslam replay
-// --config configs/synthetic.toml --until 75 --save-map`, under full relaxation (which made it)
-// and expects exactly the uninterrupted run; under today's default scheme it must be refused
-// with an error containing `refusal`.
-void ExpectOldMapResumesUnderFullRelaxationOnly(const fs::path& root, const std::string& config,
-                                                const std::string& fixture_name,
-                                                const std::string& refusal) {
+// --config configs/synthetic.toml --until 75 --save-map`, under the values that made it
+// (AsMadeByFormat) and expects exactly the uninterrupted run; under today's defaults it must be
+// refused with an error containing `refusal`.
+void ExpectOldMapResumesUnderItsOwnValuesOnly(const fs::path& root, const std::string& config,
+                                              int format, const std::string& fixture_name,
+                                              const std::string& refusal) {
   const std::string tag = fs::path(fixture_name).stem().string();
   const fs::path whole = root / ("whole_" + tag), rest = root / ("rest_" + tag);
   const std::string fixture =
       (fs::path(RATSLAM_SOURCE_DIR) / "tests" / "data" / fixture_name).string();
-  const std::string full = WithFullRelaxation(config, root / (tag + "-full.toml"));
-  ASSERT_FALSE(full.empty());
+  const std::string then = AsMadeByFormat(format, config, root / (tag + "-then.toml"));
+  ASSERT_FALSE(then.empty());
   auto args = [&](const std::string& c, const fs::path& out) {
     return "replay --quiet --config " + c + " --data " + (root / "data").string() + " --out " +
            out.string();
   };
-  ASSERT_EQ(RunRatslam(args(full, whole), root).exit_code, 0);
-  const Result r = RunRatslam(args(full, rest) + " --load-map " + fixture, root);
+  ASSERT_EQ(RunRatslam(args(then, whole), root).exit_code, 0);
+  const Result r = RunRatslam(args(then, rest) + " --load-map " + fixture, root);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   ExpectSameRun(whole, rest);
   const Result refused =
-      RunRatslam(args(config, root / (tag + "_incremental")) + " --load-map " + fixture, root);
+      RunRatslam(args(config, root / (tag + "_today")) + " --load-map " + fixture, root);
   EXPECT_EQ(refused.exit_code, 1);
   EXPECT_NE(refused.err.find(refusal), std::string::npos) << refused.err;
 }
@@ -199,8 +209,8 @@ void ExpectOldMapResumesUnderFullRelaxationOnly(const fs::path& root, const std:
 // load and resume to exactly the uninterrupted run; it holds only a fingerprint, and the error
 // under the incremental scheme names the key.
 TEST_F(ReplayEndToEndTest, MapFromThePreviousReleaseResumesToTheSameRun) {
-  ExpectOldMapResumesUnderFullRelaxationOnly(
-      root_, config_, "map-v2-synthetic.map",
+  ExpectOldMapResumesUnderItsOwnValuesOnly(
+      root_, config_, 2, "map-v2-synthetic.map",
       "experience_map.relaxation_scheme is \"incremental\", but maps of format 2 were made with "
       "\"full\"");
 }
@@ -209,9 +219,16 @@ TEST_F(ReplayEndToEndTest, MapFromThePreviousReleaseResumesToTheSameRun) {
 // which names no relaxation scheme: it was made with full relaxation, and the error names the
 // key and both values.
 TEST_F(ReplayEndToEndTest, FormatThreeMapResumesUnderFullRelaxationOnly) {
-  ExpectOldMapResumesUnderFullRelaxationOnly(
-      root_, config_, "map-v3-synthetic.map",
+  ExpectOldMapResumesUnderItsOwnValuesOnly(
+      root_, config_, 3, "map-v3-synthetic.map",
       "experience_map.relaxation_scheme: \"full\" -> \"incremental\"");
+}
+
+// A format-4 map (made by the release before the PDR orientation test) resumes with the test
+// off, as it was made; under today's default the error names the key and both values.
+TEST_F(ReplayEndToEndTest, FormatFourMapResumesWithoutTheOrientationTestOnly) {
+  ExpectOldMapResumesUnderItsOwnValuesOnly(root_, config_, 4, "map-v4-synthetic.map",
+                                           "pdr.min_orientation_steadiness: 0.0 -> 0.85");
 }
 
 // A key added after format 2 must be at its default to resume a format-2 map (which was made
@@ -284,8 +301,8 @@ TEST_F(SimulatedSaveResumeTest, FusedFrontEndFromAMapOfThePreviousRelease) {
   // Made with `ratslam replay --config configs/demo.toml --until 200 --save-map` by format 2,
   // which relaxed every link.
   const fs::path& dir = root_->path();
-  const std::string config = WithFullRelaxation(
-      (fs::path(RATSLAM_SOURCE_DIR) / "configs" / "demo.toml").string(), dir / "demo-full.toml");
+  const std::string config = AsMadeByFormat(
+      2, (fs::path(RATSLAM_SOURCE_DIR) / "configs" / "demo.toml").string(), dir / "demo-full.toml");
   ASSERT_FALSE(config.empty());
   const fs::path whole = dir / "v2_whole", rest = dir / "v2_rest";
   ASSERT_EQ(RunRatslam(Args(config, whole), dir).exit_code, 0);

@@ -172,6 +172,8 @@ constexpr AddedKey kKeysAddedAfter[] = {
     {3, "experience_map.relaxation_scheme", "\"full\""},
     {3, "experience_map.relaxation_tolerance_m"},
     {3, "experience_map.relaxation_tolerance_rad"},
+    {4, "pdr.orientation_window_s"},
+    {4, "pdr.min_orientation_steadiness", "0.0"},
 };
 
 }  // namespace

@@ -18,8 +18,10 @@ constexpr char kMagic[8] = {'R', 'S', 'L', 'M', 'A', 'P', '\0', '\1'};
 // The version written, and the oldest one read. A field added in a new version is listed in
 // state_schema.h as `(a.version() < N || a(field))`, so older files load with its default.
 // Version 2 is the first release with save and resume (tests/data/map-v2-*.map must load);
-// version 3 adds the resolved configuration, version 4 incremental relaxation's pending work.
-constexpr uint32_t kVersion = 4;
+// version 3 adds the resolved configuration, version 4 incremental relaxation's pending work,
+// version 5 no new field: its configurations have the PDR's orientation test (maps of format 4
+// resume only with it off, pdr.min_orientation_steadiness = 0).
+constexpr uint32_t kVersion = 5;
 constexpr uint32_t kOldestVersion = 2;
 
 }  // namespace

@@ -48,9 +48,13 @@ StatusOr<Dataset> PhoneLogToDataset(PhoneLog log, const PhoneLogOptions& options
   std::stable_sort(streams.ground_truth.begin(), streams.ground_truth.end(), by_time);
   Dataset d;
   d.name = log.name;
+  PdrReport pdr;
   const std::vector<Step> steps =
-      PedestrianDeadReckoning(streams.accelerometer, streams.headings, options.pdr);
-  if (report) report->steps = steps.size();
+      PedestrianDeadReckoning(streams.accelerometer, streams.headings, options.pdr, &pdr);
+  if (report) {
+    report->steps = steps.size();
+    report->steps_not_walking = pdr.steps_not_walking;
+  }
   d.odometry = StepsToOdometry(steps, log.start_time_s);
   for (auto& [time, readings] : streams.scans) d.wifi.push_back({time, std::move(readings)});
   double last_compass = -std::numeric_limits<double>::infinity();

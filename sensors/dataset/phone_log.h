@@ -34,8 +34,9 @@ struct PhoneLogReport {
   size_t lines = 0;
   size_t skipped_malformed = 0;  // only in lenient mode
   size_t skipped_other_types = 0;
-  size_t steps = 0;        // set by PhoneLogToDataset
-  GeoReference reference;  // the reference actually used
+  size_t steps = 0;              // set by PhoneLogToDataset
+  size_t steps_not_walking = 0;  // dropped by the orientation test (gestures), ditto
+  GeoReference reference;        // the reference actually used
 };
 
 // What a phone log reader collects, in file order.
