@@ -10,6 +10,16 @@
 
 namespace ratslam {
 
+std::string ToString(ViewMemory memory) {
+  return memory == ViewMemory::kFrames ? "frames" : "time";
+}
+
+StatusOr<ViewMemory> ViewMemoryFromString(const std::string& name) {
+  if (name == "frames") return ViewMemory::kFrames;
+  if (name == "time") return ViewMemory::kTime;
+  return Status::Error("unknown view memory \"" + name + "\" (frames, time)");
+}
+
 bool LocalViewOptions::IsValid(std::string* error) const {
   return schema::CheckFields(*this, error);
 }
@@ -28,6 +38,11 @@ double LocalViewCells::DecayAtStartOfFrame(const ViewTemplate& t, uint64_t frame
   return std::max(options_.decay_floor, t.decay - options_.decay_restore_per_frame * elapsed);
 }
 
+double LocalViewCells::DecayAtTime(const ViewTemplate& t, double time_s) const {
+  const double elapsed = std::max(0.0, time_s - t.decay_time_s);
+  return std::max(options_.decay_floor, t.decay - options_.decay_restore_per_s * elapsed);
+}
+
 StatusOr<std::optional<Injection>> LocalViewCells::Observe(const ViewDecision& decision,
                                                            const PoseCellPosition& current_pose) {
   const uint64_t frame = ++state_.frame;
@@ -44,6 +59,7 @@ StatusOr<std::optional<Injection>> LocalViewCells::Observe(const ViewDecision& d
     t.created_time_s = decision.time_s;
     t.decay = options_.decay_floor;
     t.decay_frame = frame;
+    t.decay_time_s = decision.time_s;
     state_.templates.push_back(std::move(t));
     return std::optional<Injection>();
   }
@@ -53,11 +69,19 @@ StatusOr<std::optional<Injection>> LocalViewCells::Observe(const ViewDecision& d
   }
   ViewTemplate& t = state_.templates[decision.template_id];
   ++t.match_count;
-  const double decay = DecayAtStartOfFrame(t, frame) + options_.decay_per_match;
-  t.decay = std::max(options_.decay_floor, decay - options_.decay_restore_per_frame);
+  double decay = 0.0;
+  bool recent = false;
+  if (options_.memory == ViewMemory::kTime) {
+    decay = DecayAtTime(t, decision.time_s) + options_.decay_per_match;
+    t.decay = decay;
+    t.decay_time_s = std::max(t.decay_time_s, decision.time_s);
+    recent = decision.time_s - t.created_time_s < options_.skip_recent_s;
+  } else {
+    decay = DecayAtStartOfFrame(t, frame) + options_.decay_per_match;
+    t.decay = std::max(options_.decay_floor, decay - options_.decay_restore_per_frame);
+    recent = decision.template_id + static_cast<uint64_t>(options_.skip_recent_templates) >= count;
+  }
   t.decay_frame = frame;
-  const bool recent =
-      decision.template_id + static_cast<uint64_t>(options_.skip_recent_templates) >= count;
   if (recent || !decision.allow_injection) return std::optional<Injection>();
   const double energy = options_.injection_gain *
                         (options_.energy_limit - std::exp(options_.energy_decay_rate * decay)) /
@@ -79,7 +103,8 @@ Status LocalViewCells::SetState(State state) {
     const std::string name = "local view state: template " + std::to_string(i);
     if (t.id != i) return Status::Error(name + " has id " + std::to_string(t.id));
     if (!std::isfinite(t.decay) || std::abs(t.decay) > kMaxCoordinate ||
-        !std::isfinite(t.created_time_s) || std::abs(t.created_time_s) > kMaxCoordinate) {
+        !std::isfinite(t.created_time_s) || std::abs(t.created_time_s) > kMaxCoordinate ||
+        !std::isfinite(t.decay_time_s) || std::abs(t.decay_time_s) > kMaxCoordinate) {
       return Status::Error(name + " has a non-finite or out-of-range decay or time");
     }
     if (t.decay_frame > state.frame) {

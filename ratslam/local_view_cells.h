@@ -2,6 +2,19 @@
 // pose-cell position at its creation; seeing it again injects energy there (Milford and Wyeth
 // 2008), with a per-template decay that weakens repeated consecutive injections (the decay model
 // of OpenRatSLAM, Ball et al. 2013: E = gain * (limit - exp(rate * decay)) / limit).
+//
+// Two memory models say how a template recovers from its matches and when it is too new to
+// inject (ViewMemory):
+//   frames  OpenRatSLAM's: the decay restores by decay_restore_per_frame per view frame and the
+//           newest skip_recent_templates templates never inject. Made for cameras at 10-30
+//           frames per second along a route that keeps making templates.
+//   time    the decay restores by decay_restore_per_s per second of data time since the
+//           template's last match, and templates made less than skip_recent_s ago never inject.
+//           For sparse frames that revisit a small set of templates, such as Wi-Fi scans every
+//           4 s: under `frames` a Wi-Fi template matched twice in a row stays exhausted for 40-80 s
+//           (0.05 per 4 s frame), and in a run of 20-35 templates the 10 newest are a third of
+//           the map, so on the IPIN logs 147 matches made 8 injections. The default rate, 0.5 per
+//           second, is OpenRatSLAM's 0.05 per frame at 10 frames per second.
 #ifndef RATSLAM_LOCAL_VIEW_CELLS_H_
 #define RATSLAM_LOCAL_VIEW_CELLS_H_
 
@@ -16,14 +29,21 @@
 
 namespace ratslam {
 
+enum class ViewMemory { kFrames, kTime };
+std::string ToString(ViewMemory memory);
+StatusOr<ViewMemory> ViewMemoryFromString(const std::string& name);
+
 struct LocalViewOptions {
-  double injection_gain = 0.15;           // energy injected by a fully rested template
-  double decay_per_match = 1.0;           // added to a template's decay on each match
-  double decay_restore_per_frame = 0.05;  // removed from every template's decay each frame
-  double decay_floor = 1.0;               // decay never falls below this
-  double energy_limit = 30.0;             // "limit" in the energy formula above
-  double energy_decay_rate = 1.2;         // "rate" in the energy formula above
-  int skip_recent_templates = 10;         // the newest templates never inject
+  double injection_gain = 0.15;             // energy injected by a fully rested template
+  double decay_per_match = 1.0;             // added to a template's decay on each match
+  double decay_restore_per_frame = 0.05;    // removed from every template's decay each frame
+  double decay_floor = 1.0;                 // decay never falls below this
+  double energy_limit = 30.0;               // "limit" in the energy formula above
+  double energy_decay_rate = 1.2;           // "rate" in the energy formula above
+  int skip_recent_templates = 10;           // the newest templates never inject
+  ViewMemory memory = ViewMemory::kFrames;  // see ViewMemory
+  double decay_restore_per_s = 0.5;         // time memory: removed from the decay per second
+  double skip_recent_s = 10.0;              // time memory: templates this young never inject
 
   bool IsValid(std::string* error) const;
 
@@ -43,6 +63,17 @@ struct LocalViewOptions {
     v("skip_recent_templates", skip_recent_templates,
       "matches to this many newest templates inject no energy",
       schema::Unit("templates").NonNegative());
+    v("memory", memory,
+      "frames (OpenRatSLAM: decay restores per view frame, the newest skip_recent_templates never "
+      "inject) or time (per second of data time; templates younger than skip_recent_s never "
+      "inject): for sparse, often-repeated templates such as Wi-Fi scans",
+      schema::Any());
+    v("decay_restore_per_s", decay_restore_per_s,
+      "time memory: removed from a template's decay per second since its last match",
+      schema::Unit("1/s").NonNegative());
+    v("skip_recent_s", skip_recent_s,
+      "time memory: matches to templates made less than this long ago inject no energy",
+      schema::Unit("s").NonNegative());
   }
 };
 
@@ -65,6 +96,7 @@ struct ViewTemplate {
   double created_time_s = 0.0;
   double decay = 1.0;  // value after the restore of frame decay_frame
   uint64_t decay_frame = 0;
+  double decay_time_s = 0.0;  // time memory: data time at which `decay` held
   uint32_t match_count = 0;
   std::vector<uint32_t> experience_ids;  // experiences created or linked with this template
 };
@@ -101,6 +133,7 @@ class LocalViewCells {
 
  private:
   double DecayAtStartOfFrame(const ViewTemplate& t, uint64_t frame) const;
+  double DecayAtTime(const ViewTemplate& t, double time_s) const;
 
   LocalViewOptions options_;
   int dim_theta_cells_;

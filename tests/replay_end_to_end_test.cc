@@ -297,6 +297,18 @@ TEST_F(SimulatedSaveResumeTest, FusedFrontEnd) {
   ExpectResumeEqualsWhole((fs::path(RATSLAM_SOURCE_DIR) / "configs" / "demo.toml").string(), 250.0);
 }
 
+// Time memory keeps a per-template time of the last decay update (map format 5): a resumed run
+// must carry it, or the decay after the split would restore from the wrong time.
+TEST_F(SimulatedSaveResumeTest, FusedFrontEndWithTimeMemory) {
+  const fs::path config = root_->path() / "demo-time-memory.toml";
+  std::string text = Slurp(fs::path(RATSLAM_SOURCE_DIR) / "configs" / "demo.toml");
+  const std::string key = "memory = \"frames\"";
+  ASSERT_NE(text.find(key), std::string::npos);
+  text.replace(text.find(key), key.size(), "memory = \"time\"");
+  std::ofstream(config) << text;
+  ExpectResumeEqualsWhole(config.string(), 250.0);
+}
+
 TEST_F(SimulatedSaveResumeTest, FusedFrontEndFromAMapOfThePreviousRelease) {
   // Made with `ratslam replay --config configs/demo.toml --until 200 --save-map` by format 2,
   // which relaxed every link.

@@ -45,6 +45,8 @@ struct TomlCodec<WifiLearning> : EnumCodec<WifiLearning, WifiLearningFromString>
 template <>
 struct TomlCodec<RelaxationScheme> : EnumCodec<RelaxationScheme, RelaxationSchemeFromString> {};
 template <>
+struct TomlCodec<ViewMemory> : EnumCodec<ViewMemory, ViewMemoryFromString> {};
+template <>
 struct TomlCodec<FrontEndKind> : EnumCodec<FrontEndKind, FrontEndKindFromString> {};
 }  // namespace ratslam::schema
 
@@ -174,6 +176,9 @@ constexpr AddedKey kKeysAddedAfter[] = {
     {3, "experience_map.relaxation_tolerance_rad"},
     {4, "pdr.orientation_window_s"},
     {4, "pdr.min_orientation_steadiness", "0.0"},
+    {4, "local_view.memory"},
+    {4, "local_view.decay_restore_per_s"},
+    {4, "local_view.skip_recent_s"},
 };
 
 }  // namespace

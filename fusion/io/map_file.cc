@@ -15,22 +15,14 @@ namespace ratslam {
 namespace {
 
 constexpr char kMagic[8] = {'R', 'S', 'L', 'M', 'A', 'P', '\0', '\1'};
-// The version written, and the oldest one read. A field added in a new version is listed in
-// state_schema.h as `(a.version() < N || a(field))`, so older files load with its default.
-// Version 2 is the first release with save and resume (tests/data/map-v2-*.map must load);
-// version 3 adds the resolved configuration, version 4 incremental relaxation's pending work,
-// version 5 no new field: its configurations have the PDR's orientation test (maps of format 4
-// resume only with it off, pdr.min_orientation_steadiness = 0).
-constexpr uint32_t kVersion = 5;
-constexpr uint32_t kOldestVersion = 2;
 
 }  // namespace
 
 std::string EncodeMapFile(const MapFile& map) {
   ByteWriter w;
   w.bytes().append(kMagic, sizeof kMagic);
-  w.Pod(kVersion);
-  EncodeArchive archive(w, kVersion);
+  w.Pod(kMapFormatVersion);
+  EncodeArchive archive(w, kMapFormatVersion);
   Describe(archive, const_cast<MapFile&>(map));  // the encoder only reads
   return std::move(w.bytes());
 }
@@ -44,10 +36,10 @@ StatusOr<MapFile> DecodeMapFile(const std::string& bytes, const std::string& sou
   uint32_t version = 0;
   MapFile map;
   if (!r.Pod(&version)) return Status::Error(r.error());
-  if (version < kOldestVersion || version > kVersion) {
+  if (version < kOldestMapFormatVersion || version > kMapFormatVersion) {
     return Status::Error(source + ": map file version " + std::to_string(version) +
-                         " (this program reads " + std::to_string(kOldestVersion) + " to " +
-                         std::to_string(kVersion) + ")");
+                         " (this program reads " + std::to_string(kOldestMapFormatVersion) +
+                         " to " + std::to_string(kMapFormatVersion) + ")");
   }
   DecodeArchive archive(r, version);
   if (!Describe(archive, map)) return Status::Error(r.error());

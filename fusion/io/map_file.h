@@ -13,6 +13,16 @@
 
 namespace ratslam {
 
+// The version written, and the oldest one read. A field added in a new version is listed in
+// state_schema.h as `(a.version() < N || a(field))`, so older files load with its default.
+// Version 2 is the first release with save and resume (tests/data/map-v2-*.map must load);
+// version 3 adds the resolved configuration, version 4 incremental relaxation's pending work,
+// version 5 the time memory of local view cells (a template's decay_time_s); its
+// configurations have the PDR's orientation test (maps of format 4 resume only with it off,
+// pdr.min_orientation_steadiness = 0).
+inline constexpr uint32_t kMapFormatVersion = 5;
+inline constexpr uint32_t kOldestMapFormatVersion = 2;
+
 struct MapFile {
   // The format version the file was read from (written: always the current one). Not part of
   // the schema's body: it is the header that says how to read the body.

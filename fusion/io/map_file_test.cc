@@ -105,7 +105,7 @@ constexpr size_t MemberCount() {
 // Counts the fields a Describe function lists (nested objects count once, as one member).
 class CountingArchive {
  public:
-  uint32_t version() const { return 4; }  // the version written
+  uint32_t version() const { return kMapFormatVersion; }  // the version written
   template <typename T>
   bool operator()(T&) {
     ++count;
@@ -147,7 +147,7 @@ TEST(MapFileTest, SchemaListsEveryMemberOfEverySavedStruct) {
   ExpectSchemaComplete<PoseCellPosition>("PoseCellPosition", 3);
   ExpectSchemaComplete<LocalOffset>("LocalOffset", 3);
   ExpectSchemaComplete<PoseCellNetwork::State>("PoseCellNetwork::State", 5);
-  ExpectSchemaComplete<ViewTemplate>("ViewTemplate", 7);
+  ExpectSchemaComplete<ViewTemplate>("ViewTemplate", 8);
   ExpectSchemaComplete<LocalViewCells::State>("LocalViewCells::State", 2);
   ExpectSchemaComplete<Experience>("Experience", 9);
   ExpectSchemaComplete<Link>("Link", 8);

@@ -36,7 +36,8 @@ bool Describe(A& a, PoseCellNetwork::State& s) {
 template <typename A>
 bool Describe(A& a, ViewTemplate& t) {
   return a(t.id) && a.Object(t.pose_cells) && a(t.created_time_s) && a(t.decay) &&
-         a(t.decay_frame) && a(t.match_count) && a(t.experience_ids);
+         a(t.decay_frame) && a(t.match_count) && a(t.experience_ids) &&
+         (a.version() < 5 || a(t.decay_time_s));
 }
 
 template <typename A>
