@@ -48,7 +48,7 @@ double WifiFingerprintMatcher::Weight(const Fingerprint& q, const Fingerprint& j
   const double two_sigma2 = 2.0 * options_.kernel_variance_dbm2;
   size_t a = 0, b = 0;
   int common = 0;
-  double hit = 0.0, extra = 0.0, miss = 0.0;
+  double hit = 0.0, diff = 0.0, extra = 0.0, miss = 0.0;
   while (a < q.ap_ids.size() || b < j.ap_ids.size()) {
     if (b == j.ap_ids.size() || (a < q.ap_ids.size() && q.ap_ids[a] < j.ap_ids[b])) {
       extra += Penalty2(q.rssi_dbm[a++]);
@@ -57,10 +57,12 @@ double WifiFingerprintMatcher::Weight(const Fingerprint& q, const Fingerprint& j
     } else {
       const double d = q.rssi_dbm[a++] - j.rssi_dbm[b++];
       hit += d * d;
+      diff += d;
       ++common;
     }
   }
   if (common == 0) return 0.0;
+  if (options_.offset_invariant) hit = std::max(0.0, hit - diff * diff / common);
   const double e = static_cast<double>(q.ap_ids.size()) - common;
   const double m = static_cast<double>(j.ap_ids.size()) - common;
   // w_hit^(1/H): the H-th root of a product of exponentials is the exponential of the mean.
@@ -74,6 +76,7 @@ void WifiFingerprintMatcher::ForEachCandidate(const Fingerprint& query, Visit&& 
   if (common_.size() < n) {
     common_.resize(n, 0);
     hit_sum_.resize(n, 0.0);
+    diff_sum_.resize(n, 0.0);
     extra_common_.resize(n, 0.0);
     miss_common_.resize(n, 0.0);
   }
@@ -88,6 +91,7 @@ void WifiFingerprintMatcher::ForEachCandidate(const Fingerprint& query, Visit&& 
       if (common_[p.fingerprint]++ == 0) touched_.push_back(p.fingerprint);
       const double d = s - p.rssi_dbm;
       hit_sum_[p.fingerprint] += d * d;
+      diff_sum_[p.fingerprint] += d;
       extra_common_[p.fingerprint] += extra;
       miss_common_[p.fingerprint] += p.penalty2;
     }
@@ -100,10 +104,13 @@ void WifiFingerprintMatcher::ForEachCandidate(const Fingerprint& query, Visit&& 
     const double m = static_cast<double>(state_.fingerprints[id].ap_ids.size()) - h;
     const double extra = std::max(0.0, extra_total - extra_common_[id]);
     const double miss = std::max(0.0, miss_penalty_total_[id] - miss_common_[id]);
-    visit(id, std::exp(-hit_sum_[id] / (two_sigma2 * h) - extra / two_sigma2 - miss / two_sigma2) *
-                  h / (h + e + m));
+    const double hit = options_.offset_invariant
+                           ? std::max(0.0, hit_sum_[id] - diff_sum_[id] * diff_sum_[id] / h)
+                           : hit_sum_[id];
+    visit(id, std::exp(-hit / (two_sigma2 * h) - extra / two_sigma2 - miss / two_sigma2) * h /
+                  (h + e + m));
     common_[id] = 0;
-    hit_sum_[id] = extra_common_[id] = miss_common_[id] = 0.0;
+    hit_sum_[id] = diff_sum_[id] = extra_common_[id] = miss_common_[id] = 0.0;
   }
 }
 

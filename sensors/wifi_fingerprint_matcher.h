@@ -9,6 +9,11 @@
 // strong AP that should be there and is not is strong evidence against a match and an AP near
 // the sensitivity floor (often missed by a scan) is almost none.
 //
+// With `offset_invariant`, the hit term of eq. 3 compares the RSSI differences around their
+// mean over the H common APs, sum (d - mean d)^2 instead of sum d^2: a constant offset between
+// the two scans (two phones that read several dB apart: 6-8 dB between the IPIN 2023 phones)
+// then costs nothing. The penalties of eqs. 4-5 keep absolute RSSI.
+//
 // Fingerprints are indexed by BSSID: a query touches only the stored fingerprints that share an
 // AP with it; the per-fingerprint totals of penalties are precomputed, so extra and missing APs
 // cost nothing beyond the shared ones.
@@ -31,6 +36,7 @@ struct WifiMatcherOptions {
   double penalty_per_dbm = 0.1;        // P(s) = penalty_per_dbm * max(0, s - penalty_floor_dbm)
   double match_threshold = 0.25;       // t_wifi: smallest weight w that is a match
   double min_rssi_dbm = -100.0;        // readings weaker than this are dropped from scans
+  bool offset_invariant = false;       // eq. 3 on differences around their mean (see above)
 
   bool IsValid(std::string* error) const;
 
@@ -47,6 +53,10 @@ struct WifiMatcherOptions {
     v("match_threshold", match_threshold, "t_wifi: smallest weight w (eq. 6) that is a match",
       schema::Unit("").Within(0, 1));
     v("min_rssi_dbm", min_rssi_dbm, "readings weaker than this are ignored", schema::Unit("dBm"));
+    v("offset_invariant", offset_invariant,
+      "eq. 3 compares RSSI differences around their mean over the common APs, so a constant "
+      "offset between phones costs nothing",
+      schema::Any());
   }
 };
 
@@ -109,7 +119,7 @@ class WifiFingerprintMatcher {
   std::vector<double> miss_penalty_total_;      // by fingerprint: sum of P(s)^2 of all its APs
   mutable std::vector<uint32_t> touched_;       // scratch for queries
   mutable std::vector<uint32_t> common_;
-  mutable std::vector<double> hit_sum_, extra_common_, miss_common_;
+  mutable std::vector<double> hit_sum_, diff_sum_, extra_common_, miss_common_;
 };
 
 }  // namespace ratslam

@@ -38,6 +38,29 @@ TEST(WifiFingerprintMatcherTest, Equation6WorkedExample) {
   EXPECT_NEAR(m.Weights(q)[0], 0.5 * std::exp(-0.375), 1e-12);
 }
 
+// Offset-invariant eq. 3, the worked example again: differences 2 and 4 have mean 3, so the hit
+// term sums (2-3)^2 + (4-3)^2 = 2 instead of 20: w = 0.5 exp(-2/40/2 - 0.1 - 0.025). The indexed
+// path must agree with the pairwise one, and a scan 7 dB below a stored one scores as the stored
+// one itself does on the shared APs (only the penalties of eqs. 4-5 see absolute RSSI).
+TEST(WifiFingerprintMatcherTest, OffsetInvariantHitTermWorkedExample) {
+  WifiMatcherOptions options;
+  options.offset_invariant = true;
+  WifiFingerprintMatcher m(options);
+  const Fingerprint q = m.MakeFingerprint({{"A", -50}, {"B", -60}, {"C", -70}});
+  const Fingerprint j = m.MakeFingerprint({{"A", -52}, {"B", -64}, {"D", -80}});
+  const double expected = 0.5 * std::exp(-2.0 / 40.0 / 2.0 - 0.1 - 0.025);
+  EXPECT_NEAR(m.Weight(q, j), expected, 1e-12);
+  m.Add(j);
+  EXPECT_NEAR(m.Weights(q)[0], expected, 1e-12);
+  const Fingerprint stored = m.MakeFingerprint({{"a", -50}, {"b", -60}, {"c", -70}});
+  const Fingerprint quieter = m.MakeFingerprint({{"a", -57}, {"b", -67}, {"c", -77}});
+  EXPECT_NEAR(m.Weight(quieter, stored), 1.0, 1e-12);
+  WifiFingerprintMatcher plain({});
+  EXPECT_LT(plain.Weight(plain.MakeFingerprint({{"a", -57}, {"b", -67}, {"c", -77}}),
+                         plain.MakeFingerprint({{"a", -50}, {"b", -60}, {"c", -70}})),
+            0.5);
+}
+
 TEST(WifiFingerprintMatcherTest, MissingStrongApCostsMoreThanMissingWeakAp) {
   WifiFingerprintMatcher m({});
   const Fingerprint stored =

@@ -65,6 +65,12 @@ TEST(IpinEndToEndTest, WifiRatslamClosesOutAndBackLoops) {
   EXPECT_GE(within_10, chance + 0.3) << "chance " << chance;
   EXPECT_EQ(s["floor_mistakes"], 0);
   EXPECT_LT(s["map_ate_m"].get<double>(), 0.7 * s["odometry_ate_m"].get<double>());
+  // The second walk closes loops on the first one's templates (measured: 28 of 38 matches, 93 %
+  // within 10 m), and those are as good as the matches overall, well above chance.
+  const int cross = s["cross_session_matches"];
+  EXPECT_GE(cross, 10);
+  EXPECT_LE(cross, matches);
+  EXPECT_GE(s["cross_session_match_rate_within_m"]["10"].get<double>(), chance + 0.3);
   // The Wi-Fi similarity matrix of the same walks (the Wi-Fi loop-closure paper's figure 9).
   const fs::path png = out / "wifi_similarity.png";
   const std::string render = std::string(RATSLAM_BINARY) +

@@ -179,6 +179,7 @@ constexpr AddedKey kKeysAddedAfter[] = {
     {4, "local_view.memory"},
     {4, "local_view.decay_restore_per_s"},
     {4, "local_view.skip_recent_s"},
+    {4, "wifi.offset_invariant"},
 };
 
 }  // namespace

@@ -40,6 +40,23 @@ void RecordPose(const ExperienceMap& map, const TrajectoryRecord& record, double
   *theta_rad = pose.theta_rad;
 }
 
+namespace {
+
+// The share of distances within 2, 5, 10 and 20 m, keyed "2", "5", "10", "20" (0 when empty).
+nlohmann::ordered_json RatesWithin(const std::vector<double>& distances_m) {
+  nlohmann::ordered_json within;
+  for (int d : {2, 5, 10, 20}) {
+    size_t n = 0;
+    for (double m : distances_m) n += m <= d;
+    within[std::to_string(d)] =
+        distances_m.empty() ? 0.0
+                            : static_cast<double>(n) / static_cast<double>(distances_m.size());
+  }
+  return within;
+}
+
+}  // namespace
+
 RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, const RunInfo& info) {
   const ReplayPipeline::State& state = pipeline.state();
   const Ratslam& slam = pipeline.slam();
@@ -79,6 +96,14 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
 
     // Every template match: how far is the true position now from the true position where the
     // matched template was stored? A match to another floor is a floor mistake.
+    const auto session_of = [&](double t) {
+      size_t k = 0;
+      while (k + 1 < dataset.session_start_times_s.size() &&
+             t >= dataset.session_start_times_s[k + 1]) {
+        ++k;
+      }
+      return k;
+    };
     for (const FrameRecord& f : state.frames) {
       if (f.is_new || f.recent) continue;  // only matches that can close a loop
       const auto now = InterpolateGroundTruth(dataset.ground_truth, f.time_s);
@@ -86,8 +111,12 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
                                                slam.local_view().at(f.template_id).created_time_s);
       if (!now || !then) continue;
       ++s.evaluated_matches;
-      s.match_distances_m.push_back(std::hypot(now->x_m - then->x_m, now->y_m - then->y_m));
+      const double distance = std::hypot(now->x_m - then->x_m, now->y_m - then->y_m);
+      s.match_distances_m.push_back(distance);
       if (now->floor != then->floor) ++s.floor_mistakes;
+      if (session_of(f.time_s) != session_of(slam.local_view().at(f.template_id).created_time_s)) {
+        s.cross_session_distances_m.push_back(distance);
+      }
     }
   }
 
@@ -144,15 +173,12 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
   if (s.ate_points) j["ate_points"] = s.ate_points;
   if (!dataset.ground_truth.empty()) {
     j["matches"] = s.evaluated_matches;
-    nlohmann::ordered_json within;
-    for (int d : {2, 5, 10, 20}) {
-      size_t n = 0;
-      for (double m : s.match_distances_m) n += m <= d;
-      within[std::to_string(d)] =
-          s.evaluated_matches ? static_cast<double>(n) / s.evaluated_matches : 0.0;
-    }
-    j["match_rate_within_m"] = within;
+    j["match_rate_within_m"] = RatesWithin(s.match_distances_m);
     j["floor_mistakes"] = s.floor_mistakes;
+    if (dataset.session_start_times_s.size() > 1) {
+      j["cross_session_matches"] = s.cross_session_distances_m.size();
+      j["cross_session_match_rate_within_m"] = RatesWithin(s.cross_session_distances_m);
+    }
   }
   s.json = j.dump(2) + "\n";
   return s;

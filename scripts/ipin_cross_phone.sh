@@ -1,0 +1,65 @@
+#!/usr/bin/env bash
+# Cross-phone matches on the IPIN 2023 training routes: repetitions 01-02 were recorded with one
+# phone (SM-A520F), 03-04 with another (SM-G930F). Runs the four repetitions of each route as one
+# multi-session run with a config and with the same config plus [wifi] offset_invariant = true,
+# and prints per route: template matches between the two phones' sessions, the share of them
+# within 5 m and 10 m of where the matched template was stored, and map ATE.
+# Usage: scripts/ipin_cross_phone.sh [config] [out dir]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+config=${1:-configs/ipin2023-wifi-compass.toml}
+out=${2:-out/ipin-cross-phone}
+data=../shared/data/ipin2023-t3
+bin=./build/apps/ratslam
+mkdir -p "$out"
+grep -q '^\[wifi\]' "$config" || { echo "$config has no [wifi] section" >&2; exit 1; }
+sed 's/^\[wifi\]$/[wifi]\noffset_invariant = true/' "$config" > "$out/invariant.toml"
+echo "| route | cross-phone matches | <=5 m | <=10 m | map ATE m | offset-invariant: matches | <=5 m | <=10 m | map ATE m |"
+echo "|---|---|---|---|---|---|---|---|---|"
+for route in 01 02 03 21 22 23; do
+  args=()
+  for rep in 01 02 03 04; do args+=(--data "$data/IPIN2023_T3_TrainingTrial${route}_repetition${rep}.txt"); done
+  "$bin" import "${args[@]}" --out "$out/data-$route" > /dev/null 2>&1
+  "$bin" replay --quiet --config "$config" --data "$out/data-$route" --out "$out/plain-$route" > /dev/null
+  "$bin" replay --quiet --config "$out/invariant.toml" --data "$out/data-$route" \
+    --out "$out/invariant-$route" > /dev/null
+  /usr/bin/python3 - "$out/data-$route" "$out/plain-$route" "$out/invariant-$route" "$route" <<'PY'
+import bisect, csv, json, math, re, sys
+data = sys.argv[1]
+starts = [float(x) for x in re.search(r"session_start_times_s = \[(.*)\]",
+                                      open(data + "/manifest.toml").read()).group(1).split(",")]
+gt = [(float(r["time_s"]), float(r["x_m"]), float(r["y_m"]))
+      for r in csv.DictReader(open(data + "/ground_truth.csv"))]
+times = [g[0] for g in gt]
+def session(t):
+    return max(k for k, s in enumerate(starts) if t >= s or k == 0)
+def truth(t):
+    # Linear interpolation inside one session's ground truth; none outside it.
+    i = bisect.bisect_left(times, t)
+    if i < len(gt) and gt[i][0] == t: return gt[i][1:]
+    if i == 0 or i == len(gt): return None
+    a, b = gt[i - 1], gt[i]
+    if session(a[0]) != session(b[0]): return None
+    f = (t - a[0]) / (b[0] - a[0])
+    return (a[1] + f * (b[1] - a[1]), a[2] + f * (b[2] - a[2]))
+cells = []
+for run in sys.argv[2:4]:
+    created, distances = {}, []
+    for r in csv.DictReader(open(run + "/frames.csv")):
+        t, tid = float(r["time_s"]), int(r["template_id"])
+        if r["new_template"] == "1":
+            created[tid] = t
+            continue
+        if r["recent"] == "1": continue
+        then = created[tid]
+        if (session(t) >= 2) == (session(then) >= 2): continue  # same phone
+        a, b = truth(t), truth(then)
+        if a is None or b is None: continue
+        distances.append(math.hypot(a[0] - b[0], a[1] - b[1]))
+    n = len(distances)
+    rate = lambda d: f"{sum(x <= d for x in distances) / n:.2f}" if n else "-"
+    ate = json.load(open(run + "/summary.json"))["map_ate_m"]
+    cells += [str(n), rate(5), rate(10), f"{ate:.2f}"]
+print(f"| {sys.argv[4]} | " + " | ".join(cells) + " |")
+PY
+done
