@@ -148,6 +148,10 @@ TEST_F(SimulatedScenarios, AliasedFloorsWifiPreventsFloorMistakes) {
   const json fused = Replay("aliased_floors", true, true, true);
   EXPECT_GT(camera["floor_mistakes"].get<int>(), 200);
   EXPECT_LE(wifi["floor_mistakes"].get<int>(), 5);
+  // A match to the other floor is a miss at every d, even where the floors lie on top of each
+  // other (they once counted as within 20 m here).
+  EXPECT_LE(camera["match_rate_within_m"]["20"].get<double>(),
+            1.0 - camera["floor_mistakes"].get<double>() / camera["matches"].get<double>() + 1e-12);
   EXPECT_LT(fused["floor_mistakes"].get<int>(), camera["floor_mistakes"].get<int>() / 3);
 
   const double vision = Evaluate("aliased_floors", "vision")["floor_mistake_rate"];

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -95,7 +96,8 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
     s.ate_points = truth.size();
 
     // Every template match: how far is the true position now from the true position where the
-    // matched template was stored? A match to another floor is a floor mistake.
+    // matched template was stored? A match to another floor is a floor mistake, infinitely far
+    // (a miss at every d, as in the localisation benchmark).
     const auto session_of = [&](double t) {
       size_t k = 0;
       while (k + 1 < dataset.session_start_times_s.size() &&
@@ -111,9 +113,11 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
                                                slam.local_view().at(f.template_id).created_time_s);
       if (!now || !then) continue;
       ++s.evaluated_matches;
-      const double distance = std::hypot(now->x_m - then->x_m, now->y_m - then->y_m);
+      const bool other_floor = now->floor != then->floor;
+      const double distance = other_floor ? std::numeric_limits<double>::infinity()
+                                          : std::hypot(now->x_m - then->x_m, now->y_m - then->y_m);
       s.match_distances_m.push_back(distance);
-      if (now->floor != then->floor) ++s.floor_mistakes;
+      if (other_floor) ++s.floor_mistakes;
       if (session_of(f.time_s) != session_of(slam.local_view().at(f.template_id).created_time_s)) {
         s.cross_session_distances_m.push_back(distance);
       }
