@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "common/number_text.h"
 #include "fusion/io/config.h"
 #include "fusion/io/visual_model_file.h"
 #include "session/evaluation_baselines.h"
@@ -210,23 +211,26 @@ Status EvaluationSession::WriteOutputs() {
   j["wall_time_s"] = result_.wall_time_s;
   result_.json = j.dump(2) + "\n";
 
+  // Numbers in shortest round-trip form; error_m is numeric (inf for another floor, empty for a
+  // rejection) and status says which case it is.
   std::ostringstream csv;
-  csv << "query,x_m,y_m,floor,match,match_x_m,match_y_m,match_floor,error_m\n";
+  csv << "query,x_m,y_m,floor,match,match_x_m,match_y_m,match_floor,error_m,status\n";
   for (size_t i = 0; i < result_.queries.size(); ++i) {
     const auto& q = result_.queries[i];
     const int64_t match = result_.matches[i];
-    csv << i << ',' << q.x_m << ',' << q.y_m << ',' << q.floor << ',' << match;
+    csv << i << ',' << ShortestNumber(q.x_m) << ',' << ShortestNumber(q.y_m) << ',' << q.floor
+        << ',' << match;
     if (match >= 0) {
       const auto& p = result_.map[match];
-      csv << ',' << p.x_m << ',' << p.y_m << ',' << p.floor;
+      csv << ',' << ShortestNumber(p.x_m) << ',' << ShortestNumber(p.y_m) << ',' << p.floor;
     } else {
       csv << ",,,";
     }
     const double e = m.errors_m[i];
-    csv << ','
-        << (std::isnan(e)   ? std::string("rejected")
+    csv << ',' << (std::isnan(e) ? "" : ShortestNumber(e)) << ','
+        << (std::isnan(e)   ? "rejected"
             : std::isinf(e) ? "other_floor"
-                            : Key(e))
+                            : "located")
         << '\n';
   }
   return out_->Write({{"evaluation.json", result_.json}, {"queries.csv", csv.str()}});

@@ -6,10 +6,14 @@
 // 80 % for an answer drawn at random among 5 floors).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
 
 namespace {
 namespace fs = std::filesystem;
@@ -104,6 +108,33 @@ TEST(EvaluateEndToEndTest, FingerprintRowsAllLearnTheWifiTree) {
   // had 9.8 %): at least nine tenths of it.
   EXPECT_GE(j["correct_within_m"]["5"].get<double>(),
             0.9 * j["baselines"]["knn"]["correct_within_m"]["5"].get<double>());
+  // queries.csv round-trips its numbers: the error recomputed from the printed UTM coordinates
+  // equals the printed error exactly (6 significant digits once moved them by over 1 m), and
+  // the status agrees with the error column.
+  std::ifstream csv(out / "queries.csv");
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_EQ(line, "query,x_m,y_m,floor,match,match_x_m,match_y_m,match_floor,error_m,status");
+  size_t located = 0, rows = 0;
+  while (std::getline(csv, line)) {
+    std::vector<std::string> f;
+    std::stringstream fields(line);
+    for (std::string x; std::getline(fields, x, ',');) f.push_back(x);
+    if (f.size() == 9) f.push_back("");  // a trailing empty field
+    ASSERT_EQ(f.size(), 10u) << line;
+    ++rows;
+    if (f[9] != "located") {
+      EXPECT_TRUE(f[9] == "rejected" ? f[8].empty() : (f[9] == "other_floor" && f[8] == "inf"))
+          << line;
+      continue;
+    }
+    ++located;
+    const double error =
+        std::hypot(std::stod(f[1]) - std::stod(f[5]), std::stod(f[2]) - std::stod(f[6]));
+    ASSERT_EQ(error, std::stod(f[8])) << line;
+  }
+  EXPECT_EQ(rows, j["queries"].get<size_t>());
+  EXPECT_GT(located, rows / 2);
   fs::remove_all(out);
 }
 

@@ -9,16 +9,13 @@
 
 #include "common/circular.h"
 #include "common/geometry.h"
+#include "common/number_text.h"
 #include "fusion/io/run_columns.h"
 
 namespace ratslam {
 namespace {
 
-std::string Num(double value) {
-  char buffer[40];
-  std::snprintf(buffer, sizeof buffer, "%.17g", value);
-  return buffer;
-}
+std::string Num(double value) { return ShortestNumber(value); }
 
 std::string TumLine(double t, double x, double y, double theta) {
   return Num(t) + " " + Num(x) + " " + Num(y) + " 0 0 0 " + Num(std::sin(theta / 2)) + " " +

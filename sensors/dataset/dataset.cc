@@ -11,6 +11,7 @@
 
 #include "common/circular.h"
 #include "common/file_util.h"
+#include "common/number_text.h"
 #include "common/text_file.h"
 #include "common/toml_binder.h"
 #include "sensors/dataset/csv.h"
@@ -164,11 +165,7 @@ Status ReadCompass(const std::string& path, Dataset* d) {
   return Status::Ok();
 }
 
-std::string Number(double value) {
-  char buffer[40];
-  std::snprintf(buffer, sizeof buffer, "%.17g", value);
-  return buffer;
-}
+std::string Number(double value) { return ShortestNumber(value); }
 
 }  // namespace
 
