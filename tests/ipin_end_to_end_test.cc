@@ -10,9 +10,11 @@
 // chance. Dead reckoning drifts by tens of metres over two walks; the map must beat it clearly.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -71,6 +73,57 @@ TEST(IpinEndToEndTest, WifiRatslamClosesOutAndBackLoops) {
   EXPECT_GE(cross, 10);
   EXPECT_LE(cross, matches);
   EXPECT_GE(s["cross_session_match_rate_within_m"]["10"].get<double>(), chance + 0.3);
+  // TUM files as evo reads them: 8 columns, strictly increasing stamps (the join of two logs
+  // once wrote the first stamp twice).
+  std::map<std::string, std::map<double, std::pair<double, double>>> tum;
+  for (const char* name : {"trajectory_tum.txt", "odometry_tum.txt", "ground_truth_tum.txt"}) {
+    std::ifstream file(out / name);
+    std::string line;
+    double previous = -1e300;
+    while (std::getline(file, line)) {
+      if (line.empty() || line[0] == '#') continue;
+      std::istringstream fields(line);
+      std::vector<double> v;
+      for (double x; fields >> x;) v.push_back(x);
+      ASSERT_EQ(v.size(), 8u) << name << ": " << line;
+      EXPECT_GT(v[0], previous) << name << ": " << line;
+      previous = v[0];
+      tum[name][v[0]] = {v[1], v[2]};
+    }
+    EXPECT_GT(tum[name].size(), 100u) << name;
+  }
+  // What evo_ape tum ground_truth_tum.txt X_tum.txt -a computes (stamps associated exactly,
+  // best rigid fit, RMSE), here with a closed-form 2D fit written independently of ours.
+  const auto ape = [&](const std::string& estimate) {
+    std::vector<std::pair<double, double>> p, q;
+    for (const auto& [t, g] : tum["ground_truth_tum.txt"]) {
+      p.push_back(tum[estimate].at(t));
+      q.push_back(g);
+    }
+    double px = 0, py = 0, qx = 0, qy = 0;
+    for (size_t i = 0; i < p.size(); ++i)
+      px += p[i].first, py += p[i].second, qx += q[i].first, qy += q[i].second;
+    px /= p.size(), py /= p.size(), qx /= q.size(), qy /= q.size();
+    double dot = 0, cross = 0;
+    for (size_t i = 0; i < p.size(); ++i) {
+      const double ax = p[i].first - px, ay = p[i].second - py, bx = q[i].first - qx,
+                   by = q[i].second - qy;
+      dot += ax * bx + ay * by;
+      cross += ax * by - ay * bx;
+    }
+    const double angle = std::atan2(cross, dot), c = std::cos(angle), s_ = std::sin(angle);
+    double sum = 0;
+    for (size_t i = 0; i < p.size(); ++i) {
+      const double ax = p[i].first - px, ay = p[i].second - py;
+      const double dx = c * ax - s_ * ay + qx - q[i].first,
+                   dy = s_ * ax + c * ay + qy - q[i].second;
+      sum += dx * dx + dy * dy;
+    }
+    return std::sqrt(sum / p.size());
+  };
+  EXPECT_NEAR(ape("trajectory_tum.txt"), s["trajectory_ate_m"].get<double>(), 1e-6);
+  EXPECT_NEAR(ape("odometry_tum.txt"), s["odometry_ate_m"].get<double>(), 1e-6);
+  EXPECT_EQ(tum["ground_truth_tum.txt"].size(), s["ate_points"].get<size_t>());
   // The Wi-Fi similarity matrix of the same walks (the Wi-Fi loop-closure paper's figure 9).
   const fs::path png = out / "wifi_similarity.png";
   const std::string render = std::string(RATSLAM_BINARY) +

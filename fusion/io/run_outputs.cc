@@ -17,6 +17,12 @@ namespace {
 
 std::string Num(double value) { return ShortestNumber(value); }
 
+// TUM files need strictly increasing stamps (evo_traj --full_check): of trajectory records at
+// one time (odometry rows a data set repeats), only the last, the pose after all of them.
+bool InTumFiles(const std::vector<TrajectoryRecord>& trajectory, size_t i) {
+  return i + 1 == trajectory.size() || trajectory[i + 1].time_s > trajectory[i].time_s;
+}
+
 std::string TumLine(double t, double x, double y, double theta) {
   return Num(t) + " " + Num(x) + " " + Num(y) + " 0 0 0 " + Num(std::sin(theta / 2)) + " " +
          Num(std::cos(theta / 2)) + "\n";
@@ -76,10 +82,13 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
       }
     }
     if (auto a = AlignRigid2D(estimate, truth)) s.map_ate_m = a->rmse_m;
-    // The corrected trajectory and raw odometry, at the same odometry times.
+    // The corrected trajectory and raw odometry, at the times the TUM files hold (so evo on
+    // trajectory_tum.txt and ground_truth_tum.txt reproduces these numbers).
     std::vector<Point2> corrected, odometry;
     truth.clear();
-    for (const TrajectoryRecord& r : state.trajectory) {
+    for (size_t i = 0; i < state.trajectory.size(); ++i) {
+      const TrajectoryRecord& r = state.trajectory[i];
+      if (!InTumFiles(state.trajectory, i)) continue;
       if (auto gt = InterpolateGroundTruth(dataset.ground_truth, r.time_s)) {
         double x, y, theta;
         RecordPose(map, r, &x, &y, &theta);
@@ -209,17 +218,27 @@ StatusOr<RunSummary> WriteRunOutputs(OutputFolder& folder, const ReplayPipeline&
   }
   files.emplace_back("links.csv", links.str());
 
-  std::ostringstream trajectory, odometry;
+  std::ostringstream trajectory, odometry, ground_truth;
   trajectory << "# timestamp tx ty tz qx qy qz qw (experience map, final relaxation)\n";
   odometry << "# timestamp tx ty tz qx qy qz qw (raw odometry)\n";
-  for (const TrajectoryRecord& r : state.trajectory) {
+  ground_truth << "# timestamp tx ty tz qx qy qz qw (ground truth, interpolated at the "
+                  "trajectory's stamps where it covers them; not aligned)\n";
+  for (size_t i = 0; i < state.trajectory.size(); ++i) {
+    const TrajectoryRecord& r = state.trajectory[i];
+    if (!InTumFiles(state.trajectory, i)) continue;
     double x, y, theta;
     RecordPose(map, r, &x, &y, &theta);
     trajectory << TumLine(r.time_s, x, y, theta);
     odometry << TumLine(r.time_s, r.odometry_x_m, r.odometry_y_m, r.odometry_theta_rad);
+    if (auto gt = InterpolateGroundTruth(dataset.ground_truth, r.time_s)) {
+      ground_truth << TumLine(r.time_s, gt->x_m, gt->y_m, gt->theta_rad);
+    }
   }
   files.emplace_back("trajectory_tum.txt", trajectory.str());
   files.emplace_back("odometry_tum.txt", odometry.str());
+  if (!dataset.ground_truth.empty()) {
+    files.emplace_back("ground_truth_tum.txt", ground_truth.str());
+  }
 
   // g2o: poses, and each link as a relative pose in its source's frame; unit information.
   std::ostringstream g2o;

@@ -42,7 +42,8 @@ void RecordPose(const ExperienceMap& map, const TrajectoryRecord& record, double
 
 RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, const RunInfo& info);
 
-// Writes experiences.csv, links.csv, trajectory_tum.txt, odometry_tum.txt, experience_map.g2o,
+// Writes experiences.csv, links.csv, trajectory_tum.txt, odometry_tum.txt (and with ground truth
+// ground_truth_tum.txt), experience_map.g2o,
 // frames.csv and summary.json into `folder`, all of them or none (a failure keeps the earlier
 // files and names the one that failed).
 StatusOr<RunSummary> WriteRunOutputs(OutputFolder& folder, const ReplayPipeline& pipeline,

@@ -89,12 +89,12 @@ StatusOr<Dataset> LoadSessions(const std::vector<std::string>& paths,
     if (!std::isfinite(first)) return Status::Error(path + ": empty data set");
     const double shift = std::isfinite(end_of_previous) ? end_of_previous + gap_s - first : 0.0;
     joined.session_start_times_s.push_back(first + shift);
+    // A still row at the session's start; rows at that same time add no motion (a row's speed
+    // holds from the previous row's time to its own) and would repeat the time stamp.
     joined.odometry.push_back({first + shift, 0.0, 0.0});
     for (auto r : d->odometry) {
       r.time_s += shift;
-      if (r.time_s > joined.odometry.back().time_s || joined.odometry.size() == 1) {
-        joined.odometry.push_back(r);
-      }
+      if (r.time_s > joined.odometry.back().time_s) joined.odometry.push_back(r);
     }
     for (auto r : d->images) {
       r.time_s += shift;
