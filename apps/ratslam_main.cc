@@ -184,6 +184,12 @@ int RunReplay(const ReplayRequest& request) {
     std::cerr << "ratslam: interrupted; state saved in " << result.saved_map << "\n";
     return kExitInterrupted;
   }
+  if (result.summary && result.summary->frames == 0) {
+    std::cerr << "ratslam: the run processed no frame (no view for the front end to judge); "
+                 "the outputs in "
+              << request.out << " hold dead reckoning only\n";
+    return kExitError;
+  }
   return kExitOk;
 }
 

@@ -21,6 +21,46 @@ std::string ToString(FrontEndKind kind) {
   return "unknown";
 }
 
+namespace {
+
+// A shipped config (configs/) for the streams a data set has.
+std::string ConfigThatFits(const Dataset& d) {
+  const bool images = !d.images.empty(), wifi = !d.wifi.empty(), compass = !d.compass.empty();
+  if (images && wifi && compass) return "configs/sim-fused.toml (camera, Wi-Fi and compass)";
+  if (images) return "configs/synthetic.toml (the classic camera front end)";
+  if (wifi && compass) return "configs/ipin2023-wifi-compass.toml (Wi-Fi and compass)";
+  if (wifi) return "configs/ipin2023-wifi.toml (Wi-Fi)";
+  return "";
+}
+
+}  // namespace
+
+Status CheckFrontEndInputs(const FrontEndSettings& settings, const Dataset& dataset) {
+  const FrontEndKind kind = settings.front_end.kind;
+  bool camera = kind == FrontEndKind::kClassicCamera, wifi = false, compass = false;
+  if (kind == FrontEndKind::kFused) {
+    camera = settings.fused.use_camera;
+    wifi = settings.fused.use_wifi;
+    compass = settings.fused.use_compass;
+  } else if (kind == FrontEndKind::kFabmap) {
+    const fabmap::FabmapMode mode = settings.fabmap.localiser.localiser.mode;
+    camera = fabmap::UsesVision(mode);
+    wifi = fabmap::UsesWifi(mode);
+  }
+  std::string missing;
+  if (camera && dataset.images.empty()) missing = "camera images";
+  if (wifi && dataset.wifi.empty())
+    missing += (missing.empty() ? "" : " and ") + std::string("Wi-Fi scans");
+  if (compass && dataset.compass.empty())
+    missing += (missing.empty() ? "" : " and ") + std::string("a compass (heading) stream");
+  if (missing.empty()) return Status::Ok();
+  std::string message = "the " + ToString(kind) + " front end needs " + missing +
+                        ", and data set '" + dataset.name + "' has none";
+  const std::string fits = ConfigThatFits(dataset);
+  if (!fits.empty()) message += "; a config that fits this data: " + fits;
+  return Status::Error(message);
+}
+
 StatusOr<FrontEndKind> FrontEndKindFromString(const std::string& name) {
   if (name == "classic_camera") return FrontEndKind::kClassicCamera;
   if (name == "fused") return FrontEndKind::kFused;

@@ -201,6 +201,13 @@ StatusOr<std::shared_ptr<const FabmapResources>> PrepareFabmapResources(
     const FrontEndSettings& settings, const Dataset& dataset,
     std::optional<fabmap::TrainedVisualModel> visual);
 
+// Fails, before any work, when `dataset` lacks a stream the front end needs: images for a
+// camera (classic camera, fused use_camera, FABMAP modes with vision), Wi-Fi scans for Wi-Fi
+// (fused use_wifi, FABMAP modes with Wi-Fi), a heading stream for the compass (fused
+// use_compass). The message names the front end, the missing stream and a shipped config
+// that fits the streams the data set has.
+Status CheckFrontEndInputs(const FrontEndSettings& settings, const Dataset& dataset);
+
 // `fabmap` is required by the kFabmap front end (it throws std::invalid_argument without it,
 // like the pipeline does for invalid options).
 std::unique_ptr<FrontEnd> CreateFrontEnd(const FrontEndSettings& settings,

@@ -122,6 +122,44 @@ TEST(FrontEndTest, WifiOnlyMakesFramesFromScansAndStateRoundTrips) {
   EXPECT_FALSE(b->DecodeState(corrupt).ok());
 }
 
+// Each front end names the stream it lacks, and the suggested config fits what the data has.
+TEST(FrontEndTest, MissingInputStreamsAreNamedWithAConfigThatFits) {
+  Dataset phone;  // an IPIN log: scans and headings, no images
+  phone.name = "phone";
+  phone.wifi.push_back({1.0, {{"ap", -50.0}}});
+  phone.compass.push_back({1.0, 0.0});
+  FrontEndSettings classic;  // the default: classic camera
+  Status s = CheckFrontEndInputs(classic, phone);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("classic_camera front end needs camera images"), std::string::npos)
+      << s.message();
+  EXPECT_NE(s.message().find("configs/ipin2023-wifi-compass.toml"), std::string::npos);
+
+  FrontEndSettings wifi_compass;
+  wifi_compass.front_end.kind = FrontEndKind::kFused;
+  wifi_compass.fused.use_compass = true;
+  EXPECT_TRUE(CheckFrontEndInputs(wifi_compass, phone).ok());
+  Dataset no_compass = phone;
+  no_compass.compass.clear();
+  s = CheckFrontEndInputs(wifi_compass, no_compass);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("a compass (heading) stream"), std::string::npos) << s.message();
+  EXPECT_NE(s.message().find("configs/ipin2023-wifi.toml"), std::string::npos) << s.message();
+
+  Dataset camera_only;
+  camera_only.name = "loop";
+  camera_only.images.push_back({0.0, "0.png"});
+  FrontEndSettings fabmap_wifi;
+  fabmap_wifi.front_end.kind = FrontEndKind::kFabmap;
+  fabmap_wifi.fabmap.localiser.localiser.mode = fabmap::FabmapMode::kWifi;
+  s = CheckFrontEndInputs(fabmap_wifi, camera_only);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("fabmap front end needs Wi-Fi scans"), std::string::npos)
+      << s.message();
+  EXPECT_NE(s.message().find("configs/synthetic.toml"), std::string::npos) << s.message();
+  EXPECT_TRUE(CheckFrontEndInputs(classic, camera_only).ok());
+}
+
 TEST(FrontEndTest, KindNamesRoundTrip) {
   for (FrontEndKind k :
        {FrontEndKind::kClassicCamera, FrontEndKind::kFused, FrontEndKind::kFabmap}) {

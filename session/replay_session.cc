@@ -65,6 +65,7 @@ Status ReplaySession::Load() {
         ReplaceOdometryWithVisual(&dataset.value(), env_.images, options_.pipeline.visual_odometry)
             .WithContext("visual odometry"));
   }
+  RATSLAM_RETURN_IF_ERROR(CheckFrontEndInputs(options_.pipeline.sensors, *dataset));
   dataset_ = std::move(dataset).value();
   return env_.out->Write("config.toml",
                          "# Resolved configuration of this run (ratslam print-config format).\n" +

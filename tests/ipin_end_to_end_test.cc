@@ -17,6 +17,8 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <tuple>
+#include <utility>
 
 #include "sensors/dataset/dataset_loader.h"
 
@@ -135,6 +137,36 @@ TEST(IpinEndToEndTest, WifiRatslamClosesOutAndBackLoops) {
     EXPECT_GT(fs::file_size(png), 10000u);
   }
   fs::remove_all(out);
+}
+
+// A run that cannot do anything says so. No config (the classic camera) on a phone log: refused
+// at start-up, naming the missing stream and a config that fits. A Wi-Fi config stopped before
+// the first scan: it ran, but processed no frame, so it exits 1 too.
+TEST(IpinEndToEndTest, RunsThatCannotDoAnythingSaySo) {
+  const fs::path log = fs::path(RATSLAM_SHARED_DATA_DIR) / "ipin2023-t3" /
+                       "IPIN2023_T3_TrainingTrial01_repetition01.txt";
+  if (!fs::exists(log)) GTEST_SKIP() << "missing " << log;
+  const fs::path out =
+      fs::temp_directory_path() / ("ratslam_ipin_empty_" + std::to_string(::getpid()));
+  const std::string err = (out.string() + ".err");
+  const auto run = [&](const std::string& args) {
+    const std::string command = std::string(RATSLAM_BINARY) + " replay --quiet " + args +
+                                " --data " + log.string() + " --out " + out.string() +
+                                " > /dev/null 2> " + err;
+    const int status = std::system(command.c_str());
+    std::ifstream in(err);
+    return std::make_pair(WEXITSTATUS(status), std::string(std::istreambuf_iterator<char>(in), {}));
+  };
+  auto [code, message] = run("");
+  EXPECT_EQ(code, 1);
+  EXPECT_NE(message.find("needs camera images"), std::string::npos) << message;
+  EXPECT_NE(message.find("configs/ipin2023-wifi-compass.toml"), std::string::npos) << message;
+  std::tie(code, message) = run(std::string("--config ") + RATSLAM_SOURCE_DIR +
+                                "/configs/ipin2023-wifi.toml --until 0.5");  // first scan: 0.65 s
+  EXPECT_EQ(code, 1);
+  EXPECT_NE(message.find("processed no frame"), std::string::npos) << message;
+  fs::remove_all(out);
+  fs::remove(err);
 }
 
 }  // namespace
