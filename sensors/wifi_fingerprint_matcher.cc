@@ -4,6 +4,7 @@
 #include <cmath>
 #include <map>
 #include <stdexcept>
+#include <utility>
 
 namespace ratslam {
 
@@ -72,11 +73,20 @@ double WifiFingerprintMatcher::Weight(const Fingerprint& q, const Fingerprint& j
 
 template <typename Visit>
 void WifiFingerprintMatcher::ForEachCandidate(const Fingerprint& query, Visit&& visit) const {
+  if (options_.offset_invariant) {
+    ForEachCandidateOf<true>(query, std::forward<Visit>(visit));
+  } else {
+    ForEachCandidateOf<false>(query, std::forward<Visit>(visit));
+  }
+}
+
+template <bool kOffsetInvariant, typename Visit>
+void WifiFingerprintMatcher::ForEachCandidateOf(const Fingerprint& query, Visit&& visit) const {
   const size_t n = state_.fingerprints.size();
   if (common_.size() < n) {
     common_.resize(n, 0);
     hit_sum_.resize(n, 0.0);
-    diff_sum_.resize(n, 0.0);
+    if (kOffsetInvariant) diff_sum_.resize(n, 0.0);
     extra_common_.resize(n, 0.0);
     miss_common_.resize(n, 0.0);
   }
@@ -91,7 +101,7 @@ void WifiFingerprintMatcher::ForEachCandidate(const Fingerprint& query, Visit&& 
       if (common_[p.fingerprint]++ == 0) touched_.push_back(p.fingerprint);
       const double d = s - p.rssi_dbm;
       hit_sum_[p.fingerprint] += d * d;
-      diff_sum_[p.fingerprint] += d;
+      if constexpr (kOffsetInvariant) diff_sum_[p.fingerprint] += d;
       extra_common_[p.fingerprint] += extra;
       miss_common_[p.fingerprint] += p.penalty2;
     }
@@ -104,13 +114,13 @@ void WifiFingerprintMatcher::ForEachCandidate(const Fingerprint& query, Visit&& 
     const double m = static_cast<double>(state_.fingerprints[id].ap_ids.size()) - h;
     const double extra = std::max(0.0, extra_total - extra_common_[id]);
     const double miss = std::max(0.0, miss_penalty_total_[id] - miss_common_[id]);
-    const double hit = options_.offset_invariant
-                           ? std::max(0.0, hit_sum_[id] - diff_sum_[id] * diff_sum_[id] / h)
-                           : hit_sum_[id];
+    double hit = hit_sum_[id];
+    if constexpr (kOffsetInvariant) hit = std::max(0.0, hit - diff_sum_[id] * diff_sum_[id] / h);
     visit(id, std::exp(-hit / (two_sigma2 * h) - extra / two_sigma2 - miss / two_sigma2) * h /
                   (h + e + m));
     common_[id] = 0;
-    hit_sum_[id] = diff_sum_[id] = extra_common_[id] = miss_common_[id] = 0.0;
+    hit_sum_[id] = extra_common_[id] = miss_common_[id] = 0.0;
+    if constexpr (kOffsetInvariant) diff_sum_[id] = 0.0;
   }
 }
 

@@ -110,6 +110,9 @@ class WifiFingerprintMatcher {
   // Visits every stored fingerprint sharing an AP with the query: visit(id, weight).
   template <typename Visit>
   void ForEachCandidate(const Fingerprint& query, Visit&& visit) const;
+  // The loop itself, compiled once per hit term so the plain one pays nothing for the other.
+  template <bool kOffsetInvariant, typename Visit>
+  void ForEachCandidateOf(const Fingerprint& query, Visit&& visit) const;
   void Index(uint32_t id);
 
   WifiMatcherOptions options_;
