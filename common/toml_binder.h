@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "common/number_text.h"
 #include "common/schema.h"
 #include "common/status.h"
 #include "common/toml_string.h"
@@ -29,9 +30,7 @@ struct TomlCodec;
 
 // Numbers: shortest text that reads back to the same double, always with a '.' or exponent.
 inline std::string TomlNumber(double value) {
-  char buffer[64];
-  const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
-  std::string text(buffer, result.ptr);
+  std::string text = ShortestNumber(value);
   if (text.find_first_of(".eEn") == std::string::npos) text += ".0";
   return text;
 }
