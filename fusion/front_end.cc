@@ -17,6 +17,8 @@ std::string ToString(FrontEndKind kind) {
       return "fused";
     case FrontEndKind::kFabmap:
       return "fabmap";
+    case FrontEndKind::kNone:
+      return "none";
   }
   return "unknown";
 }
@@ -42,6 +44,8 @@ Status CheckFrontEndInputs(const FrontEndSettings& settings, const Dataset& data
     camera = settings.fused.use_camera;
     wifi = settings.fused.use_wifi;
     compass = settings.fused.use_compass;
+  } else if (kind == FrontEndKind::kNone) {
+    wifi = true;
   } else if (kind == FrontEndKind::kFabmap) {
     const fabmap::FabmapMode mode = settings.fabmap.localiser.localiser.mode;
     camera = fabmap::UsesVision(mode);
@@ -65,7 +69,9 @@ StatusOr<FrontEndKind> FrontEndKindFromString(const std::string& name) {
   if (name == "classic_camera") return FrontEndKind::kClassicCamera;
   if (name == "fused") return FrontEndKind::kFused;
   if (name == "fabmap") return FrontEndKind::kFabmap;
-  return Status::Error("unknown front end '" + name + "' (valid: classic_camera, fused, fabmap)");
+  if (name == "none") return FrontEndKind::kNone;
+  return Status::Error("unknown front end '" + name +
+                       "' (valid: classic_camera, fused, fabmap, none)");
 }
 
 bool FabmapSettings::IsValid(std::string* error) const {
@@ -118,6 +124,8 @@ std::unique_ptr<FrontEnd> CreateFrontEnd(const FrontEndSettings& s,
       return front_end_internal::MakeFusedFrontEnd(s.fused, s.camera_12x9, s.wifi);
     case FrontEndKind::kFabmap:
       return front_end_internal::MakeFabmapFrontEnd(s.fabmap, std::move(fabmap));
+    case FrontEndKind::kNone:
+      return front_end_internal::MakeNoViewFrontEnd();
   }
   return nullptr;
 }

@@ -43,7 +43,8 @@
 
 namespace ratslam {
 
-enum class FrontEndKind { kClassicCamera, kFused, kFabmap };
+// kNone matches nothing: every Wi-Fi scan is a new template (Wi-Fi sequence loop closure alone).
+enum class FrontEndKind { kClassicCamera, kFused, kFabmap, kNone };
 std::string ToString(FrontEndKind kind);
 // Fails with the list of valid names.
 StatusOr<FrontEndKind> FrontEndKindFromString(const std::string& name);
@@ -54,7 +55,9 @@ struct FrontEndOptions {
   bool IsValid(std::string*) const { return true; }
   template <typename Visitor>
   void VisitFields(Visitor&& v) {
-    v("kind", kind, "front end that decides the active local view: classic_camera, fused or fabmap",
+    v("kind", kind,
+      "front end that decides the active local view: classic_camera, fused, fabmap or none "
+      "(every Wi-Fi scan a new template)",
       schema::Any());
   }
 };

@@ -35,6 +35,7 @@ std::unique_ptr<FrontEnd> MakeClassicCameraFrontEnd(const ClassicCameraOptions& 
 std::unique_ptr<FrontEnd> MakeFusedFrontEnd(const FusedOptions& options,
                                             const KernelCameraOptions& camera,
                                             const WifiMatcherOptions& wifi);
+std::unique_ptr<FrontEnd> MakeNoViewFrontEnd();
 std::unique_ptr<FrontEnd> MakeFabmapFrontEnd(const FabmapSettings& settings,
                                              std::shared_ptr<const FabmapResources> resources);
 

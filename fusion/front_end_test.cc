@@ -161,8 +161,8 @@ TEST(FrontEndTest, MissingInputStreamsAreNamedWithAConfigThatFits) {
 }
 
 TEST(FrontEndTest, KindNamesRoundTrip) {
-  for (FrontEndKind k :
-       {FrontEndKind::kClassicCamera, FrontEndKind::kFused, FrontEndKind::kFabmap}) {
+  for (FrontEndKind k : {FrontEndKind::kClassicCamera, FrontEndKind::kFused, FrontEndKind::kFabmap,
+                         FrontEndKind::kNone}) {
     EXPECT_EQ(FrontEndKindFromString(ToString(k)).value(), k);
   }
   EXPECT_FALSE(FrontEndKindFromString("fab_map").ok());

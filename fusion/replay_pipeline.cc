@@ -19,7 +19,8 @@ bool PipelineOptions::IsValid(std::string* error) const {
          check(sensors.camera_12x9.IsValid(&inner), "camera_12x9") &&
          check(sensors.wifi.IsValid(&inner), "wifi") && check(pdr.IsValid(&inner), "pdr") &&
          check(visual_odometry.IsValid(&inner), "visual_odometry") && ratslam.IsValid(error) &&
-         sensors.fabmap.IsValid(error) && check(evaluation.IsValid(&inner), "evaluation");
+         check(wifi_sequence.IsValid(&inner), "wifi_sequence") && sensors.fabmap.IsValid(error) &&
+         check(evaluation.IsValid(&inner), "evaluation");
 }
 
 namespace {
@@ -74,7 +75,8 @@ ReplayPipeline::ReplayPipeline(const PipelineOptions& options, const Dataset& da
       events_(MergeEvents(dataset)),
       slam_(std::make_unique<Ratslam>(options.ratslam)),
       fabmap_(std::move(fabmap)),
-      front_end_(CreateFrontEnd(options.sensors, fabmap_)) {
+      front_end_(CreateFrontEnd(options.sensors, fabmap_)),
+      wifi_sequence_(std::make_unique<WifiSequenceLoopCloser>(options.wifi_sequence)) {
   state_.events_total = events_.size();
 }
 
@@ -116,6 +118,13 @@ Status ReplayPipeline::Run(const ReplayControl& control) {
       control.progress(progress);
     }
   }
+  if (finished() && options_.wifi_sequence.enabled && !state_.wifi_sequence_flushed) {
+    // The sequence still open when the data ends (a walk that ends where it began) is matched
+    // too, and the map relaxed until the new links settle, as no odometry step follows.
+    state_.wifi_sequence_flushed = true;
+    const double end_s = events_.empty() ? 0.0 : events_.back().time_s;
+    RATSLAM_RETURN_IF_ERROR(LinkLoop(wifi_sequence_->Flush(end_s), end_s));
+  }
   return Status::Ok();
 }
 
@@ -128,6 +137,7 @@ Status ReplayPipeline::HandleOdometry(const Event& event) {
   step.time_s = row.time_s;
   step.forward_m = row.forward_speed_m_per_s * dt;
   step.rotation_rad = row.turn_rate_rad_per_s * dt;
+  state_.travel_m += std::abs(step.forward_m);
   StatusOr<ActionKind> action = slam_->OnOdometry(step);
   if (!action.ok()) return action.status();
 
@@ -166,9 +176,86 @@ Status ReplayPipeline::HandleImage(const Event& event) {
 
 Status ReplayPipeline::HandleWifi(const Event& event) {
   ++state_.wifi_scans_seen;
-  StatusOr<std::optional<FrameDecision>> decision = front_end_->OnWifi(dataset_.wifi[event.index]);
+  const WifiScan& scan = dataset_.wifi[event.index];
+  StatusOr<std::optional<FrameDecision>> decision = front_end_->OnWifi(scan);
   if (!decision.ok()) return decision.status();
-  return decision.value() ? Apply(*decision.value()) : Status::Ok();
+  if (decision.value()) RATSLAM_RETURN_IF_ERROR(Apply(*decision.value()));
+  return options_.wifi_sequence.enabled ? AddSequencePose(scan) : Status::Ok();
+}
+
+Pose2 ReplayPipeline::MapPose(const SequencePose& pose) const {
+  const ExperienceMap& map = slam_->experience_map();
+  if (pose.anchor < 0 || static_cast<size_t>(pose.anchor) >= map.num_experiences()) {
+    return pose.odometry;
+  }
+  const Experience& e = map.experience(static_cast<uint32_t>(pose.anchor));
+  return Compose({e.x_m, e.y_m, e.theta_rad}, pose.anchor_offset.x_m, pose.anchor_offset.y_m,
+                 pose.anchor_offset.theta_rad);
+}
+
+namespace {
+
+// Travel added at each session start of a multi-session run: smoothing never mixes sessions, and
+// every pose of an earlier session is far enough behind to be a loop candidate.
+constexpr double kSessionGapM = 1000.0;
+
+Pose2 Inverse(const Pose2& p) {
+  const double c = std::cos(p.theta_rad), s = std::sin(p.theta_rad);
+  return {-(c * p.x_m + s * p.y_m), s * p.x_m - c * p.y_m, WrapAngle(-p.theta_rad)};
+}
+
+Pose2 Then(const Pose2& a, const Pose2& b) { return Compose(a, b.x_m, b.y_m, b.theta_rad); }
+
+}  // namespace
+
+Status ReplayPipeline::AddSequencePose(const WifiScan& scan) {
+  const ExperienceMap& map = slam_->experience_map();
+  SequencePose pose;
+  pose.time_s = scan.time_s;
+  size_t session = 0;
+  const std::vector<double>& starts = dataset_.session_start_times_s;
+  while (session + 1 < starts.size() && scan.time_s >= starts[session + 1]) ++session;
+  pose.travel_m = state_.travel_m + kSessionGapM * static_cast<double>(session);
+  pose.odometry = {state_.odometry_x_m, state_.odometry_y_m, state_.odometry_theta_rad};
+  pose.compass_heading_rad = front_end_->CompassHeading();
+  if (map.current()) {
+    pose.anchor = *map.current();
+    pose.anchor_offset = {map.offset().forward_m, map.offset().left_m, map.offset().facing_rad};
+  }
+  std::vector<Point2> positions;
+  positions.reserve(wifi_sequence_->size() + 1);
+  for (size_t i = 0; i < wifi_sequence_->size(); ++i) {
+    const Pose2 p = MapPose(wifi_sequence_->pose(i));
+    positions.push_back({p.x_m, p.y_m});
+  }
+  const Pose2 here = MapPose(pose);
+  positions.push_back({here.x_m, here.y_m});
+  StatusOr<std::optional<SequenceLoop>> loop = wifi_sequence_->AddPose(pose, scan, positions);
+  if (!loop.ok()) return loop.status();
+  return LinkLoop(loop.value(), scan.time_s);
+}
+
+Status ReplayPipeline::LinkLoop(const std::optional<SequenceLoop>& loop, double time_s) {
+  if (!loop || !loop->accepted) return Status::Ok();
+  bool added = false;
+  for (const SequenceCorrespondence& c : loop->correspondences) {
+    if (!c.inlier) continue;
+    const SequencePose& now = wifi_sequence_->pose(c.current_pose);
+    const SequencePose& then = wifi_sequence_->pose(c.past_pose);
+    if (now.anchor < 0 || then.anchor < 0) continue;
+    // The current pose seen from the past one (the verified fit), carried to their anchors:
+    // anchor_now in anchor_then's frame = offset_then * relative * offset_now^-1.
+    const Pose2 relative = wifi_sequence_->RelativePose(*loop, c.current_pose, c.past_pose);
+    const Pose2 link = Then(Then(then.anchor_offset, relative), Inverse(now.anchor_offset));
+    StatusOr<bool> linked = slam_->AddConstraint(static_cast<uint32_t>(then.anchor),
+                                                 static_cast<uint32_t>(now.anchor), link, time_s);
+    if (!linked.ok()) return linked.status();
+    added |= linked.value();
+  }
+  if (added && finished()) {
+    for (int i = 0; i < 100; ++i) slam_->RelaxExperienceMap();
+  }
+  return Status::Ok();
 }
 
 Status ReplayPipeline::Apply(const FrameDecision& decision) {
@@ -189,6 +276,7 @@ ReplayPipeline::State ReplayPipeline::Snapshot() const {
   State snapshot = state_;
   snapshot.ratslam = slam_->GetState();
   snapshot.front_end = front_end_->EncodeState();
+  snapshot.wifi_sequence = wifi_sequence_->state();
   return snapshot;
 }
 
@@ -204,14 +292,25 @@ Status ReplayPipeline::Restore(const State& state) {
   RATSLAM_RETURN_IF_ERROR(slam->SetState(state.ratslam));
   std::unique_ptr<FrontEnd> front_end = CreateFrontEnd(options_.sensors, fabmap_);
   RATSLAM_RETURN_IF_ERROR(front_end->DecodeState(state.front_end));
+  auto wifi_sequence = std::make_unique<WifiSequenceLoopCloser>(options_.wifi_sequence);
+  RATSLAM_RETURN_IF_ERROR(wifi_sequence->SetState(state.wifi_sequence));
+  for (const SequencePose& p : state.wifi_sequence.poses) {
+    if (p.anchor >= static_cast<int64_t>(state.ratslam.experience_map.experiences.size())) {
+      return Status::Error(
+          "saved map: a Wi-Fi sequence pose refers to an experience that does "
+          "not exist");
+    }
+  }
   if (front_end->size() != slam->local_view().size()) {
     return Status::Error("saved map: front-end templates and local view cells differ in number");
   }
   slam_ = std::move(slam);
   front_end_ = std::move(front_end);
+  wifi_sequence_ = std::move(wifi_sequence);
   state_ = state;
   state_.ratslam = {};
   state_.front_end.clear();
+  state_.wifi_sequence = {};
   return Status::Ok();
 }
 

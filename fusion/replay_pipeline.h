@@ -17,6 +17,7 @@
 #include "common/status.h"
 #include "fusion/fabmap/evaluation.h"
 #include "fusion/front_end.h"
+#include "fusion/wifi_sequence/wifi_sequence.h"
 #include "ratslam/ratslam.h"
 #include "ratslam/records.h"
 #include "sensors/dataset/dataset.h"
@@ -32,6 +33,7 @@ struct PipelineOptions {
   PdrOptions pdr;                         // odometry from phone logs
   VisualOdometryOptions visual_odometry;  // odometry from a camera alone
   RatslamOptions ratslam;
+  WifiSequenceOptions wifi_sequence;     // Wi-Fi sequence loop closure beside the front end
   fabmap::EvaluationOptions evaluation;  // `ratslam evaluate` only: how map and queries split
 
   bool IsValid(std::string* error) const;
@@ -50,6 +52,7 @@ struct PipelineOptions {
     v("local_view", ratslam.local_view);
     v("experience_map", ratslam.experience_map);
     v("action", ratslam.action);
+    v("wifi_sequence", wifi_sequence);
     v("fabmap", sensors.fabmap.localiser.localiser);
     v("fabmap_front_end", sensors.fabmap.front_end);
     v("fabmap_model", sensors.fabmap.localiser.fabmap);
@@ -96,6 +99,11 @@ class ReplayPipeline {
     uint64_t wifi_scans_seen = 0;
     uint64_t compass_readings_seen = 0;
     uint64_t images_skipped = 0;  // images the front end does not use
+    // Wi-Fi sequence loop closure: its poses and loops, the odometric travel so far, and
+    // whether the sequence open at the end of the data was matched.
+    WifiSequenceLoopCloser::State wifi_sequence;
+    double travel_m = 0.0;
+    bool wifi_sequence_flushed = false;
   };
 
   // `options` must be valid; throws std::invalid_argument otherwise. `dataset` and `images`
@@ -120,6 +128,11 @@ class ReplayPipeline {
   // Restores a snapshot; fails if it does not belong to this data set and these options.
   Status Restore(const State& state);
   const std::vector<Event>& events() const { return events_; }
+  // Wi-Fi sequence loop closure (its poses, loops and similarity), whether enabled or not.
+  const WifiSequenceLoopCloser& wifi_sequence() const { return *wifi_sequence_; }
+  // The map's current estimate of a loop-closer pose: its anchor experience composed with the
+  // pose's offset (the dead-reckoned position before the first experience).
+  Pose2 MapPose(const SequencePose& pose) const;
   // How a FABMAP front end learnt its Wi-Fi model; nothing for the other front ends.
   std::optional<FabmapLearningReport> fabmap_learning() const {
     return front_end_->fabmap_learning();
@@ -130,6 +143,8 @@ class ReplayPipeline {
   Status HandleImage(const Event& event);
   Status HandleWifi(const Event& event);
   Status Apply(const FrameDecision& decision);
+  Status AddSequencePose(const WifiScan& scan);
+  Status LinkLoop(const std::optional<SequenceLoop>& loop, double time_s);
 
   PipelineOptions options_;
   const Dataset& dataset_;
@@ -138,6 +153,7 @@ class ReplayPipeline {
   std::unique_ptr<Ratslam> slam_;
   std::shared_ptr<const FabmapResources> fabmap_;
   std::unique_ptr<FrontEnd> front_end_;
+  std::unique_ptr<WifiSequenceLoopCloser> wifi_sequence_;
   State state_;  // the parts not held by slam_ and camera_
 };
 

@@ -331,3 +331,87 @@ TEST(ReplayPipelineTest, StopAndResumeEqualsOneRunForOnlineFabmapLearning) {
 
 }  // namespace
 }  // namespace ratslam
+
+namespace ratslam {
+namespace {
+
+PipelineOptions SequenceOptions(FrontEndKind kind) {
+  PipelineOptions o = WifiOptions();
+  o.sensors.front_end.kind = kind;
+  o.wifi_sequence.enabled = true;
+  return o;
+}
+
+TEST(ReplayPipelineWifiSequenceTest, SequenceLoopClosureAloneLinksTheSecondLapToTheFirst) {
+  const Dataset data = SquareLoop();
+  NoImages images;
+  ReplayPipeline pipeline(SequenceOptions(FrontEndKind::kNone), data, &images);
+  ASSERT_TRUE(pipeline.Run({}).ok());
+  EXPECT_EQ(pipeline.slam().counters().loop_closures, 0u);  // nothing by appearance
+  EXPECT_EQ(pipeline.wifi_sequence().size(), data.wifi.size());
+  size_t sequence_links = 0;
+  for (const Link& l : pipeline.slam().experience_map().links()) {
+    if (!l.wifi_sequence) continue;
+    ++sequence_links;
+    // A link joins places one lap (80 s) apart, give or take two scans (a DP pair may be a scan
+    // off, and a scan's experience is the one made before it).
+    const auto& e = pipeline.slam().experience_map().experiences();
+    EXPECT_NEAR(std::abs(e[l.to].time_s - e[l.from].time_s), 80.0, 4.5);
+    EXPECT_TRUE(l.loop_closure);
+    // Odometry is exact here, so whatever the pair, the link must put `to` where it truly is
+    // seen from `from` (the fit's relative pose, not "the same place").
+    const Experience& from = e[l.from];
+    const double x = from.x_m + l.distance_m * std::cos(from.theta_rad + l.heading_rad);
+    const double y = from.y_m + l.distance_m * std::sin(from.theta_rad + l.heading_rad);
+    EXPECT_NEAR(x, e[l.to].x_m, 0.3);
+    EXPECT_NEAR(y, e[l.to].y_m, 0.3);
+  }
+  EXPECT_GE(sequence_links, 5u);
+}
+
+TEST(ReplayPipelineWifiSequenceTest, StopAndResumeEqualsOneRun) {
+  const Dataset data = SquareLoop();
+  NoImages images;
+  const PipelineOptions options = SequenceOptions(FrontEndKind::kFused);
+  ReplayPipeline whole(options, data, &images);
+  ASSERT_TRUE(whole.Run({}).ok());
+  for (double cut_s : {60.0, 110.0, 150.0}) {
+    ReplayPipeline first(options, data, &images);
+    ReplayControl half;
+    half.until_time_s = cut_s;
+    ASSERT_TRUE(first.Run(half).ok());
+    ReplayPipeline second(options, data, &images);
+    ASSERT_TRUE(second.Restore(first.Snapshot()).ok());
+    ASSERT_TRUE(second.Run({}).ok());
+    const auto& a = whole.slam().experience_map();
+    const auto& b = second.slam().experience_map();
+    ASSERT_EQ(a.num_links(), b.num_links()) << "cut at " << cut_s;
+    for (size_t i = 0; i < a.num_experiences(); ++i) {
+      EXPECT_EQ(a.experiences()[i].x_m, b.experiences()[i].x_m);
+      EXPECT_EQ(a.experiences()[i].y_m, b.experiences()[i].y_m);
+    }
+    ASSERT_EQ(whole.wifi_sequence().loops().size(), second.wifi_sequence().loops().size());
+    for (size_t l = 0; l < whole.wifi_sequence().loops().size(); ++l) {
+      EXPECT_EQ(whole.wifi_sequence().loops()[l].dp_cost,
+                second.wifi_sequence().loops()[l].dp_cost);
+    }
+  }
+}
+
+TEST(ReplayPipelineWifiSequenceTest, RestoreRefusesAPoseAnchoredToAMissingExperience) {
+  const Dataset data = SquareLoop();
+  NoImages images;
+  const PipelineOptions options = SequenceOptions(FrontEndKind::kNone);
+  ReplayPipeline pipeline(options, data, &images);
+  ReplayControl half;
+  half.until_time_s = 60.0;
+  ASSERT_TRUE(pipeline.Run(half).ok());
+  ReplayPipeline::State s = pipeline.Snapshot();
+  ASSERT_FALSE(s.wifi_sequence.poses.empty());
+  s.wifi_sequence.poses.back().anchor = 100000;
+  ReplayPipeline other(options, data, &images);
+  EXPECT_FALSE(other.Restore(s).ok());
+}
+
+}  // namespace
+}  // namespace ratslam

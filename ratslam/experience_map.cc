@@ -99,6 +99,41 @@ uint32_t ExperienceMap::CreateExperience(uint32_t template_id, const PoseCellPos
   return e.id;
 }
 
+bool ExperienceMap::Linked(uint32_t a, uint32_t b) const {
+  for (uint32_t link_id : state_.experiences[a].link_ids) {
+    const Link& l = state_.links[link_id];
+    if ((l.from == a && l.to == b) || (l.from == b && l.to == a)) return true;
+  }
+  return false;
+}
+
+StatusOr<bool> ExperienceMap::AddConstraint(uint32_t from, uint32_t to, const Pose2& relative,
+                                            double time_s) {
+  if (from >= state_.experiences.size() || to >= state_.experiences.size()) {
+    return Status::Error("experience map: constraint between unknown experiences " +
+                         std::to_string(from) + " and " + std::to_string(to));
+  }
+  if (!std::isfinite(relative.x_m) || !std::isfinite(relative.y_m) ||
+      !std::isfinite(relative.theta_rad) || !std::isfinite(time_s)) {
+    return Status::Error("experience map: constraint with a non-finite pose or time");
+  }
+  if (from == to || Linked(from, to)) return false;
+  // AddLink measures the link from the odometry offset; give it the constraint instead.
+  const LocalOffset odometry = state_.offset;
+  const double start = state_.offset_start_time_s;
+  state_.offset = {relative.x_m, relative.y_m, WrapAngle(relative.theta_rad)};
+  state_.offset_start_time_s = time_s;
+  const std::optional<double>& a = state_.experiences[from].compass_heading_rad;
+  const std::optional<double>& b = state_.experiences[to].compass_heading_rad;
+  std::optional<double> facing;
+  if (a && b) facing = *b - *a;
+  AddLink(from, to, time_s, facing, true);
+  state_.links.back().wifi_sequence = true;
+  state_.offset = odometry;
+  state_.offset_start_time_s = start;
+  return true;
+}
+
 StatusOr<bool> ExperienceMap::LinkTo(uint32_t id, double time_s,
                                      std::optional<double> compass_heading_rad) {
   if (id >= state_.experiences.size()) {
@@ -107,12 +142,7 @@ StatusOr<bool> ExperienceMap::LinkTo(uint32_t id, double time_s,
   bool added = false;
   if (state_.current && *state_.current != id) {
     const uint32_t from = *state_.current;
-    bool exists = false;
-    for (uint32_t link_id : state_.experiences[from].link_ids) {
-      const Link& l = state_.links[link_id];
-      if ((l.from == from && l.to == id) || (l.from == id && l.to == from)) exists = true;
-    }
-    if (!exists) {
+    if (!Linked(from, id)) {
       const std::optional<double>& a = state_.experiences[from].compass_heading_rad;
       const std::optional<double>& b = state_.experiences[id].compass_heading_rad;
       std::optional<double> facing;

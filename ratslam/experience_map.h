@@ -88,7 +88,8 @@ struct Link {
   double heading_rad = 0.0;  // direction of `to` seen from `from`, relative to from's facing
   double facing_rad = 0.0;   // to's facing minus from's facing
   double duration_s = 0.0;
-  bool loop_closure = false;  // true when `to` existed before the link was made
+  bool loop_closure = false;   // true when `to` existed before the link was made
+  bool wifi_sequence = false;  // made by Wi-Fi sequence loop closure (AddConstraint)
 };
 
 // Odometry accumulated since the current experience, in that experience's frame.
@@ -131,6 +132,14 @@ class ExperienceMap {
   StatusOr<bool> LinkTo(uint32_t id, double time_s,
                         std::optional<double> compass_heading_rad = std::nullopt);
 
+  // Links existing experiences `from` and `to` with `to`'s pose in `from`'s frame measured by
+  // something other than odometry (Wi-Fi sequence loop closure); the current experience does not
+  // change. When both experiences carry a compass heading, the link's facing is their compass
+  // difference, as for the spine's own links (a facing measured through odometry at a turn can be
+  // off by half a turn, and one such link rotates a whole session). Returns false (adding nothing)
+  // when the two are the same or already linked; fails on an unknown id or a non-finite pose.
+  StatusOr<bool> AddConstraint(uint32_t from, uint32_t to, const Pose2& relative, double time_s);
+
   // `relaxation_sweeps` passes of relaxation (see RelaxationScheme).
   void Relax();
   // Link updates made by Relax since construction (not saved): a measure of relaxation cost.
@@ -158,6 +167,7 @@ class ExperienceMap {
  private:
   void AddLink(uint32_t from, uint32_t to, double time_s, std::optional<double> facing_override,
                bool loop_closure);
+  bool Linked(uint32_t a, uint32_t b) const;
 
   void RelaxFull();
   void RelaxIncremental();

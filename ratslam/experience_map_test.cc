@@ -71,6 +71,44 @@ TEST(ExperienceMapTest, RelaxationReducesLoopClosureError) {
   EXPECT_EQ(map.links().back().loop_closure, true);
 }
 
+TEST(ExperienceMapTest, AConstraintClosesTheLoopLikeALinkAndKeepsTheCurrentExperience) {
+  ExperienceMap map = DriveBiasedSquare({});
+  const double before = LoopError(map);
+  const uint32_t last = static_cast<uint32_t>(map.num_experiences() - 1);
+  // Experience 0 seen from the last one: 1 m ahead, facing a quarter turn left (the square).
+  StatusOr<bool> added = map.AddConstraint(last, 0, {1.0, 0.0, kPi / 2}, 40.0);
+  ASSERT_TRUE(added.ok());
+  EXPECT_TRUE(added.value());
+  EXPECT_EQ(map.current(), last);
+  EXPECT_TRUE(map.links().back().wifi_sequence);
+  EXPECT_TRUE(map.links().back().loop_closure);
+  EXPECT_NEAR(map.links().back().distance_m, 1.0, 1e-12);
+  EXPECT_NEAR(map.links().back().facing_rad, kPi / 2, 1e-12);
+  for (int i = 0; i < 50; ++i) map.Relax();
+  EXPECT_LT(LoopError(map), 0.25 * before);
+  // The same pair again, an experience with itself, unknown ids, NaN: nothing added.
+  EXPECT_FALSE(map.AddConstraint(0, last, {1.0, 0.0, 0.0}, 41.0).value());
+  EXPECT_FALSE(map.AddConstraint(3, 3, {1.0, 0.0, 0.0}, 41.0).value());
+  EXPECT_FALSE(map.AddConstraint(0, 999, {1.0, 0.0, 0.0}, 41.0).ok());
+  EXPECT_FALSE(map.AddConstraint(0, 5, {NAN, 0.0, 0.0}, 41.0).ok());
+  EXPECT_EQ(map.links().size(), 40u);  // 39 odometry links and the constraint
+}
+
+TEST(ExperienceMapCompassTest, AConstraintTakesTheCompassFacing) {
+  ExperienceMap map({});
+  map.CreateExperience(0, {}, 0.0, 0.3);
+  map.Integrate(5.0, 0.0);
+  map.CreateExperience(1, {}, 1.0);
+  map.Integrate(5.0, 0.0);
+  map.CreateExperience(2, {}, 2.0, 2.0);
+  map.Integrate(5.0, 0.0);
+  map.CreateExperience(3, {}, 3.0);  // no compass here
+  ASSERT_TRUE(map.AddConstraint(0, 2, {10.0, 0.0, 3.0}, 4.0).value());
+  EXPECT_NEAR(map.links().back().facing_rad, 1.7, 1e-12);  // 2.0 - 0.3, not the 3.0 measured
+  ASSERT_TRUE(map.AddConstraint(0, 3, {15.0, 0.0, 0.25}, 4.0).value());
+  EXPECT_NEAR(map.links().back().facing_rad, 0.25, 1e-12);
+}
+
 TEST(ExperienceMapTest, AnchoredFirstExperienceDoesNotMove) {
   ExperienceMapOptions options;
   options.anchor_first_experience = true;

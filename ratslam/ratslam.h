@@ -72,6 +72,14 @@ class Ratslam {
   Status OnView(const ViewDecision& decision);
   // One odometry step followed by the action logic.
   StatusOr<ActionKind> OnOdometry(const OdometryStep& step);
+  // A link between existing experiences measured outside the spine (Wi-Fi sequence loop
+  // closure; see ExperienceMap::AddConstraint), relaxed with the next odometry step.
+  StatusOr<bool> AddConstraint(uint32_t from, uint32_t to, const Pose2& relative, double time_s) {
+    return experience_map_.AddConstraint(from, to, relative, time_s);
+  }
+  // One relaxation action on the experience map (after constraints added when no odometry step
+  // follows).
+  void RelaxExperienceMap() { experience_map_.Relax(); }
   // The latest absolute heading (compass), or none; used by the action logic and stored with new
   // experiences (see ExperienceMap).
   void SetCompassHeading(std::optional<double> heading_rad) { compass_heading_rad_ = heading_rad; }

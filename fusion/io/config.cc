@@ -182,6 +182,16 @@ constexpr AddedKey kKeysAddedAfter[] = {
     {4, "wifi.offset_invariant"},
 };
 
+// Whole sections added after a map format version: older maps resume only with every key at its
+// default, and their fingerprints were taken without the section.
+struct AddedSection {
+  uint32_t after_version;
+  const char* name;
+};
+constexpr AddedSection kSectionsAddedAfter[] = {
+    {5, "wifi_sequence"},
+};
+
 }  // namespace
 
 uint64_t ConfigFingerprint(const PipelineOptions& options) {
@@ -219,11 +229,27 @@ StatusOr<uint64_t> FingerprintAsOfMapVersion(const PipelineOptions& options, uin
     }
     dropped.insert(added.key);
   }
-  // Print again, leaving out the dropped keys' lines (and keeping the layout otherwise).
+  std::set<std::string> dropped_sections;
+  for (const AddedSection& added : kSectionsAddedAfter) {
+    if (map_version > added.after_version) continue;
+    const std::string prefix = std::string(added.name) + ".";
+    for (size_t i = 0; i < lines.size(); ++i) {
+      if (lines[i].first.compare(0, prefix.size(), prefix) != 0) continue;
+      if (lines[i].second != defaults[i].second) {
+        return Status::Error(lines[i].first + " is " + lines[i].second + ", but maps of format " +
+                             std::to_string(map_version) + " were made without [" + added.name +
+                             "]");
+      }
+    }
+    dropped_sections.insert(added.name);
+  }
+  // Print again, leaving out the dropped keys' lines and sections (a section's lines run to the
+  // blank line before the next header), keeping the layout otherwise.
   std::istringstream in(printed);
   std::string line, section, kept;
   while (std::getline(in, line)) {
     if (!line.empty() && line.front() == '[') section = line.substr(1, line.size() - 2);
+    if (dropped_sections.count(section)) continue;
     const size_t eq = line.find(" = ");
     if (eq != std::string::npos && dropped.count(section + "." + line.substr(0, eq))) continue;
     kept += line + "\n";

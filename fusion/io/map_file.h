@@ -19,8 +19,10 @@ namespace ratslam {
 // version 3 adds the resolved configuration, version 4 incremental relaxation's pending work,
 // version 5 the time memory of local view cells (a template's decay_time_s); its
 // configurations have the PDR's orientation test (maps of format 4 resume only with it off,
-// pdr.min_orientation_steadiness = 0).
-inline constexpr uint32_t kMapFormatVersion = 5;
+// pdr.min_orientation_steadiness = 0). Version 6 adds Wi-Fi sequence loop closure (its state
+// and the links it made); its configurations have the [wifi_sequence] section (maps of format 5
+// and older resume with it off).
+inline constexpr uint32_t kMapFormatVersion = 6;
 inline constexpr uint32_t kOldestMapFormatVersion = 2;
 
 struct MapFile {

@@ -150,13 +150,19 @@ TEST(MapFileTest, SchemaListsEveryMemberOfEverySavedStruct) {
   ExpectSchemaComplete<ViewTemplate>("ViewTemplate", 8);
   ExpectSchemaComplete<LocalViewCells::State>("LocalViewCells::State", 2);
   ExpectSchemaComplete<Experience>("Experience", 9);
-  ExpectSchemaComplete<Link>("Link", 8);
+  ExpectSchemaComplete<Link>("Link", 9);
   ExpectSchemaComplete<ExperienceMap::State>("ExperienceMap::State", 6);
   ExpectSchemaComplete<Ratslam::Counters>("Ratslam::Counters", 5);
   ExpectSchemaComplete<Ratslam::State>("Ratslam::State", 6);
   ExpectSchemaComplete<TrajectoryRecord>("TrajectoryRecord", 6);
   ExpectSchemaComplete<FrameRecord>("FrameRecord", 6);
-  ExpectSchemaComplete<ReplayPipeline::State>("ReplayPipeline::State", 14);
+  ExpectSchemaComplete<Pose2>("Pose2", 3);
+  ExpectSchemaComplete<PoseSignal>("PoseSignal", 2);
+  ExpectSchemaComplete<SequencePose>("SequencePose", 6);
+  ExpectSchemaComplete<SequenceCorrespondence>("SequenceCorrespondence", 5);
+  ExpectSchemaComplete<SequenceLoop>("SequenceLoop", 10);
+  ExpectSchemaComplete<WifiSequenceLoopCloser::State>("WifiSequenceLoopCloser::State", 8);
+  ExpectSchemaComplete<ReplayPipeline::State>("ReplayPipeline::State", 17);
   ExpectSchemaComplete<MapFile>("MapFile", 5, /*header_members=*/1);  // format_version
 }
 

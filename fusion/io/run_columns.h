@@ -27,7 +27,13 @@ inline const RunCsvColumns kExperienceColumns = {
     {"pose_cell_x", "pose_cell_y", "pose_cell_theta"}};
 inline const RunCsvColumns kLinkColumns = {{"id", "from_id", "to_id", "distance_m", "heading_rad",
                                             "facing_rad", "duration_s", "loop_closure"},
-                                           {}};
+                                           {"kind"}};
+
+// links.csv's `kind`: odometry (a new experience), loop_closure (RatSLAM re-used an experience)
+// or wifi_sequence (Wi-Fi sequence loop closure).
+inline const char* LinkKindName(bool loop_closure, bool wifi_sequence) {
+  return wifi_sequence ? "wifi_sequence" : loop_closure ? "loop_closure" : "odometry";
+}
 inline const RunCsvColumns kFrameColumns = {
     {"time_s", "template_id", "new_template", "experience_id"}, {"source", "recent"}};
 

@@ -59,6 +59,92 @@ nlohmann::ordered_json RatesWithin(const std::vector<double>& distances_m) {
   return within;
 }
 
+// Mean, standard deviation and maximum (the paper's table I); empty input gives zeros.
+nlohmann::ordered_json ErrorStatistics(const std::vector<double>& v) {
+  double sum = 0.0, sum2 = 0.0, max = 0.0;
+  for (double x : v) {
+    sum += x;
+    sum2 += x * x;
+    max = std::max(max, x);
+  }
+  const double n = static_cast<double>(v.size());
+  const double mean = v.empty() ? 0.0 : sum / n;
+  const double variance = v.empty() ? 0.0 : std::max(sum2 / n - mean * mean, 0.0);
+  return {{"count", v.size()}, {"mean", mean}, {"std", std::sqrt(variance)}, {"max", max}};
+}
+
+// Wi-Fi sequence loop closure: loops and, with ground truth, the correspondence errors of
+// table I: in metres (true positions of the two scans) and in poses (how many poses the past
+// pose is from the past pose truly nearest the current one, among the poses the past sequence
+// spans). Verified: inliers of accepted loops; unverified: every DP pair of every loop matched.
+nlohmann::ordered_json SequenceSummary(const WifiSequenceLoopCloser& closer,
+                                       const ExperienceMap& map, const Dataset& dataset) {
+  nlohmann::ordered_json j;
+  size_t accepted = 0, links = 0, verified = 0;
+  for (const SequenceLoop& l : closer.loops()) {
+    accepted += l.accepted;
+    if (l.accepted) verified += l.inliers;
+  }
+  for (const Link& l : map.links()) links += l.wifi_sequence;
+  j["poses"] = closer.size();
+  j["loops_matched"] = closer.loops().size();
+  j["loops_accepted"] = accepted;
+  j["verified_correspondences"] = verified;
+  j["links"] = links;
+  nlohmann::ordered_json loops = nlohmann::ordered_json::array();
+  for (const SequenceLoop& l : closer.loops()) {
+    loops.push_back({{"id", l.id},
+                     {"matched_time_s", l.time_s},
+                     {"current_poses", l.current_sequence.size()},
+                     {"past_poses", l.past_sequence.size()},
+                     {"inliers", l.inliers},
+                     {"rotation_rad", l.transform.theta_rad},
+                     {"outcome", l.outcome}});
+  }
+  j["loops"] = loops;
+  if (dataset.ground_truth.empty()) return j;
+  std::vector<std::optional<GroundTruthRow>> truth(closer.size());
+  for (size_t i = 0; i < closer.size(); ++i) {
+    truth[i] = InterpolateGroundTruth(dataset.ground_truth, closer.pose(i).time_s);
+  }
+  auto metres = [&](uint32_t a, uint32_t b) {
+    if (!truth[a] || !truth[b]) return std::numeric_limits<double>::quiet_NaN();
+    if (truth[a]->floor != truth[b]->floor) return std::numeric_limits<double>::infinity();
+    return std::hypot(truth[a]->x_m - truth[b]->x_m, truth[a]->y_m - truth[b]->y_m);
+  };
+  std::vector<double> verified_m, verified_poses, unverified_m;
+  for (const SequenceLoop& l : closer.loops()) {
+    if (l.past_sequence.empty()) continue;
+    const uint32_t lo = l.past_sequence.front(), hi = l.past_sequence.back();
+    for (const SequenceCorrespondence& c : l.correspondences) {
+      const double m = metres(c.current_pose, c.past_pose);
+      if (std::isnan(m)) continue;
+      unverified_m.push_back(m);
+      if (!l.accepted || !c.inlier) continue;
+      verified_m.push_back(m);
+      // The truly nearest pose of the same past visit: follow the past track from the matched
+      // pose while the true distance falls (a past sequence may span several visits).
+      uint32_t nearest = c.past_pose;
+      for (int direction : {-1, 1}) {
+        uint32_t p = c.past_pose;
+        while (true) {
+          const int64_t next = static_cast<int64_t>(p) + direction;
+          if (next < lo || next > hi) break;
+          if (!(metres(c.current_pose, static_cast<uint32_t>(next)) < metres(c.current_pose, p)))
+            break;
+          p = static_cast<uint32_t>(next);
+        }
+        if (metres(c.current_pose, p) < metres(c.current_pose, nearest)) nearest = p;
+      }
+      verified_poses.push_back(std::abs(static_cast<double>(nearest) - c.past_pose));
+    }
+  }
+  j["verified_error_m"] = ErrorStatistics(verified_m);
+  j["verified_error_poses"] = ErrorStatistics(verified_poses);
+  j["unverified_error_m"] = ErrorStatistics(unverified_m);
+  return j;
+}
+
 }  // namespace
 
 RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, const RunInfo& info) {
@@ -163,6 +249,9 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
   }
   if (dataset.session_start_times_s.size() > 1)
     j["sessions"] = dataset.session_start_times_s.size();
+  if (pipeline.wifi_sequence().options().enabled) {
+    j["wifi_sequence"] = SequenceSummary(pipeline.wifi_sequence(), map, dataset);
+  }
   j["events_done"] = state.next_event;
   j["events_total"] = state.events_total;
   j["finished"] = pipeline.finished();
@@ -214,7 +303,8 @@ StatusOr<RunSummary> WriteRunOutputs(OutputFolder& folder, const ReplayPipeline&
   for (const Link& l : map.links()) {
     links << l.id << ',' << l.from << ',' << l.to << ',' << Num(l.distance_m) << ','
           << Num(l.heading_rad) << ',' << Num(l.facing_rad) << ',' << Num(l.duration_s) << ','
-          << (l.loop_closure ? 1 : 0) << '\n';
+          << (l.loop_closure ? 1 : 0) << ',' << LinkKindName(l.loop_closure, l.wifi_sequence)
+          << '\n';
   }
   files.emplace_back("links.csv", links.str());
 
@@ -247,6 +337,8 @@ StatusOr<RunSummary> WriteRunOutputs(OutputFolder& folder, const ReplayPipeline&
         << Num(e.theta_rad) << '\n';
   }
   for (const Link& l : map.links()) {
+    // g2o skips comment lines; they say which edges Wi-Fi sequence loop closure made.
+    if (l.wifi_sequence) g2o << "# wifi_sequence link " << l.id << '\n';
     g2o << "EDGE_SE2 " << l.from << ' ' << l.to << ' '
         << Num(l.distance_m * std::cos(l.heading_rad)) << ' '
         << Num(l.distance_m * std::sin(l.heading_rad)) << ' ' << Num(l.facing_rad)
@@ -261,6 +353,27 @@ StatusOr<RunSummary> WriteRunOutputs(OutputFolder& folder, const ReplayPipeline&
            << f.experience_id << ',' << ToString(f.source) << ',' << (f.recent ? 1 : 0) << '\n';
   }
   files.emplace_back("frames.csv", frames.str());
+
+  if (pipeline.wifi_sequence().options().enabled) {
+    // Every correspondence of every loop matched, with the scans' times and map positions.
+    const WifiSequenceLoopCloser& closer = pipeline.wifi_sequence();
+    std::ostringstream loops;
+    loops << "loop_id,matched_time_s,accepted,current_pose,past_pose,current_time_s,"
+             "past_time_s,similarity,inlier,residual_m,current_x_m,current_y_m,past_x_m,past_y_m\n";
+    for (const SequenceLoop& l : closer.loops()) {
+      for (const SequenceCorrespondence& c : l.correspondences) {
+        const Pose2 now = pipeline.MapPose(closer.pose(c.current_pose));
+        const Pose2 then = pipeline.MapPose(closer.pose(c.past_pose));
+        loops << l.id << ',' << Num(l.time_s) << ',' << (l.accepted ? 1 : 0) << ','
+              << c.current_pose << ',' << c.past_pose << ','
+              << Num(closer.pose(c.current_pose).time_s) << ','
+              << Num(closer.pose(c.past_pose).time_s) << ',' << Num(c.similarity) << ','
+              << (c.inlier ? 1 : 0) << ',' << Num(c.residual_m) << ',' << Num(now.x_m) << ','
+              << Num(now.y_m) << ',' << Num(then.x_m) << ',' << Num(then.y_m) << '\n';
+      }
+    }
+    files.emplace_back("wifi_sequence_loops.csv", loops.str());
+  }
 
   RunSummary summary = Summarise(pipeline, dataset, info);
   files.emplace_back("summary.json", summary.json);

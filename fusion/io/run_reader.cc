@@ -71,6 +71,17 @@ StatusOr<RunFolder> ReadRunFolder(const std::string& folder) {
     READ_NUMBER(l.heading_rad, *li, r, "heading_rad");
     READ_NUMBER(l.facing_rad, *li, r, "facing_rad");
     READ_NUMBER(l.duration_s, *li, r, "duration_s");
+    if (li->has_column("kind")) {
+      StatusOr<std::string> kind = li->Text(r, "kind");
+      if (!kind.ok()) return kind.status();
+      l.wifi_sequence = *kind == "wifi_sequence";
+      if (*kind != LinkKindName(l.loop_closure, l.wifi_sequence)) {
+        return li->ErrorAt(r, "kind",
+                           "'" + *kind +
+                               "' does not fit loop_closure (odometry, loop_closure "
+                               "or wifi_sequence)");
+      }
+    }
     run.links.push_back(l);
   }
   StatusOr<CsvTable> fr = CsvTable::Read((fs::path(folder) / "frames.csv").string(),

@@ -54,7 +54,8 @@ bool Describe(A& a, Experience& e) {
 template <typename A>
 bool Describe(A& a, Link& l) {
   return a(l.id) && a(l.from) && a(l.to) && a(l.distance_m) && a(l.heading_rad) &&
-         a(l.facing_rad) && a(l.duration_s) && a(l.loop_closure);
+         a(l.facing_rad) && a(l.duration_s) && a(l.loop_closure) &&
+         (a.version() < 6 || a(l.wifi_sequence));
 }
 
 template <typename A>
@@ -89,12 +90,55 @@ bool Describe(A& a, FrameRecord& f) {
 }
 
 template <typename A>
+bool Describe(A& a, Pose2& p) {
+  return a(p.x_m) && a(p.y_m) && a(p.theta_rad);
+}
+
+template <typename A>
+bool Describe(A& a, std::string& s) {
+  return a(s);
+}
+
+template <typename A>
+bool Describe(A& a, PoseSignal& s) {
+  return a(s.aps) && a(s.quality) &&
+         a.Check(s.aps.size() == s.quality.size(), "Wi-Fi sequence signal sizes differ");
+}
+
+template <typename A>
+bool Describe(A& a, SequencePose& p) {
+  return a(p.time_s) && a(p.travel_m) && a.Object(p.odometry) && a(p.anchor) &&
+         a.Object(p.anchor_offset) && a(p.compass_heading_rad);
+}
+
+template <typename A>
+bool Describe(A& a, SequenceCorrespondence& c) {
+  return a(c.current_pose) && a(c.past_pose) && a(c.similarity) && a(c.inlier) && a(c.residual_m);
+}
+
+template <typename A>
+bool Describe(A& a, SequenceLoop& l) {
+  return a(l.id) && a(l.time_s) && a(l.current_sequence) && a(l.past_sequence) &&
+         a.Objects(l.correspondences, 25) && a.Object(l.transform) && a(l.dp_cost) &&
+         a(l.inliers) && a(l.accepted) && a(l.outcome);
+}
+
+template <typename A>
+bool Describe(A& a, WifiSequenceLoopCloser::State& s) {
+  return a.Objects(s.bssids, 8) && a.Objects(s.poses, 81) && a.Objects(s.signals, 16) &&
+         a(s.open_sequence) && a(s.open_continues) && a(s.open_start_radius_m) &&
+         a(s.open_end_radius_m) && a.Objects(s.loops, 81);
+}
+
+template <typename A>
 bool Describe(A& a, ReplayPipeline::State& s) {
   return a.Object(s.ratslam) && a(s.front_end) && a(s.next_event) && a(s.events_total) &&
          a(s.last_odometry_time_s) && a(s.have_odometry) && a(s.odometry_x_m) &&
          a(s.odometry_y_m) && a(s.odometry_theta_rad) && a.Objects(s.trajectory, 64) &&
          a.Objects(s.frames, 23) && a(s.wifi_scans_seen) && a(s.compass_readings_seen) &&
-         a(s.images_skipped);
+         a(s.images_skipped) &&
+         (a.version() < 6 ||
+          (a.Object(s.wifi_sequence) && a(s.travel_m) && a(s.wifi_sequence_flushed)));
 }
 
 // The header after the magic bytes and version: which options and data set made the map. The

@@ -296,7 +296,8 @@ Verification VerifyCorrespondences(const std::vector<Point2>& current,
     const double sigma = std::max(1.4826 * Median(inlier_residuals), options.residual_floor_m);
     bool changed = false;
     for (size_t m = 0; m < n; ++m) {
-      const bool in = v.residual_m[m] <= options.outlier_sigmas * sigma;
+      const bool in =
+          v.residual_m[m] <= std::min(options.outlier_sigmas * sigma, options.inlier_distance_m);
       changed |= in != v.inlier[m];
       v.inlier[m] = in;
     }
@@ -338,7 +339,8 @@ StatusOr<std::optional<SequenceLoop>> WifiSequenceLoopCloser::AddPose(
                          " map positions for " + std::to_string(t + 1) + " poses");
   }
   if (!std::isfinite(pose.time_s) || !std::isfinite(pose.travel_m) || !Finite(pose.odometry) ||
-      !Finite(pose.anchor_offset)) {
+      !Finite(pose.anchor_offset) ||
+      (pose.compass_heading_rad && !std::isfinite(*pose.compass_heading_rad))) {
     return Status::Error("Wi-Fi sequence: pose at t=" + std::to_string(pose.time_s) +
                          " has a non-finite time, travel or pose");
   }
@@ -372,7 +374,12 @@ StatusOr<std::optional<SequenceLoop>> WifiSequenceLoopCloser::AddPose(
     }
   }
   state_.poses.push_back(pose);
-  state_.signals.push_back(unique);
+  PoseSignal saved;
+  for (const auto& [ap, quality] : unique) {
+    saved.aps.push_back(ap);
+    saved.quality.push_back(quality);
+  }
+  state_.signals.push_back(std::move(saved));
   matrix_.Add(pose.travel_m, std::move(unique));
 
   // Section III-B.1: is the map's estimate of this pose inside a past pose's confidence circle?
@@ -471,46 +478,97 @@ std::optional<SequenceLoop> WifiSequenceLoopCloser::Match(double time_s, bool en
     state_.loops.push_back(loop);
     return loop;
   }
-  std::vector<double> cost(rows * cols);
-  for (size_t r = 0; r < rows; ++r) {
-    for (size_t c = 0; c < cols; ++c) {
-      const double sim = std::clamp(ps_similarity[c][r], 0.0, 1.0);
-      cost[r * cols + c] = 1.0 / std::max(sim, options_.min_similarity);
-    }
+  // The PS may hold several past visits (a route walked many times): each visit (a run of PS
+  // poses without a travel gap above past_split_m) is spotted by continuous DP on its own, and
+  // the visit whose correspondences verify best (most inliers, then least DP cost) is kept. One
+  // DP over all visits would hop from one visit to a later one part way.
+  std::vector<std::pair<size_t, size_t>> visits;  // [first, last) columns
+  for (size_t c = 0; c < cols; ++c) {
+    const bool split = c == 0 || state_.poses[loop.past_sequence[c]].travel_m -
+                                         state_.poses[loop.past_sequence[c - 1]].travel_m >
+                                     options_.past_split_m;
+    if (split) visits.emplace_back(c, c);
+    visits.back().second = c + 1;
   }
-  StatusOr<DpMatch> dp = ContinuousDpMatch(cost, rows, cols, options_.dp_alpha);
-  if (!dp.ok()) {
-    loop.outcome = "no DP path";
+  bool matched = false, compass_refused = false;
+  for (const auto& [first, last] : visits) {
+    const size_t width = last - first;
+    std::vector<double> cost(rows * width);
+    for (size_t r = 0; r < rows; ++r) {
+      for (size_t c = 0; c < width; ++c) {
+        const double sim = std::clamp(ps_similarity[first + c][r], 0.0, 1.0);
+        cost[r * width + c] = 1.0 / std::max(sim, options_.min_similarity);
+      }
+    }
+    StatusOr<DpMatch> dp = ContinuousDpMatch(cost, rows, width, options_.dp_alpha);
+    if (!dp.ok()) continue;
+    std::vector<SequenceCorrespondence> pairs;
+    std::vector<Point2> a, b;
+    for (const DpCorrespondence& pair : dp.value().pairs) {
+      SequenceCorrespondence corr;
+      corr.current_pose = cs[pair.current];
+      corr.past_pose = loop.past_sequence[first + pair.past];
+      corr.similarity = std::clamp(ps_similarity[first + pair.past][pair.current], 0.0, 1.0);
+      pairs.push_back(corr);
+      const Pose2& pc = state_.poses[corr.current_pose].odometry;
+      const Pose2& pp = state_.poses[corr.past_pose].odometry;
+      a.push_back({pc.x_m, pc.y_m});
+      b.push_back({pp.x_m, pp.y_m});
+    }
+    Verification v = VerifyCorrespondences(a, b, options_);
+    if (!CompassAgrees(pairs, v)) {
+      compass_refused = true;
+      continue;
+    }
+    if (matched && (v.inliers < loop.inliers ||
+                    (v.inliers == loop.inliers && dp.value().cost >= loop.dp_cost))) {
+      continue;
+    }
+    matched = true;
+    for (size_t k = 0; k < pairs.size(); ++k) {
+      pairs[k].inlier = v.inlier[k];
+      pairs[k].residual_m = v.residual_m[k];
+    }
+    loop.correspondences = std::move(pairs);
+    loop.dp_cost = dp.value().cost;
+    loop.inliers = static_cast<uint32_t>(v.inliers);
+    loop.transform = {v.transform.translation_x_m, v.transform.translation_y_m,
+                      v.transform.rotation_rad};
+  }
+  if (!matched) {
+    loop.outcome = compass_refused ? "fit rotation disagrees with the compass" : "no DP path";
     state_.loops.push_back(loop);
     return loop;
   }
-  loop.dp_cost = dp.value().cost;
-  std::vector<Point2> a, b;
-  for (const DpCorrespondence& pair : dp.value().pairs) {
-    SequenceCorrespondence corr;
-    corr.current_pose = cs[pair.current];
-    corr.past_pose = loop.past_sequence[pair.past];
-    corr.similarity = std::clamp(ps_similarity[pair.past][pair.current], 0.0, 1.0);
-    loop.correspondences.push_back(corr);
-    const Pose2& pc = state_.poses[corr.current_pose].odometry;
-    const Pose2& pp = state_.poses[corr.past_pose].odometry;
-    a.push_back({pc.x_m, pc.y_m});
-    b.push_back({pp.x_m, pp.y_m});
-  }
-  const Verification v = VerifyCorrespondences(a, b, options_);
-  for (size_t k = 0; k < loop.correspondences.size(); ++k) {
-    loop.correspondences[k].inlier = v.inlier[k];
-    loop.correspondences[k].residual_m = v.residual_m[k];
-  }
-  loop.inliers = static_cast<uint32_t>(v.inliers);
-  loop.transform = {v.transform.translation_x_m, v.transform.translation_y_m,
-                    v.transform.rotation_rad};
+  const size_t inliers = loop.inliers;
   loop.accepted =
-      v.inliers >= static_cast<size_t>(options_.min_inliers) &&
-      static_cast<double>(v.inliers) >= options_.min_inlier_fraction * static_cast<double>(rows);
+      inliers >= static_cast<size_t>(options_.min_inliers) &&
+      static_cast<double>(inliers) >= options_.min_inlier_fraction * static_cast<double>(rows);
   loop.outcome = loop.accepted ? "accepted" : "too few consistent correspondences";
   state_.loops.push_back(loop);
   return loop;
+}
+
+bool WifiSequenceLoopCloser::CompassAgrees(const std::vector<SequenceCorrespondence>& pairs,
+                                           const Verification& v) const {
+  // Each sequence's odometry frame is turned from the world by the circular mean of compass
+  // minus odometry heading over its verified poses; the fit must turn the current frame onto the
+  // past one by the difference.
+  double cs_sin = 0, cs_cos = 0, ps_sin = 0, ps_cos = 0;
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    if (!v.inlier[k]) continue;
+    const SequencePose& c = state_.poses[pairs[k].current_pose];
+    const SequencePose& p = state_.poses[pairs[k].past_pose];
+    if (!c.compass_heading_rad || !p.compass_heading_rad) return true;  // nothing to compare
+    cs_sin += std::sin(*c.compass_heading_rad - c.odometry.theta_rad);
+    cs_cos += std::cos(*c.compass_heading_rad - c.odometry.theta_rad);
+    ps_sin += std::sin(*p.compass_heading_rad - p.odometry.theta_rad);
+    ps_cos += std::cos(*p.compass_heading_rad - p.odometry.theta_rad);
+  }
+  if (v.inliers == 0) return true;
+  const double expected = std::atan2(cs_sin, cs_cos) - std::atan2(ps_sin, ps_cos);
+  return std::abs(WrapAngle(v.transform.rotation_rad - expected)) <=
+         options_.max_compass_disagreement_rad;
 }
 
 Pose2 WifiSequenceLoopCloser::RelativePose(const SequenceLoop& loop, uint32_t current,
@@ -540,13 +598,18 @@ Status WifiSequenceLoopCloser::SetState(State state) {
     const SequencePose& p = state.poses[i];
     if (!std::isfinite(p.time_s) || !std::isfinite(p.travel_m) || !Finite(p.odometry) ||
         !Finite(p.anchor_offset) || p.anchor < -1 ||
+        (p.compass_heading_rad && !std::isfinite(*p.compass_heading_rad)) ||
         (i > 0 && p.travel_m < state.poses[i - 1].travel_m)) {
       return fail("pose " + std::to_string(i) + " is not finite or goes back");
     }
-    for (size_t k = 0; k < state.signals[i].size(); ++k) {
-      const auto& [ap, v] = state.signals[i][k];
-      if (ap >= state.bssids.size() || !(v >= 0.0 && v <= 100.0) ||
-          (k > 0 && ap <= state.signals[i][k - 1].first)) {
+    const PoseSignal& s = state.signals[i];
+    if (s.aps.size() != s.quality.size()) {
+      return fail("signal of pose " + std::to_string(i) +
+                  " has APs and values differing in number");
+    }
+    for (size_t k = 0; k < s.aps.size(); ++k) {
+      if (s.aps[k] >= state.bssids.size() || !(s.quality[k] >= 0.0 && s.quality[k] <= 100.0) ||
+          (k > 0 && s.aps[k] <= s.aps[k - 1])) {
         return fail("signal of pose " + std::to_string(i) + " is out of range");
       }
     }
@@ -573,7 +636,13 @@ Status WifiSequenceLoopCloser::SetState(State state) {
     if (!Finite(l.transform)) return fail("a loop transform is not finite");
   }
   SmoothedSignalMatrix matrix(options_.smoothing_tau_m, options_.smoothing_cutoff_tau);
-  for (size_t i = 0; i < n; ++i) matrix.Add(state.poses[i].travel_m, state.signals[i]);
+  for (size_t i = 0; i < n; ++i) {
+    SparseSignal signal;
+    for (size_t k = 0; k < state.signals[i].aps.size(); ++k) {
+      signal.emplace_back(state.signals[i].aps[k], state.signals[i].quality[k]);
+    }
+    matrix.Add(state.poses[i].travel_m, std::move(signal));
+  }
   state_ = std::move(state);
   ap_index_ = std::move(index);
   matrix_ = std::move(matrix);

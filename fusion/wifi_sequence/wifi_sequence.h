@@ -53,10 +53,11 @@ struct WifiSequenceOptions {
   double confidence_sigmas = 3.0;          // the paper's 3-sigma ellipse
   double min_loop_travel_m = 30.0;         // a past pose must be this much travel behind
   int min_sequence_poses = 5;              // shorter CS (after trimming) or PS: no loop
-  int max_sequence_poses = 200;            // a CS this long is matched, and a new one starts
+  int max_sequence_poses = 30;             // a CS this long is matched, and a new one starts
 
   // Past sequence and DP (section III-B.3, III-C.1).
   double past_similarity = 0.8;  // PS: least similarity to some CS pose
+  double past_split_m = 15.0;    // PS poses further apart in travel are separate past visits
   double dp_alpha = 1.1;         // eq. 5's weight of non-diagonal steps
   double min_similarity = 0.01;  // cost = 1 / max(similarity, this)
 
@@ -65,8 +66,9 @@ struct WifiSequenceOptions {
   double inlier_distance_m = 3.0;      // residual that agrees with a hypothesis
   double outlier_sigmas = 3.0;         // statistical test: residual above this many sigma drops
   double residual_floor_m = 0.5;       // least sigma of that test (dead reckoning is not exact)
-  int min_inliers = 5;                 // a loop needs this many verified correspondences
-  double min_inlier_fraction = 0.5;    // and this share of the CS
+  double max_compass_disagreement_rad = 0.5;  // fit rotation against the compass (if known)
+  int min_inliers = 5;                        // a loop needs this many verified correspondences
+  double min_inlier_fraction = 0.5;           // and this share of the CS
 
   bool IsValid(std::string* error) const;
 
@@ -109,6 +111,10 @@ struct WifiSequenceOptions {
     v("past_similarity", past_similarity,
       "past sequence: poses at least this similar (cosine) to some pose of the current one",
       schema::Unit("").Within(0, 1));
+    v("past_split_m", past_split_m,
+      "past sequence: a travel gap above this between PS poses starts another past visit, "
+      "spotted by its own DP",
+      schema::Unit("m").Positive());
     v("dp_alpha", dp_alpha, "alpha of eq. 5: cost weight of a non-diagonal DP step",
       schema::Unit("").AtLeast(1));
     v("min_similarity", min_similarity,
@@ -125,6 +131,10 @@ struct WifiSequenceOptions {
       schema::Unit("sigmas").Positive());
     v("residual_floor_m", residual_floor_m, "verification: least sigma of the outlier test",
       schema::Unit("m").Positive());
+    v("max_compass_disagreement_rad", max_compass_disagreement_rad,
+      "verification, when every pose has a compass heading: the fit's rotation must agree with "
+      "the rotation the compass gives between the two sequences' odometry frames within this",
+      schema::Unit("rad").Within(0, 3.2));
     v("min_inliers", min_inliers, "a loop needs at least this many verified correspondences",
       schema::Unit("correspondences").AtLeast(2));
     v("min_inlier_fraction", min_inlier_fraction, "and at least this share of the current sequence",
@@ -207,6 +217,12 @@ Verification VerifyCorrespondences(const std::vector<Point2>& current,
                                    const std::vector<Point2>& past,
                                    const WifiSequenceOptions& options);
 
+// A pose's raw signal as saved: eq. 1's signal quality per AP heard, ascending AP index.
+struct PoseSignal {
+  std::vector<uint32_t> aps;
+  std::vector<double> quality;
+};
+
 // A pose of the loop closer: one Wi-Fi scan.
 struct SequencePose {
   double time_s = 0.0;
@@ -214,6 +230,7 @@ struct SequencePose {
   Pose2 odometry;         // dead-reckoned pose
   int64_t anchor = -1;    // the caller's anchor (the current experience), -1 for none
   Pose2 anchor_offset;    // this pose in the anchor's frame
+  std::optional<double> compass_heading_rad;  // absolute heading at the scan, if known
 };
 
 struct SequenceCorrespondence {
@@ -242,7 +259,7 @@ class WifiSequenceLoopCloser {
   struct State {
     std::vector<std::string> bssids;  // AP index -> BSSID
     std::vector<SequencePose> poses;
-    std::vector<SparseSignal> signals;    // per pose: eq. 1's signal quality per AP heard
+    std::vector<PoseSignal> signals;      // per pose
     std::vector<uint32_t> open_sequence;  // the CS being built (untrimmed)
     bool open_continues = false;          // it continues one cut at max_sequence_poses
     double open_start_radius_m = 0.0;     // its first confidence radius
@@ -280,6 +297,8 @@ class WifiSequenceLoopCloser {
   // last confidence circle is trimmed) and records the loop; none for a too short sequence.
   std::optional<SequenceLoop> Match(double time_s, bool ended);
   double Sigma(double travel_m) const;
+  // True unless every verified pose has a compass heading and the fit's rotation disagrees.
+  bool CompassAgrees(const std::vector<SequenceCorrespondence>& pairs, const Verification& v) const;
 
   WifiSequenceOptions options_;
   State state_;

@@ -377,8 +377,8 @@ TEST(WifiSequenceLoopCloserTest, BadInputIsAnErrorOrNoLoopNeverACrash) {
   twice.readings = {{"aa", -80.0}, {"aa", -60.0}, {"bb", NAN}};
   pose.travel_m = 1.0;
   ASSERT_TRUE(closer.AddPose(pose, twice, {{0, 0}, {1, 0}}).ok());
-  ASSERT_EQ(closer.state().signals[1].size(), 1u);
-  EXPECT_DOUBLE_EQ(closer.state().signals[1][0].second, 80.0);
+  ASSERT_EQ(closer.state().signals[1].aps.size(), 1u);
+  EXPECT_DOUBLE_EQ(closer.state().signals[1].quality[0], 80.0);
   // NaN odometry, travel going back, a map position missing or NaN: errors, nothing changes.
   SequencePose bad = pose;
   bad.odometry.x_m = NAN;
@@ -397,7 +397,7 @@ TEST(WifiSequenceLoopCloserTest, BadInputIsAnErrorOrNoLoopNeverACrash) {
   s.bssids.push_back(s.bssids[0]);
   EXPECT_FALSE(closer.SetState(s).ok());
   s = closer.state();
-  s.signals[1][0].first = 9;
+  s.signals[1].aps[0] = 9;
   EXPECT_FALSE(closer.SetState(s).ok());
   EXPECT_EQ(closer.size(), 2u);
 }
