@@ -160,7 +160,7 @@ TEST(MapFileTest, SchemaListsEveryMemberOfEverySavedStruct) {
   ExpectSchemaComplete<PoseSignal>("PoseSignal", 2);
   ExpectSchemaComplete<SequencePose>("SequencePose", 6);
   ExpectSchemaComplete<SequenceCorrespondence>("SequenceCorrespondence", 5);
-  ExpectSchemaComplete<SequenceLoop>("SequenceLoop", 10);
+  ExpectSchemaComplete<SequenceLoop>("SequenceLoop", 11);
   ExpectSchemaComplete<WifiSequenceLoopCloser::State>("WifiSequenceLoopCloser::State", 8);
   ExpectSchemaComplete<ReplayPipeline::State>("ReplayPipeline::State", 17);
   ExpectSchemaComplete<MapFile>("MapFile", 5, /*header_members=*/1);  // format_version

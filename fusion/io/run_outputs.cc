@@ -99,6 +99,7 @@ nlohmann::ordered_json SequenceSummary(const WifiSequenceLoopCloser& closer,
                      {"past_poses", l.past_sequence.size()},
                      {"inliers", l.inliers},
                      {"rotation_rad", l.transform.theta_rad},
+                     {"reversed", l.reversed},
                      {"outcome", l.outcome}});
   }
   j["loops"] = loops;
@@ -113,14 +114,21 @@ nlohmann::ordered_json SequenceSummary(const WifiSequenceLoopCloser& closer,
     return std::hypot(truth[a]->x_m - truth[b]->x_m, truth[a]->y_m - truth[b]->y_m);
   };
   std::vector<double> verified_m, verified_poses, unverified_m;
+  size_t verified_floor_mistakes = 0, unverified_floor_mistakes = 0;
   for (const SequenceLoop& l : closer.loops()) {
     if (l.past_sequence.empty()) continue;
     const uint32_t lo = l.past_sequence.front(), hi = l.past_sequence.back();
     for (const SequenceCorrespondence& c : l.correspondences) {
       const double m = metres(c.current_pose, c.past_pose);
       if (std::isnan(m)) continue;
+      const bool verified = l.accepted && c.inlier;
+      if (std::isinf(m)) {  // the two scans are on different floors
+        ++unverified_floor_mistakes;
+        verified_floor_mistakes += verified;
+        continue;
+      }
       unverified_m.push_back(m);
-      if (!l.accepted || !c.inlier) continue;
+      if (!verified) continue;
       verified_m.push_back(m);
       // The truly nearest pose of the same past visit: follow the past track from the matched
       // pose while the true distance falls (a past sequence may span several visits).
@@ -142,6 +150,8 @@ nlohmann::ordered_json SequenceSummary(const WifiSequenceLoopCloser& closer,
   j["verified_error_m"] = ErrorStatistics(verified_m);
   j["verified_error_poses"] = ErrorStatistics(verified_poses);
   j["unverified_error_m"] = ErrorStatistics(unverified_m);
+  j["verified_floor_mistakes"] = verified_floor_mistakes;
+  j["unverified_floor_mistakes"] = unverified_floor_mistakes;
   return j;
 }
 

@@ -120,14 +120,14 @@ template <typename A>
 bool Describe(A& a, SequenceLoop& l) {
   return a(l.id) && a(l.time_s) && a(l.current_sequence) && a(l.past_sequence) &&
          a.Objects(l.correspondences, 25) && a.Object(l.transform) && a(l.dp_cost) &&
-         a(l.inliers) && a(l.accepted) && a(l.outcome);
+         a(l.inliers) && a(l.reversed) && a(l.accepted) && a(l.outcome);
 }
 
 template <typename A>
 bool Describe(A& a, WifiSequenceLoopCloser::State& s) {
   return a.Objects(s.bssids, 8) && a.Objects(s.poses, 81) && a.Objects(s.signals, 16) &&
          a(s.open_sequence) && a(s.open_continues) && a(s.open_start_radius_m) &&
-         a(s.open_end_radius_m) && a.Objects(s.loops, 81);
+         a(s.open_end_radius_m) && a.Objects(s.loops, 82);
 }
 
 template <typename A>

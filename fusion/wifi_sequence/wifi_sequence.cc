@@ -492,48 +492,56 @@ std::optional<SequenceLoop> WifiSequenceLoopCloser::Match(double time_s, bool en
   }
   bool matched = false, compass_refused = false;
   for (const auto& [first, last] : visits) {
-    const size_t width = last - first;
-    std::vector<double> cost(rows * width);
-    for (size_t r = 0; r < rows; ++r) {
-      for (size_t c = 0; c < width; ++c) {
-        const double sim = std::clamp(ps_similarity[first + c][r], 0.0, 1.0);
-        cost[r * width + c] = 1.0 / std::max(sim, options_.min_similarity);
+    for (const bool reversed : {false, true}) {
+      if (reversed && !options_.match_reversed) continue;
+      const size_t width = last - first;
+      // Column c of this DP: the visit in time order, or backwards (walked the other way).
+      auto column = [&, first = first, last = last](size_t c) {
+        return reversed ? last - 1 - c : first + c;
+      };
+      std::vector<double> cost(rows * width);
+      for (size_t r = 0; r < rows; ++r) {
+        for (size_t c = 0; c < width; ++c) {
+          const double sim = std::clamp(ps_similarity[column(c)][r], 0.0, 1.0);
+          cost[r * width + c] = 1.0 / std::max(sim, options_.min_similarity);
+        }
       }
+      StatusOr<DpMatch> dp = ContinuousDpMatch(cost, rows, width, options_.dp_alpha);
+      if (!dp.ok()) continue;
+      std::vector<SequenceCorrespondence> pairs;
+      std::vector<Point2> a, b;
+      for (const DpCorrespondence& pair : dp.value().pairs) {
+        SequenceCorrespondence corr;
+        corr.current_pose = cs[pair.current];
+        corr.past_pose = loop.past_sequence[column(pair.past)];
+        corr.similarity = std::clamp(ps_similarity[column(pair.past)][pair.current], 0.0, 1.0);
+        pairs.push_back(corr);
+        const Pose2& pc = state_.poses[corr.current_pose].odometry;
+        const Pose2& pp = state_.poses[corr.past_pose].odometry;
+        a.push_back({pc.x_m, pc.y_m});
+        b.push_back({pp.x_m, pp.y_m});
+      }
+      Verification v = VerifyCorrespondences(a, b, options_);
+      if (!CompassAgrees(pairs, v)) {
+        compass_refused = true;
+        continue;
+      }
+      if (matched && (v.inliers < loop.inliers ||
+                      (v.inliers == loop.inliers && dp.value().cost >= loop.dp_cost))) {
+        continue;
+      }
+      matched = true;
+      for (size_t k = 0; k < pairs.size(); ++k) {
+        pairs[k].inlier = v.inlier[k];
+        pairs[k].residual_m = v.residual_m[k];
+      }
+      loop.correspondences = std::move(pairs);
+      loop.dp_cost = dp.value().cost;
+      loop.inliers = static_cast<uint32_t>(v.inliers);
+      loop.transform = {v.transform.translation_x_m, v.transform.translation_y_m,
+                        v.transform.rotation_rad};
+      loop.reversed = reversed;
     }
-    StatusOr<DpMatch> dp = ContinuousDpMatch(cost, rows, width, options_.dp_alpha);
-    if (!dp.ok()) continue;
-    std::vector<SequenceCorrespondence> pairs;
-    std::vector<Point2> a, b;
-    for (const DpCorrespondence& pair : dp.value().pairs) {
-      SequenceCorrespondence corr;
-      corr.current_pose = cs[pair.current];
-      corr.past_pose = loop.past_sequence[first + pair.past];
-      corr.similarity = std::clamp(ps_similarity[first + pair.past][pair.current], 0.0, 1.0);
-      pairs.push_back(corr);
-      const Pose2& pc = state_.poses[corr.current_pose].odometry;
-      const Pose2& pp = state_.poses[corr.past_pose].odometry;
-      a.push_back({pc.x_m, pc.y_m});
-      b.push_back({pp.x_m, pp.y_m});
-    }
-    Verification v = VerifyCorrespondences(a, b, options_);
-    if (!CompassAgrees(pairs, v)) {
-      compass_refused = true;
-      continue;
-    }
-    if (matched && (v.inliers < loop.inliers ||
-                    (v.inliers == loop.inliers && dp.value().cost >= loop.dp_cost))) {
-      continue;
-    }
-    matched = true;
-    for (size_t k = 0; k < pairs.size(); ++k) {
-      pairs[k].inlier = v.inlier[k];
-      pairs[k].residual_m = v.residual_m[k];
-    }
-    loop.correspondences = std::move(pairs);
-    loop.dp_cost = dp.value().cost;
-    loop.inliers = static_cast<uint32_t>(v.inliers);
-    loop.transform = {v.transform.translation_x_m, v.transform.translation_y_m,
-                      v.transform.rotation_rad};
   }
   if (!matched) {
     loop.outcome = compass_refused ? "fit rotation disagrees with the compass" : "no DP path";

@@ -58,6 +58,7 @@ struct WifiSequenceOptions {
   // Past sequence and DP (section III-B.3, III-C.1).
   double past_similarity = 0.8;  // PS: least similarity to some CS pose
   double past_split_m = 15.0;    // PS poses further apart in travel are separate past visits
+  bool match_reversed = false;   // also spot the CS in each past visit walked the other way
   double dp_alpha = 1.1;         // eq. 5's weight of non-diagonal steps
   double min_similarity = 0.01;  // cost = 1 / max(similarity, this)
 
@@ -115,6 +116,10 @@ struct WifiSequenceOptions {
       "past sequence: a travel gap above this between PS poses starts another past visit, "
       "spotted by its own DP",
       schema::Unit("m").Positive());
+    v("match_reversed", match_reversed,
+      "also match each past visit backwards: a corridor walked the other way (the DP then pairs "
+      "the current sequence with the visit in reverse order)",
+      schema::Any());
     v("dp_alpha", dp_alpha, "alpha of eq. 5: cost weight of a non-diagonal DP step",
       schema::Unit("").AtLeast(1));
     v("min_similarity", min_similarity,
@@ -250,6 +255,7 @@ struct SequenceLoop {
   Pose2 transform;  // maps the CS's dead-reckoned poses onto the PS's (verified fit)
   double dp_cost = 0.0;
   uint32_t inliers = 0;
+  bool reversed = false;  // matched against a past visit walked the other way
   bool accepted = false;
   std::string outcome;  // "accepted" or why not
 };
