@@ -19,6 +19,7 @@
 #include "apps/cli.h"
 #include "apps/demo_config.h"
 #include "apps/progress.h"
+#include "apps/wifi_sequence_images.h"
 #include "common/file_util.h"
 #include "common/output_folder.h"
 #include "fusion/io/config.h"
@@ -54,7 +55,8 @@ const char kUsage[] =
     "      multi-session run) and writes the map, trajectory and summary into O. --until T stops "
     "after data time T seconds; --save-map F saves the\n"
     "      whole state to F; --load-map F resumes from F. Ctrl-C stops cleanly and saves.\n"
-    "      --render also writes experience_map.png, template_graph.png and pose_cells.png;\n"
+    "      --render also writes experience_map.png, template_graph.png and pose_cells.png\n"
+    "      (and with [wifi_sequence] wifi_sequence_similarity.png and wifi_sequence_pairs.png);\n"
     "      --animate N writes an experience-map frame every N events to O/animation/.\n"
     "      --lenient skips and counts malformed lines of phone logs instead of failing.\n"
     "  ratslam import --data D [--data D2 ...] --out F [--config C] [--lenient]\n"
@@ -167,6 +169,9 @@ int RunReplay(const ReplayRequest& request) {
     Status rendered = renderer.ok() ? WriteRunImages(*renderer.value(), session.pipeline().View(),
                                                      session.dataset(), request.out)
                                     : renderer.status();
+    if (rendered.ok() && session.pipeline().wifi_sequence().options().enabled) {
+      rendered = WriteWifiSequenceImages(*renderer.value(), session.pipeline(), request.out);
+    }
     if (!rendered.ok()) exit_code = fail(rendered.WithContext("images not written"));
   }
   if (!result.replay.ok()) {

@@ -238,3 +238,50 @@ TEST(GoldenImageTest, SimilarityMatrix) {
 
 }  // namespace
 }  // namespace ratslam
+
+namespace ratslam {
+namespace {
+
+// A Wi-Fi sequence link is told apart from RatSLAM's loop closures: its own legend entry, its
+// count in the caption, and black ink (no category colour) along it, not red.
+TEST(GoldenImageTest, WifiSequenceLinksAreMarkedApart) {
+  ExperienceMapImageData data = GoldenLoop();
+  data.ground_truth.clear();
+  Link across;
+  across.id = 12;
+  across.from = 3;  // the top of the loop
+  across.to = 9;    // the bottom: the link crosses the empty middle
+  across.loop_closure = true;
+  across.wifi_sequence = true;
+  data.links.push_back(across);
+  WorldToImage to_image;
+  const Scene scene = ExperienceMapScene(data, GoldenLoopOptions(), &to_image);
+  EXPECT_TRUE(HasText(scene, "Wi-Fi sequence link"));
+  EXPECT_TRUE(HasText(scene, "12 experiences, 13 links, 2 loop closures (1 by Wi-Fi sequences)"));
+  WorldToImage unused;
+  EXPECT_FALSE(HasText(ExperienceMapScene(GoldenLoop(), GoldenLoopOptions(), &unused),
+                       "Wi-Fi sequence link"));
+
+  StatusOr<std::unique_ptr<SceneRenderer>> renderer = CreateOsMesaRenderer();
+  if (!renderer.ok()) GTEST_SKIP() << "OSMesa unavailable: " << renderer.status().message();
+  StatusOr<RgbaImage> image = renderer.value()->Render(scene);
+  ASSERT_TRUE(image.ok());
+  const ScenePoint a = to_image(data.experiences[3].x_m, data.experiences[3].y_m);
+  const ScenePoint b = to_image(data.experiences[9].x_m, data.experiences[9].y_m);
+  for (float f : {0.3f, 0.5f, 0.7f}) {
+    const int x = static_cast<int>(std::lround(a.x + f * (b.x - a.x)));
+    const int y = static_cast<int>(std::lround(a.y + f * (b.y - a.y)));
+    int darkest = 3 * 255;
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        const uint8_t* q =
+            &image->pixels[(static_cast<size_t>(y + dy) * image->width + x + dx) * 4];
+        darkest = std::min(darkest, q[0] + q[1] + q[2]);
+      }
+    }
+    EXPECT_LT(darkest, 150) << "the Wi-Fi sequence link is not drawn in black at " << f;
+  }
+}
+
+}  // namespace
+}  // namespace ratslam

@@ -29,8 +29,9 @@ namespace {
 namespace fs = std::filesystem;
 
 nlohmann::json Replay(const std::string& config, const std::vector<fs::path>& logs,
-                      const fs::path& out) {
-  std::string command = std::string(RATSLAM_BINARY) + " replay --quiet --config " + config;
+                      const fs::path& out, const std::string& extra = "") {
+  std::string command =
+      std::string(RATSLAM_BINARY) + " replay --quiet " + extra + " --config " + config;
   for (const fs::path& log : logs) command += " --data " + log.string();
   command += " --out " + out.string() + " > /dev/null";
   EXPECT_EQ(std::system(command.c_str()), 0) << command;
@@ -53,7 +54,12 @@ TEST_P(IpinWifiSequenceTest, VerifiedSequencesCloseLoopsOnRealWalks) {
       ("ratslam_ipin_sequence_" + std::string(GetParam()) + "_" + std::to_string(::getpid()));
   const std::string config =
       std::string(RATSLAM_SOURCE_DIR) + "/configs/ipin2023-wifi-sequence-alone.toml";
-  const nlohmann::json with = Replay(config, logs, out / "with");
+  const nlohmann::json with = Replay(config, logs, out / "with", "--render");
+  // Figs. 9 and 10 beside the usual images.
+  for (const char* png : {"wifi_sequence_similarity.png", "wifi_sequence_pairs.png"}) {
+    ASSERT_TRUE(fs::exists(out / "with" / png)) << png;
+    EXPECT_GT(fs::file_size(out / "with" / png), 10000u) << png;
+  }
   // The same run without the loop closer: the shipped file with enabled = false.
   std::ifstream shipped(config);
   std::stringstream text;

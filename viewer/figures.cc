@@ -14,6 +14,8 @@ namespace {
 
 constexpr Rgba kWhite{255, 255, 255, 255};
 constexpr Rgba kLoopClosure{220, 50, 32, 255};
+constexpr Rgba kWifiSequence{0, 0, 0,
+                             255};  // links of Wi-Fi sequence loop closure (no category colour)
 constexpr Rgba kGroundTruth{160, 160, 160, 200};
 
 std::string FormatNumber(double value) {
@@ -215,6 +217,13 @@ Scene ExperienceMapScene(const ExperienceMapImageData& data,
                      s.Line({x, y}, {x + 30, y}, 3.0f, kLoopClosure);
                      s.Text({x + 38, y + 5}, "loop closure", 14, kInk);
                    }});
+  if (std::any_of(data.links.begin(), data.links.end(),
+                  [](const Link& l) { return l.wifi_sequence; })) {
+    items.push_back({38 + TextWidthPx("Wi-Fi sequence link", 14), [](Scene& s, float x, float y) {
+                       s.Line({x, y}, {x + 30, y}, 3.0f, kWifiSequence);
+                       s.Text({x + 38, y + 5}, "Wi-Fi sequence link", 14, kInk);
+                     }});
+  }
   // The time range of the colours (shared between panels when the options fix it).
   double t_first = std::numeric_limits<double>::infinity(), t_last = -t_first;
   for (const Experience& e : data.experiences) {
@@ -299,15 +308,17 @@ Scene ExperienceMapScene(const ExperienceMapImageData& data,
       scene.Disc(to_image(e.x_m, e.y_m), node_radius, color_of(e), 10);
     }
   }
-  size_t loop_closures = 0;
+  size_t loop_closures = 0, sequence_links = 0;
   for (const Link& l : data.links) {
     if (!l.loop_closure) continue;
     ++loop_closures;
+    sequence_links += l.wifi_sequence;
     const Experience& a = data.experiences[l.from];
     const Experience& b = data.experiences[l.to];
-    scene.Line(to_image(a.x_m, a.y_m), to_image(b.x_m, b.y_m),
-               n_links > 20000 ? link_width : link_width + 1.0f,
-               WithAlpha(kLoopClosure, n_links > 20000 ? 150 : 220));
+    scene.Line(
+        to_image(a.x_m, a.y_m), to_image(b.x_m, b.y_m),
+        n_links > 20000 ? link_width : link_width + 1.0f,
+        WithAlpha(l.wifi_sequence ? kWifiSequence : kLoopClosure, n_links > 20000 ? 150 : 220));
   }
   if (data.current && *data.current < data.experiences.size()) {
     // The current pose: an arrow head pointing along the experience's facing.
@@ -326,7 +337,9 @@ Scene ExperienceMapScene(const ExperienceMapImageData& data,
   scene.Text({margin, 50},
              std::to_string(data.experiences.size()) + " experiences, " + std::to_string(n_links) +
                  " links, " + std::to_string(loop_closures) +
-                 (loop_closures == 1 ? " loop closure" : " loop closures"),
+                 (loop_closures == 1 ? " loop closure" : " loop closures") +
+                 (sequence_links ? " (" + std::to_string(sequence_links) + " by Wi-Fi sequences)"
+                                 : std::string()),
              14, kInk);
 
   // Scale bar, bottom left: a nice length near a fifth of the plot width.
@@ -506,8 +519,11 @@ Scene SimilarityMatrixScene(const std::vector<float>& matrix, const std::vector<
                             const SimilarityImageOptions& options) {
   const int n = static_cast<int>(times_s.size());
   const int size = options.size_px;
-  Scene scene(size + 190, size + 150, kWhite);
-  const float left = 80, top = 80;
+  const float legend_band = options.legend.empty() ? 0 : 24;
+  Scene scene(size + 190, size + 150 + static_cast<int>(legend_band), kWhite);
+  const float left = 80, top = 80 + legend_band;
+  const double range =
+      options.value_max > options.value_min ? options.value_max - options.value_min : 1.0;
   if (n > 0 && matrix.size() == static_cast<size_t>(n) * n) {
     SceneImage heat;
     heat.left = left;
@@ -515,10 +531,16 @@ Scene SimilarityMatrixScene(const std::vector<float>& matrix, const std::vector<
     heat.width = heat.height = static_cast<float>(size);
     heat.pixels_wide = heat.pixels_high = n;
     for (float v : matrix) {
-      const Rgba c = SequentialColor(v);
+      const Rgba c = SequentialColor(std::clamp((v - options.value_min) / range, 0.0, 1.0));
       heat.rgba.insert(heat.rgba.end(), {c.r, c.g, c.b, 255});
     }
     scene.Image(std::move(heat));
+    const float cell = static_cast<float>(size) / n;
+    for (const SimilarityMark& m : options.marks) {
+      if (m.row < 0 || m.row >= n || m.col < 0 || m.col >= n) continue;
+      scene.Disc({left + (m.col + 0.5f) * cell, top + (m.row + 0.5f) * cell},
+                 std::max(2.5f, 0.5f * cell), m.color, 10);
+    }
     // Time runs down the rows, as in a matrix; the y axis labels show it.
     const double t0 = times_s.front(), t1 = times_s.back() > t0 ? times_s.back() : t0 + 1;
     const double step = NiceStep(t1 - t0, 8);
@@ -547,10 +569,61 @@ Scene SimilarityMatrixScene(const std::vector<float>& matrix, const std::vector<
                          bar.rgba.begin() + i * 4 + 4);
   }
   scene.Image(std::move(vertical));
-  scene.Text({left + size + 55, top + 12}, "1", 14, kInk);
-  scene.Text({left + size + 55, top + size}, "0", 14, kInk);
+  scene.Text({left + size + 55, top + 12}, FormatNumber(options.value_max), 14, kInk);
+  scene.Text({left + size + 55, top + size}, FormatNumber(options.value_min), 14, kInk);
   scene.Text({left + size + 40, top - 12}, options.value_label, 14, kInk, TextAnchor::kCenter);
   scene.Text({20, 26}, options.title.empty() ? "similarity matrix" : options.title, 18, kInk);
+  float x = 20;
+  for (const auto& [color, label] : options.legend) {
+    scene.Disc({x + 5, 49}, 5, color, 10);
+    scene.Text({x + 16, 54}, label, 14, kInk);
+    x += 40 + TextWidthPx(label, 14);
+  }
+  return scene;
+}
+
+Scene SequencePairsScene(const SequencePairsData& data, const std::string& title) {
+  const int panel = 800, top = 80, margin = 30;
+  Scene scene(2 * panel, panel + top, kWhite);
+  double min_x = std::numeric_limits<double>::infinity(), max_x = -min_x, min_y = min_x,
+         max_y = -min_x;
+  for (const Point2& p : data.positions) {
+    min_x = std::min(min_x, p.x);
+    max_x = std::max(max_x, p.x);
+    min_y = std::min(min_y, p.y);
+    max_y = std::max(max_y, p.y);
+  }
+  if (!std::isfinite(min_x)) min_x = min_y = -1, max_x = max_y = 1;
+  const double span = std::max({max_x - min_x, max_y - min_y, 1e-3});
+  scene.Text({20, 26}, title, 18, kInk);
+  for (int p = 0; p < 2; ++p) {
+    WorldToImage to_image;
+    to_image.scale_px_per_m = (panel - 2 * margin) / span;
+    to_image.center_x_m = 0.5 * (min_x + max_x);
+    to_image.center_y_m = 0.5 * (min_y + max_y);
+    to_image.center_x_px = p * panel + panel / 2.0;
+    to_image.center_y_px = top + panel / 2.0;
+    std::vector<ScenePoint> track;
+    for (const Point2& q : data.positions) track.push_back(to_image(q.x, q.y));
+    scene.Polyline(track, 1.5f, kGroundTruth);
+    size_t drawn = 0;
+    for (const SequencePairsData::Pair& pair : data.pairs) {
+      if (pair.current >= data.positions.size() || pair.past >= data.positions.size()) continue;
+      if (p == 1 && !pair.verified) continue;
+      ++drawn;
+      const Point2& a = data.positions[pair.current];
+      const Point2& b = data.positions[pair.past];
+      scene.Line(to_image(a.x, a.y), to_image(b.x, b.y), 1.5f,
+                 WithAlpha(p == 1 ? kWifiSequence : kLoopClosure, 200));
+      scene.Disc(to_image(a.x, a.y), 2.5f, kInk, 8);
+    }
+    scene.Text({p * panel + 20.0f, 58},
+               (p == 0 ? "DP correspondences before verification: " : "verified: ") +
+                   std::to_string(drawn),
+               15, kInk);
+  }
+  scene.Line({static_cast<float>(panel), top}, {static_cast<float>(panel), top + panel}, 1.0f,
+             kGrid);
   return scene;
 }
 

@@ -109,11 +109,33 @@ struct PoseCellImageOptions {
 // The activity summed over theta as an x-y heat map, and the theta marginal as a ring.
 Scene PoseCellScene(const PoseCellNetwork& network, const PoseCellImageOptions& options);
 
+// A dot on a similarity matrix (row and column in matrix cells), e.g. a loop's correspondences.
+struct SimilarityMark {
+  int row = 0, col = 0;
+  Rgba color;
+};
+
 struct SimilarityImageOptions {
   int size_px = 1000;
   std::string title;
   std::string value_label = "similarity";
+  double value_min = 0.0, value_max = 1.0;           // the colour scale's ends
+  std::vector<SimilarityMark> marks;                 // drawn over the matrix
+  std::vector<std::pair<Rgba, std::string>> legend;  // what the marks mean, under the title
 };
+
+// Scans on the map and the pairs a loop closer matched between them (Kudo and Miura, fig. 10).
+struct SequencePairsData {
+  std::vector<Point2> positions;  // per scan, on the map
+  struct Pair {
+    uint32_t current = 0, past = 0;  // scan indices
+    bool verified = false;
+  };
+  std::vector<Pair> pairs;
+};
+// Two panels over the same view: every pair (left) and the verified ones (right); the scans'
+// track in grey.
+Scene SequencePairsScene(const SequencePairsData& data, const std::string& title);
 
 // An n x n matrix (row-major, values in [0, 1]) sampled at `times_s` as a heat map.
 Scene SimilarityMatrixScene(const std::vector<float>& matrix, const std::vector<double>& times_s,

@@ -1,0 +1,22 @@
+// The images of Wi-Fi sequence loop closure (Kudo and Miura, figs. 9 and 10), from a replay.
+#ifndef RATSLAM_APPS_WIFI_SEQUENCE_IMAGES_H_
+#define RATSLAM_APPS_WIFI_SEQUENCE_IMAGES_H_
+
+#include <string>
+
+#include "common/status.h"
+#include "fusion/replay_pipeline.h"
+#include "render/renderer.h"
+
+namespace ratslam {
+
+// Writes wifi_sequence_similarity.png (the smoothed similarity of every pair of scans, at most
+// 1000 x 1000 cells, with each loop's correspondences marked: verified, rejected) and
+// wifi_sequence_pairs.png (the correspondences on the final map before and after verification)
+// into `folder`.
+Status WriteWifiSequenceImages(SceneRenderer& renderer, const ReplayPipeline& pipeline,
+                               const std::string& folder);
+
+}  // namespace ratslam
+
+#endif  // RATSLAM_APPS_WIFI_SEQUENCE_IMAGES_H_
