@@ -24,10 +24,10 @@ double SignalQuality(double rssi_dbm, double min_rssi_dbm) {
 
 namespace {
 
-// a += w * b, both ascending by AP index.
-void AddScaled(SparseSignal* a, const SparseSignal& b, double w) {
-  SparseSignal out;
-  out.reserve(a->size() + b.size());
+// a += w * b, both ascending by AP index; `out` is scratch (swapped with a, so that its storage
+// is reused from call to call).
+void AddScaled(SparseSignal* a, const SparseSignal& b, double w, SparseSignal& out) {
+  out.clear();
   size_t i = 0, j = 0;
   while (i < a->size() || j < b.size()) {
     if (j == b.size() || (i < a->size() && (*a)[i].first < b[j].first)) {
@@ -41,7 +41,7 @@ void AddScaled(SparseSignal* a, const SparseSignal& b, double w) {
       ++j;
     }
   }
-  *a = std::move(out);
+  a->swap(out);
 }
 
 double Dot(const SparseSignal& a, const SparseSignal& b) {
@@ -84,10 +84,10 @@ void SmoothedSignalMatrix::Add(double travel_m, SparseSignal s) {
     const double d = travel_m - travel_[t];
     if (d > cutoff_m_) break;
     const double w = Weight(d);
-    AddScaled(&sum_[t], raw_[n], w);
+    AddScaled(&sum_[t], raw_[n], w, scratch_);
     weight_sum_[t] += w;
     norm_[t] = -1.0;
-    AddScaled(&sum_[n], raw_[t], w);
+    AddScaled(&sum_[n], raw_[t], w, scratch_);
     weight_sum_[n] += w;
   }
 }

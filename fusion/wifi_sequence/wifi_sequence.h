@@ -185,6 +185,7 @@ class SmoothedSignalMatrix {
   std::vector<SparseSignal> sum_;     // unnormalised sum_i w s_i
   std::vector<double> weight_sum_;    // sum_i w
   mutable std::vector<double> norm_;  // |sum_| per row; negative: stale
+  SparseSignal scratch_;              // merge buffer (no state)
 };
 
 // One pair of the DP path: row `current` of the CS matched to column `past` of the PS.
