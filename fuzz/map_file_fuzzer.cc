@@ -1,7 +1,7 @@
 // Map files: decoding never crashes; a map that decodes and is accepted by a pipeline (classic
-// camera, fused, or FABMAP front end) runs on for a few hundred events and summarises its
-// outputs without touching an id that does not exist. The fuzzer found a dangling trajectory
-// id (Summarise) in 19 executions before restores were validated.
+// camera, fused, FABMAP front end, or Wi-Fi sequence loop closure alone) runs on for a few hundred
+// events and summarises its outputs without touching an id that does not exist. The fuzzer found a
+// dangling trajectory id (Summarise) in 19 executions before restores were validated.
 #include <cmath>
 #include <memory>
 #include <numbers>
@@ -96,7 +96,12 @@ struct Setup {
     fabmap_wifi.sensors.front_end.kind = FrontEndKind::kFabmap;
     fabmap_wifi.sensors.fabmap.localiser.localiser.mode = fabmap::FabmapMode::kWifi;
     fabmap_wifi.sensors.fabmap.localiser.virtual_wifi.use_exploration_scans = true;
-    options = {classic, fused, fabmap_wifi};
+    // Wi-Fi sequence loop closure alone (its poses, loops and links in the saved state).
+    PipelineOptions sequence;
+    sequence.sensors.front_end.kind = FrontEndKind::kNone;
+    sequence.wifi_sequence.enabled = true;
+    sequence.wifi_sequence.min_loop_travel_m = 20.0;
+    options = {classic, fused, fabmap_wifi, sequence};
     for (const PipelineOptions& o : options) {
       fabmap.push_back(o.sensors.front_end.kind == FrontEndKind::kFabmap
                            ? PrepareFabmapResources(o.sensors, dataset, std::nullopt).value()
@@ -118,7 +123,7 @@ Setup& Shared() {
 std::vector<std::string> FuzzSeeds() {
   std::vector<std::string> seeds;
   for (size_t i = 0; i < Shared().options.size(); ++i) {
-    for (double until : {30.0, 100.0}) {
+    for (double until : {30.0, 100.0, 127.0}) {
       auto pipeline = Shared().Pipeline(i);
       ReplayControl control;
       control.until_time_s = until;
