@@ -415,3 +415,27 @@ TEST(ReplayPipelineWifiSequenceTest, RestoreRefusesAPoseAnchoredToAMissingExperi
 
 }  // namespace
 }  // namespace ratslam
+
+namespace ratslam {
+namespace {
+
+TEST(ReplayPipelineWifiSequenceTest, RunsBesideTheFabmapFrontEnd) {
+  const Dataset data = SquareLoop();
+  NoImages images;
+  PipelineOptions options = FabmapWifiOptions(WifiLearning::kOnline);
+  options.wifi_sequence.enabled = true;
+  auto resources = PrepareFabmapResources(options.sensors, data, std::nullopt);
+  ASSERT_TRUE(resources.ok()) << resources.status().message();
+  ReplayPipeline pipeline(options, data, &images, *resources);
+  ASSERT_TRUE(pipeline.Run({}).ok());
+  // Every scan is a pose of the loop closer whatever the front end decides, and the second lap
+  // is matched against the first.
+  EXPECT_EQ(pipeline.wifi_sequence().size(), data.wifi.size());
+  EXPECT_GE(pipeline.wifi_sequence().loops().size(), 1u);
+  for (const SequencePose& p : pipeline.wifi_sequence().state().poses) {
+    EXPECT_LT(p.anchor, static_cast<int64_t>(pipeline.slam().experience_map().num_experiences()));
+  }
+}
+
+}  // namespace
+}  // namespace ratslam

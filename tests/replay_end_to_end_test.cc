@@ -231,6 +231,30 @@ TEST_F(ReplayEndToEndTest, FormatFourMapResumesWithoutTheOrientationTestOnly) {
                                            "pdr.min_orientation_steadiness: 0.0 -> 0.85");
 }
 
+// A format-5 map (made by the release before Wi-Fi sequence loop closure, with
+// `ratslam replay --config configs/synthetic.toml --until 75 --save-map`) resumes under today's
+// defaults to exactly the uninterrupted run: its configuration lacks [wifi_sequence], which
+// defaults to off. Turning the loop closer on is refused, naming the key.
+TEST_F(ReplayEndToEndTest, FormatFiveMapResumesWithWifiSequenceOffOnly) {
+  const fs::path fixture = fs::path(RATSLAM_SOURCE_DIR) / "tests" / "data" / "map-v5-synthetic.map";
+  auto args = [&](const std::string& c, const fs::path& out) {
+    return "replay --quiet --config " + c + " --data " + (root_ / "data").string() + " --out " +
+           out.string();
+  };
+  const fs::path whole = root_ / "whole_v5", rest = root_ / "rest_v5";
+  ASSERT_EQ(RunRatslam(args(config_, whole), root_).exit_code, 0);
+  const Result r = RunRatslam(args(config_, rest) + " --load-map " + fixture.string(), root_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  ExpectSameRun(whole, rest);
+  const fs::path on = root_ / "sequence-on.toml";
+  std::ofstream(on) << Slurp(config_) << "\n[wifi_sequence]\nenabled = true\n";
+  const Result refused = RunRatslam(
+      args(on.string(), root_ / "v5_sequence") + " --load-map " + fixture.string(), root_);
+  EXPECT_EQ(refused.exit_code, 1);
+  EXPECT_NE(refused.err.find("wifi_sequence.enabled: false -> true"), std::string::npos)
+      << refused.err;
+}
+
 // A key added after format 2 must be at its default to resume a format-2 map (which was made
 // without it); the error names the key.
 TEST_F(ReplayEndToEndTest, MapFromThePreviousReleaseRefusesAKeyItCouldNotHaveUsed) {
