@@ -6,7 +6,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake ninja-build pkg-config git clang-format python3
-  libboost-dev libboost-graph-dev
+  libboost-dev libboost-graph-dev libeigen3-dev
   libopencv-dev libosmesa6-dev libtomlplusplus-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev googletest libbenchmark-dev
   "$@"

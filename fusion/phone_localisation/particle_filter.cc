@@ -1,0 +1,286 @@
+#include "fusion/phone_localisation/particle_filter.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <numbers>
+#include <stdexcept>
+
+#include "common/circular.h"
+
+namespace ratslam {
+
+std::string ToString(ScanLikelihood likelihood) {
+  return likelihood == ScanLikelihood::kSum ? "sum" : "product";
+}
+
+StatusOr<ScanLikelihood> ScanLikelihoodFromString(const std::string& name) {
+  if (name == "sum") return ScanLikelihood::kSum;
+  if (name == "product") return ScanLikelihood::kProduct;
+  return Status::Error("unknown scan likelihood '" + name + "' (sum, product)");
+}
+
+bool ParticleFilterOptions::IsValid(std::string* error) const {
+  return schema::CheckFields(*this, error);
+}
+
+std::vector<size_t> SystematicResample(const std::vector<double>& weights, size_t count, double u) {
+  double total = 0.0;
+  for (double w : weights) total += std::max(w, 0.0);
+  std::vector<size_t> out;
+  if (!(total > 0.0) || count == 0) return out;
+  out.reserve(count);
+  const double step = total / static_cast<double>(count);
+  double target = u * step, cumulative = 0.0;
+  size_t i = 0;
+  for (size_t k = 0; k < count; ++k) {
+    while (i + 1 < weights.size() && cumulative + std::max(weights[i], 0.0) <= target) {
+      cumulative += std::max(weights[i], 0.0);
+      ++i;
+    }
+    out.push_back(i);
+    target += step;
+  }
+  return out;
+}
+
+std::vector<std::pair<Point2, double>> WeightedKMeans(const std::vector<Point2>& points,
+                                                      const std::vector<double>& weights, int k,
+                                                      Random* random) {
+  std::vector<std::pair<Point2, double>> out;
+  if (points.empty() || k <= 0 || weights.size() != points.size()) return out;
+  auto d2 = [](const Point2& a, const Point2& b) {
+    return (a.x - b.x) * (a.x - b.x) + (a.y - b.y) * (a.y - b.y);
+  };
+  // k-means++: the first centre by weight, each next with probability ~ weight * distance^2.
+  std::vector<Point2> centres;
+  std::vector<double> nearest(points.size(), std::numeric_limits<double>::infinity());
+  auto pick = [&](const std::vector<double>& mass) -> std::optional<size_t> {
+    double total = 0.0;
+    for (double m : mass) total += m;
+    if (!(total > 0.0)) return std::nullopt;
+    double r = random->Uniform() * total;
+    for (size_t i = 0; i < mass.size(); ++i) {
+      r -= mass[i];
+      if (r < 0.0) return i;
+    }
+    return mass.size() - 1;
+  };
+  std::optional<size_t> first = pick(weights);
+  if (!first) return out;
+  centres.push_back(points[*first]);
+  while (static_cast<int>(centres.size()) < k) {
+    std::vector<double> mass(points.size());
+    for (size_t i = 0; i < points.size(); ++i) {
+      nearest[i] = std::min(nearest[i], d2(points[i], centres.back()));
+      mass[i] = weights[i] * nearest[i];
+    }
+    std::optional<size_t> next = pick(mass);
+    if (!next) break;  // every point sits on a centre
+    centres.push_back(points[*next]);
+  }
+  std::vector<size_t> label(points.size(), 0);
+  std::vector<double> mass(centres.size());
+  for (int round = 0; round < 50; ++round) {
+    bool moved = round == 0;
+    for (size_t i = 0; i < points.size(); ++i) {
+      size_t best = 0;
+      for (size_t c = 1; c < centres.size(); ++c) {
+        if (d2(points[i], centres[c]) < d2(points[i], centres[best])) best = c;
+      }
+      moved |= best != label[i];
+      label[i] = best;
+    }
+    if (!moved) break;
+    std::vector<Point2> sum(centres.size());
+    std::fill(mass.begin(), mass.end(), 0.0);
+    for (size_t i = 0; i < points.size(); ++i) {
+      sum[label[i]].x += weights[i] * points[i].x;
+      sum[label[i]].y += weights[i] * points[i].y;
+      mass[label[i]] += weights[i];
+    }
+    for (size_t c = 0; c < centres.size(); ++c) {
+      if (mass[c] > 0) centres[c] = {sum[c].x / mass[c], sum[c].y / mass[c]};
+    }
+  }
+  std::fill(mass.begin(), mass.end(), 0.0);
+  double total = 0.0;
+  for (size_t i = 0; i < points.size(); ++i) {
+    mass[label[i]] += weights[i];
+    total += weights[i];
+  }
+  for (size_t c = 0; c < centres.size(); ++c) {
+    if (mass[c] > 0) out.push_back({centres[c], total > 0 ? mass[c] / total : 0.0});
+  }
+  std::stable_sort(out.begin(), out.end(),
+                   [](const auto& a, const auto& b) { return a.second > b.second; });
+  return out;
+}
+
+namespace {
+const ParticleFilterOptions& Validated(const ParticleFilterOptions& options) {
+  std::string error;
+  if (!options.IsValid(&error)) throw std::invalid_argument("ParticleFilterOptions: " + error);
+  return options;
+}
+}  // namespace
+
+ParticleFilter::ParticleFilter(const WifiGpMap& map, const ParticleFilterOptions& options)
+    : map_(map), options_(Validated(options)), random_(options.seed) {}
+
+Status ParticleFilter::Initialise(bool have_compass) {
+  std::vector<std::pair<int, Point2>> cells;
+  for (int floor : map_.floors()) {
+    for (const Point2& c : map_.KnownCells(floor)) cells.emplace_back(floor, c);
+  }
+  if (cells.empty()) return Status::Error("the Wi-Fi map stores no cell to locate a phone in");
+  const double half = 0.5 * map_.options().cell_size_m;
+  particles_.assign(static_cast<size_t>(options_.particles), Particle());
+  for (Particle& p : particles_) {
+    const auto& [floor, c] =
+        cells[std::min(cells.size() - 1,
+                       static_cast<size_t>(random_.Uniform() * static_cast<double>(cells.size())))];
+    p.floor = floor;
+    p.x_m = c.x + random_.Uniform(-half, half);
+    p.y_m = c.y + random_.Uniform(-half, half);
+    p.heading_offset_rad = have_compass ? random_.Gaussian(0.0, options_.compass_offset_sigma_rad)
+                                        : random_.Uniform(-std::numbers::pi, std::numbers::pi);
+    p.weight = 1.0 / static_cast<double>(particles_.size());
+  }
+  return Status::Ok();
+}
+
+void ParticleFilter::Step(double forward_m, double heading_rad) {
+  for (Particle& p : particles_) {
+    p.heading_offset_rad += random_.Gaussian(0.0, options_.heading_offset_walk_rad);
+    const double heading =
+        heading_rad + p.heading_offset_rad + random_.Gaussian(0.0, options_.heading_sigma_rad);
+    const double length = forward_m * (1.0 + random_.Gaussian(0.0, options_.step_length_sigma));
+    p.x_m += length * std::cos(heading);
+    p.y_m += length * std::sin(heading);
+  }
+}
+
+void ParticleFilter::Diffuse(double dt_s) {
+  const double sigma = options_.random_walk_m_per_s * std::sqrt(std::max(dt_s, 0.0));
+  for (Particle& p : particles_) {
+    p.x_m += random_.Gaussian(0.0, sigma);
+    p.y_m += random_.Gaussian(0.0, sigma);
+  }
+}
+
+double ParticleFilter::Likelihood(const Point2& p, int floor,
+                                  const std::vector<std::pair<int64_t, double>>& known) const {
+  const double noise2 = map_.options().noise_sigma_dbm * map_.options().noise_sigma_dbm;
+  double sum = 0.0, log_product = 0.0;
+  for (const auto& [ap, rssi] : known) {
+    const WifiGpMap::Cell c = map_.Predict(static_cast<size_t>(ap), floor, p);
+    const double variance = c.variance_dbm2 + noise2;
+    const double z = rssi - c.mean_dbm;
+    const double log_density =
+        -0.5 * z * z / variance - 0.5 * std::log(2 * std::numbers::pi * variance);
+    sum += std::exp(log_density);  // eq. 14 (a reading of an AP not heard is 0 and absent)
+    log_product += log_density;
+  }
+  return options_.likelihood == ScanLikelihood::kSum ? sum : log_product;
+}
+
+size_t ParticleFilter::Update(const std::vector<std::pair<std::string, double>>& readings) {
+  std::vector<std::pair<int64_t, double>> known;
+  for (const auto& [bssid, rssi] : readings) {
+    const int64_t ap = map_.Find(bssid);
+    if (ap >= 0 && std::isfinite(rssi)) known.emplace_back(ap, rssi);
+  }
+  if (known.empty() || particles_.empty()) return known.size();
+  std::vector<double> value(particles_.size());
+  double max_log = -std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < particles_.size(); ++i) {
+    const Particle& p = particles_[i];
+    value[i] = Likelihood({p.x_m, p.y_m}, p.floor, known);
+    if (options_.likelihood == ScanLikelihood::kProduct) max_log = std::max(max_log, value[i]);
+  }
+  for (size_t i = 0; i < particles_.size(); ++i) {
+    Particle& p = particles_[i];
+    // The product in logs, shifted by its largest value so that exp stays in range.
+    const double l =
+        options_.likelihood == ScanLikelihood::kSum ? value[i] : std::exp(value[i] - max_log);
+    p.weight *= l * (map_.Covers(p.floor, {p.x_m, p.y_m}) ? 1.0 : options_.off_map_weight);
+  }
+  Normalise();
+  if (EffectiveSampleSize() < options_.resample_below * static_cast<double>(particles_.size())) {
+    Resample();
+  }
+  return known.size();
+}
+
+void ParticleFilter::Normalise() {
+  double total = 0.0;
+  for (const Particle& p : particles_) total += p.weight;
+  if (!(total > 0.0) || !std::isfinite(total)) {
+    // Every particle explained the scan equally badly: start the weights over.
+    for (Particle& p : particles_) p.weight = 1.0 / static_cast<double>(particles_.size());
+    return;
+  }
+  for (Particle& p : particles_) p.weight /= total;
+}
+
+double ParticleFilter::EffectiveSampleSize() const {
+  double sum2 = 0.0;
+  for (const Particle& p : particles_) sum2 += p.weight * p.weight;
+  return sum2 > 0.0 ? 1.0 / sum2 : 0.0;
+}
+
+void ParticleFilter::Resample() {
+  std::vector<double> w(particles_.size());
+  for (size_t i = 0; i < particles_.size(); ++i) w[i] = particles_[i].weight;
+  const std::vector<size_t> pick = SystematicResample(w, particles_.size(), random_.Uniform());
+  if (pick.empty()) return;
+  std::vector<Particle> next;
+  next.reserve(pick.size());
+  for (size_t i : pick) {
+    next.push_back(particles_[i]);
+    next.back().weight = 1.0 / static_cast<double>(pick.size());
+  }
+  particles_ = std::move(next);
+  ++resamplings_;
+}
+
+LocationEstimate ParticleFilter::Estimate() const {
+  std::map<int, double> by_floor;
+  for (const Particle& p : particles_) by_floor[p.floor] += p.weight;
+  LocationEstimate e;
+  double best = -1.0;
+  for (const auto& [floor, w] : by_floor) {
+    if (w > best) {
+      best = w;
+      e.floor = floor;
+    }
+  }
+  double sx = 0, sy = 0, sw = 0;
+  for (const Particle& p : particles_) {
+    if (p.floor != e.floor) continue;
+    sx += p.weight * p.x_m;
+    sy += p.weight * p.y_m;
+    sw += p.weight;
+  }
+  if (sw > 0) {
+    e.x_m = sx / sw;
+    e.y_m = sy / sw;
+  }
+  return e;
+}
+
+std::vector<std::pair<Point2, double>> ParticleFilter::Candidates() {
+  const int floor = Estimate().floor;
+  std::vector<Point2> points;
+  std::vector<double> weights;
+  for (const Particle& p : particles_) {
+    if (p.floor != floor) continue;
+    points.push_back({p.x_m, p.y_m});
+    weights.push_back(p.weight);
+  }
+  return WeightedKMeans(points, weights, options_.candidates, &random_);
+}
+
+}  // namespace ratslam

@@ -1,0 +1,150 @@
+// Locating a phone in a Wi-Fi map with a particle filter (Kudo and Miura, section IV-B and IV-C;
+// equation numbers are that paper's).
+//
+//  - Motion: each dead-reckoning step (forward distance, heading change) moves every particle
+//    along its own heading, with step-length and heading noise; with no step source a random
+//    walk. A particle's heading is the phone's (compass or integrated) plus a per-particle
+//    offset, drawn at the start (small with a compass, uniform without) and walking slowly.
+//  - Weight: eq. 13-14's sum over heard APs of a Gaussian density of the reading around the
+//    map's mean (variance: the map's plus the measurement noise), or the documented alternative,
+//    the product of those densities (the likelihood of independent readings, which the sum is
+//    not). APs the map does not know are left out; a scan with none the map knows leaves the
+//    weights as they are. A particle off the cells the map stores is down-weighted.
+//  - Resampling: systematic, when the effective sample size falls below a share of the count.
+//  - Candidates: k-means (k-means++ seeding from the filter's seeded generator) over the
+//    particles, the paper's twelve (section IV-C.2).
+// Floors: each particle keeps the floor it was drawn on (no stairs model).
+#ifndef RATSLAM_FUSION_PHONE_LOCALISATION_PARTICLE_FILTER_H_
+#define RATSLAM_FUSION_PHONE_LOCALISATION_PARTICLE_FILTER_H_
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "common/geometry.h"
+#include "common/random.h"
+#include "common/schema.h"
+#include "common/status.h"
+#include "fusion/phone_localisation/wifi_gp_map.h"
+
+namespace ratslam {
+
+// How a particle's weight follows from a scan.
+//  - kSum: eq. 13, the sum of eq. 14's per-AP densities (the paper's).
+//  - kProduct: their product (independent readings), computed in logs.
+enum class ScanLikelihood { kSum, kProduct };
+std::string ToString(ScanLikelihood likelihood);
+StatusOr<ScanLikelihood> ScanLikelihoodFromString(const std::string& name);
+
+struct ParticleFilterOptions {
+  int particles = 2000;                   // particle count
+  double step_length_sigma = 0.15;        // relative step-length noise per step
+  double heading_sigma_rad = 0.05;        // heading noise per step
+  double heading_offset_walk_rad = 0.01;  // per step: drift of a particle's heading offset
+  double compass_offset_sigma_rad = 0.3;  // initial heading offset spread with a compass
+  double random_walk_m_per_s = 0.8;       // no step source: position noise per second
+  double off_map_weight = 0.01;           // weight factor of a particle off the stored cells
+  double resample_below = 0.5;            // resample when ESS < this share of the count
+  ScanLikelihood likelihood = ScanLikelihood::kSum;  // see ScanLikelihood
+  int candidates = 12;                               // k of the k-means candidates (section IV-C.2)
+  uint64_t seed = 1;                                 // the filter's random generator
+
+  bool IsValid(std::string* error) const;
+
+  template <typename Visitor>
+  void VisitFields(Visitor&& v) {
+    v("particles", particles, "particle count", schema::Unit("particles").Within(1, 10000000));
+    v("step_length_sigma", step_length_sigma, "relative step-length noise per step",
+      schema::Unit("").NonNegative());
+    v("heading_sigma_rad", heading_sigma_rad, "heading noise per step",
+      schema::Unit("rad").NonNegative());
+    v("heading_offset_walk_rad", heading_offset_walk_rad,
+      "per step: random walk of a particle's heading offset", schema::Unit("rad").NonNegative());
+    v("compass_offset_sigma_rad", compass_offset_sigma_rad,
+      "with a compass: spread of the initial heading offsets (uniform without one)",
+      schema::Unit("rad").NonNegative());
+    v("random_walk_m_per_s", random_walk_m_per_s,
+      "without steps: position noise per second of a random walk",
+      schema::Unit("m/s").NonNegative());
+    v("off_map_weight", off_map_weight,
+      "weight factor of a particle on a cell the map does not store",
+      schema::Unit("").Within(0, 1));
+    v("resample_below", resample_below,
+      "systematic resampling when the effective sample size falls below this share",
+      schema::Unit("").Within(0, 1));
+    v("likelihood", likelihood,
+      "sum (eq. 13, the paper's) or product (independent readings) of the per-AP densities",
+      schema::Any());
+    v("candidates", candidates, "k of the k-means candidate locations (the paper's 12)",
+      schema::Unit("").AtLeast(1));
+    v("seed", seed, "seed of the filter's random generator", schema::Any());
+  }
+};
+
+struct Particle {
+  double x_m = 0.0, y_m = 0.0;
+  double heading_offset_rad = 0.0;
+  int floor = 0;
+  double weight = 0.0;
+};
+
+struct LocationEstimate {
+  double x_m = 0.0, y_m = 0.0;
+  int floor = 0;  // the floor holding most weight
+};
+
+class ParticleFilter {
+ public:
+  // `map` must outlive the filter; `options` must be valid (throws std::invalid_argument).
+  ParticleFilter(const WifiGpMap& map, const ParticleFilterOptions& options);
+
+  // Spreads the particles uniformly over the cells the map stores (all floors), equal weights.
+  // Fails when the map stores no cell.
+  Status Initialise(bool have_compass);
+  // One dead-reckoning step in the phone's frame, `heading_rad` the phone's heading after it.
+  void Step(double forward_m, double heading_rad);
+  // A random walk over `dt_s` seconds (no step source).
+  void Diffuse(double dt_s);
+  // Weights the particles by a scan (BSSID, RSSI); resamples when the ESS is low. Returns how
+  // many readings the map knew (0: weights unchanged).
+  size_t Update(const std::vector<std::pair<std::string, double>>& readings);
+
+  LocationEstimate Estimate() const;
+  // k-means centres of the particles on the estimate's floor (weighted), at most `candidates` of
+  // them, heaviest first, with their weight shares.
+  std::vector<std::pair<Point2, double>> Candidates();
+  double EffectiveSampleSize() const;
+  const std::vector<Particle>& particles() const { return particles_; }
+  uint64_t resamplings() const { return resamplings_; }
+
+  // The weight eq. 13-14 (or the product) gives one particle at `p` on `floor` (for tests).
+  double Likelihood(const Point2& p, int floor,
+                    const std::vector<std::pair<int64_t, double>>& known_readings) const;
+
+ private:
+  void Normalise();
+  void Resample();
+
+  const WifiGpMap& map_;
+  ParticleFilterOptions options_;
+  Random random_;
+  std::vector<Particle> particles_;
+  uint64_t resamplings_ = 0;
+};
+
+// Systematic resampling: `count` indices into `weights` (normalised or not), drawn with one
+// uniform offset `u` in [0, 1): index i appears about count * w_i times, never off by more than
+// one. Empty for no positive weight.
+std::vector<size_t> SystematicResample(const std::vector<double>& weights, size_t count, double u);
+
+// Weighted k-means (k-means++ seeding from `random`, then Lloyd iterations until no point moves
+// or 50 rounds): at most k centres (fewer for fewer distinct points), each with its weight.
+std::vector<std::pair<Point2, double>> WeightedKMeans(const std::vector<Point2>& points,
+                                                      const std::vector<double>& weights, int k,
+                                                      Random* random);
+
+}  // namespace ratslam
+
+#endif  // RATSLAM_FUSION_PHONE_LOCALISATION_PARTICLE_FILTER_H_

@@ -1,0 +1,208 @@
+#include "fusion/phone_localisation/particle_filter.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace ratslam {
+namespace {
+
+TEST(ParticleFilterOptionsTest, DefaultsAreValid) {
+  std::string error;
+  EXPECT_TRUE(ParticleFilterOptions().IsValid(&error)) << error;
+  EXPECT_EQ(ParticleFilterOptions().candidates, 12);  // section IV-C.2
+  for (ScanLikelihood l : {ScanLikelihood::kSum, ScanLikelihood::kProduct}) {
+    EXPECT_EQ(ScanLikelihoodFromString(ToString(l)).value(), l);
+  }
+  EXPECT_FALSE(ScanLikelihoodFromString("mean").ok());
+}
+
+TEST(SystematicResampleTest, DrawsEachIndexInProportionToItsWeight) {
+  const std::vector<double> w = {0.1, 0.0, 0.6, 0.3};
+  for (double u : {0.0, 0.37, 0.99}) {
+    const std::vector<size_t> pick = SystematicResample(w, 100, u);
+    ASSERT_EQ(pick.size(), 100u);
+    std::vector<int> count(4, 0);
+    for (size_t i : pick) ++count[i];
+    EXPECT_NEAR(count[0], 10, 1);
+    EXPECT_EQ(count[1], 0);  // a zero weight is never drawn
+    EXPECT_NEAR(count[2], 60, 1);
+    EXPECT_NEAR(count[3], 30, 1);
+    for (size_t k = 1; k < pick.size(); ++k) EXPECT_GE(pick[k], pick[k - 1]);
+  }
+  EXPECT_TRUE(SystematicResample({0.0, 0.0}, 10, 0.5).empty());
+}
+
+TEST(WeightedKMeansTest, FindsPlantedClusters) {
+  Random random(5);
+  const std::vector<Point2> truth = {{0, 0}, {20, 0}, {0, 30}, {25, 25}};
+  std::vector<Point2> points;
+  std::vector<double> weights;
+  for (size_t c = 0; c < truth.size(); ++c) {
+    for (int i = 0; i < 200; ++i) {
+      points.push_back({truth[c].x + random.Gaussian(0, 1), truth[c].y + random.Gaussian(0, 1)});
+      weights.push_back(c == 0 ? 2.0 : 1.0);  // the first cluster carries twice the weight
+    }
+  }
+  Random seeded(9);
+  const auto centres = WeightedKMeans(points, weights, 4, &seeded);
+  ASSERT_EQ(centres.size(), 4u);
+  std::set<size_t> found;
+  for (const auto& [c, share] : centres) {
+    for (size_t t = 0; t < truth.size(); ++t) {
+      if (std::hypot(c.x - truth[t].x, c.y - truth[t].y) < 0.5) found.insert(t);
+    }
+  }
+  EXPECT_EQ(found.size(), 4u);
+  // Heaviest first: the doubled cluster holds 2/5 of the weight.
+  EXPECT_NEAR(centres[0].second, 0.4, 1e-9);
+  EXPECT_NEAR(centres[0].first.x, 0.0, 0.5);
+  // Fewer distinct points than k: fewer centres, no crash.
+  Random again(1);
+  EXPECT_EQ(WeightedKMeans({{1, 1}, {1, 1}}, {1, 1}, 12, &again).size(), 1u);
+  EXPECT_TRUE(WeightedKMeans({}, {}, 12, &again).empty());
+}
+
+// A 40 m x 20 m floor with APs on a grid and log-distance path loss: the map is trained on
+// noise-free samples every metre, and a phone walking a known path with noisy scans and steps.
+struct Field {
+  std::vector<Point2> aps;
+  Field() {
+    for (double x = 0; x <= 40; x += 10) {
+      for (double y = 0; y <= 20; y += 10) aps.push_back({x, y});
+    }
+  }
+  std::vector<std::pair<std::string, double>> Scan(const Point2& p, Random* noise) const {
+    std::vector<std::pair<std::string, double>> r;
+    for (size_t a = 0; a < aps.size(); ++a) {
+      const double d = std::hypot(p.x - aps[a].x, p.y - aps[a].y);
+      const double rssi = -30.0 - 25.0 * std::log10(1.0 + d) + (noise ? noise->Gaussian(0, 3) : 0);
+      if (rssi > -85.0) r.emplace_back("ap" + std::to_string(a), rssi);
+    }
+    return r;
+  }
+};
+
+WifiGpMap TrainedMap(const Field& field) {
+  std::vector<WifiMapSample> samples;
+  for (double x = 0; x <= 40; x += 2.0) {
+    for (double y = 0; y <= 20; y += 4.0)
+      samples.push_back({{x, y}, 0, field.Scan({x, y}, nullptr)});
+  }
+  WifiGpOptions options;
+  options.length_scale_m = 3.0;
+  StatusOr<WifiGpMap> map = WifiGpMap::Build(samples, options);
+  EXPECT_TRUE(map.ok()) << map.status().message();
+  return std::move(map.value());
+}
+
+TEST(WifiGpMapTest, PredictsTheFieldNearItsSamplesAndThePriorElsewhere) {
+  const Field field;
+  const WifiGpMap map = TrainedMap(field);
+  EXPECT_EQ(map.bssids().size(), field.aps.size());
+  EXPECT_EQ(map.floors(), std::vector<int>{0});
+  // Between the samples the mean is within a few dB of the truth where the AP is heard well.
+  std::vector<double> errors;
+  for (double x = 3.5; x <= 36; x += 3.7) {
+    for (double y = 3.1; y <= 17; y += 3.3) {
+      for (const auto& [bssid, rssi] : field.Scan({x, y}, nullptr)) {
+        if (rssi < -70) continue;  // near the edge of hearing the unheard floor pulls it down
+        bool stored = false;
+        const auto c = map.Predict(static_cast<size_t>(map.Find(bssid)), 0, {x, y}, &stored);
+        ASSERT_TRUE(stored);
+        errors.push_back(std::abs(c.mean_dbm - rssi));
+      }
+    }
+  }
+  // Samples 2-4 m apart miss the sharp peak next to an AP; elsewhere the GP is close.
+  ASSERT_GT(errors.size(), 100u);
+  std::sort(errors.begin(), errors.end());
+  double sum = 0.0;
+  for (double e : errors) sum += e;
+  EXPECT_LT(sum / errors.size(), 1.5);
+  EXPECT_LT(errors[errors.size() * 9 / 10], 3.0);
+  // Far off the floor and on another floor: the prior.
+  bool stored = true;
+  const auto far = map.Predict(0, 0, {500, 500}, &stored);
+  EXPECT_FALSE(stored);
+  EXPECT_EQ(far.mean_dbm, -100.0f);
+  EXPECT_FALSE(map.Covers(3, {10, 10}));
+  EXPECT_TRUE(map.Covers(0, {10, 10}));
+  EXPECT_EQ(map.Find("nope"), -1);
+}
+
+TEST(WifiGpMapTest, FileRoundTripAndBadFiles) {
+  const WifiGpMap map = TrainedMap(Field());
+  const std::string bytes = map.Encode();
+  StatusOr<WifiGpMap> back = WifiGpMap::Decode(bytes, "w.wifimap");
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  EXPECT_EQ(back->bssids(), map.bssids());
+  EXPECT_EQ(back->stored_cells(), map.stored_cells());
+  EXPECT_EQ(back->Predict(3, 0, {12.3, 4.5}).mean_dbm, map.Predict(3, 0, {12.3, 4.5}).mean_dbm);
+  for (size_t cut : {size_t{0}, size_t{5}, bytes.size() / 2, bytes.size() - 1}) {
+    StatusOr<WifiGpMap> bad = WifiGpMap::Decode(bytes.substr(0, cut), "w.wifimap");
+    ASSERT_FALSE(bad.ok()) << "cut at " << cut;
+    EXPECT_NE(bad.status().message().find("w.wifimap"), std::string::npos);
+  }
+  EXPECT_FALSE(WifiGpMap::Decode(bytes + "x", "w.wifimap").ok());
+  // Bad input to Build: no sample, a NaN position, a NaN reading.
+  EXPECT_FALSE(WifiGpMap::Build({}, WifiGpOptions()).ok());
+  EXPECT_FALSE(WifiGpMap::Build({{{NAN, 0}, 0, {{"a", -50}}}}, WifiGpOptions()).ok());
+  EXPECT_FALSE(WifiGpMap::Build({{{0, 0}, 0, {{"a", NAN}}}}, WifiGpOptions()).ok());
+}
+
+TEST(ParticleFilterTest, ConvergesOnTheWalkerInAKnownField) {
+  const Field field;
+  const WifiGpMap map = TrainedMap(field);
+  for (ScanLikelihood likelihood : {ScanLikelihood::kSum, ScanLikelihood::kProduct}) {
+    ParticleFilterOptions options;
+    options.likelihood = likelihood;
+    options.particles = 3000;
+    ParticleFilter filter(map, options);
+    ASSERT_TRUE(filter.Initialise(/*have_compass=*/true).ok());
+    Random noise(7);
+    // Walk east along y = 10 at 1 m per step, a scan every 2 steps.
+    Point2 at{3, 10};
+    std::vector<double> errors;
+    for (int step = 1; step <= 34; ++step) {
+      at.x += 1.0;
+      filter.Step(1.0 + noise.Gaussian(0, 0.05), noise.Gaussian(0, 0.03));
+      if (step % 2) continue;
+      EXPECT_GT(filter.Update(field.Scan(at, &noise)), 0u);
+      const LocationEstimate e = filter.Estimate();
+      errors.push_back(std::hypot(e.x_m - at.x, e.y_m - at.y));
+    }
+    // Chance: a uniform guess on the 40 x 20 m floor is about 12 m from the walker on average.
+    double late = 0.0;
+    for (size_t i = errors.size() - 5; i < errors.size(); ++i) late += errors[i] / 5;
+    EXPECT_LT(late, 2.5) << ToString(likelihood);
+    EXPECT_GT(filter.resamplings(), 0u);
+    const auto candidates = filter.Candidates();
+    ASSERT_FALSE(candidates.empty());
+    EXPECT_LE(candidates.size(), 12u);
+    EXPECT_LT(std::hypot(candidates[0].first.x - at.x, candidates[0].first.y - at.y), 3.0);
+  }
+}
+
+TEST(ParticleFilterTest, UnknownApsAndAnEmptyMapLeaveABeliefNotACrash) {
+  const WifiGpMap map = TrainedMap(Field());
+  ParticleFilter filter(map, ParticleFilterOptions());
+  ASSERT_TRUE(filter.Initialise(false).ok());
+  const double ess = filter.EffectiveSampleSize();
+  EXPECT_EQ(filter.Update({{"unknown", -60.0}}), 0u);  // weights unchanged
+  EXPECT_DOUBLE_EQ(filter.EffectiveSampleSize(), ess);
+  EXPECT_EQ(filter.Update({}), 0u);
+  filter.Diffuse(2.0);
+  StatusOr<WifiGpMap> nothing = WifiGpMap::Build({{{0, 0}, 0, {}}}, WifiGpOptions());
+  ASSERT_TRUE(nothing.ok());
+  ParticleFilter empty(*nothing, ParticleFilterOptions());
+  EXPECT_FALSE(empty.Initialise(false).ok());
+}
+
+}  // namespace
+}  // namespace ratslam

@@ -1,0 +1,359 @@
+#include "fusion/phone_localisation/wifi_gp_map.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "common/byte_buffer.h"
+
+namespace ratslam {
+namespace {
+
+constexpr char kMagic[] = "RSWIFIGP";
+constexpr uint32_t kVersion = 1;
+constexpr int kTileCells = 8;  // cells per tile side: one local GP per tile
+
+using Key = std::pair<int, int>;
+
+Key CellOf(const Point2& p, double size) {
+  return {static_cast<int>(std::floor(p.x / size)), static_cast<int>(std::floor(p.y / size))};
+}
+
+struct Bin {
+  double sum_x = 0, sum_y = 0;
+  std::vector<size_t> samples;
+};
+
+}  // namespace
+
+StatusOr<WifiGpMap> WifiGpMap::Build(const std::vector<WifiMapSample>& samples,
+                                     const WifiGpOptions& options) {
+  std::string error;
+  if (!options.IsValid(&error)) return Status::Error("Wi-Fi map options: " + error);
+  if (samples.empty()) return Status::Error("Wi-Fi map: no scan with a position to learn from");
+  WifiGpMap map;
+  map.options_ = options;
+  map.samples_ = samples.size();
+  // Per AP, the samples that heard it (the strongest reading of a BSSID heard twice).
+  std::vector<std::map<size_t, double>> heard_by;
+  for (size_t i = 0; i < samples.size(); ++i) {
+    const WifiMapSample& s = samples[i];
+    if (!std::isfinite(s.position.x) || !std::isfinite(s.position.y) ||
+        std::abs(s.position.x) > 1e7 || std::abs(s.position.y) > 1e7) {
+      return Status::Error("Wi-Fi map: sample " + std::to_string(i) + " has no finite position");
+    }
+    for (const auto& [bssid, rssi] : s.readings) {
+      if (!std::isfinite(rssi)) {
+        return Status::Error("Wi-Fi map: sample " + std::to_string(i) + " has a non-finite RSSI");
+      }
+      auto [it, added] = map.index_.emplace(bssid, map.bssids_.size());
+      if (added) {
+        map.bssids_.push_back(bssid);
+        heard_by.emplace_back();
+      }
+      auto [at, first] = heard_by[it->second].emplace(i, rssi);
+      if (!first) at->second = std::max(at->second, rssi);
+    }
+  }
+  // Samples binned per floor.
+  std::map<int, std::map<Key, Bin>> bins;
+  for (size_t i = 0; i < samples.size(); ++i) {
+    Bin& b = bins[samples[i].floor][CellOf(samples[i].position, options.bin_size_m)];
+    b.sum_x += samples[i].position.x;
+    b.sum_y += samples[i].position.y;
+    b.samples.push_back(i);
+  }
+  const double noise2 = options.noise_sigma_dbm * options.noise_sigma_dbm;
+  const double signal2 = options.signal_sigma_dbm * options.signal_sigma_dbm;
+  const double reach = 4.0 * options.length_scale_m;  // kernel below e^-8 beyond
+  const double cell = options.cell_size_m;
+  map.grids_.resize(map.bssids_.size());
+  for (size_t ap = 0; ap < map.bssids_.size(); ++ap) {
+    std::map<int, std::vector<Key>> heard_bins;  // per floor
+    for (const auto& [i, rssi] : heard_by[ap]) {
+      heard_bins[samples[i].floor].push_back(CellOf(samples[i].position, options.bin_size_m));
+    }
+    for (auto& [floor, keys] : heard_bins) {
+      std::sort(keys.begin(), keys.end());
+      keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+      const std::set<Key> heard(keys.begin(), keys.end());
+      // Training points: heard bins, and bins within unheard_reach_m of one (an AP not heard
+      // counts as unheard_rssi_dbm).
+      const int span = static_cast<int>(std::ceil(options.unheard_reach_m / options.bin_size_m));
+      std::vector<Point2> points;
+      std::vector<double> values, noise;
+      for (const auto& [key, bin] : bins[floor]) {
+        bool near = heard.count(key) > 0;
+        for (int dx = -span; !near && dx <= span; ++dx) {
+          for (int dy = -span; !near && dy <= span; ++dy) {
+            near = heard.count({key.first + dx, key.second + dy}) > 0 &&
+                   std::hypot(dx, dy) * options.bin_size_m <= options.unheard_reach_m;
+          }
+        }
+        if (!near) continue;
+        double sum = 0.0;
+        for (size_t i : bin.samples) {
+          auto it = heard_by[ap].find(i);
+          sum += it == heard_by[ap].end() ? options.unheard_rssi_dbm : it->second;
+        }
+        const double n = static_cast<double>(bin.samples.size());
+        points.push_back({bin.sum_x / n, bin.sum_y / n});
+        values.push_back(sum / n);
+        noise.push_back(noise2 / n);
+      }
+      // Cells to store: within grid_margin_m of a heard bin's centre.
+      std::set<Key> cells;
+      const int margin = static_cast<int>(std::ceil(options.grid_margin_m / cell)) + 1;
+      for (const Key& k : keys) {
+        const Point2 c{(k.first + 0.5) * options.bin_size_m, (k.second + 0.5) * options.bin_size_m};
+        const Key center = CellOf(c, cell);
+        for (int dx = -margin; dx <= margin; ++dx) {
+          for (int dy = -margin; dy <= margin; ++dy) {
+            const Point2 q{(center.first + dx + 0.5) * cell, (center.second + dy + 0.5) * cell};
+            if (std::hypot(q.x - c.x, q.y - c.y) <= options.grid_margin_m) {
+              cells.insert({center.first + dx, center.second + dy});
+            }
+          }
+        }
+      }
+      Grid grid;
+      grid.floor = floor;
+      int max_x = std::numeric_limits<int>::min(), max_y = max_x;
+      grid.min_x = grid.min_y = std::numeric_limits<int>::max();
+      for (const Key& k : cells) {
+        grid.min_x = std::min(grid.min_x, k.first);
+        grid.min_y = std::min(grid.min_y, k.second);
+        max_x = std::max(max_x, k.first);
+        max_y = std::max(max_y, k.second);
+      }
+      grid.width = max_x - grid.min_x + 1;
+      grid.height = max_y - grid.min_y + 1;
+      const size_t size = static_cast<size_t>(grid.width) * grid.height;
+      grid.mean_dbm.assign(size, std::numeric_limits<float>::quiet_NaN());
+      grid.variance_dbm2.assign(size, std::numeric_limits<float>::quiet_NaN());
+      // One local GP per tile, from the training points within reach of the tile.
+      std::map<Key, std::vector<Key>> tiles;
+      for (const Key& k : cells) {
+        tiles[{static_cast<int>(std::floor(static_cast<double>(k.first) / kTileCells)),
+               static_cast<int>(std::floor(static_cast<double>(k.second) / kTileCells))}]
+            .push_back(k);
+      }
+      for (const auto& [tile, tile_cells] : tiles) {
+        const double x0 = tile.first * kTileCells * cell - reach,
+                     x1 = (tile.first + 1) * kTileCells * cell + reach;
+        const double y0 = tile.second * kTileCells * cell - reach,
+                     y1 = (tile.second + 1) * kTileCells * cell + reach;
+        std::vector<Point2> p;
+        std::vector<double> v, n;
+        for (size_t i = 0; i < points.size(); ++i) {
+          if (points[i].x < x0 || points[i].x > x1 || points[i].y < y0 || points[i].y > y1) {
+            continue;
+          }
+          p.push_back(points[i]);
+          v.push_back(values[i]);
+          n.push_back(noise[i]);
+        }
+        std::optional<GaussianProcess2D> gp;
+        if (!p.empty()) {
+          StatusOr<GaussianProcess2D> fit = GaussianProcess2D::Fit(
+              p, v, n, options.unheard_rssi_dbm, signal2, options.length_scale_m);
+          if (!fit.ok()) return fit.status().WithContext("Wi-Fi map: AP " + map.bssids_[ap]);
+          gp = std::move(fit.value());
+        }
+        for (const Key& k : tile_cells) {
+          const Point2 q{(k.first + 0.5) * cell, (k.second + 0.5) * cell};
+          double mean = options.unheard_rssi_dbm, variance = signal2;
+          if (gp) {
+            mean = gp->Mean(q);
+            std::optional<double> here;
+            if (options.signal_dependent_variance) {
+              // Eq. 12 on eq. 1's scale, back in dBm^2 (an SQ unit is half a dB).
+              here = SignalDependentVariance(2.0 * (mean + 100.0)) / 4.0;
+            }
+            variance = gp->Variance(q, here);
+          }
+          const size_t at =
+              static_cast<size_t>(k.second - grid.min_y) * grid.width + (k.first - grid.min_x);
+          grid.mean_dbm[at] = static_cast<float>(mean);
+          grid.variance_dbm2[at] = static_cast<float>(variance);
+        }
+      }
+      map.grids_[ap].push_back(std::move(grid));
+    }
+  }
+  map.IndexCoverage();
+  return map;
+}
+
+void WifiGpMap::IndexCoverage() {
+  coverage_.clear();
+  for (const auto& per_ap : grids_) {
+    for (const Grid& g : per_ap) {
+      std::set<Key>& c = coverage_[g.floor];
+      for (int y = 0; y < g.height; ++y) {
+        for (int x = 0; x < g.width; ++x) {
+          if (!std::isnan(g.mean_dbm[static_cast<size_t>(y) * g.width + x])) {
+            c.insert({g.min_x + x, g.min_y + y});
+          }
+        }
+      }
+    }
+  }
+}
+
+WifiGpMap::Cell WifiGpMap::Predict(size_t ap, int floor, const Point2& p, bool* stored) const {
+  const Key k = CellOf(p, options_.cell_size_m);
+  if (stored) *stored = false;
+  if (ap < grids_.size()) {
+    for (const Grid& g : grids_[ap]) {
+      if (g.floor != floor) continue;
+      const int x = k.first - g.min_x, y = k.second - g.min_y;
+      if (x < 0 || y < 0 || x >= g.width || y >= g.height) break;
+      const size_t at = static_cast<size_t>(y) * g.width + x;
+      if (std::isnan(g.mean_dbm[at])) break;
+      if (stored) *stored = true;
+      return {g.mean_dbm[at], g.variance_dbm2[at]};
+    }
+  }
+  return {static_cast<float>(options_.unheard_rssi_dbm),
+          static_cast<float>(options_.signal_sigma_dbm * options_.signal_sigma_dbm)};
+}
+
+int64_t WifiGpMap::Find(const std::string& bssid) const {
+  auto it = index_.find(bssid);
+  return it == index_.end() ? -1 : static_cast<int64_t>(it->second);
+}
+
+std::vector<int> WifiGpMap::floors() const {
+  std::vector<int> out;
+  for (const auto& [floor, cells] : coverage_) {
+    if (!cells.empty()) out.push_back(floor);
+  }
+  return out;
+}
+
+std::vector<Point2> WifiGpMap::KnownCells(int floor) const {
+  std::vector<Point2> out;
+  auto it = coverage_.find(floor);
+  if (it == coverage_.end()) return out;
+  for (const Key& k : it->second) {
+    out.push_back(
+        {(k.first + 0.5) * options_.cell_size_m, (k.second + 0.5) * options_.cell_size_m});
+  }
+  return out;
+}
+
+bool WifiGpMap::Covers(int floor, const Point2& p) const {
+  auto it = coverage_.find(floor);
+  return it != coverage_.end() && it->second.count(CellOf(p, options_.cell_size_m)) > 0;
+}
+
+size_t WifiGpMap::stored_cells() const {
+  size_t n = 0;
+  for (const auto& per_ap : grids_) {
+    for (const Grid& g : per_ap) {
+      n += static_cast<size_t>(std::count_if(g.mean_dbm.begin(), g.mean_dbm.end(),
+                                             [](float v) { return !std::isnan(v); }));
+    }
+  }
+  return n;
+}
+
+std::string WifiGpMap::Encode() const {
+  ByteWriter w;
+  w.String(kMagic);
+  w.Pod(kVersion);
+  WifiGpOptions o = options_;
+  o.VisitFields([&](const char*, auto& field, const char*, const auto&) {
+    using T = std::decay_t<decltype(field)>;
+    if constexpr (std::is_same_v<T, bool>) {
+      w.Bool(field);
+    } else {
+      w.Pod(field);
+    }
+  });
+  w.Pod<uint64_t>(samples_);
+  w.Count(bssids_.size());
+  for (size_t ap = 0; ap < bssids_.size(); ++ap) {
+    w.String(bssids_[ap]);
+    w.Count(grids_[ap].size());
+    for (const Grid& g : grids_[ap]) {
+      w.Pod(g.floor);
+      w.Pod(g.min_x);
+      w.Pod(g.min_y);
+      w.Pod(g.width);
+      w.Pod(g.height);
+      w.PodVector(g.mean_dbm);
+      w.PodVector(g.variance_dbm2);
+    }
+  }
+  return std::move(w.bytes());
+}
+
+StatusOr<WifiGpMap> WifiGpMap::Decode(const std::string& bytes, const std::string& name) {
+  ByteReader r(bytes, name);
+  auto fail = [&](const std::string& what) {
+    return Status::Error(name + ": " + (r.error().empty() ? what : r.error()));
+  };
+  std::string magic;
+  uint32_t version = 0;
+  if (!r.String(&magic) || magic != kMagic) return fail("not a Wi-Fi map file");
+  if (!r.Pod(&version)) return fail("truncated");
+  if (version != kVersion) {
+    return fail("Wi-Fi map format " + std::to_string(version) + " (this program reads " +
+                std::to_string(kVersion) + ")");
+  }
+  WifiGpMap map;
+  bool ok = true;
+  map.options_.VisitFields([&](const char*, auto& field, const char*, const auto&) {
+    using T = std::decay_t<decltype(field)>;
+    if constexpr (std::is_same_v<T, bool>) {
+      ok = ok && r.Bool(&field);
+    } else {
+      ok = ok && r.Pod(&field);
+    }
+  });
+  std::string invalid;
+  if (!ok) return fail("truncated options");
+  if (!map.options_.IsValid(&invalid)) return fail("options: " + invalid);
+  uint64_t samples = 0;
+  size_t aps = 0;
+  if (!r.Pod(&samples) || !r.Count(16, &aps)) return fail("truncated");
+  map.samples_ = samples;
+  map.grids_.resize(aps);
+  for (size_t ap = 0; ap < aps; ++ap) {
+    std::string bssid;
+    size_t grids = 0;
+    if (!r.String(&bssid) || !r.Count(36, &grids)) return fail("truncated");
+    if (!map.index_.emplace(bssid, map.bssids_.size()).second) {
+      return fail("BSSID " + bssid + " appears twice");
+    }
+    map.bssids_.push_back(bssid);
+    for (size_t k = 0; k < grids; ++k) {
+      Grid g;
+      if (!(r.Pod(&g.floor) && r.Pod(&g.min_x) && r.Pod(&g.min_y) && r.Pod(&g.width) &&
+            r.Pod(&g.height) && r.PodVector(&g.mean_dbm) && r.PodVector(&g.variance_dbm2))) {
+        return fail("truncated grid");
+      }
+      const int64_t cells = static_cast<int64_t>(g.width) * g.height;
+      if (g.width <= 0 || g.height <= 0 || std::abs(int64_t{g.min_x}) > 1e8 ||
+          std::abs(int64_t{g.min_y}) > 1e8 || cells != static_cast<int64_t>(g.mean_dbm.size()) ||
+          g.mean_dbm.size() != g.variance_dbm2.size()) {
+        return fail("grid of AP " + bssid + " has a size that does not fit its cells");
+      }
+      for (size_t c = 0; c < g.mean_dbm.size(); ++c) {
+        const float m = g.mean_dbm[c], v = g.variance_dbm2[c];
+        if (std::isnan(m) != std::isnan(v) ||
+            (!std::isnan(m) && (!std::isfinite(m) || !std::isfinite(v) || v < 0))) {
+          return fail("grid of AP " + bssid + " has an invalid cell");
+        }
+      }
+      map.grids_[ap].push_back(std::move(g));
+    }
+  }
+  if (!r.AtEnd()) return fail("trailing bytes");
+  map.IndexCoverage();
+  return map;
+}
+
+}  // namespace ratslam

@@ -1,0 +1,82 @@
+// The precomputed Wi-Fi maps of Kudo and Miura's section IV-A (fig. 15): per access point and
+// floor, the GP's mean and variance on grid cells near where the AP was heard (see
+// gaussian_process.h for the choices behind them). The GP is fitted per tile of cells from the
+// training bins within reach (the kernel is negligible beyond a few length scales), so a map of
+// thousands of poses and hundreds of APs builds in seconds and stores only cells near the APs.
+#ifndef RATSLAM_FUSION_PHONE_LOCALISATION_WIFI_GP_MAP_H_
+#define RATSLAM_FUSION_PHONE_LOCALISATION_WIFI_GP_MAP_H_
+
+#include <cstdint>
+#include <map>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "common/geometry.h"
+#include "common/status.h"
+#include "fusion/phone_localisation/gaussian_process.h"
+
+namespace ratslam {
+
+// A training sample: a position on the map, its floor, and the scan heard there.
+struct WifiMapSample {
+  Point2 position;
+  int floor = 0;
+  std::vector<std::pair<std::string, double>> readings;  // BSSID, RSSI (dBm)
+};
+
+class WifiGpMap {
+ public:
+  struct Cell {
+    float mean_dbm = 0.0f;
+    float variance_dbm2 = 0.0f;  // the GP's (latent) variance; add the noise for a measurement
+  };
+  struct Grid {
+    int32_t floor = 0;
+    int32_t min_x = 0, min_y = 0, width = 0, height = 0;  // in cells
+    std::vector<float> mean_dbm;                          // row-major; NaN: not stored
+    std::vector<float> variance_dbm2;                     // row-major
+  };
+
+  // Fits every AP heard in `samples` on every floor it was heard on. Fails on invalid options, no
+  // sample, or a non-finite position or reading.
+  static StatusOr<WifiGpMap> Build(const std::vector<WifiMapSample>& samples,
+                                   const WifiGpOptions& options);
+
+  // The prediction for AP `ap` (index into bssids()) at `p` on `floor`: the stored cell, or the
+  // prior (unheard mean, sigma_f^2) where none is. `stored` says which.
+  Cell Predict(size_t ap, int floor, const Point2& p, bool* stored = nullptr) const;
+  // AP index of a BSSID, or -1.
+  int64_t Find(const std::string& bssid) const;
+  const WifiGpOptions& options() const { return options_; }
+  const std::vector<std::string>& bssids() const { return bssids_; }
+  const std::vector<Grid>& grids(size_t ap) const { return grids_[ap]; }
+  // Floors with a stored cell, ascending.
+  std::vector<int> floors() const;
+  // Centres of the cells any AP stores on `floor` (where a phone can be, as far as the map knows).
+  std::vector<Point2> KnownCells(int floor) const;
+  // Whether any AP stores the cell holding `p` on `floor`.
+  bool Covers(int floor, const Point2& p) const;
+  size_t stored_cells() const;
+  size_t samples() const { return samples_; }
+
+  // Versioned binary file (magic, version, options, BSSIDs, grids). Decode checks every count and
+  // value; an error names the file.
+  std::string Encode() const;
+  static StatusOr<WifiGpMap> Decode(const std::string& bytes, const std::string& name);
+
+ private:
+  void IndexCoverage();
+  WifiGpOptions options_;
+  size_t samples_ = 0;
+  std::vector<std::string> bssids_;
+  std::map<std::string, size_t> index_;
+  std::vector<std::vector<Grid>> grids_;  // per AP, per floor it was heard on
+  // Per floor, the union of the stored cells, for Covers and KnownCells.
+  std::map<int, std::set<std::pair<int, int>>> coverage_;
+};
+
+}  // namespace ratslam
+
+#endif  // RATSLAM_FUSION_PHONE_LOCALISATION_WIFI_GP_MAP_H_
