@@ -105,6 +105,8 @@ inline std::optional<PipelineOptions> LoadOptions(const Arguments& args,
 // `ratslam render ...` (render_command.cc).
 int RenderCommand(int argc, char** argv);
 int EvaluateCommand(int argc, char** argv);
+int WifiMapCommand(int argc, char** argv);
+int LocateCommand(int argc, char** argv);
 int SimulateCommand(int argc, char** argv);
 int SweepCommand(int argc, char** argv);
 // Simulates `world` into the replay data set `out` (with world.toml, simulation.json and

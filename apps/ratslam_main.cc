@@ -64,8 +64,9 @@ const char kUsage[] =
     "  ratslam demo --out O [--quiet]\n"
     "      Simulates the built-in day_night world (camera, Wi-Fi, compass, odometry) into\n"
     "      O/data, replays it into O with the fused front end and renders the images.\n"
-    "  ratslam print-config [--config C]\n"
-    "      Prints the resolved configuration (the defaults when no file is given).\n"
+    "  ratslam print-config [locate] [--config C]\n"
+    "      Prints the resolved configuration (the defaults when no file is given); with\n"
+    "      `locate`, that of wifi-map and locate.\n"
     "  ratslam import-openratslam FILE.ini\n"
     "      Converts an OpenRatSLAM configuration file to ours (TOML on stdout).\n"
     "  ratslam synthesize --out D [--seed S] [--laps N]\n"
@@ -81,6 +82,12 @@ const char kUsage[] =
     "      FABMAP localisation benchmark: maps M, localises every node of Q, writes\n"
     "      evaluation.json, queries.csv and localisation.png to O. M and Q may be the same\n"
     "      data set: [evaluation] split and map_fraction then divide it.\n"
+    "  ratslam wifi-map --data D [--data D2 ...] --out W [--config C] [--lenient]\n"
+    "      Gaussian-process Wi-Fi maps (per AP, mean and variance grids) from data sets with\n"
+    "      ground truth into the file W ([wifi_map] in C).\n"
+    "  ratslam locate --wifi-map W --data PHONE_LOG --out O [--config C] [--lenient] [--quiet]\n"
+    "      Locates a phone in W with a particle filter ([particle_filter], [pdr]): writes\n"
+    "      trajectory_tum.txt, errors.csv (with ground truth), candidates.csv, summary.json.\n"
     "  ratslam simulate --world NAME|FILE --out D [--seed S] [--quiet]\n"
     "      Simulates a world (built in: office, circular, day_night, aliased_floors,\n"
     "      apartment; or a world TOML file) into the replay data set D, with world.toml,\n"
@@ -274,9 +281,23 @@ int Demo(int argc, char** argv) {
 
 int PrintConfigCommand(int argc, char** argv) {
   auto args = ParseArguments(argc, argv, 2, {"--config"});
-  if (!args || !args->positional.empty()) {
+  const bool locate = args && args->positional == std::vector<std::string>{"locate"};
+  if (!args || (!args->positional.empty() && !locate)) {
     std::cerr << kUsage;
     return kExitUsage;
+  }
+  if (locate) {  // the configuration of wifi-map and locate
+    LocateOptions o;
+    if (args->values.count("--config")) {
+      StatusOr<LocateOptions> loaded = LoadLocateConfigFile(args->values.at("--config"));
+      if (!loaded.ok()) {
+        std::cerr << "ratslam: " << loaded.status().message() << "\n";
+        return kExitError;
+      }
+      o = *loaded;
+    }
+    std::cout << PrintLocateConfig(o);
+    return kExitOk;
   }
   std::string path;
   auto options = LoadOptions(*args, &path);
@@ -377,6 +398,8 @@ int Dispatch(int argc, char** argv) {
   if (command == "synthesize") return SynthesizeCommand(argc, argv);
   if (command == "render") return RenderCommand(argc, argv);
   if (command == "evaluate") return EvaluateCommand(argc, argv);
+  if (command == "wifi-map") return WifiMapCommand(argc, argv);
+  if (command == "locate") return LocateCommand(argc, argv);
   if (command == "simulate") return SimulateCommand(argc, argv);
   if (command == "sweep") return SweepCommand(argc, argv);
   if (command == "import") return ImportCommand(argc, argv);

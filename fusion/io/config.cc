@@ -48,6 +48,8 @@ template <>
 struct TomlCodec<ViewMemory> : EnumCodec<ViewMemory, ViewMemoryFromString> {};
 template <>
 struct TomlCodec<FrontEndKind> : EnumCodec<FrontEndKind, FrontEndKindFromString> {};
+template <>
+struct TomlCodec<ScanLikelihood> : EnumCodec<ScanLikelihood, ScanLikelihoodFromString> {};
 }  // namespace ratslam::schema
 
 namespace ratslam {
@@ -73,12 +75,17 @@ StatusOr<PipelineOptions> ParseConfig(const std::string& text, const std::string
   return ParseConfigOnto(text, source_name, PipelineOptions());
 }
 
-StatusOr<PipelineOptions> ParseConfigOnto(const std::string& text, const std::string& source_name,
-                                          const PipelineOptions& base) {
+namespace {
+
+// Reads the sections `Options::VisitSections` lists onto `base`: unknown sections and keys, wrong
+// types and invalid values are errors naming the file and line.
+template <typename Options>
+StatusOr<Options> ParseSectionsOnto(const std::string& text, const std::string& source_name,
+                                    const Options& base) {
   StatusOr<toml::table> parsed = schema::ParseToml(text, source_name);
   if (!parsed.ok()) return parsed.status();
   const toml::table& root = *parsed;
-  PipelineOptions options = base;
+  Options options = base;
   std::set<std::string> sections;
   Status status;
   options.VisitSections([&](const char* name, auto& section) {
@@ -111,14 +118,33 @@ StatusOr<PipelineOptions> ParseConfigOnto(const std::string& text, const std::st
   return options;
 }
 
+}  // namespace
+
+StatusOr<PipelineOptions> ParseConfigOnto(const std::string& text, const std::string& source_name,
+                                          const PipelineOptions& base) {
+  return ParseSectionsOnto(text, source_name, base);
+}
+
+StatusOr<LocateOptions> ParseLocateConfig(const std::string& text, const std::string& source_name) {
+  return ParseSectionsOnto(text, source_name, LocateOptions());
+}
+
+StatusOr<LocateOptions> LoadLocateConfigFile(const std::string& path) {
+  StatusOr<std::string> text = ReadRegularFile(path, "config file", kMaxConfigBytes);
+  if (!text.ok()) return text.status();
+  return ParseLocateConfig(*text, path);
+}
+
 StatusOr<PipelineOptions> LoadConfigFile(const std::string& path) {
   StatusOr<std::string> text = ReadRegularFile(path, "config file", kMaxConfigBytes);
   if (!text.ok()) return text.status();
   return ParseConfig(*text, path);
 }
 
-std::string PrintConfig(const PipelineOptions& options, bool comments) {
-  PipelineOptions copy = options;
+namespace {
+template <typename Options>
+std::string PrintSections(const Options& options, bool comments) {
+  Options copy = options;
   std::ostringstream out;
   bool first = true;
   copy.VisitSections([&](const char* name, auto& section) {
@@ -129,6 +155,15 @@ std::string PrintConfig(const PipelineOptions& options, bool comments) {
     section.VisitFields(printer);
   });
   return out.str();
+}
+}  // namespace
+
+std::string PrintConfig(const PipelineOptions& options, bool comments) {
+  return PrintSections(options, comments);
+}
+
+std::string PrintLocateConfig(const LocateOptions& options, bool comments) {
+  return PrintSections(options, comments);
 }
 
 namespace {

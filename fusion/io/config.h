@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "common/status.h"
+#include "fusion/phone_localisation/locate_options.h"
 #include "fusion/replay_pipeline.h"
 
 namespace ratslam {
@@ -23,6 +24,11 @@ StatusOr<PipelineOptions> ParseConfigOnto(const std::string& text, const std::st
 // The resolved configuration as TOML, every key present; with `comments`, each key is preceded
 // by its documentation line. ParseConfig(PrintConfig(x)) == x.
 std::string PrintConfig(const PipelineOptions& options, bool comments = true);
+
+// The same for `ratslam wifi-map` and `ratslam locate` ([wifi_map], [particle_filter], [pdr]).
+StatusOr<LocateOptions> ParseLocateConfig(const std::string& text, const std::string& source_name);
+StatusOr<LocateOptions> LoadLocateConfigFile(const std::string& path);
+std::string PrintLocateConfig(const LocateOptions& options, bool comments = true);
 
 // A stable 64-bit fingerprint of the resolved configuration (FNV-1a of PrintConfig without
 // comments), stored in map files so that a map is resumed only with the config that made it.

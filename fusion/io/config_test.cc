@@ -125,7 +125,9 @@ TEST(ConfigTest, ReadmeDocumentsEveryKeyWithItsDefault) {
     documented[section + "." + line.substr(3, key_end - 3)] =
         line.substr(default_begin + 1, default_end - default_begin - 1);
   }
-  std::istringstream printed(PrintConfig(PipelineOptions(), false));
+  // The replay's configuration and that of wifi-map and locate (whose [pdr] is the replay's).
+  std::istringstream printed(PrintConfig(PipelineOptions(), false) + "\n" +
+                             PrintLocateConfig(LocateOptions(), false));
   std::set<std::string> read;
   while (std::getline(printed, line)) {
     if (line.empty()) continue;
@@ -143,6 +145,31 @@ TEST(ConfigTest, ReadmeDocumentsEveryKeyWithItsDefault) {
   for (const auto& [key, value] : documented) {
     EXPECT_TRUE(read.count(key)) << key << " is documented but not read by the program";
   }
+}
+
+TEST(ConfigTest, LocateConfigReadsItsSectionsAndRefusesOthers) {
+  StatusOr<LocateOptions> o = ParseLocateConfig(
+      "[particle_filter]\nlikelihood = \"product\"\nparticles = 500\n[wifi_map]\n"
+      "length_scale_m = 2.0\n",
+      "l.toml");
+  ASSERT_TRUE(o.ok()) << o.status().message();
+  EXPECT_EQ(o->particle_filter.likelihood, ScanLikelihood::kProduct);
+  EXPECT_EQ(o->particle_filter.particles, 500);
+  EXPECT_EQ(o->wifi_map.length_scale_m, 2.0);
+  StatusOr<LocateOptions> back = ParseLocateConfig(PrintLocateConfig(*o), "p.toml");
+  ASSERT_TRUE(back.ok());
+  EXPECT_EQ(PrintLocateConfig(*back), PrintLocateConfig(*o));
+  // A replay section, a typo and a bad enum name the file and line.
+  StatusOr<LocateOptions> replay = ParseLocateConfig("[camera]\nshift_px = 3\n", "l.toml");
+  ASSERT_FALSE(replay.ok());
+  EXPECT_NE(replay.status().message().find("unknown section 'camera'"), std::string::npos);
+  StatusOr<LocateOptions> typo = ParseLocateConfig("[particle_filter]\nparticle = 5\n", "l.toml");
+  ASSERT_FALSE(typo.ok());
+  EXPECT_NE(typo.status().message().find("l.toml:2"), std::string::npos) << typo.status().message();
+  StatusOr<LocateOptions> bad =
+      ParseLocateConfig("[particle_filter]\nlikelihood = \"mean\"\n", "l.toml");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.status().message().find("sum, product"), std::string::npos);
 }
 
 TEST(ConfigTest, BadEnumListsValidNames) {

@@ -33,7 +33,7 @@ StatusOr<WifiGpMap> WifiGpMap::Build(const std::vector<WifiMapSample>& samples,
   if (samples.empty()) return Status::Error("Wi-Fi map: no scan with a position to learn from");
   WifiGpMap map;
   map.options_ = options;
-  map.samples_ = samples.size();
+  map.training_ = samples;
   // Per AP, the samples that heard it (the strongest reading of a BSSID heard twice).
   std::vector<std::map<size_t, double>> heard_by;
   for (size_t i = 0; i < samples.size(); ++i) {
@@ -272,7 +272,9 @@ std::string WifiGpMap::Encode() const {
       w.Pod(field);
     }
   });
-  w.Pod<uint64_t>(samples_);
+  w.Bool(reference_.has_value());
+  w.Pod(reference_ ? reference_->first : 0.0);
+  w.Pod(reference_ ? reference_->second : 0.0);
   w.Count(bssids_.size());
   for (size_t ap = 0; ap < bssids_.size(); ++ap) {
     w.String(bssids_[ap]);
@@ -285,6 +287,18 @@ std::string WifiGpMap::Encode() const {
       w.Pod(g.height);
       w.PodVector(g.mean_dbm);
       w.PodVector(g.variance_dbm2);
+    }
+  }
+  // The training samples, readings by AP index.
+  w.Count(training_.size());
+  for (const WifiMapSample& s : training_) {
+    w.Pod(s.position.x);
+    w.Pod(s.position.y);
+    w.Pod<int32_t>(s.floor);
+    w.Count(s.readings.size());
+    for (const auto& [bssid, rssi] : s.readings) {
+      w.Pod<uint32_t>(static_cast<uint32_t>(index_.at(bssid)));
+      w.Pod(rssi);
     }
   }
   return std::move(w.bytes());
@@ -316,10 +330,18 @@ StatusOr<WifiGpMap> WifiGpMap::Decode(const std::string& bytes, const std::strin
   std::string invalid;
   if (!ok) return fail("truncated options");
   if (!map.options_.IsValid(&invalid)) return fail("options: " + invalid);
-  uint64_t samples = 0;
+  bool has_reference = false;
+  double latitude = 0, longitude = 0;
   size_t aps = 0;
-  if (!r.Pod(&samples) || !r.Count(16, &aps)) return fail("truncated");
-  map.samples_ = samples;
+  if (!r.Bool(&has_reference) || !r.Pod(&latitude) || !r.Pod(&longitude) || !r.Count(16, &aps)) {
+    return fail("truncated");
+  }
+  if (has_reference) {
+    if (!(std::abs(latitude) <= 90) || !(std::abs(longitude) <= 180)) {
+      return fail("geographic reference out of range");
+    }
+    map.reference_ = std::make_pair(latitude, longitude);
+  }
   map.grids_.resize(aps);
   for (size_t ap = 0; ap < aps; ++ap) {
     std::string bssid;
@@ -349,6 +371,31 @@ StatusOr<WifiGpMap> WifiGpMap::Decode(const std::string& bytes, const std::strin
         }
       }
       map.grids_[ap].push_back(std::move(g));
+    }
+  }
+  size_t samples = 0;
+  if (!r.Count(24, &samples)) return fail("truncated samples");
+  map.training_.resize(samples);
+  for (WifiMapSample& s : map.training_) {
+    int32_t floor = 0;
+    size_t readings = 0;
+    if (!(r.Pod(&s.position.x) && r.Pod(&s.position.y) && r.Pod(&floor) &&
+          r.Count(12, &readings))) {
+      return fail("truncated sample");
+    }
+    if (!std::isfinite(s.position.x) || !std::isfinite(s.position.y) ||
+        std::abs(s.position.x) > 1e7 || std::abs(s.position.y) > 1e7) {
+      return fail("a sample's position is not finite");
+    }
+    s.floor = floor;
+    for (size_t k = 0; k < readings; ++k) {
+      uint32_t ap = 0;
+      double rssi = 0;
+      if (!(r.Pod(&ap) && r.Pod(&rssi))) return fail("truncated sample");
+      if (ap >= map.bssids_.size() || !std::isfinite(rssi) || std::abs(rssi) > 1000) {
+        return fail("a sample's reading refers to no AP or is out of range");
+      }
+      s.readings.emplace_back(map.bssids_[ap], rssi);
     }
   }
   if (!r.AtEnd()) return fail("trailing bytes");

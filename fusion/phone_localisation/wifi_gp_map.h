@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <set>
 #include <string>
 #include <utility>
@@ -59,7 +60,13 @@ class WifiGpMap {
   // Whether any AP stores the cell holding `p` on `floor`.
   bool Covers(int floor, const Point2& p) const;
   size_t stored_cells() const;
-  size_t samples() const { return samples_; }
+  size_t samples() const { return training_.size(); }
+  // The samples the map was fitted on (for fingerprint baselines beside the filter).
+  const std::vector<WifiMapSample>& training_samples() const { return training_; }
+  // The geographic origin of the map's frame (latitude, longitude in degrees) when its data came
+  // from geo-referenced logs: a phone log must be read in the same frame.
+  const std::optional<std::pair<double, double>>& geo_reference_deg() const { return reference_; }
+  void set_geo_reference_deg(std::optional<std::pair<double, double>> r) { reference_ = r; }
 
   // Versioned binary file (magic, version, options, BSSIDs, grids). Decode checks every count and
   // value; an error names the file.
@@ -69,7 +76,8 @@ class WifiGpMap {
  private:
   void IndexCoverage();
   WifiGpOptions options_;
-  size_t samples_ = 0;
+  std::vector<WifiMapSample> training_;
+  std::optional<std::pair<double, double>> reference_;
   std::vector<std::string> bssids_;
   std::map<std::string, size_t> index_;
   std::vector<std::vector<Grid>> grids_;  // per AP, per floor it was heard on

@@ -1,0 +1,298 @@
+// `ratslam wifi-map` and `ratslam locate`: Gaussian-process Wi-Fi maps from data with ground
+// truth, and a particle filter that locates a phone in them (Kudo and Miura, section IV).
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <limits>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "apps/cli.h"
+#include "common/number_text.h"
+#include "common/output_folder.h"
+#include "common/text_file.h"
+#include "fusion/io/config.h"
+#include "fusion/phone_localisation/particle_filter.h"
+#include "fusion/phone_localisation/wifi_gp_map.h"
+#include "sensors/dataset/dataset_loader.h"
+#include "sensors/dataset/ipin_log.h"
+#include "session/evaluation_baselines.h"
+
+namespace ratslam {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr size_t kMaxWifiMapBytes = size_t{1} << 31;
+
+std::optional<LocateOptions> LoadLocateOptions(const Arguments& args, const char* command) {
+  if (!args.values.count("--config")) return LocateOptions();
+  StatusOr<LocateOptions> o = LoadLocateConfigFile(args.values.at("--config"));
+  if (!o.ok()) {
+    std::cerr << "ratslam " << command << ": " << o.status().message() << "\n";
+    return std::nullopt;
+  }
+  return *o;
+}
+
+// Loads data sets in one frame: IPIN logs share the first one's geographic origin (or the given
+// one). Returns the origin used, if any log had one.
+StatusOr<std::vector<Dataset>> LoadInOneFrame(const std::vector<std::string>& paths,
+                                              PhoneLogOptions phone,
+                                              std::optional<std::pair<double, double>>* origin) {
+  if (*origin) phone.reference = GeoReference{(*origin)->first, (*origin)->second};
+  std::vector<Dataset> out;
+  for (const std::string& path : paths) {
+    StatusOr<DatasetFormat> format = DetectDatasetFormat(path);
+    if (!format.ok()) return format.status();
+    if (format.value() == DatasetFormat::kIpinLog) {
+      PhoneLogReport report;
+      StatusOr<Dataset> d = ReadIpinLog(path, phone, &report);
+      if (!d.ok()) return d.status();
+      if (!phone.reference) {
+        phone.reference = report.reference;
+        *origin = std::make_pair(report.reference.latitude_deg, report.reference.longitude_deg);
+      }
+      out.push_back(std::move(d.value()));
+    } else {
+      StatusOr<Dataset> d = LoadDataset(path, phone);
+      if (!d.ok()) return d.status();
+      out.push_back(std::move(d.value()));
+    }
+  }
+  return out;
+}
+
+std::vector<std::pair<std::string, double>> Readings(const WifiScan& scan) {
+  std::vector<std::pair<std::string, double>> r;
+  for (const WifiReading& w : scan.readings) r.emplace_back(w.bssid, w.rssi_dbm);
+  return r;
+}
+
+// Percentiles of the errors on the right floor; a wrong floor (infinite error) is counted apart.
+nlohmann::ordered_json ErrorSummary(std::vector<double> all) {
+  nlohmann::ordered_json j;
+  std::vector<double> errors;
+  for (double e : all) {
+    if (std::isfinite(e)) errors.push_back(e);
+  }
+  std::sort(errors.begin(), errors.end());
+  j["count"] = errors.size();
+  j["wrong_floor"] = all.size() - errors.size();
+  if (errors.empty()) return j;
+  auto at = [&](double q) {
+    return errors[std::min(errors.size() - 1, static_cast<size_t>(q * (errors.size() - 1) + 0.5))];
+  };
+  double sum = 0.0;
+  for (double e : errors) sum += e;
+  j["mean_error_m"] = sum / errors.size();
+  j["median_error_m"] = at(0.5);
+  j["p75_error_m"] = at(0.75);
+  j["p90_error_m"] = at(0.9);
+  return j;
+}
+
+}  // namespace
+
+int WifiMapCommand(int argc, char** argv) {
+  const auto args = ParseArguments(argc, argv, 2, {"--data", "--out", "--config"});
+  if (!args || !args->all.count("--data") || !args->values.count("--out")) {
+    std::cerr << "usage: ratslam wifi-map --data D [--data D2 ...] --out W [--config C] "
+                 "[--lenient]\n";
+    return kExitUsage;
+  }
+  const std::optional<LocateOptions> options = LoadLocateOptions(*args, "wifi-map");
+  if (!options) return kExitError;
+  auto fail = [](const Status& s) {
+    std::cerr << "ratslam wifi-map: " << s.message() << "\n";
+    return kExitError;
+  };
+  const auto start = std::chrono::steady_clock::now();
+  PhoneLogOptions phone;
+  phone.lenient = args->lenient;
+  phone.pdr = options->pdr;
+  std::optional<std::pair<double, double>> origin;
+  StatusOr<std::vector<Dataset>> data = LoadInOneFrame(args->all.at("--data"), phone, &origin);
+  if (!data.ok()) return fail(data.status());
+  std::vector<WifiMapSample> samples;
+  size_t scans = 0;
+  for (const Dataset& d : data.value()) {
+    for (const WifiScan& scan : d.wifi) {
+      ++scans;
+      const auto truth = InterpolateGroundTruth(d.ground_truth, scan.time_s);
+      if (!truth || scan.readings.empty()) continue;
+      samples.push_back({{truth->x_m, truth->y_m}, truth->floor, Readings(scan)});
+    }
+  }
+  if (samples.empty()) {
+    return fail(Status::Error(
+        std::to_string(scans) +
+        " Wi-Fi scans and none with ground truth at its time: a Wi-Fi map needs positions"));
+  }
+  StatusOr<WifiGpMap> map = WifiGpMap::Build(samples, options->wifi_map);
+  if (!map.ok()) return fail(map.status());
+  map->set_geo_reference_deg(origin);
+  const fs::path out = args->values.at("--out");
+  StatusOr<std::unique_ptr<DiskFolder>> folder =
+      DiskFolder::Open(out.has_parent_path() ? out.parent_path().string() : ".");
+  if (!folder.ok()) return fail(folder.status());
+  Status written = folder.value()->Write(out.filename().string(), map->Encode());
+  if (!written.ok()) return fail(written);
+  nlohmann::ordered_json j;
+  j["wifi_map"] = out.string();
+  j["scans"] = scans;
+  j["samples"] = samples.size();
+  j["access_points"] = map->bssids().size();
+  j["floors"] = map->floors();
+  j["stored_cells"] = map->stored_cells();
+  j["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::cout << j.dump(2) << "\n";
+  return kExitOk;
+}
+
+int LocateCommand(int argc, char** argv) {
+  const auto args = ParseArguments(argc, argv, 2, {"--wifi-map", "--data", "--out", "--config"});
+  if (!args || !args->values.count("--wifi-map") || !args->values.count("--data") ||
+      !args->values.count("--out")) {
+    std::cerr << "usage: ratslam locate --wifi-map W --data PHONE_LOG --out O [--config C] "
+                 "[--lenient] [--quiet]\n";
+    return kExitUsage;
+  }
+  const std::optional<LocateOptions> options = LoadLocateOptions(*args, "locate");
+  if (!options) return kExitError;
+  auto fail = [](const Status& s) {
+    std::cerr << "ratslam locate: " << s.message() << "\n";
+    return kExitError;
+  };
+  const std::string map_path = args->values.at("--wifi-map");
+  StatusOr<std::string> bytes = ReadRegularFile(map_path, "Wi-Fi map", kMaxWifiMapBytes);
+  if (!bytes.ok()) return fail(bytes.status());
+  StatusOr<WifiGpMap> map = WifiGpMap::Decode(*bytes, map_path);
+  if (!map.ok()) return fail(map.status());
+  PhoneLogOptions phone;
+  phone.lenient = args->lenient;
+  phone.pdr = options->pdr;
+  std::optional<std::pair<double, double>> origin = map->geo_reference_deg();
+  StatusOr<std::vector<Dataset>> data = LoadInOneFrame({args->values.at("--data")}, phone, &origin);
+  if (!data.ok()) return fail(data.status());
+  const Dataset& d = data.value().front();
+  if (d.wifi.empty()) {
+    return fail(
+        Status::Error(args->values.at("--data") + ": no Wi-Fi scan to locate the phone by"));
+  }
+  ParticleFilter filter(map.value(), options->particle_filter);
+  const bool compass = !d.compass.empty();
+  Status initialised = filter.Initialise(compass);
+  if (!initialised.ok()) return fail(initialised);
+
+  // Replay odometry (PDR steps), compass and scans in time order.
+  std::ostringstream tum, errors, candidates;
+  tum << "# timestamp tx ty tz qx qy qz qw (particle filter estimate at each Wi-Fi scan)\n";
+  errors << "time_s,x_m,y_m,floor,known_aps,true_x_m,true_y_m,true_floor,error_m,"
+            "knn_error_m\n";
+  candidates << "time_s,rank,x_m,y_m,weight\n";
+  std::vector<double> filter_errors, knn_errors;
+  size_t unknown_scans = 0;
+  std::optional<double> heading, last_time, last_odometry;
+  double integrated_heading = 0.0;
+  // Fingerprint baseline on the map's own training scans (weighted 3-NN, session/).
+  std::vector<fabmap::EvaluationNode> map_nodes;
+  for (const WifiMapSample& s : map->training_samples()) {
+    fabmap::EvaluationNode n;
+    n.x_m = s.position.x;
+    n.y_m = s.position.y;
+    n.floor = s.floor;
+    std::vector<WifiReading> r;
+    for (const auto& [b, v] : s.readings) r.push_back({b, v});
+    n.wifi = r;
+    map_nodes.push_back(std::move(n));
+  }
+  std::vector<fabmap::EvaluationNode> queries;
+  for (const WifiScan& scan : d.wifi) {
+    fabmap::EvaluationNode q;
+    q.wifi = scan.readings;
+    queries.push_back(std::move(q));
+  }
+  const std::vector<fabmap::Estimate> knn = KnnEstimates(map_nodes, queries);
+  size_t scan_index = 0;
+  for (const Event& e : MergeEvents(d)) {
+    if (e.type == EventType::kCompass) {
+      heading = d.compass[e.index].heading_rad;
+    } else if (e.type == EventType::kOdometry) {
+      const OdometryRow& row = d.odometry[e.index];
+      const double dt = last_odometry ? row.time_s - *last_odometry : 0.0;
+      last_odometry = row.time_s;
+      integrated_heading += row.turn_rate_rad_per_s * dt;
+      const double forward = row.forward_speed_m_per_s * dt;
+      if (forward != 0.0) filter.Step(forward, compass && heading ? *heading : integrated_heading);
+    } else if (e.type == EventType::kWifi) {
+      const WifiScan& scan = d.wifi[e.index];
+      if (d.odometry.empty() && last_time) filter.Diffuse(scan.time_s - *last_time);
+      last_time = scan.time_s;
+      const size_t known = filter.Update(Readings(scan));
+      unknown_scans += known == 0;
+      const LocationEstimate est = filter.Estimate();
+      tum << ShortestNumber(scan.time_s) << ' ' << ShortestNumber(est.x_m) << ' '
+          << ShortestNumber(est.y_m) << " 0 0 0 0 1\n";
+      const auto found = filter.Candidates();
+      for (size_t k = 0; k < found.size(); ++k) {
+        candidates << ShortestNumber(scan.time_s) << ',' << k << ','
+                   << ShortestNumber(found[k].first.x) << ',' << ShortestNumber(found[k].first.y)
+                   << ',' << ShortestNumber(found[k].second) << '\n';
+      }
+      errors << ShortestNumber(scan.time_s) << ',' << ShortestNumber(est.x_m) << ','
+             << ShortestNumber(est.y_m) << ',' << est.floor << ',' << known;
+      const auto truth = InterpolateGroundTruth(d.ground_truth, scan.time_s);
+      if (truth) {
+        const bool wrong_floor = truth->floor != est.floor;
+        const double error = wrong_floor ? std::numeric_limits<double>::infinity()
+                                         : std::hypot(est.x_m - truth->x_m, est.y_m - truth->y_m);
+        filter_errors.push_back(error);
+        const fabmap::Estimate& k = knn[scan_index];
+        const double knn_error = !k.located || k.floor != truth->floor
+                                     ? std::numeric_limits<double>::infinity()
+                                     : std::hypot(k.x_m - truth->x_m, k.y_m - truth->y_m);
+        knn_errors.push_back(knn_error);
+        errors << ',' << ShortestNumber(truth->x_m) << ',' << ShortestNumber(truth->y_m) << ','
+               << truth->floor << ',' << ShortestNumber(error) << ',' << ShortestNumber(knn_error)
+               << '\n';
+      } else {
+        errors << ",,,,,\n";
+      }
+      ++scan_index;
+    }
+  }
+  nlohmann::ordered_json j;
+  j["data"] = args->values.at("--data");
+  j["wifi_map"] = map_path;
+  j["scans"] = d.wifi.size();
+  j["scans_without_known_ap"] = unknown_scans;
+  j["steps_from"] = d.odometry.empty() ? "random walk" : "pedestrian dead reckoning";
+  j["heading_from"] = compass ? "compass" : "integrated turn rate";
+  j["likelihood"] = ToString(options->particle_filter.likelihood);
+  j["particles"] = options->particle_filter.particles;
+  j["resamplings"] = filter.resamplings();
+  if (!filter_errors.empty()) {
+    nlohmann::ordered_json f = ErrorSummary(filter_errors);
+    for (auto& [key, value] : f.items()) j[key] = value;
+    j["knn_baseline"] = ErrorSummary(knn_errors);
+  }
+  const std::string summary = j.dump(2) + "\n";
+  StatusOr<std::unique_ptr<DiskFolder>> folder = DiskFolder::Open(args->values.at("--out"));
+  if (!folder.ok()) return fail(folder.status());
+  Status written = folder.value()->Write({{"config.toml", PrintLocateConfig(*options)},
+                                          {"trajectory_tum.txt", tum.str()},
+                                          {"errors.csv", errors.str()},
+                                          {"candidates.csv", candidates.str()},
+                                          {"summary.json", summary}});
+  if (!written.ok()) return fail(written);
+  if (!args->quiet) std::cout << summary;
+  return kExitOk;
+}
+
+}  // namespace ratslam
