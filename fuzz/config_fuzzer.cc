@@ -13,7 +13,8 @@ std::vector<std::string> FuzzSeeds() {
   fused.sensors.fused.use_camera = true;
   fused.sensors.fused.use_compass = true;
   return {PrintConfig(PipelineOptions()), PrintConfig(fused, false),
-          "[front_end]\nkind = \"fabmap\"\n[fabmap]\nmode = \"early\"\n[wifi_words]\nbins = 8\n"};
+          "[front_end]\nkind = \"fabmap\"\n[fabmap]\nmode = \"early\"\n[wifi_words]\nbins = 8\n",
+          PrintLocateConfig(LocateOptions())};
 }
 
 }  // namespace ratslam::fuzz
@@ -21,6 +22,20 @@ std::vector<std::string> FuzzSeeds() {
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace ratslam;
   const std::string text(reinterpret_cast<const char*>(data), size);
+  // The same text as a wifi-map / locate configuration: the same invariants.
+  StatusOr<LocateOptions> locate = ParseLocateConfig(text, "fuzz.toml");
+  if (!locate.ok() && locate.status().message().rfind("fuzz.toml", 0) != 0) {
+    fuzz::InvariantFailed("error does not name the file: " + locate.status().message());
+  }
+  if (locate.ok()) {
+    std::string invalid;
+    if (!locate->IsValid(&invalid)) fuzz::InvariantFailed("accepted an invalid config: " + invalid);
+    const std::string printed = PrintLocateConfig(*locate);
+    StatusOr<LocateOptions> back = ParseLocateConfig(printed, "printed.toml");
+    if (!back.ok() || PrintLocateConfig(*back) != printed) {
+      fuzz::InvariantFailed("locate config print/parse round trip differs");
+    }
+  }
   StatusOr<PipelineOptions> options = ParseConfig(text, "fuzz.toml");
   if (!options.ok()) {
     if (options.status().message().rfind("fuzz.toml", 0) != 0) {

@@ -47,11 +47,11 @@ struct WifiGpOptions {
   template <typename Visitor>
   void VisitFields(Visitor&& v) {
     v("length_scale_m", length_scale_m, "l of eqs. 9 and 11: the kernel's length scale",
-      schema::Unit("m").Positive());
+      schema::Unit("m").Within(0.01, 1000));
     v("signal_sigma_dbm", signal_sigma_dbm, "sigma_f of eq. 9: the signal's prior deviation",
-      schema::Unit("dBm").Positive());
+      schema::Unit("dBm").Within(0.01, 1000));
     v("noise_sigma_dbm", noise_sigma_dbm, "sigma_p of eq. 7: measurement noise",
-      schema::Unit("dBm").Positive());
+      schema::Unit("dBm").Within(0.01, 1000));
     v("unheard_rssi_dbm", unheard_rssi_dbm,
       "RSSI an AP not heard counts as, and the GP's prior mean",
       schema::Unit("dBm").Within(-200, 0));
@@ -59,11 +59,11 @@ struct WifiGpOptions {
       "poses where the AP was not heard train its GP only this close to where it was heard",
       schema::Unit("m").NonNegative());
     v("bin_size_m", bin_size_m, "training points are averaged on a grid of this size",
-      schema::Unit("m").Positive());
+      schema::Unit("m").Within(0.01, 1000));
     v("cell_size_m", cell_size_m, "cell of the precomputed mean and variance grids",
-      schema::Unit("m").Positive());
+      schema::Unit("m").Within(0.01, 1000));
     v("grid_margin_m", grid_margin_m, "grid cells this close to where an AP was heard are stored",
-      schema::Unit("m").Positive());
+      schema::Unit("m").Within(0.01, 1000));
     v("signal_dependent_variance", signal_dependent_variance,
       "eqs. 10-12: the variance follows F_s of the predicted signal (converted to dBm)",
       schema::Any());

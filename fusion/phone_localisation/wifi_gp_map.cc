@@ -15,8 +15,14 @@ constexpr int kTileCells = 8;  // cells per tile side: one local GP per tile
 
 using Key = std::pair<int, int>;
 
+// The cell holding `p`; a point beyond a billion cells (or not finite) lands in a cell no grid
+// holds, as int cannot represent it.
 Key CellOf(const Point2& p, double size) {
-  return {static_cast<int>(std::floor(p.x / size)), static_cast<int>(std::floor(p.y / size))};
+  const double x = std::floor(p.x / size), y = std::floor(p.y / size);
+  if (!(std::abs(x) < 1e9 && std::abs(y) < 1e9)) {
+    return {std::numeric_limits<int>::min(), std::numeric_limits<int>::min()};
+  }
+  return {static_cast<int>(x), static_cast<int>(y)};
 }
 
 struct Bin {
@@ -207,7 +213,7 @@ WifiGpMap::Cell WifiGpMap::Predict(size_t ap, int floor, const Point2& p, bool* 
   if (ap < grids_.size()) {
     for (const Grid& g : grids_[ap]) {
       if (g.floor != floor) continue;
-      const int x = k.first - g.min_x, y = k.second - g.min_y;
+      const int64_t x = int64_t{k.first} - g.min_x, y = int64_t{k.second} - g.min_y;
       if (x < 0 || y < 0 || x >= g.width || y >= g.height) break;
       const size_t at = static_cast<size_t>(y) * g.width + x;
       if (std::isnan(g.mean_dbm[at])) break;

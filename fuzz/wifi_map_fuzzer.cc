@@ -1,0 +1,76 @@
+// Wi-Fi map files (`ratslam wifi-map`): errors name the file; a map that decodes answers every
+// lookup (inside and outside its grids, on any floor) and carries a particle filter through a few
+// steps and scans without touching memory it does not own.
+#include <cmath>
+#include <string>
+
+#include "fusion/phone_localisation/particle_filter.h"
+#include "fusion/phone_localisation/wifi_gp_map.h"
+#include "fuzz/fuzz_support.h"
+
+namespace ratslam::fuzz {
+
+std::vector<std::string> FuzzSeeds() {
+  std::vector<std::string> seeds;
+  for (int floors : {1, 2}) {
+    std::vector<WifiMapSample> samples;
+    for (int f = 0; f < floors; ++f) {
+      for (double x = 0; x <= 12; x += 2) {
+        for (double y = 0; y <= 6; y += 3) {
+          WifiMapSample s{{x, y}, f, {}};
+          for (int a = 0; a < 3; ++a) {
+            const double d = std::hypot(x - 6 * a, y - 3);
+            if (d < 9)
+              s.readings.emplace_back("ap" + std::to_string(a), -40 - 20 * std::log10(1 + d));
+          }
+          samples.push_back(s);
+        }
+      }
+    }
+    WifiGpOptions options;
+    options.grid_margin_m = 3.0;
+    StatusOr<WifiGpMap> map = WifiGpMap::Build(samples, options);
+    if (!map.ok()) InvariantFailed("the seed map failed: " + map.status().message());
+    if (floors == 2) map->set_geo_reference_deg(std::make_pair(40.3, -3.7));
+    seeds.push_back(map->Encode());
+  }
+  return seeds;
+}
+
+}  // namespace ratslam::fuzz
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  using namespace ratslam;
+  StatusOr<WifiGpMap> map =
+      WifiGpMap::Decode(std::string(reinterpret_cast<const char*>(data), size), "w.wifimap");
+  if (!map.ok()) {
+    if (map.status().message().rfind("w.wifimap", 0) != 0) {
+      fuzz::InvariantFailed("error does not name the file: " + map.status().message());
+    }
+    return 0;
+  }
+  for (size_t ap = 0; ap < map->bssids().size() + 1; ++ap) {
+    for (int floor : {-1, 0, 1, 7}) {
+      for (const Point2& p : {Point2{0, 0}, Point2{5.5, 2.5}, Point2{-1e6, 1e6}}) {
+        const WifiGpMap::Cell c = map->Predict(ap, floor, p);
+        if (std::isnan(c.mean_dbm)) fuzz::InvariantFailed("a lookup returned NaN");
+      }
+    }
+  }
+  if (map->stored_cells() > 200000) return 0;  // a filter over a huge map is not the point here
+  ParticleFilterOptions options;
+  options.particles = 50;
+  ParticleFilter filter(*map, options);
+  if (!filter.Initialise(true).ok()) return 0;
+  std::vector<std::pair<std::string, double>> scan;
+  for (const std::string& b : map->bssids()) scan.emplace_back(b, -60.0);
+  scan.emplace_back("unknown", -50.0);
+  for (int i = 0; i < 3; ++i) {
+    filter.Step(1.0, 0.3 * i);
+    filter.Update(scan);
+  }
+  const LocationEstimate e = filter.Estimate();
+  if (!std::isfinite(e.x_m) || !std::isfinite(e.y_m)) fuzz::InvariantFailed("estimate not finite");
+  (void)filter.Candidates();
+  return 0;
+}
