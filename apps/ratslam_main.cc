@@ -77,6 +77,7 @@ const char kUsage[] =
     "  ratslam render pose-cells --map F [--config C] --out F\n"
     "  ratslam render similarity --data D [--data D2 ...] [--config C] --out F [--frames N]\n"
     "                 [--sensor camera|wifi]\n"
+    "  ratslam render wifi-map --wifi-map W --out F [--ap BSSID] [--floor N]\n"
     "      Images from a run folder, a saved map, or a data set (PNG).\n"
     "  ratslam evaluate [--config C] --map M --query Q --out O [--lenient] [--quiet]\n"
     "      FABMAP localisation benchmark: maps M, localises every node of Q, writes\n"

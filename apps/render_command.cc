@@ -4,9 +4,11 @@
 #include <sstream>
 
 #include "apps/cli.h"
+#include "common/text_file.h"
 #include "fusion/io/config.h"
 #include "fusion/io/map_file.h"
 #include "fusion/io/run_reader.h"
+#include "fusion/phone_localisation/wifi_gp_map.h"
 #include "render/renderer.h"
 #include "sensors/dataset/dataset.h"
 #include "sensors/dataset/dataset_loader.h"
@@ -27,7 +29,8 @@ const char kRenderUsage[] =
     "  ratslam render template-graph --run O [--out F] [--size WxH] [--spans A-B:label,...]\n"
     "  ratslam render pose-cells --map F [--config C] --out F\n"
     "  ratslam render similarity --data D [--data D2 ...] [--config C] --out F [--frames N]\n"
-    "                 [--sensor camera|wifi]\n";
+    "                 [--sensor camera|wifi]\n"
+    "  ratslam render wifi-map --wifi-map W --out F [--ap BSSID] [--floor N]\n";
 
 int Fail(const std::string& message) {
   std::cerr << "ratslam: " << message << "\n";
@@ -211,6 +214,61 @@ int RenderSimilarity(const Arguments& args) {
   return status.ok() ? kExitOk : Fail(status.message());
 }
 
+// The GP mean and variance of one AP (Kudo and Miura, fig. 15), with the training scans.
+int RenderWifiMap(const Arguments& args) {
+  if (!args.values.count("--wifi-map") || !args.values.count("--out")) {
+    return Fail(std::string("--wifi-map and --out are required\n") + kRenderUsage);
+  }
+  const std::string path = args.values.at("--wifi-map");
+  StatusOr<std::string> bytes = ReadRegularFile(path, "Wi-Fi map", size_t{1} << 31);
+  if (!bytes.ok()) return Fail(bytes.status().message());
+  StatusOr<WifiGpMap> map = WifiGpMap::Decode(*bytes, path);
+  if (!map.ok()) return Fail(map.status().message());
+  if (map->bssids().empty()) return Fail(path + ": the map holds no access point");
+  // The AP asked for, or the one with the most stored cells.
+  size_t ap = 0;
+  if (args.values.count("--ap")) {
+    const int64_t found = map->Find(args.values.at("--ap"));
+    if (found < 0) return Fail(path + ": no access point " + args.values.at("--ap"));
+    ap = static_cast<size_t>(found);
+  } else {
+    size_t most = 0;
+    for (size_t a = 0; a < map->bssids().size(); ++a) {
+      size_t cells = 0;
+      for (const auto& g : map->grids(a)) cells += g.mean_dbm.size();
+      if (cells > most) most = cells, ap = a;
+    }
+  }
+  const auto& grids = map->grids(ap);
+  if (grids.empty()) return Fail(path + ": access point " + map->bssids()[ap] + " has no grid");
+  int floor = grids.front().floor;
+  if (args.values.count("--floor")) {
+    auto f = ParseInteger("--floor", args.values.at("--floor"), -1000, 1000);
+    if (!f) return kExitUsage;
+    floor = static_cast<int>(*f);
+  }
+  const auto grid = std::find_if(grids.begin(), grids.end(),
+                                 [floor](const WifiGpMap::Grid& g) { return g.floor == floor; });
+  if (grid == grids.end()) {
+    return Fail(path + ": access point " + map->bssids()[ap] + " was not heard on floor " +
+                std::to_string(floor));
+  }
+  const double cell = map->options().cell_size_m;
+  GridField mean{"mean RSSI (dBm), eq. 8", grid->width,        grid->height,  cell,
+                 grid->min_x * cell,       grid->min_y * cell, grid->mean_dbm};
+  GridField variance{"variance (dBm^2), eq. 10", grid->width,        grid->height,       cell,
+                     grid->min_x * cell,         grid->min_y * cell, grid->variance_dbm2};
+  std::vector<Point2> points;
+  for (const WifiMapSample& s : map->training_samples()) {
+    if (s.floor == floor) points.push_back(s.position);
+  }
+  Status status = Write(GridFieldsScene({mean, variance}, points,
+                                        "Wi-Fi map of " + map->bssids()[ap] + ", floor " +
+                                            std::to_string(floor) + " (dots: training scans)"),
+                        args.values.at("--out"));
+  return status.ok() ? kExitOk : Fail(status.message());
+}
+
 }  // namespace
 
 int RenderCommand(int argc, char** argv) {
@@ -219,9 +277,10 @@ int RenderCommand(int argc, char** argv) {
     return kExitUsage;
   }
   const std::string what = argv[2];
-  auto args = ParseArguments(argc, argv, 3,
-                             {"--run", "--data", "--out", "--size", "--color", "--sessions",
-                              "--spans", "--map", "--config", "--frames", "--sensor"});
+  auto args = ParseArguments(
+      argc, argv, 3,
+      {"--run", "--data", "--out", "--size", "--color", "--sessions", "--spans", "--map",
+       "--config", "--frames", "--sensor", "--wifi-map", "--ap", "--floor"});
   if (!args || !args->positional.empty()) {
     std::cerr << kRenderUsage;
     return kExitUsage;
@@ -230,6 +289,7 @@ int RenderCommand(int argc, char** argv) {
   if (what == "template-graph") return RenderTemplateGraph(*args);
   if (what == "pose-cells") return RenderPoseCells(*args);
   if (what == "similarity") return RenderSimilarity(*args);
+  if (what == "wifi-map") return RenderWifiMap(*args);
   std::cerr << "ratslam: unknown image '" << what << "'\n" << kRenderUsage;
   return kExitUsage;
 }

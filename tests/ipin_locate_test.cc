@@ -86,6 +86,17 @@ TEST(IpinLocateTest, AParticleFilterLocatesAnotherPhoneInTheWifiMap) {
   EXPECT_LT(mean, 5.0);
   EXPECT_LT(mean, s["knn_baseline"]["mean_error_m"].get<double>());
 
+  // Fig. 15 of the busiest AP; an AP the map does not know is an error.
+  const Result drawn = RunRatslam(
+      "render wifi-map --wifi-map " + map.string() + " --out " + (root / "ap.png").string(), root);
+  EXPECT_EQ(drawn.exit_code, 0) << drawn.err;
+  EXPECT_GT(fs::file_size(root / "ap.png"), 10000u);
+  EXPECT_EQ(RunRatslam("render wifi-map --wifi-map " + map.string() + " --ap nope --out " +
+                           (root / "no.png").string(),
+                       root)
+                .exit_code,
+            1);
+
   // Bad input: a corrupt map names the file; a log with no Wi-Fi says so; data without ground
   // truth cannot make a map.
   std::ofstream(root / "bad.wifimap") << bytes->substr(0, bytes->size() / 2);

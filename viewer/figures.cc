@@ -627,4 +627,81 @@ Scene SequencePairsScene(const SequencePairsData& data, const std::string& title
   return scene;
 }
 
+Scene GridFieldsScene(const std::vector<GridField>& fields, const std::vector<Point2>& points,
+                      const std::string& title) {
+  const int panel = 700, top = 70, bar = 90, bottom = 50;
+  const int n = std::max<int>(1, static_cast<int>(fields.size()));
+  Scene scene(n * (panel + bar), top + panel + bottom, kWhite);
+  scene.Text({20, 26}, title, 18, kInk);
+  // One world window for every panel: the union of the grids.
+  double x0 = std::numeric_limits<double>::infinity(), y0 = x0, x1 = -x0, y1 = -x0;
+  for (const GridField& g : fields) {
+    x0 = std::min(x0, g.origin_x_m);
+    y0 = std::min(y0, g.origin_y_m);
+    x1 = std::max(x1, g.origin_x_m + g.width * g.cell_size_m);
+    y1 = std::max(y1, g.origin_y_m + g.height * g.cell_size_m);
+  }
+  if (!std::isfinite(x0)) x0 = y0 = 0, x1 = y1 = 1;
+  const double scale = (panel - 20) / std::max({x1 - x0, y1 - y0, 1e-3});
+  for (size_t k = 0; k < fields.size(); ++k) {
+    const GridField& g = fields[k];
+    const float left = static_cast<float>(k * (panel + bar) + 10);
+    scene.Text({left, top - 12.0f}, g.label, 15, kInk);
+    float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+    for (float v : g.values) {
+      if (std::isnan(v)) continue;
+      lo = std::min(lo, v);
+      hi = std::max(hi, v);
+    }
+    if (!std::isfinite(lo)) lo = 0, hi = 1;
+    if (hi <= lo) hi = lo + 1;
+    if (g.width > 0 && g.height > 0 && g.values.size() == static_cast<size_t>(g.width) * g.height) {
+      SceneImage heat;
+      heat.left = left + static_cast<float>((g.origin_x_m - x0) * scale);
+      heat.top = top + static_cast<float>((y1 - (g.origin_y_m + g.height * g.cell_size_m)) * scale);
+      heat.width = static_cast<float>(g.width * g.cell_size_m * scale);
+      heat.height = static_cast<float>(g.height * g.cell_size_m * scale);
+      heat.pixels_wide = g.width;
+      heat.pixels_high = g.height;
+      for (int row = g.height - 1; row >= 0; --row) {  // the image's top row is the north
+        for (int col = 0; col < g.width; ++col) {
+          const float v = g.values[static_cast<size_t>(row) * g.width + col];
+          const Rgba c =
+              std::isnan(v) ? Rgba{255, 255, 255, 0} : SequentialColor((v - lo) / (hi - lo));
+          heat.rgba.insert(heat.rgba.end(), {c.r, c.g, c.b, c.a});
+        }
+      }
+      scene.Image(std::move(heat));
+    }
+    for (const Point2& p : points) {
+      scene.Disc({left + static_cast<float>((p.x - x0) * scale),
+                  top + static_cast<float>((y1 - p.y) * scale)},
+                 1.6f, kInk, 8);
+    }
+    // Colour bar, low values at the bottom.
+    SceneImage strip = ColorBar(0, 0, 0, 0);
+    SceneImage vertical;
+    vertical.left = left + panel;
+    vertical.top = top;
+    vertical.width = 18;
+    vertical.height = panel - 20;
+    vertical.pixels_wide = 1;
+    vertical.pixels_high = 256;
+    vertical.smooth = true;
+    for (int i = 255; i >= 0; --i) {
+      vertical.rgba.insert(vertical.rgba.end(), strip.rgba.begin() + i * 4,
+                           strip.rgba.begin() + i * 4 + 4);
+    }
+    scene.Image(std::move(vertical));
+    scene.Text({left + panel + 24, top + 12.0f}, FormatNumber(std::round(hi * 10) / 10), 13, kInk);
+    scene.Text({left + panel + 24, top + panel - 20.0f}, FormatNumber(std::round(lo * 10) / 10), 13,
+               kInk);
+  }
+  const double bar_m = NiceStep(0.2 * (panel - 20) / scale, 1);
+  const float bar_px = static_cast<float>(bar_m * scale), y = top + panel + 20.0f;
+  scene.Line({10, y}, {10 + bar_px, y}, 3.0f, kInk);
+  scene.Text({10 + bar_px / 2, y - 8}, FormatNumber(bar_m) + " m", 14, kInk, TextAnchor::kCenter);
+  return scene;
+}
+
 }  // namespace ratslam

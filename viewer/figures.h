@@ -137,6 +137,20 @@ struct SequencePairsData {
 // track in grey.
 Scene SequencePairsScene(const SequencePairsData& data, const std::string& title);
 
+// A field over the plane on a grid of cells (row-major from the south-west corner; NaN: no
+// value), drawn as a heat map with its own colour scale (e.g. a GP Wi-Fi map's mean or variance).
+struct GridField {
+  std::string label;  // panel title, with the unit
+  int width = 0, height = 0;
+  double cell_size_m = 1.0;
+  double origin_x_m = 0.0, origin_y_m = 0.0;  // south-west corner of cell (0, 0)
+  std::vector<float> values;
+};
+// The fields side by side at one scale (each with a colour bar from its lowest to its highest
+// value), `points` (e.g. where the data was taken) as dots on every panel, a scale bar.
+Scene GridFieldsScene(const std::vector<GridField>& fields, const std::vector<Point2>& points,
+                      const std::string& title);
+
 // An n x n matrix (row-major, values in [0, 1]) sampled at `times_s` as a heat map.
 Scene SimilarityMatrixScene(const std::vector<float>& matrix, const std::vector<double>& times_s,
                             const SimilarityImageOptions& options);
