@@ -15,7 +15,6 @@
 #include "apps/cli.h"
 #include "common/number_text.h"
 #include "common/output_folder.h"
-#include "common/text_file.h"
 #include "fusion/io/config.h"
 #include "fusion/phone_localisation/particle_filter.h"
 #include "fusion/phone_localisation/wifi_gp_map.h"
@@ -27,8 +26,6 @@ namespace ratslam {
 namespace {
 
 namespace fs = std::filesystem;
-
-constexpr size_t kMaxWifiMapBytes = size_t{1} << 31;
 
 std::optional<LocateOptions> LoadLocateOptions(const Arguments& args, const char* command) {
   if (!args.values.count("--config")) return LocateOptions();
@@ -170,9 +167,7 @@ int LocateCommand(int argc, char** argv) {
     return kExitError;
   };
   const std::string map_path = args->values.at("--wifi-map");
-  StatusOr<std::string> bytes = ReadRegularFile(map_path, "Wi-Fi map", kMaxWifiMapBytes);
-  if (!bytes.ok()) return fail(bytes.status());
-  StatusOr<WifiGpMap> map = WifiGpMap::Decode(*bytes, map_path);
+  StatusOr<WifiGpMap> map = WifiGpMap::Load(map_path);
   if (!map.ok()) return fail(map.status());
   PhoneLogOptions phone;
   phone.lenient = args->lenient;

@@ -4,7 +4,6 @@
 #include <sstream>
 
 #include "apps/cli.h"
-#include "common/text_file.h"
 #include "fusion/io/config.h"
 #include "fusion/io/map_file.h"
 #include "fusion/io/run_reader.h"
@@ -220,9 +219,7 @@ int RenderWifiMap(const Arguments& args) {
     return Fail(std::string("--wifi-map and --out are required\n") + kRenderUsage);
   }
   const std::string path = args.values.at("--wifi-map");
-  StatusOr<std::string> bytes = ReadRegularFile(path, "Wi-Fi map", size_t{1} << 31);
-  if (!bytes.ok()) return Fail(bytes.status().message());
-  StatusOr<WifiGpMap> map = WifiGpMap::Decode(*bytes, path);
+  StatusOr<WifiGpMap> map = WifiGpMap::Load(path);
   if (!map.ok()) return Fail(map.status().message());
   if (map->bssids().empty()) return Fail(path + ": the map holds no access point");
   // The AP asked for, or the one with the most stored cells.

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "common/byte_buffer.h"
+#include "common/text_file.h"
 
 namespace ratslam {
 namespace {
@@ -407,6 +408,12 @@ StatusOr<WifiGpMap> WifiGpMap::Decode(const std::string& bytes, const std::strin
   if (!r.AtEnd()) return fail("trailing bytes");
   map.IndexCoverage();
   return map;
+}
+
+StatusOr<WifiGpMap> WifiGpMap::Load(const std::string& path) {
+  StatusOr<std::string> bytes = ReadRegularFile(path, "Wi-Fi map", size_t{1} << 31);
+  if (!bytes.ok()) return bytes.status();
+  return Decode(*bytes, path);
 }
 
 }  // namespace ratslam

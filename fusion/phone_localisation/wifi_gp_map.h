@@ -72,6 +72,8 @@ class WifiGpMap {
   // value; an error names the file.
   std::string Encode() const;
   static StatusOr<WifiGpMap> Decode(const std::string& bytes, const std::string& name);
+  // Reads and decodes the file `path` (a regular file of at most 2 GiB).
+  static StatusOr<WifiGpMap> Load(const std::string& path);
 
  private:
   void IndexCoverage();
