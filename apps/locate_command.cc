@@ -16,6 +16,7 @@
 #include "common/number_text.h"
 #include "common/output_folder.h"
 #include "fusion/io/config.h"
+#include "fusion/io/run_reader.h"
 #include "fusion/phone_localisation/particle_filter.h"
 #include "fusion/phone_localisation/wifi_gp_map.h"
 #include "sensors/dataset/dataset_loader.h"
@@ -94,13 +95,68 @@ nlohmann::ordered_json ErrorSummary(std::vector<double> all) {
   return j;
 }
 
+// Samples from a replay's run folder: each scan of the run's data (loaded as the replay loaded
+// it, so times agree) placed where the run's final map puts the robot at that time
+// (trajectory_tum.txt); the map's frame is the run's. Also finds the compass's offset to that
+// frame and, with ground truth, the map's alignment onto the truth.
+Status SamplesFromRun(const std::string& run_folder, const std::vector<std::string>& paths,
+                      bool lenient, std::vector<WifiMapSample>* samples, size_t* scans,
+                      WifiGpMap* frame_of) {
+  const fs::path run = run_folder;
+  StatusOr<RunFolder> folder = ReadRunFolder(run.string());
+  if (!folder.ok()) return folder.status();
+  StatusOr<PipelineOptions> config = LoadConfigFile((run / "config.toml").string());
+  if (!config.ok()) return config.status();
+  StatusOr<std::vector<GroundTruthRow>> trajectory =
+      ReadTumTrajectory((run / "trajectory_tum.txt").string());
+  if (!trajectory.ok()) return trajectory.status();
+  PhoneLogOptions phone;
+  phone.lenient = lenient;
+  phone.pdr = config->pdr;
+  StatusOr<Dataset> data = LoadSessions(paths, phone);
+  if (!data.ok()) return data.status();
+  if (!folder->dataset_name.empty() && folder->dataset_name != data->name) {
+    return Status::Error(run.string() + ": the run replayed data set '" + folder->dataset_name +
+                         "', not '" + data->name + "' (give --data as the replay did)");
+  }
+  for (const WifiScan& scan : data->wifi) {
+    ++*scans;
+    const auto pose = InterpolateGroundTruth(*trajectory, scan.time_s);
+    if (!pose || scan.readings.empty()) continue;
+    samples->push_back({{pose->x_m, pose->y_m}, 0, Readings(scan)});
+  }
+  // The compass's offset: circular mean of map heading minus compass heading.
+  double sum_sin = 0.0, sum_cos = 0.0;
+  for (const CompassRow& c : data->compass) {
+    const auto pose = InterpolateGroundTruth(*trajectory, c.time_s);
+    if (!pose) continue;
+    sum_sin += std::sin(pose->theta_rad - c.heading_rad);
+    sum_cos += std::cos(pose->theta_rad - c.heading_rad);
+  }
+  if (sum_sin != 0.0 || sum_cos != 0.0)
+    frame_of->set_compass_to_map_rad(std::atan2(sum_sin, sum_cos));
+  std::vector<Point2> on_map, on_truth;
+  for (const GroundTruthRow& p : *trajectory) {
+    const auto truth = InterpolateGroundTruth(data->ground_truth, p.time_s);
+    if (!truth) continue;
+    on_map.push_back({p.x_m, p.y_m});
+    on_truth.push_back({truth->x_m, truth->y_m});
+  }
+  frame_of->set_truth_from_map(AlignRigid2D(on_map, on_truth));
+  return Status::Ok();
+}
+
 }  // namespace
 
 int WifiMapCommand(int argc, char** argv) {
-  const auto args = ParseArguments(argc, argv, 2, {"--data", "--out", "--config"});
+  const auto args = ParseArguments(argc, argv, 2, {"--data", "--out", "--config", "--run"});
   if (!args || !args->all.count("--data") || !args->values.count("--out")) {
     std::cerr << "usage: ratslam wifi-map --data D [--data D2 ...] --out W [--config C] "
-                 "[--lenient]\n";
+                 "[--lenient]\n"
+                 "       ratslam wifi-map --run RUN_FOLDER --data D [--data D2 ...] --out W "
+                 "[--config C]\n"
+                 "  (--run: positions from the run's trajectory_tum.txt, in its map's frame; "
+                 "--data as given to that replay)\n";
     return kExitUsage;
   }
   const std::optional<LocateOptions> options = LoadLocateOptions(*args, "wifi-map");
@@ -114,26 +170,42 @@ int WifiMapCommand(int argc, char** argv) {
   phone.lenient = args->lenient;
   phone.pdr = options->pdr;
   std::optional<std::pair<double, double>> origin;
-  StatusOr<std::vector<Dataset>> data = LoadInOneFrame(args->all.at("--data"), phone, &origin);
-  if (!data.ok()) return fail(data.status());
   std::vector<WifiMapSample> samples;
   size_t scans = 0;
-  for (const Dataset& d : data.value()) {
-    for (const WifiScan& scan : d.wifi) {
-      ++scans;
-      const auto truth = InterpolateGroundTruth(d.ground_truth, scan.time_s);
-      if (!truth || scan.readings.empty()) continue;
-      samples.push_back({{truth->x_m, truth->y_m}, truth->floor, Readings(scan)});
+  WifiGpMap frame;  // carries the run's frame when --run is given
+  const bool from_run = args->values.count("--run") > 0;
+  if (from_run) {
+    Status got = SamplesFromRun(args->values.at("--run"), args->all.at("--data"), args->lenient,
+                                &samples, &scans, &frame);
+    if (!got.ok()) return fail(got);
+    // The geographic origin the replay's phone logs were read in (the first log's).
+    StatusOr<std::vector<Dataset>> first =
+        LoadInOneFrame({args->all.at("--data").front()}, phone, &origin);
+    if (!first.ok()) return fail(first.status());
+  } else {
+    StatusOr<std::vector<Dataset>> data = LoadInOneFrame(args->all.at("--data"), phone, &origin);
+    if (!data.ok()) return fail(data.status());
+    for (const Dataset& d : data.value()) {
+      for (const WifiScan& scan : d.wifi) {
+        ++scans;
+        const auto truth = InterpolateGroundTruth(d.ground_truth, scan.time_s);
+        if (!truth || scan.readings.empty()) continue;
+        samples.push_back({{truth->x_m, truth->y_m}, truth->floor, Readings(scan)});
+      }
     }
   }
   if (samples.empty()) {
     return fail(Status::Error(
         std::to_string(scans) +
-        " Wi-Fi scans and none with ground truth at its time: a Wi-Fi map needs positions"));
+        (from_run ? " Wi-Fi scans and none within the run's trajectory: a Wi-Fi map needs positions"
+                  : " Wi-Fi scans and none with ground truth at its time: a Wi-Fi map needs "
+                    "positions")));
   }
   StatusOr<WifiGpMap> map = WifiGpMap::Build(samples, options->wifi_map);
   if (!map.ok()) return fail(map.status());
   map->set_geo_reference_deg(origin);
+  map->set_compass_to_map_rad(frame.compass_to_map_rad());
+  map->set_truth_from_map(frame.truth_from_map());
   const fs::path out = args->values.at("--out");
   StatusOr<std::unique_ptr<DiskFolder>> folder =
       DiskFolder::Open(out.has_parent_path() ? out.parent_path().string() : ".");
@@ -147,6 +219,11 @@ int WifiMapCommand(int argc, char** argv) {
   j["access_points"] = map->bssids().size();
   j["floors"] = map->floors();
   j["stored_cells"] = map->stored_cells();
+  j["positions_from"] = from_run ? "run trajectory" : "ground truth";
+  if (from_run) {
+    j["compass_to_map_rad"] = map->compass_to_map_rad();
+    if (map->truth_from_map()) j["map_to_truth_rmse_m"] = map->truth_from_map()->rmse_m;
+  }
   j["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::cout << j.dump(2) << "\n";
   return kExitOk;
@@ -224,7 +301,10 @@ int LocateCommand(int argc, char** argv) {
       last_odometry = row.time_s;
       integrated_heading += row.turn_rate_rad_per_s * dt;
       const double forward = row.forward_speed_m_per_s * dt;
-      if (forward != 0.0) filter.Step(forward, compass && heading ? *heading : integrated_heading);
+      if (forward != 0.0) {
+        filter.Step(forward,
+                    compass && heading ? *heading + map->compass_to_map_rad() : integrated_heading);
+      }
     } else if (e.type == EventType::kWifi) {
       const WifiScan& scan = d.wifi[e.index];
       if (d.odometry.empty() && last_time) filter.Diffuse(scan.time_s - *last_time);
@@ -244,14 +324,26 @@ int LocateCommand(int argc, char** argv) {
              << ShortestNumber(est.y_m) << ',' << est.floor << ',' << known;
       const auto truth = InterpolateGroundTruth(d.ground_truth, scan.time_s);
       if (truth) {
-        const bool wrong_floor = truth->floor != est.floor;
-        const double error = wrong_floor ? std::numeric_limits<double>::infinity()
-                                         : std::hypot(est.x_m - truth->x_m, est.y_m - truth->y_m);
+        // A map made from a run is in the run's frame and has one floor: its estimates are
+        // scored after its alignment onto the truth, on position alone.
+        const auto& align = map->truth_from_map();
+        auto to_truth = [&](double x, double y) {
+          if (!align) return Point2{x, y};
+          const double c = std::cos(align->rotation_rad), s = std::sin(align->rotation_rad);
+          return Point2{c * x - s * y + align->translation_x_m,
+                        s * x + c * y + align->translation_y_m};
+        };
+        auto floor_differs = [&](int floor) { return !align && floor != truth->floor; };
+        const Point2 e = to_truth(est.x_m, est.y_m);
+        const double error = floor_differs(est.floor)
+                                 ? std::numeric_limits<double>::infinity()
+                                 : std::hypot(e.x - truth->x_m, e.y - truth->y_m);
         filter_errors.push_back(error);
         const fabmap::Estimate& k = knn[scan_index];
-        const double knn_error = !k.located || k.floor != truth->floor
+        const Point2 ke = to_truth(k.x_m, k.y_m);
+        const double knn_error = !k.located || floor_differs(k.floor)
                                      ? std::numeric_limits<double>::infinity()
-                                     : std::hypot(k.x_m - truth->x_m, k.y_m - truth->y_m);
+                                     : std::hypot(ke.x - truth->x_m, ke.y - truth->y_m);
         knn_errors.push_back(knn_error);
         errors << ',' << ShortestNumber(truth->x_m) << ',' << ShortestNumber(truth->y_m) << ','
                << truth->floor << ',' << ShortestNumber(error) << ',' << ShortestNumber(knn_error)
@@ -272,6 +364,10 @@ int LocateCommand(int argc, char** argv) {
   j["likelihood"] = ToString(options->particle_filter.likelihood);
   j["particles"] = options->particle_filter.particles;
   j["resamplings"] = filter.resamplings();
+  if (map->truth_from_map()) {
+    j["errors_after_map_alignment"] = true;  // the map is a run's: scored in the truth's frame
+    j["map_to_truth_rmse_m"] = map->truth_from_map()->rmse_m;
+  }
   if (!filter_errors.empty()) {
     nlohmann::ordered_json f = ErrorSummary(filter_errors);
     for (auto& [key, value] : f.items()) j[key] = value;

@@ -4,7 +4,9 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
+#include "common/text_file.h"
 #include "fusion/io/run_columns.h"
 #include "sensors/dataset/csv.h"
 
@@ -124,8 +126,53 @@ StatusOr<RunFolder> ReadRunFolder(const std::string& folder) {
     if (j.is_object() && j.contains("data_folder") && j["data_folder"].is_string()) {
       run.dataset_folder = j["data_folder"].get<std::string>();
     }
+    if (j.is_object() && j.contains("dataset") && j["dataset"].is_string()) {
+      run.dataset_name = j["dataset"].get<std::string>();
+    }
   }
   return run;
+}
+
+StatusOr<std::vector<GroundTruthRow>> ReadTumTrajectory(const std::string& path) {
+  std::ifstream in;
+  RATSLAM_RETURN_IF_ERROR(OpenRegularFile(path, "TUM trajectory", &in));
+  static const char* const kFields[] = {"timestamp", "tx", "ty", "tz", "qx", "qy", "qz", "qw"};
+  std::vector<GroundTruthRow> rows;
+  std::string line;
+  for (size_t number = 1;; ++number) {
+    const LineResult got = ReadLine(in, &line);
+    if (got == LineResult::kEnd) break;
+    const std::string where = path + ":" + std::to_string(number);
+    if (got == LineResult::kTooLong) return Status::Error(where + ": line too long");
+    const size_t first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos || line[first] == '#') continue;
+    std::istringstream fields(line);
+    double v[8];
+    for (int k = 0; k < 8; ++k) {
+      std::string text;
+      if (!(fields >> text)) return Status::Error(where + ": field '" + kFields[k] + "' missing");
+      char* end = nullptr;
+      v[k] = std::strtod(text.c_str(), &end);
+      if (end == text.c_str() || *end != '\0' || !std::isfinite(v[k])) {
+        return Status::Error(where + ": field '" + kFields[k] + "' is not a finite number: '" +
+                             text + "'");
+      }
+    }
+    std::string extra;
+    if (fields >> extra) return Status::Error(where + ": more than 8 fields");
+    if (!rows.empty() && !(v[0] > rows.back().time_s)) {
+      return Status::Error(where + ": field 'timestamp' is not after the previous line's");
+    }
+    GroundTruthRow r;
+    r.time_s = v[0];
+    r.x_m = v[1];
+    r.y_m = v[2];
+    const double qx = v[4], qy = v[5], qz = v[6], qw = v[7];
+    r.theta_rad = std::atan2(2.0 * (qw * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz));
+    rows.push_back(r);
+  }
+  if (rows.empty()) return Status::Error(path + ": no pose (a TUM trajectory needs at least one)");
+  return rows;
 }
 
 }  // namespace ratslam

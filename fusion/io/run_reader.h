@@ -8,6 +8,7 @@
 #include "common/status.h"
 #include "ratslam/experience_map.h"
 #include "ratslam/records.h"
+#include "sensors/dataset/dataset.h"
 
 namespace ratslam {
 
@@ -16,11 +17,17 @@ struct RunFolder {
   std::vector<Link> links;
   std::vector<FrameRecord> frames;
   std::string dataset_folder;  // from summary.json, if recorded
+  std::string dataset_name;    // from summary.json, if recorded
 };
 
 // Errors name the file, line and column; ids must be consecutive and links must refer to
 // existing experiences.
 StatusOr<RunFolder> ReadRunFolder(const std::string& folder);
+
+// A TUM trajectory file (`timestamp tx ty tz qx qy qz qw` per line, `#` comments), e.g. a run's
+// trajectory_tum.txt, as planar poses: x, y and the yaw of the quaternion (floor 0). Errors name
+// the file, line and field: a missing or non-finite field, or a time not after the previous one.
+StatusOr<std::vector<GroundTruthRow>> ReadTumTrajectory(const std::string& path);
 
 }  // namespace ratslam
 

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <numbers>
 #include <set>
 #include <string>
@@ -154,6 +155,46 @@ TEST(WifiGpMapTest, FileRoundTripAndBadFiles) {
   EXPECT_FALSE(WifiGpMap::Build({}, WifiGpOptions()).ok());
   EXPECT_FALSE(WifiGpMap::Build({{{NAN, 0}, 0, {{"a", -50}}}}, WifiGpOptions()).ok());
   EXPECT_FALSE(WifiGpMap::Build({{{0, 0}, 0, {{"a", NAN}}}}, WifiGpOptions()).ok());
+}
+
+TEST(WifiGpMapTest, RunFrameRoundTripsAndFormatOneStillReads) {
+  WifiGpMap map = TrainedMap(Field());
+  const std::string plain = map.Encode();
+  map.set_compass_to_map_rad(1.1);  // its lowest byte differs from 0.0's
+  RigidAlignment2D a;
+  a.rotation_rad = -0.5;
+  a.translation_x_m = 3.0;
+  a.translation_y_m = -4.0;
+  a.rmse_m = 1.5;
+  map.set_truth_from_map(a);
+  const std::string framed = map.Encode();
+  StatusOr<WifiGpMap> back = WifiGpMap::Decode(framed, "w.wifimap");
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  EXPECT_EQ(back->compass_to_map_rad(), 1.1);
+  ASSERT_TRUE(back->truth_from_map().has_value());
+  EXPECT_EQ(back->truth_from_map()->rotation_rad, -0.5);
+  EXPECT_EQ(back->truth_from_map()->translation_y_m, -4.0);
+  EXPECT_EQ(back->truth_from_map()->rmse_m, 1.5);
+  // A format-1 file is the format-2 one without the frame block (a double, a flag, four
+  // doubles: 41 bytes) and with version 1: it reads with no frame.
+  ASSERT_EQ(plain.size(), framed.size());
+  size_t first = 0;
+  while (plain[first] == framed[first]) ++first;
+  const size_t version_at = plain.find("RSWIFIGP") + 8;
+  uint32_t version = 0;
+  std::memcpy(&version, plain.data() + version_at, 4);
+  ASSERT_EQ(version, 2u);
+  std::string v1 = plain.substr(0, first) + plain.substr(first + 41);
+  version = 1;
+  std::memcpy(v1.data() + version_at, &version, 4);
+  StatusOr<WifiGpMap> old = WifiGpMap::Decode(v1, "v1.wifimap");
+  ASSERT_TRUE(old.ok()) << old.status().message();
+  EXPECT_EQ(old->compass_to_map_rad(), 0.0);
+  EXPECT_FALSE(old->truth_from_map().has_value());
+  EXPECT_EQ(old->stored_cells(), map.stored_cells());
+  // A frame out of range is refused.
+  map.set_compass_to_map_rad(1e9);
+  EXPECT_FALSE(WifiGpMap::Decode(map.Encode(), "w.wifimap").ok());
 }
 
 TEST(ParticleFilterTest, ConvergesOnTheWalkerInAKnownField) {

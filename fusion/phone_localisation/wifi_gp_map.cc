@@ -11,7 +11,8 @@ namespace ratslam {
 namespace {
 
 constexpr char kMagic[] = "RSWIFIGP";
-constexpr uint32_t kVersion = 1;
+// 1: first; 2: adds the frame of maps made from a run (compass_to_map, truth_from_map).
+constexpr uint32_t kVersion = 2;
 constexpr int kTileCells = 8;  // cells per tile side: one local GP per tile
 
 using Key = std::pair<int, int>;
@@ -282,6 +283,13 @@ std::string WifiGpMap::Encode() const {
   w.Bool(reference_.has_value());
   w.Pod(reference_ ? reference_->first : 0.0);
   w.Pod(reference_ ? reference_->second : 0.0);
+  w.Pod(compass_to_map_rad_);
+  w.Bool(truth_from_map_.has_value());
+  const RigidAlignment2D a = truth_from_map_.value_or(RigidAlignment2D{});
+  w.Pod(a.rotation_rad);
+  w.Pod(a.translation_x_m);
+  w.Pod(a.translation_y_m);
+  w.Pod(a.rmse_m);
   w.Count(bssids_.size());
   for (size_t ap = 0; ap < bssids_.size(); ++ap) {
     w.String(bssids_[ap]);
@@ -320,8 +328,8 @@ StatusOr<WifiGpMap> WifiGpMap::Decode(const std::string& bytes, const std::strin
   uint32_t version = 0;
   if (!r.String(&magic) || magic != kMagic) return fail("not a Wi-Fi map file");
   if (!r.Pod(&version)) return fail("truncated");
-  if (version != kVersion) {
-    return fail("Wi-Fi map format " + std::to_string(version) + " (this program reads " +
+  if (version != kVersion && version != 1) {
+    return fail("Wi-Fi map format " + std::to_string(version) + " (this program reads 1 to " +
                 std::to_string(kVersion) + ")");
   }
   WifiGpMap map;
@@ -340,9 +348,22 @@ StatusOr<WifiGpMap> WifiGpMap::Decode(const std::string& bytes, const std::strin
   bool has_reference = false;
   double latitude = 0, longitude = 0;
   size_t aps = 0;
-  if (!r.Bool(&has_reference) || !r.Pod(&latitude) || !r.Pod(&longitude) || !r.Count(16, &aps)) {
-    return fail("truncated");
+  if (!r.Bool(&has_reference) || !r.Pod(&latitude) || !r.Pod(&longitude)) return fail("truncated");
+  if (version >= 2) {
+    bool has_alignment = false;
+    RigidAlignment2D a;
+    if (!(r.Pod(&map.compass_to_map_rad_) && r.Bool(&has_alignment) && r.Pod(&a.rotation_rad) &&
+          r.Pod(&a.translation_x_m) && r.Pod(&a.translation_y_m) && r.Pod(&a.rmse_m))) {
+      return fail("truncated frame");
+    }
+    if (!(std::abs(map.compass_to_map_rad_) <= 7.0) || !(std::abs(a.rotation_rad) <= 7.0) ||
+        !(std::abs(a.translation_x_m) <= 1e7) || !(std::abs(a.translation_y_m) <= 1e7) ||
+        !(a.rmse_m >= 0 && a.rmse_m <= 1e7)) {
+      return fail("map frame out of range");
+    }
+    if (has_alignment) map.truth_from_map_ = a;
   }
+  if (!r.Count(16, &aps)) return fail("truncated");
   if (has_reference) {
     if (!(std::abs(latitude) <= 90) || !(std::abs(longitude) <= 180)) {
       return fail("geographic reference out of range");

@@ -67,9 +67,20 @@ class WifiGpMap {
   // from geo-referenced logs: a phone log must be read in the same frame.
   const std::optional<std::pair<double, double>>& geo_reference_deg() const { return reference_; }
   void set_geo_reference_deg(std::optional<std::pair<double, double>> r) { reference_ = r; }
+  // Maps made from a replay's run folder live in that run's experience-map frame:
+  //  - compass_to_map_rad: add to a compass heading to get a heading in the map's frame (the
+  //    run's map starts facing 0 whatever the compass said; 0 for maps from ground truth);
+  //  - truth_from_map: the rigid transform from the map's frame onto the ground-truth frame of
+  //    the run's data (the alignment its map ATE uses), when that data had ground truth, so a
+  //    phone's estimate can be scored against the phone log's truth.
+  double compass_to_map_rad() const { return compass_to_map_rad_; }
+  void set_compass_to_map_rad(double r) { compass_to_map_rad_ = r; }
+  const std::optional<RigidAlignment2D>& truth_from_map() const { return truth_from_map_; }
+  void set_truth_from_map(std::optional<RigidAlignment2D> a) { truth_from_map_ = a; }
 
-  // Versioned binary file (magic, version, options, BSSIDs, grids). Decode checks every count and
-  // value; an error names the file.
+  // Versioned binary file (magic, version, options, frame, BSSIDs, grids, samples). Decode checks
+  // every count and value and reads format 1 (no frame: compass_to_map 0, no truth alignment);
+  // an error names the file.
   std::string Encode() const;
   static StatusOr<WifiGpMap> Decode(const std::string& bytes, const std::string& name);
   // Reads and decodes the file `path` (a regular file of at most 2 GiB).
@@ -80,6 +91,8 @@ class WifiGpMap {
   WifiGpOptions options_;
   std::vector<WifiMapSample> training_;
   std::optional<std::pair<double, double>> reference_;
+  double compass_to_map_rad_ = 0.0;
+  std::optional<RigidAlignment2D> truth_from_map_;
   std::vector<std::string> bssids_;
   std::map<std::string, size_t> index_;
   std::vector<std::vector<Grid>> grids_;  // per AP, per floor it was heard on
