@@ -107,6 +107,7 @@ int RenderCommand(int argc, char** argv);
 int EvaluateCommand(int argc, char** argv);
 int WifiMapCommand(int argc, char** argv);
 int LocateCommand(int argc, char** argv);
+int CallCommand(int argc, char** argv);
 int SimulateCommand(int argc, char** argv);
 int SweepCommand(int argc, char** argv);
 // Simulates `world` into the replay data set `out` (with world.toml, simulation.json and

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <iostream>
 #include <limits>
 #include <map>
@@ -16,12 +17,17 @@
 #include "common/number_text.h"
 #include "common/output_folder.h"
 #include "fusion/io/config.h"
+#include "fusion/io/map_file.h"
 #include "fusion/io/run_reader.h"
 #include "fusion/phone_localisation/particle_filter.h"
+#include "fusion/phone_localisation/robot_call.h"
 #include "fusion/phone_localisation/wifi_gp_map.h"
+#include "render/renderer.h"
 #include "sensors/dataset/dataset_loader.h"
 #include "sensors/dataset/ipin_log.h"
 #include "session/evaluation_baselines.h"
+#include "viewer/figures.h"
+#include "viewer/localisation_figure.h"
 
 namespace ratslam {
 namespace {
@@ -93,6 +99,82 @@ nlohmann::ordered_json ErrorSummary(std::vector<double> all) {
   j["p75_error_m"] = at(0.75);
   j["p90_error_m"] = at(0.9);
   return j;
+}
+
+// A point of the Wi-Fi map's frame in the ground truth's frame (the same unless the map is a
+// run's), and back.
+Point2 MapToTruth(const WifiGpMap& map, const Point2& p) {
+  const auto& a = map.truth_from_map();
+  if (!a) return p;
+  const double c = std::cos(a->rotation_rad), s = std::sin(a->rotation_rad);
+  return {c * p.x - s * p.y + a->translation_x_m, s * p.x + c * p.y + a->translation_y_m};
+}
+Point2 TruthToMap(const WifiGpMap& map, const Point2& p) {
+  const auto& a = map.truth_from_map();
+  if (!a) return p;
+  const double c = std::cos(a->rotation_rad), s = std::sin(a->rotation_rad);
+  const double x = p.x - a->translation_x_m, y = p.y - a->translation_y_m;
+  return {c * x + s * y, -s * x + c * y};
+}
+
+// What locate and call share: options, the Wi-Fi map and the phone log read in its frame.
+struct PhoneSetup {
+  LocateOptions options;
+  WifiGpMap map;
+  Dataset data;
+};
+
+StatusOr<PhoneSetup> SetUpPhone(const Arguments& args, const char* command) {
+  const std::optional<LocateOptions> options = LoadLocateOptions(args, command);
+  if (!options) return Status::Error("");  // already reported
+  PhoneSetup setup;
+  setup.options = *options;
+  StatusOr<WifiGpMap> map = WifiGpMap::Load(args.values.at("--wifi-map"));
+  if (!map.ok()) return map.status();
+  setup.map = std::move(map).value();
+  PhoneLogOptions phone;
+  phone.lenient = args.lenient;
+  phone.pdr = options->pdr;
+  std::optional<std::pair<double, double>> origin = setup.map.geo_reference_deg();
+  StatusOr<std::vector<Dataset>> data = LoadInOneFrame({args.values.at("--data")}, phone, &origin);
+  if (!data.ok()) return data.status();
+  setup.data = std::move(data.value().front());
+  if (setup.data.wifi.empty()) {
+    return Status::Error(args.values.at("--data") + ": no Wi-Fi scan to locate the phone by");
+  }
+  return setup;
+}
+
+// Replays a phone log through the filter in time order up to `until_s`: PDR steps (heading from
+// the compass, turned into the map's frame, or integrated turn rate), a random walk between
+// scans without odometry, and a weight update per scan, after which `on_scan` runs with the
+// number of readings the map knew.
+void FilterPhoneLog(const Dataset& d, const WifiGpMap& map, ParticleFilter* filter, double until_s,
+                    const std::function<void(const WifiScan&, size_t)>& on_scan) {
+  const bool compass = !d.compass.empty();
+  std::optional<double> heading, last_time, last_odometry;
+  double integrated_heading = 0.0;
+  for (const Event& e : MergeEvents(d)) {
+    if (e.time_s > until_s) break;
+    if (e.type == EventType::kCompass) {
+      heading = d.compass[e.index].heading_rad;
+    } else if (e.type == EventType::kOdometry) {
+      const OdometryRow& row = d.odometry[e.index];
+      const double dt = last_odometry ? row.time_s - *last_odometry : 0.0;
+      last_odometry = row.time_s;
+      integrated_heading += row.turn_rate_rad_per_s * dt;
+      const double forward = row.forward_speed_m_per_s * dt;
+      if (forward != 0.0) {
+        filter->Step(forward,
+                     compass && heading ? *heading + map.compass_to_map_rad() : integrated_heading);
+      }
+    } else if (e.type == EventType::kWifi) {
+      const WifiScan& scan = d.wifi[e.index];
+      if (d.odometry.empty() && last_time) filter->Diffuse(scan.time_s - *last_time);
+      last_time = scan.time_s;
+      on_scan(scan, filter->Update(Readings(scan)));
+    }
+  }
 }
 
 // Samples from a replay's run folder: each scan of the run's data (loaded as the replay loaded
@@ -237,27 +319,17 @@ int LocateCommand(int argc, char** argv) {
                  "[--lenient] [--quiet]\n";
     return kExitUsage;
   }
-  const std::optional<LocateOptions> options = LoadLocateOptions(*args, "locate");
-  if (!options) return kExitError;
   auto fail = [](const Status& s) {
-    std::cerr << "ratslam locate: " << s.message() << "\n";
+    if (!s.message().empty()) std::cerr << "ratslam locate: " << s.message() << "\n";
     return kExitError;
   };
+  StatusOr<PhoneSetup> setup = SetUpPhone(*args, "locate");
+  if (!setup.ok()) return fail(setup.status());
   const std::string map_path = args->values.at("--wifi-map");
-  StatusOr<WifiGpMap> map = WifiGpMap::Load(map_path);
-  if (!map.ok()) return fail(map.status());
-  PhoneLogOptions phone;
-  phone.lenient = args->lenient;
-  phone.pdr = options->pdr;
-  std::optional<std::pair<double, double>> origin = map->geo_reference_deg();
-  StatusOr<std::vector<Dataset>> data = LoadInOneFrame({args->values.at("--data")}, phone, &origin);
-  if (!data.ok()) return fail(data.status());
-  const Dataset& d = data.value().front();
-  if (d.wifi.empty()) {
-    return fail(
-        Status::Error(args->values.at("--data") + ": no Wi-Fi scan to locate the phone by"));
-  }
-  ParticleFilter filter(map.value(), options->particle_filter);
+  const WifiGpMap* map = &setup->map;
+  const LocateOptions* options = &setup->options;
+  const Dataset& d = setup->data;
+  ParticleFilter filter(*map, options->particle_filter);
   const bool compass = !d.compass.empty();
   Status initialised = filter.Initialise(compass);
   if (!initialised.ok()) return fail(initialised);
@@ -270,8 +342,6 @@ int LocateCommand(int argc, char** argv) {
   candidates << "time_s,rank,x_m,y_m,weight\n";
   std::vector<double> filter_errors, knn_errors;
   size_t unknown_scans = 0;
-  std::optional<double> heading, last_time, last_odometry;
-  double integrated_heading = 0.0;
   // Fingerprint baseline on the map's own training scans (weighted 3-NN, session/).
   std::vector<fabmap::EvaluationNode> map_nodes;
   for (const WifiMapSample& s : map->training_samples()) {
@@ -292,68 +362,48 @@ int LocateCommand(int argc, char** argv) {
   }
   const std::vector<fabmap::Estimate> knn = KnnEstimates(map_nodes, queries);
   size_t scan_index = 0;
-  for (const Event& e : MergeEvents(d)) {
-    if (e.type == EventType::kCompass) {
-      heading = d.compass[e.index].heading_rad;
-    } else if (e.type == EventType::kOdometry) {
-      const OdometryRow& row = d.odometry[e.index];
-      const double dt = last_odometry ? row.time_s - *last_odometry : 0.0;
-      last_odometry = row.time_s;
-      integrated_heading += row.turn_rate_rad_per_s * dt;
-      const double forward = row.forward_speed_m_per_s * dt;
-      if (forward != 0.0) {
-        filter.Step(forward,
-                    compass && heading ? *heading + map->compass_to_map_rad() : integrated_heading);
-      }
-    } else if (e.type == EventType::kWifi) {
-      const WifiScan& scan = d.wifi[e.index];
-      if (d.odometry.empty() && last_time) filter.Diffuse(scan.time_s - *last_time);
-      last_time = scan.time_s;
-      const size_t known = filter.Update(Readings(scan));
-      unknown_scans += known == 0;
-      const LocationEstimate est = filter.Estimate();
-      tum << ShortestNumber(scan.time_s) << ' ' << ShortestNumber(est.x_m) << ' '
-          << ShortestNumber(est.y_m) << " 0 0 0 0 1\n";
-      const auto found = filter.Candidates();
-      for (size_t k = 0; k < found.size(); ++k) {
-        candidates << ShortestNumber(scan.time_s) << ',' << k << ','
-                   << ShortestNumber(found[k].first.x) << ',' << ShortestNumber(found[k].first.y)
-                   << ',' << ShortestNumber(found[k].second) << '\n';
-      }
-      errors << ShortestNumber(scan.time_s) << ',' << ShortestNumber(est.x_m) << ','
-             << ShortestNumber(est.y_m) << ',' << est.floor << ',' << known;
-      const auto truth = InterpolateGroundTruth(d.ground_truth, scan.time_s);
-      if (truth) {
-        // A map made from a run is in the run's frame and has one floor: its estimates are
-        // scored after its alignment onto the truth, on position alone.
-        const auto& align = map->truth_from_map();
-        auto to_truth = [&](double x, double y) {
-          if (!align) return Point2{x, y};
-          const double c = std::cos(align->rotation_rad), s = std::sin(align->rotation_rad);
-          return Point2{c * x - s * y + align->translation_x_m,
-                        s * x + c * y + align->translation_y_m};
-        };
-        auto floor_differs = [&](int floor) { return !align && floor != truth->floor; };
-        const Point2 e = to_truth(est.x_m, est.y_m);
-        const double error = floor_differs(est.floor)
-                                 ? std::numeric_limits<double>::infinity()
-                                 : std::hypot(e.x - truth->x_m, e.y - truth->y_m);
-        filter_errors.push_back(error);
-        const fabmap::Estimate& k = knn[scan_index];
-        const Point2 ke = to_truth(k.x_m, k.y_m);
-        const double knn_error = !k.located || floor_differs(k.floor)
-                                     ? std::numeric_limits<double>::infinity()
-                                     : std::hypot(ke.x - truth->x_m, ke.y - truth->y_m);
-        knn_errors.push_back(knn_error);
-        errors << ',' << ShortestNumber(truth->x_m) << ',' << ShortestNumber(truth->y_m) << ','
-               << truth->floor << ',' << ShortestNumber(error) << ',' << ShortestNumber(knn_error)
-               << '\n';
-      } else {
-        errors << ",,,,,\n";
-      }
-      ++scan_index;
-    }
-  }
+  FilterPhoneLog(
+      d, *map, &filter, std::numeric_limits<double>::infinity(),
+      [&](const WifiScan& scan, size_t known) {
+        unknown_scans += known == 0;
+        const LocationEstimate est = filter.Estimate();
+        tum << ShortestNumber(scan.time_s) << ' ' << ShortestNumber(est.x_m) << ' '
+            << ShortestNumber(est.y_m) << " 0 0 0 0 1\n";
+        const auto found = filter.Candidates();
+        for (size_t k = 0; k < found.size(); ++k) {
+          candidates << ShortestNumber(scan.time_s) << ',' << k << ','
+                     << ShortestNumber(found[k].first.x) << ',' << ShortestNumber(found[k].first.y)
+                     << ',' << ShortestNumber(found[k].second) << '\n';
+        }
+        errors << ShortestNumber(scan.time_s) << ',' << ShortestNumber(est.x_m) << ','
+               << ShortestNumber(est.y_m) << ',' << est.floor << ',' << known;
+        const auto truth = InterpolateGroundTruth(d.ground_truth, scan.time_s);
+        if (truth) {
+          // A map made from a run is in the run's frame and has one floor: its estimates are
+          // scored after its alignment onto the truth, on position alone.
+          auto to_truth = [&](double x, double y) { return MapToTruth(*map, {x, y}); };
+          auto floor_differs = [&](int floor) {
+            return !map->truth_from_map() && floor != truth->floor;
+          };
+          const Point2 e = to_truth(est.x_m, est.y_m);
+          const double error = floor_differs(est.floor)
+                                   ? std::numeric_limits<double>::infinity()
+                                   : std::hypot(e.x - truth->x_m, e.y - truth->y_m);
+          filter_errors.push_back(error);
+          const fabmap::Estimate& k = knn[scan_index];
+          const Point2 ke = to_truth(k.x_m, k.y_m);
+          const double knn_error = !k.located || floor_differs(k.floor)
+                                       ? std::numeric_limits<double>::infinity()
+                                       : std::hypot(ke.x - truth->x_m, ke.y - truth->y_m);
+          knn_errors.push_back(knn_error);
+          errors << ',' << ShortestNumber(truth->x_m) << ',' << ShortestNumber(truth->y_m) << ','
+                 << truth->floor << ',' << ShortestNumber(error) << ',' << ShortestNumber(knn_error)
+                 << '\n';
+        } else {
+          errors << ",,,,,\n";
+        }
+        ++scan_index;
+      });
   nlohmann::ordered_json j;
   j["data"] = args->values.at("--data");
   j["wifi_map"] = map_path;
@@ -382,6 +432,226 @@ int LocateCommand(int argc, char** argv) {
                                           {"candidates.csv", candidates.str()},
                                           {"summary.json", summary}});
   if (!written.ok()) return fail(written);
+  if (!filter_errors.empty()) {
+    // The paper's fig. 16: the share of scans located within d, beside the 3-NN baseline.
+    const Scene figure = LocalisationCurvesScene(
+        {{"particle filter (" + ToString(options->particle_filter.likelihood) + ")", filter_errors},
+         {"weighted 3-NN fingerprints", knn_errors}},
+        d.name + ": " + std::to_string(filter_errors.size()) + " scans with ground truth");
+    Status drawn = RenderToPng(figure, folder.value()->Path("cumulative_error.png"));
+    if (!drawn.ok()) return fail(drawn);
+  }
+  if (!args->quiet) std::cout << summary;
+  return kExitOk;
+}
+
+namespace {
+
+// The robot's map for `call`: a replay's run folder (experiences.csv, links.csv; the robot is at
+// summary.json's current_experience, or else at the experience of frames.csv's last frame that
+// had one) or a saved map file (its current experience).
+struct RobotMap {
+  std::vector<Experience> experiences;
+  std::vector<Link> links;
+  std::optional<uint32_t> current;
+};
+
+StatusOr<RobotMap> LoadRobotMap(const std::string& path) {
+  RobotMap m;
+  if (fs::is_directory(path)) {
+    StatusOr<RunFolder> run = ReadRunFolder(path);
+    if (!run.ok()) return run.status();
+    m.experiences = std::move(run->experiences);
+    m.links = std::move(run->links);
+    m.current = run->current_experience;
+    for (auto f = run->frames.rbegin(); f != run->frames.rend() && !m.current; ++f) {
+      if (f->experience_id >= 0 && f->experience_id < static_cast<int64_t>(m.experiences.size())) {
+        m.current = static_cast<uint32_t>(f->experience_id);
+      }
+    }
+  } else {
+    StatusOr<MapFile> map = LoadMapFile(path);
+    if (!map.ok()) return map.status();
+    const ExperienceMap::State& state = map->state.ratslam.experience_map;
+    m.experiences = state.experiences;
+    m.links = state.links;
+    m.current = state.current;
+  }
+  if (m.experiences.empty()) return Status::Error(path + ": the map has no experience");
+  if (!m.current) m.current = static_cast<uint32_t>(m.experiences.size() - 1);
+  return m;
+}
+
+}  // namespace
+
+int CallCommand(int argc, char** argv) {
+  const auto args =
+      ParseArguments(argc, argv, 2, {"--map", "--wifi-map", "--data", "--at", "--out", "--config"});
+  if (!args || !args->positional.empty() || !args->values.count("--map") ||
+      !args->values.count("--wifi-map") || !args->values.count("--data") ||
+      !args->values.count("--at") || !args->values.count("--out")) {
+    std::cerr << "usage: ratslam call --map RUN_FOLDER|MAP_FILE --wifi-map W --data PHONE_LOG "
+                 "--at T --out O [--config C] [--lenient] [--quiet]\n"
+                 "  Locates the phone up to time T (the log's seconds) and plans the route the "
+                 "robot at its current experience takes to visit every candidate location.\n";
+    return kExitUsage;
+  }
+  auto fail = [](const Status& s) {
+    if (!s.message().empty()) std::cerr << "ratslam call: " << s.message() << "\n";
+    return kExitError;
+  };
+  const std::optional<double> at = ParseNumber("--at", args->values.at("--at"));
+  if (!at) return kExitUsage;
+  StatusOr<RobotMap> robot = LoadRobotMap(args->values.at("--map"));
+  if (!robot.ok()) return fail(robot.status());
+  StatusOr<PhoneSetup> setup = SetUpPhone(*args, "call");
+  if (!setup.ok()) return fail(setup.status());
+  const WifiGpMap& map = setup->map;
+  const Dataset& d = setup->data;
+  if (d.wifi.front().time_s > *at) {
+    return fail(Status::Error(args->values.at("--data") + ": no Wi-Fi scan at or before --at " +
+                              ShortestNumber(*at) + " s (the first is at " +
+                              ShortestNumber(d.wifi.front().time_s) + " s)"));
+  }
+  if (!map.truth_from_map() && !args->quiet) {
+    std::cerr << "ratslam call: note: " << args->values.at("--wifi-map")
+              << " was made from ground truth, not from a run: its frame is the robot map's "
+                 "only if the map was drawn in the truth's frame (make it with wifi-map --run)\n";
+  }
+  ParticleFilter filter(map, setup->options.particle_filter);
+  Status initialised = filter.Initialise(!d.compass.empty());
+  if (!initialised.ok()) return fail(initialised);
+  size_t scans = 0;
+  double last_scan_s = 0.0;
+  FilterPhoneLog(d, map, &filter, *at, [&](const WifiScan& scan, size_t) {
+    ++scans;
+    last_scan_s = scan.time_s;
+  });
+  const LocationEstimate estimate = filter.Estimate();
+  const std::vector<std::pair<Point2, double>> found = filter.Candidates();
+  std::vector<Point2> candidates;
+  for (const auto& c : found) candidates.push_back(c.first);
+  RouteGraph graph;
+  for (const Experience& e : robot->experiences) graph.nodes.push_back({e.x_m, e.y_m});
+  for (const Link& l : robot->links) graph.edges.push_back({l.from, l.to});
+  StatusOr<CallPlan> plan = PlanCall(graph, *robot->current, candidates);
+  if (!plan.ok()) return fail(plan.status());
+
+  nlohmann::ordered_json j;
+  j["data"] = args->values.at("--data");
+  j["map"] = args->values.at("--map");
+  j["wifi_map"] = args->values.at("--wifi-map");
+  j["at_s"] = *at;
+  j["scans_used"] = scans;
+  j["last_scan_s"] = last_scan_s;
+  j["robot_experience"] = *robot->current;
+  j["estimate"] = {{"x_m", estimate.x_m}, {"y_m", estimate.y_m}, {"floor", estimate.floor}};
+  const auto truth = InterpolateGroundTruth(d.ground_truth, last_scan_s);
+  std::optional<Point2> truth_on_map;
+  if (truth) {
+    truth_on_map = TruthToMap(map, {truth->x_m, truth->y_m});
+    j["truth_on_map"] = {{"x_m", truth_on_map->x}, {"y_m", truth_on_map->y}};
+    j["estimate_error_m"] =
+        std::hypot(estimate.x_m - truth_on_map->x, estimate.y_m - truth_on_map->y);
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const Point2& c : candidates) {
+      nearest = std::min(nearest, std::hypot(c.x - truth_on_map->x, c.y - truth_on_map->y));
+    }
+    j["nearest_candidate_error_m"] = nearest;
+  }
+  nlohmann::ordered_json cs = nlohmann::ordered_json::array();
+  for (size_t k = 0; k < found.size(); ++k) {
+    cs.push_back({{"rank", k},
+                  {"x_m", found[k].first.x},
+                  {"y_m", found[k].first.y},
+                  {"weight", found[k].second},
+                  {"experience", plan->serving_node[k]},
+                  {"distance_to_experience_m", plan->serving_distance_m[k]}});
+  }
+  j["candidates"] = cs;
+  j["stops"] = plan->stops;
+  j["tour"] = plan->exact ? "exact (Held-Karp)" : "nearest neighbour + 2-opt";
+  j["route_experiences"] = plan->route.size();
+  j["route_length_m"] = plan->length_m;
+  std::ostringstream route;
+  route << "step,experience_id,x_m,y_m,stop_of_candidates\n";
+  size_t next_stop = 0;
+  for (size_t k = 0; k < plan->route.size(); ++k) {
+    const uint32_t e = plan->route[k];
+    route << k << ',' << e << ',' << ShortestNumber(graph.nodes[e].x) << ','
+          << ShortestNumber(graph.nodes[e].y) << ',';
+    if (next_stop < plan->stops.size() && plan->stops[next_stop] == e) {
+      for (size_t c = 0; c < plan->stop_candidates[next_stop].size(); ++c) {
+        route << (c ? " " : "") << plan->stop_candidates[next_stop][c];
+      }
+      ++next_stop;
+    }
+    route << '\n';
+  }
+
+  // The figure: the experience map, the particles, the estimate, the truth, the candidates
+  // (numbered by rank) and the robot's route.
+  ExperienceMapImageData image;
+  image.experiences = robot->experiences;
+  image.links = robot->links;
+  image.current = robot->current;
+  ExperienceMapImageOptions options;
+  WorldBounds b{graph.nodes[0].x, graph.nodes[0].y, graph.nodes[0].x, graph.nodes[0].y};
+  auto grow = [&](const Point2& p) {
+    b.min_x_m = std::min(b.min_x_m, p.x - 2);
+    b.max_x_m = std::max(b.max_x_m, p.x + 2);
+    b.min_y_m = std::min(b.min_y_m, p.y - 2);
+    b.max_y_m = std::max(b.max_y_m, p.y + 2);
+  };
+  for (const Point2& p : graph.nodes) grow(p);
+  for (const Point2& p : candidates) grow(p);
+  options.bounds = b;
+  options.title = "calling the robot at " + ShortestNumber(*at) + " s: route " +
+                  ShortestNumber(std::round(plan->length_m * 10) / 10) + " m through " +
+                  std::to_string(plan->stops.size()) + " stops for " +
+                  std::to_string(candidates.size()) + " candidates";
+  WorldToImage to_image;
+  Scene scene = ExperienceMapScene(image, options, &to_image);
+  const auto& particles = filter.particles();
+  const size_t every = std::max<size_t>(1, particles.size() / 3000);
+  for (size_t k = 0; k < particles.size(); k += every) {
+    scene.Disc(to_image(particles[k].x_m, particles[k].y_m), 1.6f, {120, 120, 120, 110}, 6);
+  }
+  std::vector<ScenePoint> line;
+  for (uint32_t e : plan->route) line.push_back(to_image(graph.nodes[e].x, graph.nodes[e].y));
+  scene.Polyline(line, 6.0f, {148, 103, 189, 230});  // purple: red marks loop closures
+  for (size_t k = 0; k < candidates.size(); ++k) {
+    const ScenePoint c = to_image(candidates[k].x, candidates[k].y);
+    const ScenePoint e =
+        to_image(graph.nodes[plan->serving_node[k]].x, graph.nodes[plan->serving_node[k]].y);
+    scene.Line(c, e, 1.5f, {255, 127, 14, 255});
+    scene.Disc(c, 9.0f, {255, 127, 14, 255}, 20);
+    scene.Text({c.x, c.y + 5.0f}, std::to_string(k + 1), 14.0f, {255, 255, 255, 255},
+               TextAnchor::kCenter);
+  }
+  const ScenePoint est = to_image(estimate.x_m, estimate.y_m);
+  scene.Ring(est, 10.0f, 14.0f, 0.0f, 6.2832f, {31, 119, 180, 255}, 24);
+  if (truth_on_map) {
+    const ScenePoint t = to_image(truth_on_map->x, truth_on_map->y);
+    scene.Line({t.x - 10, t.y - 10}, {t.x + 10, t.y + 10}, 3.0f, {44, 160, 44, 255});
+    scene.Line({t.x - 10, t.y + 10}, {t.x + 10, t.y - 10}, 3.0f, {44, 160, 44, 255});
+  }
+  scene.Text(
+      {20, 75},
+      "purple: robot route   orange: candidates (k-means, by weight)   grey: particles   blue "
+      "ring: estimate" +
+          std::string(truth_on_map ? "   green x: truth" : ""),
+      15.0f, kInk);
+
+  const std::string summary = j.dump(2) + "\n";
+  StatusOr<std::unique_ptr<DiskFolder>> folder = DiskFolder::Open(args->values.at("--out"));
+  if (!folder.ok()) return fail(folder.status());
+  Status written = folder.value()->Write({{"config.toml", PrintLocateConfig(setup->options)},
+                                          {"route.csv", route.str()},
+                                          {"call.json", summary}});
+  if (!written.ok()) return fail(written);
+  Status drawn = RenderToPng(scene, folder.value()->Path("call.png"));
+  if (!drawn.ok()) return fail(drawn);
   if (!args->quiet) std::cout << summary;
   return kExitOk;
 }

@@ -85,10 +85,16 @@ const char kUsage[] =
     "      data set: [evaluation] split and map_fraction then divide it.\n"
     "  ratslam wifi-map --data D [--data D2 ...] --out W [--config C] [--lenient]\n"
     "      Gaussian-process Wi-Fi maps (per AP, mean and variance grids) from data sets with\n"
-    "      ground truth into the file W ([wifi_map] in C).\n"
+    "      ground truth into the file W ([wifi_map] in C). With --run RUN_FOLDER (and --data\n"
+    "      as that replay had it), positions come from the run's final map instead, in its\n"
+    "      frame.\n"
     "  ratslam locate --wifi-map W --data PHONE_LOG --out O [--config C] [--lenient] [--quiet]\n"
     "      Locates a phone in W with a particle filter ([particle_filter], [pdr]): writes\n"
-    "      trajectory_tum.txt, errors.csv (with ground truth), candidates.csv, summary.json.\n"
+    "      trajectory_tum.txt, errors.csv and cumulative_error.png (with ground truth),\n"
+    "      candidates.csv, summary.json.\n"
+    "  ratslam call --map RUN_FOLDER|MAP_FILE --wifi-map W --data PHONE_LOG --at T --out O\n"
+    "      Locates the phone up to time T and plans the robot's route from its current\n"
+    "      experience through every candidate location: call.json, route.csv, call.png.\n"
     "  ratslam simulate --world NAME|FILE --out D [--seed S] [--quiet]\n"
     "      Simulates a world (built in: office, circular, day_night, aliased_floors,\n"
     "      apartment; or a world TOML file) into the replay data set D, with world.toml,\n"
@@ -401,6 +407,7 @@ int Dispatch(int argc, char** argv) {
   if (command == "evaluate") return EvaluateCommand(argc, argv);
   if (command == "wifi-map") return WifiMapCommand(argc, argv);
   if (command == "locate") return LocateCommand(argc, argv);
+  if (command == "call") return CallCommand(argc, argv);
   if (command == "simulate") return SimulateCommand(argc, argv);
   if (command == "sweep") return SweepCommand(argc, argv);
   if (command == "import") return ImportCommand(argc, argv);

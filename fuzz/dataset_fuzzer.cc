@@ -33,12 +33,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace ratslam;
   namespace fs = std::filesystem;
   const std::vector<std::string> parts = fuzz::SplitParts(data, size, "\n%%\n");
-  const fs::path folder = fuzz::Scratch() / "dataset";
-  fs::remove_all(folder);
-  fs::create_directories(folder);
-  for (size_t i = 0; i < parts.size() && i < std::size(fuzz::kFiles); ++i) {
-    std::ofstream(folder / fuzz::kFiles[i], std::ios::binary) << parts[i];
-  }
+  const fs::path folder = fuzz::WriteScratchFolder(
+      "dataset", parts, {std::begin(fuzz::kFiles), std::end(fuzz::kFiles)});
   StatusOr<Dataset> d = ReadDataset(folder.string());
   if (!d.ok()) {
     if (d.status().message().rfind(folder.string(), 0) != 0) {

@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 
 namespace ratslam::fuzz {
@@ -27,6 +28,17 @@ std::vector<std::string> SplitParts(const uint8_t* data, size_t size,
     parts.push_back(text.substr(start, at - start));
     start = at + separator.size();
   }
+}
+
+std::string WriteScratchFolder(const std::string& name, const std::vector<std::string>& parts,
+                               const std::vector<std::string>& files) {
+  const std::filesystem::path folder = Scratch() / name;
+  std::filesystem::remove_all(folder);
+  std::filesystem::create_directories(folder);
+  for (size_t i = 0; i < parts.size() && i < files.size(); ++i) {
+    std::ofstream(folder / files[i], std::ios::binary) << parts[i];
+  }
+  return folder.string();
 }
 
 void InvariantFailed(const std::string& message) {

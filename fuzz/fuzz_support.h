@@ -33,6 +33,11 @@ std::string WriteScratchFile(const std::string& name, const uint8_t* data, size_
 // Splits an input into parts at a separator line; a data set's files are fuzzed as one input.
 std::vector<std::string> SplitParts(const uint8_t* data, size_t size, const std::string& separator);
 
+// A fresh folder `name` in the scratch folder holding parts[i] as files[i] (as many as both
+// have); returns its path. Data sets and run folders are fuzzed as one input this way.
+std::string WriteScratchFolder(const std::string& name, const std::vector<std::string>& parts,
+                               const std::vector<std::string>& files);
+
 // A failed invariant: prints the message and aborts, which the fuzzer reports as a crash.
 [[noreturn]] void InvariantFailed(const std::string& message);
 

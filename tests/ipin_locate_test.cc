@@ -10,11 +10,13 @@
 // route.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 #include <string>
 
@@ -118,6 +120,138 @@ TEST(IpinLocateTest, AParticleFilterLocatesAnotherPhoneInTheWifiMap) {
       "wifi-map --data " + (root / "empty").string() + " --out " + (root / "z.wifimap").string(),
       root);
   EXPECT_EQ(no_truth.exit_code, 1);
+  fs::remove_all(root);
+}
+
+// A Wi-Fi map made from a RatSLAM run (its experience map's frame, not the truth's), the phone
+// located in it, and the robot called along the run's experience graph. The route is checked
+// against the run's own CSVs (independently of the planner): every candidate's experience is on
+// it, consecutive experiences are linked, and its length is the sum of its segments.
+TEST(IpinLocateTest, ARunsMapLocatesThePhoneAndTheRobotIsCalled) {
+  const fs::path data = fs::path(RATSLAM_SHARED_DATA_DIR) / "ipin2023-t3";
+  auto log = [&](const char* rep) {
+    return (data / (std::string("IPIN2023_T3_TrainingTrial22_repetition") + rep + ".txt")).string();
+  };
+  for (const char* rep : {"01", "02", "03"}) {
+    if (!fs::exists(log(rep))) GTEST_SKIP() << "missing " << log(rep);
+  }
+  const fs::path root = fs::temp_directory_path() / ("ratslam_call_" + std::to_string(::getpid()));
+  fs::create_directories(root);
+  const std::string run = (root / "run").string(), map_file = (root / "run.map").string();
+  const std::string both = " --data " + log("01") + " --data " + log("02");
+  const Result replayed = RunRatslam("replay --quiet --config " + std::string(RATSLAM_SOURCE_DIR) +
+                                         "/configs/ipin2023-wifi-compass.toml" + both + " --out " +
+                                         run + " --save-map " + map_file,
+                                     root);
+  ASSERT_EQ(replayed.exit_code, 0) << replayed.err;
+  const std::string wifi = (root / "run.wifimap").string();
+  const Result built = RunRatslam("wifi-map --run " + run + both + " --out " + wifi, root);
+  ASSERT_EQ(built.exit_code, 0) << built.err;
+  // The same run with other data is refused by name.
+  const Result wrong =
+      RunRatslam("wifi-map --run " + run + " --data " + log("03") + " --out x.wifimap", root);
+  EXPECT_EQ(wrong.exit_code, 1);
+  EXPECT_NE(wrong.err.find("the run replayed data set"), std::string::npos) << wrong.err;
+
+  StatusOr<WifiGpMap> w = WifiGpMap::Load(wifi);
+  ASSERT_TRUE(w.ok()) << w.status().message();
+  ASSERT_TRUE(w->truth_from_map().has_value());
+  const Result located = RunRatslam("locate --quiet --wifi-map " + wifi + " --data " + log("03") +
+                                        " --out " + (root / "o").string(),
+                                    root);
+  ASSERT_EQ(located.exit_code, 0) << located.err;
+  std::ifstream in(root / "o" / "summary.json");
+  const nlohmann::json s = nlohmann::json::parse(in);
+  EXPECT_TRUE(s["errors_after_map_alignment"].get<bool>());
+  EXPECT_GT(fs::file_size(root / "o" / "cumulative_error.png"), 10000u);
+  // Chance: a uniform draw over the map's cells, moved into the truth's frame.
+  const auto& a = *w->truth_from_map();
+  std::vector<Point2> cells;
+  for (const Point2& c : w->KnownCells(0)) {
+    cells.push_back(
+        {std::cos(a.rotation_rad) * c.x - std::sin(a.rotation_rad) * c.y + a.translation_x_m,
+         std::sin(a.rotation_rad) * c.x + std::cos(a.rotation_rad) * c.y + a.translation_y_m});
+  }
+  StatusOr<CsvTable> errors = CsvTable::Read(
+      (root / "o" / "errors.csv").string(), {"time_s", "true_x_m", "true_y_m", "error_m"},
+      {"x_m", "y_m", "floor", "known_aps", "true_floor", "knn_error_m"});
+  ASSERT_TRUE(errors.ok()) << errors.status().message();
+  double chance = 0.0;
+  size_t n = 0;
+  for (size_t r = 0; r < errors->rows(); ++r) {
+    StatusOr<double> x = errors->Number(r, "true_x_m"), y = errors->Number(r, "true_y_m");
+    if (!x.ok() || !y.ok()) continue;
+    double sum = 0.0;
+    for (const Point2& c : cells) sum += std::hypot(c.x - *x, c.y - *y);
+    chance += sum / cells.size();
+    ++n;
+  }
+  ASSERT_GT(n, 30u);
+  chance /= n;
+  const double mean = s["mean_error_m"];
+  RecordProperty("run_map_chance_m", std::to_string(chance));
+  RecordProperty("run_map_mean_error_m", std::to_string(mean));
+  EXPECT_LT(mean, 0.3 * chance);
+  EXPECT_LT(mean, s["knn_baseline"]["mean_error_m"].get<double>());
+
+  // Call the robot at 100 s, from the run folder and from the saved map: the same plan.
+  auto call = [&](const std::string& robot_map, const std::string& out) {
+    const Result called =
+        RunRatslam("call --quiet --map " + robot_map + " --wifi-map " + wifi + " --data " +
+                       log("03") + " --at 100 --out " + (root / out).string(),
+                   root);
+    EXPECT_EQ(called.exit_code, 0) << called.err;
+    std::ifstream in(root / out / "call.json");
+    return nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+  };
+  const nlohmann::json c = call(run, "c");
+  ASSERT_TRUE(c.is_object());
+  EXPECT_GT(fs::file_size(root / "c" / "call.png"), 10000u);
+  EXPECT_LT(c["nearest_candidate_error_m"].get<double>(), 0.3 * chance);
+  StatusOr<CsvTable> ex = CsvTable::Read(
+      run + "/experiences.csv", {"id", "x_m", "y_m"},
+      {"theta_rad", "template_id", "time_s", "pose_cell_x", "pose_cell_y", "pose_cell_theta"});
+  StatusOr<CsvTable> links = CsvTable::Read(
+      run + "/links.csv", {"from_id", "to_id"},
+      {"id", "distance_m", "heading_rad", "facing_rad", "duration_s", "loop_closure", "kind"});
+  StatusOr<CsvTable> route = CsvTable::Read((root / "c" / "route.csv").string(), {"experience_id"},
+                                            {"step", "x_m", "y_m", "stop_of_candidates"});
+  ASSERT_TRUE(ex.ok() && links.ok() && route.ok());
+  std::set<std::pair<int, int>> linked;
+  for (size_t r = 0; r < links->rows(); ++r) {
+    const int f = static_cast<int>(*links->Number(r, "from_id"));
+    const int t = static_cast<int>(*links->Number(r, "to_id"));
+    linked.insert({f, t});
+    linked.insert({t, f});
+  }
+  std::vector<int> path;
+  for (size_t r = 0; r < route->rows(); ++r) {
+    path.push_back(static_cast<int>(*route->Number(r, "experience_id")));
+  }
+  ASSERT_FALSE(path.empty());
+  EXPECT_EQ(path.front(), c["robot_experience"].get<int>());
+  double length = 0.0;
+  for (size_t k = 1; k < path.size(); ++k) {
+    EXPECT_TRUE(linked.count({path[k - 1], path[k]})) << path[k - 1] << "-" << path[k];
+    const size_t p = static_cast<size_t>(path[k - 1]), q = static_cast<size_t>(path[k]);
+    length += std::hypot(*ex->Number(p, "x_m") - *ex->Number(q, "x_m"),
+                         *ex->Number(p, "y_m") - *ex->Number(q, "y_m"));
+  }
+  EXPECT_NEAR(length, c["route_length_m"].get<double>(), 1e-6);
+  for (const auto& candidate : c["candidates"]) {
+    EXPECT_NE(std::find(path.begin(), path.end(), candidate["experience"].get<int>()), path.end())
+        << "candidate " << candidate["rank"] << " is not visited";
+  }
+  const nlohmann::json f = call(map_file, "f");
+  ASSERT_TRUE(f.is_object());
+  EXPECT_EQ(f["robot_experience"], c["robot_experience"]);
+  EXPECT_NEAR(f["route_length_m"].get<double>(), c["route_length_m"].get<double>(), 1e-6);
+  // Asking before the first scan says so.
+  const Result early = RunRatslam("call --map " + run + " --wifi-map " + wifi + " --data " +
+                                      log("03") + " --at -5 --out " + (root / "e").string(),
+                                  root);
+  EXPECT_EQ(early.exit_code, 1);
+  EXPECT_NE(early.err.find("no Wi-Fi scan at or before"), std::string::npos) << early.err;
   fs::remove_all(root);
 }
 

@@ -232,6 +232,9 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
   j["frames"] = s.frames;
   j["templates"] = s.templates;
   j["experiences"] = s.experiences;
+  // Where the robot is at the end (the experience map's current experience, after the last
+  // odometry step; frames.csv's last row may predate it). Absent before the first experience.
+  if (map.current()) j["current_experience"] = *map.current();
   j["links"] = s.links;
   j["loop_closures"] = s.loop_closures;
   j["odometry_steps"] = state.trajectory.size();

@@ -126,6 +126,11 @@ StatusOr<RunFolder> ReadRunFolder(const std::string& folder) {
     if (j.is_object() && j.contains("data_folder") && j["data_folder"].is_string()) {
       run.dataset_folder = j["data_folder"].get<std::string>();
     }
+    if (j.is_object() && j.contains("current_experience") &&
+        j["current_experience"].is_number_unsigned() &&
+        j["current_experience"].get<uint64_t>() < run.experiences.size()) {
+      run.current_experience = j["current_experience"].get<uint32_t>();
+    }
     if (j.is_object() && j.contains("dataset") && j["dataset"].is_string()) {
       run.dataset_name = j["dataset"].get<std::string>();
     }

@@ -2,6 +2,7 @@
 #ifndef RATSLAM_FUSION_IO_RUN_READER_H_
 #define RATSLAM_FUSION_IO_RUN_READER_H_
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -16,8 +17,9 @@ struct RunFolder {
   std::vector<Experience> experiences;
   std::vector<Link> links;
   std::vector<FrameRecord> frames;
-  std::string dataset_folder;  // from summary.json, if recorded
-  std::string dataset_name;    // from summary.json, if recorded
+  std::string dataset_folder;                  // from summary.json, if recorded
+  std::string dataset_name;                    // from summary.json, if recorded
+  std::optional<uint32_t> current_experience;  // from summary.json, if recorded
 };
 
 // Errors name the file, line and column; ids must be consecutive and links must refer to
