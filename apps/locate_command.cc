@@ -26,6 +26,7 @@
 #include "sensors/dataset/dataset_loader.h"
 #include "sensors/dataset/ipin_log.h"
 #include "session/evaluation_baselines.h"
+#include "sim/world.h"
 #include "viewer/figures.h"
 #include "viewer/localisation_figure.h"
 
@@ -177,6 +178,23 @@ void FilterPhoneLog(const Dataset& d, const WifiGpMap& map, ParticleFilter* filt
   }
 }
 
+// The walls of the simulated worlds among `paths` (a replay folder holding the world.toml that
+// `ratslam simulate` wrote), in the world's frame, which is the ground truth's.
+StatusOr<std::vector<WallSegment>> WallsOfData(const std::vector<std::string>& paths) {
+  std::vector<WallSegment> walls;
+  for (const std::string& path : paths) {
+    const fs::path world = fs::path(path) / "world.toml";
+    if (!fs::is_directory(path) || !fs::exists(world)) continue;
+    StatusOr<sim::World> w = sim::LoadWorldFile(world.string());
+    if (!w.ok()) return w.status();
+    for (const sim::Wall& wall : w->walls) {
+      walls.push_back({wall.floor, {wall.from.x_m, wall.from.y_m}, {wall.to.x_m, wall.to.y_m}});
+    }
+    break;  // one world: the sessions of a simulation share it
+  }
+  return walls;
+}
+
 // Samples from a replay's run folder: each scan of the run's data (loaded as the replay loaded
 // it, so times agree) placed where the run's final map puts the robot at that time
 // (trajectory_tum.txt); the map's frame is the run's. Also finds the compass's offset to that
@@ -288,6 +306,11 @@ int WifiMapCommand(int argc, char** argv) {
   map->set_geo_reference_deg(origin);
   map->set_compass_to_map_rad(frame.compass_to_map_rad());
   map->set_truth_from_map(frame.truth_from_map());
+  if (!from_run) {  // a run's frame is not the world's: its walls would not line up
+    StatusOr<std::vector<WallSegment>> walls = WallsOfData(args->all.at("--data"));
+    if (!walls.ok()) return fail(walls.status());
+    map->set_walls(std::move(walls).value());
+  }
   const fs::path out = args->values.at("--out");
   StatusOr<std::unique_ptr<DiskFolder>> folder =
       DiskFolder::Open(out.has_parent_path() ? out.parent_path().string() : ".");
@@ -302,6 +325,7 @@ int WifiMapCommand(int argc, char** argv) {
   j["floors"] = map->floors();
   j["stored_cells"] = map->stored_cells();
   j["positions_from"] = from_run ? "run trajectory" : "ground truth";
+  j["walls"] = map->walls().size();
   if (from_run) {
     j["compass_to_map_rad"] = map->compass_to_map_rad();
     if (map->truth_from_map()) j["map_to_truth_rmse_m"] = map->truth_from_map()->rmse_m;
@@ -414,6 +438,8 @@ int LocateCommand(int argc, char** argv) {
   j["likelihood"] = ToString(options->particle_filter.likelihood);
   j["particles"] = options->particle_filter.particles;
   j["resamplings"] = filter.resamplings();
+  j["walls"] = map->walls().size();
+  j["wall_crossings"] = filter.wall_crossings();
   if (map->truth_from_map()) {
     j["errors_after_map_alignment"] = true;  // the map is a run's: scored in the truth's frame
     j["map_to_truth_rmse_m"] = map->truth_from_map()->rmse_m;

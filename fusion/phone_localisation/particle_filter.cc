@@ -126,8 +126,36 @@ const ParticleFilterOptions& Validated(const ParticleFilterOptions& options) {
 }
 }  // namespace
 
+namespace {
+constexpr double kWallCellM = 2.0;
+int WallCell(double v) {
+  return static_cast<int>(std::floor(std::clamp(v, -1e8, 1e8) / kWallCellM));
+}
+double Cross(const Point2& o, const Point2& a, const Point2& b) {
+  return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
+}
+bool OnSegment(const Point2& p, const Point2& q, const Point2& r) {  // q on p-r, collinear
+  return std::min(p.x, r.x) <= q.x && q.x <= std::max(p.x, r.x) && std::min(p.y, r.y) <= q.y &&
+         q.y <= std::max(p.y, r.y);
+}
+int Sign(double v) { return (v > 0) - (v < 0); }
+}  // namespace
+
 ParticleFilter::ParticleFilter(const WifiGpMap& map, const ParticleFilterOptions& options)
-    : map_(map), options_(Validated(options)), random_(options.seed) {}
+    : map_(map), options_(Validated(options)), random_(options.seed), floors_(map.floors()) {
+  for (uint32_t k = 0; k < map_.walls().size(); ++k) {
+    const WallSegment& w = map_.walls()[k];
+    const int x0 = WallCell(std::min(w.a.x, w.b.x)), x1 = WallCell(std::max(w.a.x, w.b.x));
+    const int y0 = WallCell(std::min(w.a.y, w.b.y)), y1 = WallCell(std::max(w.a.y, w.b.y));
+    if (static_cast<int64_t>(x1 - x0 + 1) * (y1 - y0 + 1) > 4096) {
+      long_walls_.push_back(k);  // tested for every move rather than bucketed
+      continue;
+    }
+    for (int x = x0; x <= x1; ++x) {
+      for (int y = y0; y <= y1; ++y) wall_cells_[{w.floor, x, y}].push_back(k);
+    }
+  }
+}
 
 Status ParticleFilter::Initialise(bool have_compass) {
   std::vector<std::pair<int, Point2>> cells;
@@ -151,7 +179,59 @@ Status ParticleFilter::Initialise(bool have_compass) {
   return Status::Ok();
 }
 
+bool SegmentsIntersect(const Point2& p1, const Point2& p2, const Point2& q1, const Point2& q2) {
+  const int d1 = Sign(Cross(q1, q2, p1)), d2 = Sign(Cross(q1, q2, p2));
+  const int d3 = Sign(Cross(p1, p2, q1)), d4 = Sign(Cross(p1, p2, q2));
+  if (d1 * d2 < 0 && d3 * d4 < 0) return true;
+  return (d1 == 0 && OnSegment(q1, p1, q2)) || (d2 == 0 && OnSegment(q1, p2, q2)) ||
+         (d3 == 0 && OnSegment(p1, q1, p2)) || (d4 == 0 && OnSegment(p1, q2, p2));
+}
+
+bool ParticleFilter::CrossesWall(int floor, const Point2& a, const Point2& b) const {
+  const int x0 = WallCell(std::min(a.x, b.x)), x1 = WallCell(std::max(a.x, b.x));
+  const int y0 = WallCell(std::min(a.y, b.y)), y1 = WallCell(std::max(a.y, b.y));
+  if (static_cast<int64_t>(x1 - x0 + 1) * (y1 - y0 + 1) > 64) {  // a long jump: test them all
+    for (const WallSegment& w : map_.walls()) {
+      if (w.floor == floor && SegmentsIntersect(a, b, w.a, w.b)) return true;
+    }
+    return false;
+  }
+  for (uint32_t k : long_walls_) {
+    const WallSegment& w = map_.walls()[k];
+    if (w.floor == floor && SegmentsIntersect(a, b, w.a, w.b)) return true;
+  }
+  for (int x = x0; x <= x1; ++x) {
+    for (int y = y0; y <= y1; ++y) {
+      const auto it = wall_cells_.find({floor, x, y});
+      if (it == wall_cells_.end()) continue;
+      for (uint32_t k : it->second) {
+        const WallSegment& w = map_.walls()[k];
+        if (SegmentsIntersect(a, b, w.a, w.b)) return true;
+      }
+    }
+  }
+  return false;
+}
+
+void ParticleFilter::ApplyWalls(const std::vector<Point2>& before) {
+  bool any = false;
+  for (size_t i = 0; i < particles_.size(); ++i) {
+    Particle& p = particles_[i];
+    if (CrossesWall(p.floor, before[i], {p.x_m, p.y_m})) {
+      p.weight *= options_.wall_crossing_weight;
+      ++wall_crossings_;
+      any = true;
+    }
+  }
+  if (any) Normalise();
+}
+
 void ParticleFilter::Step(double forward_m, double heading_rad) {
+  std::vector<Point2> before;
+  if (!map_.walls().empty()) {
+    before.reserve(particles_.size());
+    for (const Particle& p : particles_) before.push_back({p.x_m, p.y_m});
+  }
   for (Particle& p : particles_) {
     p.heading_offset_rad += random_.Gaussian(0.0, options_.heading_offset_walk_rad);
     const double heading =
@@ -160,14 +240,21 @@ void ParticleFilter::Step(double forward_m, double heading_rad) {
     p.x_m += length * std::cos(heading);
     p.y_m += length * std::sin(heading);
   }
+  if (!before.empty()) ApplyWalls(before);
 }
 
 void ParticleFilter::Diffuse(double dt_s) {
   const double sigma = options_.random_walk_m_per_s * std::sqrt(std::max(dt_s, 0.0));
+  std::vector<Point2> before;
+  if (!map_.walls().empty()) {
+    before.reserve(particles_.size());
+    for (const Particle& p : particles_) before.push_back({p.x_m, p.y_m});
+  }
   for (Particle& p : particles_) {
     p.x_m += random_.Gaussian(0.0, sigma);
     p.y_m += random_.Gaussian(0.0, sigma);
   }
+  if (!before.empty()) ApplyWalls(before);
 }
 
 double ParticleFilter::Likelihood(const Point2& p, int floor,
@@ -193,6 +280,23 @@ size_t ParticleFilter::Update(const std::vector<std::pair<std::string, double>>&
     if (ap >= 0 && std::isfinite(rssi)) known.emplace_back(ap, rssi);
   }
   if (known.empty() || particles_.empty()) return known.size();
+  // Floor changes: before weighting, a particle moves to another floor the map knows (same x, y)
+  // with probability floor_change_per_scan, so a phone that took the stairs is found again.
+  if (options_.floor_change_per_scan > 0.0 && floors_.size() > 1) {
+    for (Particle& p : particles_) {
+      if (random_.Uniform() >= options_.floor_change_per_scan) continue;
+      // The k-th of the floors other than the particle's, k uniform.
+      size_t k = std::min(static_cast<size_t>(random_.Uniform() * (floors_.size() - 1)),
+                          floors_.size() - 2);
+      for (int f : floors_) {
+        if (f == p.floor) continue;
+        if (k-- == 0) {
+          p.floor = f;
+          break;
+        }
+      }
+    }
+  }
   std::vector<double> value(particles_.size());
   double max_log = -std::numeric_limits<double>::infinity();
   for (size_t i = 0; i < particles_.size(); ++i) {

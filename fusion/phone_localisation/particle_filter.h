@@ -10,16 +10,24 @@
 //    the product of those densities (the likelihood of independent readings, which the sum is
 //    not). APs the map does not know are left out; a scan with none the map knows leaves the
 //    weights as they are. A particle off the cells the map stores is down-weighted.
+//  - Walls (when the map knows them, e.g. a simulated world's): a particle whose move crosses a
+//    wall on its floor has its weight multiplied by wall_crossing_weight (0: it dies and the next
+//    resampling replaces it; if every particle crossed, the weights start over). Walls are
+//    bucketed in 2 m cells so a move tests only the walls near it.
 //  - Resampling: systematic, when the effective sample size falls below a share of the count.
 //  - Candidates: k-means (k-means++ seeding from the filter's seeded generator) over the
 //    particles, the paper's twelve (section IV-C.2).
-// Floors: each particle keeps the floor it was drawn on (no stairs model).
+// Floors: at each scan a particle moves to another floor the map knows (same x, y) with a small
+// probability, so the filter follows a phone up the stairs without a stairs model; the scan's
+// weight then decides.
 #ifndef RATSLAM_FUSION_PHONE_LOCALISATION_PARTICLE_FILTER_H_
 #define RATSLAM_FUSION_PHONE_LOCALISATION_PARTICLE_FILTER_H_
 
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -46,6 +54,8 @@ struct ParticleFilterOptions {
   double compass_offset_sigma_rad = 0.3;  // initial heading offset spread with a compass
   double random_walk_m_per_s = 0.8;       // no step source: position noise per second
   double off_map_weight = 0.01;           // weight factor of a particle off the stored cells
+  double wall_crossing_weight = 0.0;      // weight factor of a particle that walks through a wall
+  double floor_change_per_scan = 0.01;    // chance a particle tries another floor at a scan
   double resample_below = 0.5;            // resample when ESS < this share of the count
   ScanLikelihood likelihood = ScanLikelihood::kSum;  // see ScanLikelihood
   int candidates = 12;                               // k of the k-means candidates (section IV-C.2)
@@ -70,6 +80,12 @@ struct ParticleFilterOptions {
       schema::Unit("m/s").NonNegative());
     v("off_map_weight", off_map_weight,
       "weight factor of a particle on a cell the map does not store",
+      schema::Unit("").Within(0, 1));
+    v("wall_crossing_weight", wall_crossing_weight,
+      "weight factor of a particle whose move crosses a wall the map knows (0: it dies)",
+      schema::Unit("").Within(0, 1));
+    v("floor_change_per_scan", floor_change_per_scan,
+      "chance that a particle moves to another floor the map knows (same x, y) at each scan",
       schema::Unit("").Within(0, 1));
     v("resample_below", resample_below,
       "systematic resampling when the effective sample size falls below this share",
@@ -100,6 +116,9 @@ class ParticleFilter {
   // `map` must outlive the filter; `options` must be valid (throws std::invalid_argument).
   ParticleFilter(const WifiGpMap& map, const ParticleFilterOptions& options);
 
+  // Particles whose last move crossed a wall (since construction).
+  uint64_t wall_crossings() const { return wall_crossings_; }
+
   // Spreads the particles uniformly over the cells the map stores (all floors), equal weights.
   // Fails when the map stores no cell.
   Status Initialise(bool have_compass);
@@ -126,13 +145,25 @@ class ParticleFilter {
  private:
   void Normalise();
   void Resample();
+  // Whether the move from `a` to `b` on `floor` crosses a wall the map knows.
+  bool CrossesWall(int floor, const Point2& a, const Point2& b) const;
+  // Penalises the particles whose move from `before` crossed a wall.
+  void ApplyWalls(const std::vector<Point2>& before);
 
   const WifiGpMap& map_;
   ParticleFilterOptions options_;
   Random random_;
   std::vector<Particle> particles_;
   uint64_t resamplings_ = 0;
+  uint64_t wall_crossings_ = 0;
+  // Wall indices by (floor, cell x, cell y) of kWallCellM cells their bounding boxes touch.
+  std::map<std::tuple<int, int, int>, std::vector<uint32_t>> wall_cells_;
+  std::vector<uint32_t> long_walls_;  // walls too long to bucket
+  std::vector<int> floors_;           // the map's floors
 };
+
+// Whether segments p1-p2 and q1-q2 intersect (touching counts).
+bool SegmentsIntersect(const Point2& p1, const Point2& p2, const Point2& q1, const Point2& q2);
 
 // Systematic resampling: `count` indices into `weights` (normalised or not), drawn with one
 // uniform offset `u` in [0, 1): index i appears about count * w_i times, never off by more than

@@ -175,8 +175,17 @@ TEST(WifiGpMapTest, RunFrameRoundTripsAndFormatOneStillReads) {
   EXPECT_EQ(back->truth_from_map()->rotation_rad, -0.5);
   EXPECT_EQ(back->truth_from_map()->translation_y_m, -4.0);
   EXPECT_EQ(back->truth_from_map()->rmse_m, 1.5);
+  // Walls round-trip too.
+  WifiGpMap walled = map;
+  walled.set_walls({{1, {0, 0}, {3, 4}}, {-2, {1.5, -1}, {1.5, 9}}});
+  StatusOr<WifiGpMap> w = WifiGpMap::Decode(walled.Encode(), "w.wifimap");
+  ASSERT_TRUE(w.ok()) << w.status().message();
+  ASSERT_EQ(w->walls().size(), 2u);
+  EXPECT_EQ(w->walls()[1].floor, -2);
+  EXPECT_EQ(w->walls()[1].b.y, 9.0);
+  EXPECT_EQ(w->walls()[0].a.x, 0.0);
   // A format-1 file is the format-2 one without the frame block (a double, a flag, four
-  // doubles: 41 bytes) and with version 1: it reads with no frame.
+  // doubles and a wall count: 49 bytes) and with version 1: it reads with no frame.
   ASSERT_EQ(plain.size(), framed.size());
   size_t first = 0;
   while (plain[first] == framed[first]) ++first;
@@ -184,7 +193,7 @@ TEST(WifiGpMapTest, RunFrameRoundTripsAndFormatOneStillReads) {
   uint32_t version = 0;
   std::memcpy(&version, plain.data() + version_at, 4);
   ASSERT_EQ(version, 2u);
-  std::string v1 = plain.substr(0, first) + plain.substr(first + 41);
+  std::string v1 = plain.substr(0, first) + plain.substr(first + 49);
   version = 1;
   std::memcpy(v1.data() + version_at, &version, 4);
   StatusOr<WifiGpMap> old = WifiGpMap::Decode(v1, "v1.wifimap");
@@ -195,6 +204,45 @@ TEST(WifiGpMapTest, RunFrameRoundTripsAndFormatOneStillReads) {
   // A frame out of range is refused.
   map.set_compass_to_map_rad(1e9);
   EXPECT_FALSE(WifiGpMap::Decode(map.Encode(), "w.wifimap").ok());
+}
+
+TEST(SegmentsIntersectTest, KnownCases) {
+  EXPECT_TRUE(SegmentsIntersect({0, 0}, {2, 2}, {0, 2}, {2, 0}));      // an X
+  EXPECT_FALSE(SegmentsIntersect({0, 0}, {1, 0}, {0, 1}, {1, 1}));     // parallel
+  EXPECT_TRUE(SegmentsIntersect({0, 0}, {1, 0}, {1, -1}, {1, 1}));     // touching an end
+  EXPECT_FALSE(SegmentsIntersect({0, 0}, {1, 0}, {2, 0}, {3, 0}));     // collinear, apart
+  EXPECT_TRUE(SegmentsIntersect({0, 0}, {2, 0}, {1, 0}, {3, 0}));      // collinear, overlapping
+  EXPECT_FALSE(SegmentsIntersect({0, 0}, {0.9, 0}, {1, -1}, {1, 1}));  // stops short
+}
+
+TEST(ParticleFilterTest, AParticleThatWalksThroughAWallDies) {
+  // A wall across the whole field at x = 10 (and one on another floor, which must not count).
+  WifiGpMap map = TrainedMap(Field());
+  map.set_walls({{0, {10, -100}, {10, 100}}, {5, {12, -100}, {12, 100}}});
+  ParticleFilterOptions options;
+  options.particles = 3000;
+  options.step_length_sigma = 0.0;
+  options.heading_sigma_rad = 0.0;
+  options.heading_offset_walk_rad = 0.0;
+  options.compass_offset_sigma_rad = 0.0;
+  ParticleFilter filter(map, options);
+  ASSERT_TRUE(filter.Initialise(true).ok());
+  const std::vector<Particle> before = filter.particles();
+  filter.Step(1.5, 0.0);  // 1.5 m east
+  const std::vector<Particle>& after = filter.particles();
+  size_t crossed = 0;
+  for (size_t i = 0; i < after.size(); ++i) {
+    ASSERT_NEAR(after[i].x_m - before[i].x_m, 1.5, 1e-12);
+    const bool through = before[i].x_m <= 10.0 && after[i].x_m >= 10.0;
+    crossed += through;
+    if (through) {
+      EXPECT_EQ(after[i].weight, 0.0) << "particle " << i << " walked through the wall";
+    } else {
+      EXPECT_GT(after[i].weight, 0.0);
+    }
+  }
+  EXPECT_GT(crossed, 0u);
+  EXPECT_EQ(filter.wall_crossings(), crossed);
 }
 
 TEST(ParticleFilterTest, ConvergesOnTheWalkerInAKnownField) {

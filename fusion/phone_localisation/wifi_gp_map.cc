@@ -11,7 +11,7 @@ namespace ratslam {
 namespace {
 
 constexpr char kMagic[] = "RSWIFIGP";
-// 1: first; 2: adds the frame of maps made from a run (compass_to_map, truth_from_map).
+// 1: first; 2: adds the frame of maps made from a run (compass_to_map, truth_from_map) and walls.
 constexpr uint32_t kVersion = 2;
 constexpr int kTileCells = 8;  // cells per tile side: one local GP per tile
 
@@ -290,6 +290,14 @@ std::string WifiGpMap::Encode() const {
   w.Pod(a.translation_x_m);
   w.Pod(a.translation_y_m);
   w.Pod(a.rmse_m);
+  w.Count(walls_.size());
+  for (const WallSegment& wall : walls_) {
+    w.Pod<int32_t>(wall.floor);
+    w.Pod(wall.a.x);
+    w.Pod(wall.a.y);
+    w.Pod(wall.b.x);
+    w.Pod(wall.b.y);
+  }
   w.Count(bssids_.size());
   for (size_t ap = 0; ap < bssids_.size(); ++ap) {
     w.String(bssids_[ap]);
@@ -362,6 +370,20 @@ StatusOr<WifiGpMap> WifiGpMap::Decode(const std::string& bytes, const std::strin
       return fail("map frame out of range");
     }
     if (has_alignment) map.truth_from_map_ = a;
+    size_t walls = 0;
+    if (!r.Count(36, &walls)) return fail("truncated walls");
+    map.walls_.resize(walls);
+    for (WallSegment& wall : map.walls_) {
+      int32_t floor = 0;
+      if (!(r.Pod(&floor) && r.Pod(&wall.a.x) && r.Pod(&wall.a.y) && r.Pod(&wall.b.x) &&
+            r.Pod(&wall.b.y))) {
+        return fail("truncated walls");
+      }
+      wall.floor = floor;
+      for (double v : {wall.a.x, wall.a.y, wall.b.x, wall.b.y}) {
+        if (!(std::abs(v) <= 1e7)) return fail("a wall's end is not finite or out of range");
+      }
+    }
   }
   if (!r.Count(16, &aps)) return fail("truncated");
   if (has_reference) {

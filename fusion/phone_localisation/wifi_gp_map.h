@@ -27,6 +27,12 @@ struct WifiMapSample {
   std::vector<std::pair<std::string, double>> readings;  // BSSID, RSSI (dBm)
 };
 
+// A wall the map knows (simulated worlds): a segment on a floor that nobody walks through.
+struct WallSegment {
+  int floor = 0;
+  Point2 a, b;
+};
+
 class WifiGpMap {
  public:
   struct Cell {
@@ -77,10 +83,14 @@ class WifiGpMap {
   void set_compass_to_map_rad(double r) { compass_to_map_rad_ = r; }
   const std::optional<RigidAlignment2D>& truth_from_map() const { return truth_from_map_; }
   void set_truth_from_map(std::optional<RigidAlignment2D> a) { truth_from_map_ = a; }
+  // Walls, when the map's data came with them (a simulated world): the particle filter keeps
+  // particles from walking through them.
+  const std::vector<WallSegment>& walls() const { return walls_; }
+  void set_walls(std::vector<WallSegment> walls) { walls_ = std::move(walls); }
 
-  // Versioned binary file (magic, version, options, frame, BSSIDs, grids, samples). Decode checks
-  // every count and value and reads format 1 (no frame: compass_to_map 0, no truth alignment);
-  // an error names the file.
+  // Versioned binary file (magic, version, options, frame, walls, BSSIDs, grids, samples). Decode
+  // checks every count and value and reads format 1 (no frame: compass_to_map 0, no truth
+  // alignment, no walls); an error names the file.
   std::string Encode() const;
   static StatusOr<WifiGpMap> Decode(const std::string& bytes, const std::string& name);
   // Reads and decodes the file `path` (a regular file of at most 2 GiB).
@@ -93,6 +103,7 @@ class WifiGpMap {
   std::optional<std::pair<double, double>> reference_;
   double compass_to_map_rad_ = 0.0;
   std::optional<RigidAlignment2D> truth_from_map_;
+  std::vector<WallSegment> walls_;
   std::vector<std::string> bssids_;
   std::map<std::string, size_t> index_;
   std::vector<std::vector<Grid>> grids_;  // per AP, per floor it was heard on
