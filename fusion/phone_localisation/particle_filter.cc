@@ -155,9 +155,74 @@ ParticleFilter::ParticleFilter(const WifiGpMap& map, const ParticleFilterOptions
       for (int y = y0; y <= y1; ++y) wall_cells_[{w.floor, x, y}].push_back(k);
     }
   }
+  for (const WifiMapSample& sample : map_.training_samples()) {
+    std::vector<std::pair<int64_t, double>> f;
+    for (const auto& [bssid, rssi] : sample.readings) {
+      const int64_t ap = map_.Find(bssid);
+      if (ap >= 0) f.emplace_back(ap, rssi);
+    }
+    std::sort(f.begin(), f.end());
+    fingerprints_.push_back(std::move(f));
+  }
+}
+
+void ParticleFilter::Reseed(const std::vector<std::pair<int64_t, double>>& known) {
+  const double fraction = reseeded_ ? options_.reseed_fraction : options_.first_reseed_fraction;
+  reseeded_ = true;
+  const size_t count = static_cast<size_t>(fraction * static_cast<double>(particles_.size()));
+  if (count == 0 || fingerprints_.empty()) return;
+  std::vector<std::pair<int64_t, double>> query = known;
+  std::sort(query.begin(), query.end());
+  // Squared Euclidean RSSI distance over the union of APs, -100 dBm where one side lacks it.
+  constexpr double kAbsent = -100.0;
+  std::vector<std::pair<double, size_t>> distance;
+  distance.reserve(fingerprints_.size());
+  for (size_t s = 0; s < fingerprints_.size(); ++s) {
+    const auto& f = fingerprints_[s];
+    double d2 = 0.0;
+    size_t i = 0, j = 0;
+    while (i < query.size() || j < f.size()) {
+      double a = kAbsent, b = kAbsent;
+      if (j == f.size() || (i < query.size() && query[i].first < f[j].first)) {
+        a = query[i++].second;
+      } else if (i == query.size() || f[j].first < query[i].first) {
+        b = f[j++].second;
+      } else {
+        a = query[i++].second;
+        b = f[j++].second;
+      }
+      d2 += (a - b) * (a - b);
+    }
+    distance.emplace_back(d2, s);
+  }
+  const size_t k = std::min(distance.size(), static_cast<size_t>(options_.reseed_neighbours));
+  std::partial_sort(distance.begin(), distance.begin() + static_cast<std::ptrdiff_t>(k),
+                    distance.end());
+  // The lightest particles (ties by index) make way.
+  std::vector<size_t> order(particles_.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::partial_sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(count), order.end(),
+                    [&](size_t a, size_t b) {
+                      return particles_[a].weight < particles_[b].weight ||
+                             (particles_[a].weight == particles_[b].weight && a < b);
+                    });
+  const double mean_weight = 1.0 / static_cast<double>(particles_.size());
+  for (size_t n = 0; n < count; ++n) {
+    const WifiMapSample& near = map_.training_samples()[distance[n % k].second];
+    Particle& p = particles_[order[n]];
+    p.floor = near.floor;
+    p.x_m = near.position.x + random_.Gaussian(0.0, options_.reseed_spread_m);
+    p.y_m = near.position.y + random_.Gaussian(0.0, options_.reseed_spread_m);
+    p.heading_offset_rad = have_compass_ ? random_.Gaussian(0.0, options_.compass_offset_sigma_rad)
+                                         : random_.Uniform(-std::numbers::pi, std::numbers::pi);
+    p.weight = mean_weight;
+  }
+  Normalise();
 }
 
 Status ParticleFilter::Initialise(bool have_compass) {
+  have_compass_ = have_compass;
+  reseeded_ = false;
   std::vector<std::pair<int, Point2>> cells;
   for (int floor : map_.floors()) {
     for (const Point2& c : map_.KnownCells(floor)) cells.emplace_back(floor, c);
@@ -297,6 +362,7 @@ size_t ParticleFilter::Update(const std::vector<std::pair<std::string, double>>&
       }
     }
   }
+  Reseed(known);
   std::vector<double> value(particles_.size());
   double max_log = -std::numeric_limits<double>::infinity();
   for (size_t i = 0; i < particles_.size(); ++i) {
