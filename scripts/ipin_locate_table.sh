@@ -3,8 +3,10 @@
 # Gaussian-process Wi-Fi map from repetitions 01 and 02 of a route (ground-truth positions),
 # then every repetition 03 and 04 (another phone) located in it by the particle filter, with the
 # paper's sum likelihood (eq. 13) and the product alternative, beside the weighted 3-NN
-# fingerprint answer per scan on the same map scans. Errors in metres at the scans with ground
-# truth; a Markdown table (the README's).
+# fingerprint answer per scan on the same map scans, and the sum likelihood on a map made from a
+# RatSLAM run of repetitions 01 and 02 instead (configs/ipin2023-wifi-compass.toml; positions from
+# the run's final map, scored after its alignment onto the truth). Errors in metres at the scans
+# with ground truth; a Markdown table (the README's).
 # Usage: scripts/ipin_locate_table.sh [DATA_DIR] [OUT_DIR]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -13,25 +15,33 @@ out=${2:-out/ipin-locate-table}
 bin=./build/apps/ratslam
 mkdir -p "$out"
 printf '[particle_filter]\nlikelihood = "product"\n' > "$out/product.toml"
-echo "| route | phone log | scans with truth | sum (eq. 13) mean / median / p75 / p90 m | product mean / median / p75 / p90 m | 3-NN mean / median / p75 / p90 m |"
-echo "|---|---|---|---|---|---|"
+echo "| route | phone log | scans with truth | sum (eq. 13) mean / median / p75 / p90 m | product mean / median / p75 / p90 m | 3-NN mean / median / p75 / p90 m | sum on a run's map, mean / median m |"
+echo "|---|---|---|---|---|---|---|"
 for route in 01 02 03 21 22 23; do
   log() { echo "$data/IPIN2023_T3_TrainingTrial${route}_repetition$1.txt"; }
   "$bin" wifi-map --data "$(log 01)" --data "$(log 02)" --out "$out/route$route.wifimap" > /dev/null
+  "$bin" replay --quiet --config configs/ipin2023-wifi-compass.toml --data "$(log 01)" \
+    --data "$(log 02)" --out "$out/route$route-run" > /dev/null
+  "$bin" wifi-map --run "$out/route$route-run" --data "$(log 01)" --data "$(log 02)" \
+    --out "$out/route$route-run.wifimap" > /dev/null
   for rep in 03 04; do
     "$bin" locate --quiet --wifi-map "$out/route$route.wifimap" --data "$(log $rep)" \
       --out "$out/route$route-rep$rep-sum"
     "$bin" locate --quiet --config "$out/product.toml" --wifi-map "$out/route$route.wifimap" \
       --data "$(log $rep)" --out "$out/route$route-rep$rep-product"
+    "$bin" locate --quiet --wifi-map "$out/route$route-run.wifimap" --data "$(log $rep)" \
+      --out "$out/route$route-rep$rep-run"
     /usr/bin/python3 - "$out/route$route-rep$rep-sum/summary.json" \
-      "$out/route$route-rep$rep-product/summary.json" "$route" "$rep" <<'PY'
+      "$out/route$route-rep$rep-product/summary.json" "$out/route$route-rep$rep-run/summary.json" \
+      "$route" "$rep" <<'PY'
 import json, sys
-s, p = (json.load(open(f)) for f in sys.argv[1:3])
+s, p, r = (json.load(open(f)) for f in sys.argv[1:4])
 def row(j):
     if not j.get("count"):
         return "-"
     return " / ".join(f"{j[k]:.1f}" for k in ("mean_error_m", "median_error_m", "p75_error_m", "p90_error_m"))
-print(f"| {sys.argv[3]} | rep{sys.argv[4]} | {s.get('count', 0)} | {row(s)} | {row(p)} | {row(s.get('knn_baseline', {}))} |")
+run = f"{r['mean_error_m']:.1f} / {r['median_error_m']:.1f}" if r.get("count") else "-"
+print(f"| {sys.argv[4]} | rep{sys.argv[5]} | {s.get('count', 0)} | {row(s)} | {row(p)} | {row(s.get('knn_baseline', {}))} | {run} |")
 PY
   done
 done
