@@ -325,6 +325,15 @@ int WifiMapCommand(int argc, char** argv) {
   j["floors"] = map->floors();
   j["stored_cells"] = map->stored_cells();
   j["positions_from"] = from_run ? "run trajectory" : "ground truth";
+  j["length_scale_m"] = map->options().length_scale_m;
+  j["signal_sigma_dbm"] = map->options().signal_sigma_dbm;
+  j["noise_sigma_dbm"] = map->options().noise_sigma_dbm;
+  if (const auto& fit = map->fit_report()) {
+    j["hyperparameter_fit"] = {{"log_marginal_likelihood_before", fit->log_likelihood_before},
+                               {"log_marginal_likelihood_after", fit->log_likelihood_after},
+                               {"training_sets", fit->sets},
+                               {"training_points", fit->points}};
+  }
   j["walls"] = map->walls().size();
   if (from_run) {
     j["compass_to_map_rad"] = map->compass_to_map_rad();

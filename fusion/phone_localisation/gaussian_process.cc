@@ -4,6 +4,7 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 namespace ratslam {
 
@@ -68,6 +69,27 @@ StatusOr<GaussianProcess2D> GaussianProcess2D::Fit(const std::vector<Point2>& po
     for (size_t j = 0; j <= i; ++j) gp.cholesky_[i * n + j] = l(i, j);
   }
   return gp;
+}
+
+StatusOr<double> GaussianProcess2D::LogMarginalLikelihood(const std::vector<Point2>& points,
+                                                          const std::vector<double>& values,
+                                                          const std::vector<double>& noise_variance,
+                                                          double prior_mean, double signal_variance,
+                                                          double length_scale_m) {
+  StatusOr<GaussianProcess2D> gp =
+      Fit(points, values, noise_variance, prior_mean, signal_variance, length_scale_m);
+  if (!gp.ok()) return gp.status();
+  // K + N = sigma_f^2 A with A = L L': y'(K+N)^-1 y = y' A^-1 y / sigma_f^2 = y' beta / sigma_f^2,
+  // log|K+N| = n log sigma_f^2 + 2 sum log L_ii.
+  const size_t n = points.size();
+  double fit = 0.0, log_det = 0.0;
+  for (size_t i = 0; i < n; ++i) {
+    fit += (values[i] - prior_mean) * gp->alpha_[i];
+    log_det += 2.0 * std::log(gp->cholesky_[i * n + i]);
+  }
+  const double nd = static_cast<double>(n);
+  return -0.5 * fit / signal_variance - 0.5 * (nd * std::log(signal_variance) + log_det) -
+         0.5 * nd * std::log(2.0 * std::numbers::pi);
 }
 
 double GaussianProcess2D::Mean(const Point2& p) const {

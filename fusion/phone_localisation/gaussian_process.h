@@ -41,6 +41,8 @@ struct WifiGpOptions {
   double cell_size_m = 1.0;                // grid cell of the precomputed maps
   double grid_margin_m = 6.0;              // cells this close to a heard bin are stored
   bool signal_dependent_variance = false;  // eqs. 10-12 instead of eq. 9's constant sigma_f
+  bool fit_hyperparameters = false;        // sigma_f and sigma_p by marginal likelihood
+  bool fit_length_scale = false;           // ... and l too
 
   bool IsValid(std::string* error) const;
 
@@ -67,6 +69,12 @@ struct WifiGpOptions {
     v("signal_dependent_variance", signal_dependent_variance,
       "eqs. 10-12: the variance follows F_s of the predicted signal (converted to dBm)",
       schema::Any());
+    v("fit_hyperparameters", fit_hyperparameters,
+      "fit signal_sigma_dbm and noise_sigma_dbm by maximising the GP marginal likelihood of the "
+      "training data (the values given are the starting point)",
+      schema::Any());
+    v("fit_length_scale", fit_length_scale, "with fit_hyperparameters: fit length_scale_m as well",
+      schema::Any());
   }
 };
 
@@ -86,6 +94,13 @@ class GaussianProcess2D {
   // Eq. 8 and eq. 10 (with eq. 9's kernel scaled by `signal_variance` of Fit, or by
   // `signal_variance_here` when given: eq. 11's F_s at this point).
   double Mean(const Point2& p) const;
+  // log p(values | points, hyper-parameters): -y'(K+N)^-1 y / 2 - log|K+N| / 2 - n log(2 pi) / 2
+  // with y = values - prior_mean (Rasmussen and Williams, eq. 2.30). Fails like Fit.
+  static StatusOr<double> LogMarginalLikelihood(const std::vector<Point2>& points,
+                                                const std::vector<double>& values,
+                                                const std::vector<double>& noise_variance,
+                                                double prior_mean, double signal_variance,
+                                                double length_scale_m);
   double Variance(const Point2& p, std::optional<double> signal_variance_here = std::nullopt) const;
 
  private:

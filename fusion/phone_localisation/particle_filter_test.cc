@@ -137,6 +137,38 @@ TEST(WifiGpMapTest, PredictsTheFieldNearItsSamplesAndThePriorElsewhere) {
   EXPECT_EQ(map.Find("nope"), -1);
 }
 
+TEST(WifiGpMapTest, MarginalLikelihoodFindsTheMeasurementNoise) {
+  // The field's readings carry 3 dBm of Gaussian noise; start the fit from 12 dBm.
+  const Field field;
+  Random noise(21);
+  std::vector<WifiMapSample> samples;
+  for (double x = 0; x <= 40; x += 2.0) {
+    for (double y = 0; y <= 20; y += 2.0)
+      samples.push_back({{x, y}, 0, field.Scan({x, y}, &noise)});
+  }
+  WifiGpOptions options;
+  options.length_scale_m = 3.0;
+  options.noise_sigma_dbm = 12.0;
+  options.fit_hyperparameters = true;
+  StatusOr<WifiGpMap> map = WifiGpMap::Build(samples, options);
+  ASSERT_TRUE(map.ok()) << map.status().message();
+  ASSERT_TRUE(map->fit_report().has_value());
+  EXPECT_GT(map->fit_report()->log_likelihood_after, map->fit_report()->log_likelihood_before);
+  EXPECT_GE(map->options().noise_sigma_dbm, 2.0);
+  EXPECT_LE(map->options().noise_sigma_dbm, 5.0);
+  EXPECT_EQ(map->options().length_scale_m, 3.0);  // not asked to fit it
+  // The fitted values are what the file keeps.
+  StatusOr<WifiGpMap> back = WifiGpMap::Decode(map->Encode(), "f.wifimap");
+  ASSERT_TRUE(back.ok());
+  EXPECT_EQ(back->options().noise_sigma_dbm, map->options().noise_sigma_dbm);
+  // Without the flag nothing is fitted.
+  options.fit_hyperparameters = false;
+  StatusOr<WifiGpMap> plain = WifiGpMap::Build(samples, options);
+  ASSERT_TRUE(plain.ok());
+  EXPECT_FALSE(plain->fit_report().has_value());
+  EXPECT_EQ(plain->options().noise_sigma_dbm, 12.0);
+}
+
 TEST(WifiGpMapTest, FileRoundTripAndBadFiles) {
   const WifiGpMap map = TrainedMap(Field());
   const std::string bytes = map.Encode();
@@ -184,8 +216,10 @@ TEST(WifiGpMapTest, RunFrameRoundTripsAndFormatOneStillReads) {
   EXPECT_EQ(w->walls()[1].floor, -2);
   EXPECT_EQ(w->walls()[1].b.y, 9.0);
   EXPECT_EQ(w->walls()[0].a.x, 0.0);
-  // A format-1 file is the format-2 one without the frame block (a double, a flag, four
-  // doubles and a wall count: 49 bytes) and with version 1: it reads with no frame.
+  // A format-1 file is the format-2 one without the two option flags format 2 added (bytes
+  // 85-86: after the 20-byte magic and version, eight doubles and one flag) and without the
+  // frame block (a double, a flag, four doubles and a wall count: 49 bytes), with version 1: it
+  // reads with no frame.
   ASSERT_EQ(plain.size(), framed.size());
   size_t first = 0;
   while (plain[first] == framed[first]) ++first;
@@ -193,7 +227,10 @@ TEST(WifiGpMapTest, RunFrameRoundTripsAndFormatOneStillReads) {
   uint32_t version = 0;
   std::memcpy(&version, plain.data() + version_at, 4);
   ASSERT_EQ(version, 2u);
-  std::string v1 = plain.substr(0, first) + plain.substr(first + 49);
+  ASSERT_EQ(plain[85], 0);  // fit_hyperparameters false
+  ASSERT_EQ(plain[86], 0);  // fit_length_scale false
+  ASSERT_GT(first, 87u);
+  std::string v1 = plain.substr(0, 85) + plain.substr(87, first - 87) + plain.substr(first + 49);
   version = 1;
   std::memcpy(v1.data() + version_at, &version, 4);
   StatusOr<WifiGpMap> old = WifiGpMap::Decode(v1, "v1.wifimap");
@@ -201,6 +238,9 @@ TEST(WifiGpMapTest, RunFrameRoundTripsAndFormatOneStillReads) {
   EXPECT_EQ(old->compass_to_map_rad(), 0.0);
   EXPECT_FALSE(old->truth_from_map().has_value());
   EXPECT_EQ(old->stored_cells(), map.stored_cells());
+  EXPECT_EQ(old->options().grid_margin_m, map.options().grid_margin_m);
+  EXPECT_EQ(old->options().signal_dependent_variance, map.options().signal_dependent_variance);
+  EXPECT_EQ(old->Predict(3, 0, {12.3, 4.5}).mean_dbm, map.Predict(3, 0, {12.3, 4.5}).mean_dbm);
   // A frame out of range is refused.
   map.set_compass_to_map_rad(1e9);
   EXPECT_FALSE(WifiGpMap::Decode(map.Encode(), "w.wifimap").ok());

@@ -11,7 +11,8 @@ namespace ratslam {
 namespace {
 
 constexpr char kMagic[] = "RSWIFIGP";
-// 1: first; 2: adds the frame of maps made from a run (compass_to_map, truth_from_map) and walls.
+// 1: first; 2: adds the frame of maps made from a run (compass_to_map, truth_from_map), walls
+// and the options fit_hyperparameters and fit_length_scale.
 constexpr uint32_t kVersion = 2;
 constexpr int kTileCells = 8;  // cells per tile side: one local GP per tile
 
@@ -31,6 +32,97 @@ struct Bin {
   double sum_x = 0, sum_y = 0;
   std::vector<size_t> samples;
 };
+
+struct TrainingSet {
+  int floor = 0;
+  std::vector<Key> heard_bins;  // sorted
+  std::vector<Point2> points;   // bin centroids
+  std::vector<double> values;   // mean RSSI per bin
+  std::vector<double> counts;   // samples per bin
+};
+
+// Marginal-likelihood fit of sigma_f and sigma_p (and l when asked), shared by every AP: the
+// summed log marginal likelihood of the largest training sets (at most kFitSets, each thinned to
+// at most kFitPoints by a fixed stride), maximised by coordinate search over fixed grids of
+// values from the given options, until a round changes nothing. Deterministic.
+constexpr size_t kFitSets = 40;
+constexpr size_t kFitPoints = 150;
+
+StatusOr<WifiGpOptions> FitHyperparameters(const std::vector<std::vector<TrainingSet>>& sets,
+                                           const WifiGpOptions& start, WifiGpFitReport* report) {
+  std::vector<const TrainingSet*> chosen;
+  for (const auto& per_ap : sets) {
+    for (const TrainingSet& set : per_ap) {
+      if (set.points.size() >= 5) chosen.push_back(&set);
+    }
+  }
+  std::stable_sort(chosen.begin(), chosen.end(), [](const TrainingSet* a, const TrainingSet* b) {
+    return a->points.size() > b->points.size();
+  });
+  if (chosen.size() > kFitSets) chosen.resize(kFitSets);
+  if (chosen.empty()) {
+    return Status::Error("Wi-Fi map: fit_hyperparameters needs an AP heard in at least 5 places");
+  }
+  struct Thinned {
+    std::vector<Point2> points;
+    std::vector<double> values, counts;
+  };
+  std::vector<Thinned> data;
+  size_t total = 0;
+  for (const TrainingSet* set : chosen) {
+    Thinned t;
+    const size_t stride = (set->points.size() + kFitPoints - 1) / kFitPoints;
+    for (size_t i = 0; i < set->points.size(); i += stride) {
+      t.points.push_back(set->points[i]);
+      t.values.push_back(set->values[i]);
+      t.counts.push_back(set->counts[i]);
+    }
+    total += t.points.size();
+    data.push_back(std::move(t));
+  }
+  auto objective = [&](const WifiGpOptions& o) {
+    double sum = 0.0;
+    for (const Thinned& t : data) {
+      std::vector<double> noise;
+      for (double n : t.counts) noise.push_back(o.noise_sigma_dbm * o.noise_sigma_dbm / n);
+      StatusOr<double> l = GaussianProcess2D::LogMarginalLikelihood(
+          t.points, t.values, noise, o.unheard_rssi_dbm, o.signal_sigma_dbm * o.signal_sigma_dbm,
+          o.length_scale_m);
+      if (!l.ok()) return -std::numeric_limits<double>::infinity();
+      sum += *l;
+    }
+    return sum;
+  };
+  static const std::vector<double> kSignal = {2, 3, 4, 5, 6, 8, 10, 12, 15, 20, 25, 30};
+  static const std::vector<double> kNoise = {1, 1.5, 2, 3, 4, 5, 6, 8, 10, 12};
+  static const std::vector<double> kLength = {0.5, 0.75, 1, 1.5, 2, 3, 4, 6, 8, 12};
+  WifiGpOptions best = start;
+  double best_value = objective(best);
+  report->log_likelihood_before = best_value;
+  for (int round = 0; round < 6; ++round) {
+    bool changed = false;
+    auto search = [&](double WifiGpOptions::*field, const std::vector<double>& grid) {
+      for (double v : grid) {
+        WifiGpOptions trial = best;
+        trial.*field = v;
+        const double value = objective(trial);
+        if (value > best_value) {
+          best_value = value;
+          best = trial;
+          changed = true;
+        }
+      }
+    };
+    search(&WifiGpOptions::signal_sigma_dbm, kSignal);
+    search(&WifiGpOptions::noise_sigma_dbm, kNoise);
+    if (start.fit_length_scale) search(&WifiGpOptions::length_scale_m, kLength);
+    if (!changed) break;
+  }
+  report->log_likelihood_after = best_value;
+  report->sets = data.size();
+  report->points = total;
+  return best;
+}
 
 }  // namespace
 
@@ -71,11 +163,9 @@ StatusOr<WifiGpMap> WifiGpMap::Build(const std::vector<WifiMapSample>& samples,
     b.sum_y += samples[i].position.y;
     b.samples.push_back(i);
   }
-  const double noise2 = options.noise_sigma_dbm * options.noise_sigma_dbm;
-  const double signal2 = options.signal_sigma_dbm * options.signal_sigma_dbm;
-  const double reach = 4.0 * options.length_scale_m;  // kernel below e^-8 beyond
-  const double cell = options.cell_size_m;
-  map.grids_.resize(map.bssids_.size());
+  // Training sets per AP and floor: heard bins, and bins within unheard_reach_m of one (an AP
+  // not heard counts as unheard_rssi_dbm), as bin centroid, mean RSSI and sample count.
+  std::vector<std::vector<TrainingSet>> sets(map.bssids_.size());
   for (size_t ap = 0; ap < map.bssids_.size(); ++ap) {
     std::map<int, std::vector<Key>> heard_bins;  // per floor
     for (const auto& [i, rssi] : heard_by[ap]) {
@@ -85,11 +175,10 @@ StatusOr<WifiGpMap> WifiGpMap::Build(const std::vector<WifiMapSample>& samples,
       std::sort(keys.begin(), keys.end());
       keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
       const std::set<Key> heard(keys.begin(), keys.end());
-      // Training points: heard bins, and bins within unheard_reach_m of one (an AP not heard
-      // counts as unheard_rssi_dbm).
       const int span = static_cast<int>(std::ceil(options.unheard_reach_m / options.bin_size_m));
-      std::vector<Point2> points;
-      std::vector<double> values, noise;
+      TrainingSet set;
+      set.floor = floor;
+      set.heard_bins = keys;
       for (const auto& [key, bin] : bins[floor]) {
         bool near = heard.count(key) > 0;
         for (int dx = -span; !near && dx <= span; ++dx) {
@@ -105,10 +194,34 @@ StatusOr<WifiGpMap> WifiGpMap::Build(const std::vector<WifiMapSample>& samples,
           sum += it == heard_by[ap].end() ? options.unheard_rssi_dbm : it->second;
         }
         const double n = static_cast<double>(bin.samples.size());
-        points.push_back({bin.sum_x / n, bin.sum_y / n});
-        values.push_back(sum / n);
-        noise.push_back(noise2 / n);
+        set.points.push_back({bin.sum_x / n, bin.sum_y / n});
+        set.values.push_back(sum / n);
+        set.counts.push_back(n);
       }
+      sets[ap].push_back(std::move(set));
+    }
+  }
+  if (options.fit_hyperparameters) {
+    WifiGpFitReport report;
+    StatusOr<WifiGpOptions> fitted = FitHyperparameters(sets, options, &report);
+    if (!fitted.ok()) return fitted.status();
+    map.options_ = *fitted;
+    map.fit_ = report;
+  }
+  const WifiGpOptions& o = map.options_;
+  const double noise2 = o.noise_sigma_dbm * o.noise_sigma_dbm;
+  const double signal2 = o.signal_sigma_dbm * o.signal_sigma_dbm;
+  const double reach = 4.0 * o.length_scale_m;  // kernel below e^-8 beyond
+  const double cell = options.cell_size_m;
+  map.grids_.resize(map.bssids_.size());
+  for (size_t ap = 0; ap < map.bssids_.size(); ++ap) {
+    for (const TrainingSet& set : sets[ap]) {
+      const int floor = set.floor;
+      const std::vector<Key>& keys = set.heard_bins;
+      const std::vector<Point2>& points = set.points;
+      const std::vector<double>& values = set.values;
+      std::vector<double> noise;
+      for (double n : set.counts) noise.push_back(noise2 / n);
       // Cells to store: within grid_margin_m of a heard bin's centre.
       std::set<Key> cells;
       const int margin = static_cast<int>(std::ceil(options.grid_margin_m / cell)) + 1;
@@ -163,8 +276,8 @@ StatusOr<WifiGpMap> WifiGpMap::Build(const std::vector<WifiMapSample>& samples,
         }
         std::optional<GaussianProcess2D> gp;
         if (!p.empty()) {
-          StatusOr<GaussianProcess2D> fit = GaussianProcess2D::Fit(
-              p, v, n, options.unheard_rssi_dbm, signal2, options.length_scale_m);
+          StatusOr<GaussianProcess2D> fit =
+              GaussianProcess2D::Fit(p, v, n, o.unheard_rssi_dbm, signal2, o.length_scale_m);
           if (!fit.ok()) return fit.status().WithContext("Wi-Fi map: AP " + map.bssids_[ap]);
           gp = std::move(fit.value());
         }
@@ -342,8 +455,12 @@ StatusOr<WifiGpMap> WifiGpMap::Decode(const std::string& bytes, const std::strin
   }
   WifiGpMap map;
   bool ok = true;
-  map.options_.VisitFields([&](const char*, auto& field, const char*, const auto&) {
+  map.options_.VisitFields([&](const char* name, auto& field, const char*, const auto&) {
     using T = std::decay_t<decltype(field)>;
+    if (version == 1 &&
+        (std::string(name) == "fit_hyperparameters" || std::string(name) == "fit_length_scale")) {
+      return;  // added in format 2
+    }
     if constexpr (std::is_same_v<T, bool>) {
       ok = ok && r.Bool(&field);
     } else {

@@ -33,6 +33,15 @@ struct WallSegment {
   Point2 a, b;
 };
 
+// What a marginal-likelihood fit of the hyper-parameters did (not stored in the file; the fitted
+// values are, in the map's options).
+struct WifiGpFitReport {
+  double log_likelihood_before = 0.0;  // at the configured values
+  double log_likelihood_after = 0.0;   // at the fitted ones
+  size_t sets = 0;                     // AP-floor training sets used
+  size_t points = 0;                   // training points in them
+};
+
 class WifiGpMap {
  public:
   struct Cell {
@@ -56,7 +65,10 @@ class WifiGpMap {
   Cell Predict(size_t ap, int floor, const Point2& p, bool* stored = nullptr) const;
   // AP index of a BSSID, or -1.
   int64_t Find(const std::string& bssid) const;
+  // The options the map was built with (fitted hyper-parameters included).
   const WifiGpOptions& options() const { return options_; }
+  // Set when Build fitted the hyper-parameters.
+  const std::optional<WifiGpFitReport>& fit_report() const { return fit_; }
   const std::vector<std::string>& bssids() const { return bssids_; }
   const std::vector<Grid>& grids(size_t ap) const { return grids_[ap]; }
   // Floors with a stored cell, ascending.
@@ -104,6 +116,7 @@ class WifiGpMap {
   double compass_to_map_rad_ = 0.0;
   std::optional<RigidAlignment2D> truth_from_map_;
   std::vector<WallSegment> walls_;
+  std::optional<WifiGpFitReport> fit_;
   std::vector<std::string> bssids_;
   std::map<std::string, size_t> index_;
   std::vector<std::vector<Grid>> grids_;  // per AP, per floor it was heard on
