@@ -3,15 +3,21 @@
 //    along corridors of a 120 x 60 m floor, each scan hearing the APs within 25 m, about 46).
 //  - FilterScan: one particle-filter update of 5,000 particles by a 30-AP scan, and one step;
 //    against one scan per second, the real-time ratio is 1 s / time. Baseline: the same update
-//    with 500 particles (cost should scale with the count).
+//    with 500 particles (cost should scale with the count). Arg 2: 0 = no walls, 1 = the floor's
+//    corridor walls (a wall along both sides of every corridor, with doors every 7.5 m), so the
+//    wall test's share of a step shows.
+//  - PlanCall: the robot's route to 12 candidates over an experience graph of 1,869 nodes along
+//    the corridors, exact by Held-Karp; baseline: 6 candidates.
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <map>
 #include <string>
 #include <vector>
 
 #include "common/random.h"
 #include "fusion/phone_localisation/particle_filter.h"
+#include "fusion/phone_localisation/robot_call.h"
 #include "fusion/phone_localisation/wifi_gp_map.h"
 
 namespace ratslam {
@@ -65,9 +71,26 @@ void BM_WifiMapBuild(benchmark::State& state) {
 }
 BENCHMARK(BM_WifiMapBuild)->Unit(benchmark::kSecond)->Iterations(1);
 
+std::vector<WallSegment> CorridorWalls() {
+  std::vector<WallSegment> walls;
+  for (double y = 0; y <= 60; y += 15) {
+    for (double x = 0; x < 120; x += 7.5) {
+      walls.push_back({0, {x + 1.0, y - 1.2}, {x + 7.5, y - 1.2}});
+      walls.push_back({0, {x + 1.0, y + 1.2}, {x + 7.5, y + 1.2}});
+    }
+  }
+  return walls;
+}
+
 void BM_FilterScan(benchmark::State& state) {
   const Floor& f = TheFloor();
-  static const WifiGpMap map = *WifiGpMap::Build(f.samples, WifiGpOptions());
+  static const WifiGpMap plain = *WifiGpMap::Build(f.samples, WifiGpOptions());
+  static const WifiGpMap walled = [] {
+    WifiGpMap m = plain;
+    m.set_walls(CorridorWalls());
+    return m;
+  }();
+  const WifiGpMap& map = state.range(1) ? walled : plain;
   ParticleFilterOptions options;
   options.particles = static_cast<int>(state.range(0));
   ParticleFilter filter(map, options);
@@ -85,7 +108,44 @@ void BM_FilterScan(benchmark::State& state) {
     benchmark::DoNotOptimize(filter.Update(scans[i++ % scans.size()]));
   }
 }
-BENCHMARK(BM_FilterScan)->Arg(5000)->Arg(500)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FilterScan)
+    ->Args({5000, 0})
+    ->Args({500, 0})
+    ->Args({5000, 1})
+    ->Unit(benchmark::kMillisecond);
+
+void BM_PlanCall(benchmark::State& state) {
+  // Experiences every 0.6 m along the floor's corridors (every 15 m both ways over 120 x 60 m),
+  // each linked to its neighbours along the corridor: 1,869 nodes, about one link per node,
+  // like an experience map.
+  RouteGraph graph;
+  std::map<std::pair<int, int>, uint32_t> id;
+  for (int ix = 0; ix <= 200; ++ix) {
+    for (int iy = 0; iy <= 100; ++iy) {
+      if (ix % 25 && iy % 25) continue;
+      id[{ix, iy}] = static_cast<uint32_t>(graph.nodes.size());
+      graph.nodes.push_back({0.6 * ix, 0.6 * iy});
+    }
+  }
+  for (const auto& [at, k] : id) {
+    for (const auto& next :
+         {std::pair{at.first + 1, at.second}, std::pair{at.first, at.second + 1}}) {
+      if (auto it = id.find(next); it != id.end()) graph.edges.push_back({k, it->second});
+    }
+  }
+  Random r(8);
+  std::vector<Point2> candidates;
+  for (int c = 0; c < state.range(0); ++c)
+    candidates.push_back({r.Uniform(0, 120), r.Uniform(0, 60)});
+  for (auto _ : state) {
+    StatusOr<CallPlan> plan = PlanCall(graph, 0, candidates);
+    benchmark::DoNotOptimize(plan);
+    state.counters["route_m"] = plan->length_m;
+  }
+  state.counters["nodes"] = static_cast<double>(graph.nodes.size());
+  state.counters["edges"] = static_cast<double>(graph.edges.size());
+}
+BENCHMARK(BM_PlanCall)->Arg(12)->Arg(6)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace ratslam
