@@ -1,6 +1,7 @@
 // Wi-Fi map files (`ratslam wifi-map`): errors name the file; a map that decodes answers every
-// lookup (inside and outside its grids, on any floor) and carries a particle filter through a few
-// steps and scans without touching memory it does not own.
+// lookup (inside and outside its grids, on any floor) and carries a particle filter (walls,
+// floor changes and sensor resetting included) through a few steps and scans without touching
+// memory it does not own.
 #include <cmath>
 #include <string>
 
@@ -31,7 +32,16 @@ std::vector<std::string> FuzzSeeds() {
     options.grid_margin_m = 3.0;
     StatusOr<WifiGpMap> map = WifiGpMap::Build(samples, options);
     if (!map.ok()) InvariantFailed("the seed map failed: " + map.status().message());
-    if (floors == 2) map->set_geo_reference_deg(std::make_pair(40.3, -3.7));
+    if (floors == 2) {
+      map->set_geo_reference_deg(std::make_pair(40.3, -3.7));
+      // The frame of a run-made map, and walls (format 2).
+      map->set_compass_to_map_rad(0.7);
+      RigidAlignment2D a;
+      a.rotation_rad = 0.3;
+      a.translation_x_m = -2.0;
+      map->set_truth_from_map(a);
+      map->set_walls({{0, {5, -1}, {5, 4}}, {1, {0, 3}, {12, 3}}});
+    }
     seeds.push_back(map->Encode());
   }
   return seeds;
@@ -67,6 +77,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   scan.emplace_back("unknown", -50.0);
   for (int i = 0; i < 3; ++i) {
     filter.Step(1.0, 0.3 * i);
+    filter.Diffuse(2.0);
     filter.Update(scan);
   }
   const LocationEstimate e = filter.Estimate();
