@@ -8,6 +8,7 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -135,10 +136,51 @@ StatusOr<LocateOptions> LoadLocateConfigFile(const std::string& path) {
   return ParseLocateConfig(*text, path);
 }
 
+namespace {
+// Whether a configuration that failed to parse is an OpenRatSLAM INI file: its [ratslam]
+// section, or `key=value` lines with keys only OpenRatSLAM uses. Returns the evidence.
+std::optional<std::string> OpenRatslamEvidence(const std::string& text) {
+  static const char* const kKeys[] = {"topic_root",
+                                      "pc_dim_xy",
+                                      "pc_dim_th",
+                                      "vt_match_threshold",
+                                      "exp_delta_pc_threshold",
+                                      "image_crop_x_min",
+                                      "vtrans_image_x_min",
+                                      "media_path"};
+  std::istringstream in(text);
+  std::string line;
+  for (size_t number = 1; std::getline(in, line); ++number) {
+    const size_t first = line.find_first_not_of(" \t");
+    if (first == std::string::npos) continue;
+    const std::string trimmed = line.substr(first);
+    if (trimmed.rfind("[ratslam]", 0) == 0 || trimmed.rfind("[general]", 0) == 0) {
+      return "line " + std::to_string(number) + ": section " + trimmed.substr(0, 9);
+    }
+    for (const char* key : kKeys) {
+      const std::string k = key;
+      if (trimmed.rfind(k, 0) == 0 && trimmed.find('=') != std::string::npos &&
+          trimmed.find_first_not_of(" \t", k.size()) == trimmed.find('=')) {
+        return "line " + std::to_string(number) + ": key " + k;
+      }
+    }
+  }
+  return std::nullopt;
+}
+}  // namespace
+
 StatusOr<PipelineOptions> LoadConfigFile(const std::string& path) {
   StatusOr<std::string> text = ReadRegularFile(path, "config file", kMaxConfigBytes);
   if (!text.ok()) return text.status();
-  return ParseConfig(*text, path);
+  StatusOr<PipelineOptions> parsed = ParseConfig(*text, path);
+  if (!parsed.ok()) {
+    if (const auto evidence = OpenRatslamEvidence(*text)) {
+      return Status::Error(path + " is an OpenRatSLAM configuration (" + *evidence +
+                           "), not ours: convert it with `ratslam import-openratslam " + path +
+                           " > config.toml` and pass that (" + parsed.status().message() + ")");
+    }
+  }
+  return parsed;
 }
 
 namespace {

@@ -220,5 +220,32 @@ TEST(ConfigTest, ImportsOpenRatslamIniAndReportsUnusedKeys) {
   std::filesystem::remove(path);
 }
 
+TEST(ConfigTest, AnOpenRatslamIniPassedAsConfigSaysHowToConvertIt) {
+  const auto path = TestScratch().path() / "given_as_config.ini";
+  // Keys OpenRatSLAM uses, in a section of ours: the INI's [ratslam] section is found first.
+  std::ofstream(path) << "# from an OpenRatSLAM data set\n[ratslam]\nvt_match_threshold=0.085\n"
+                         "pc_dim_xy=30\n";
+  StatusOr<PipelineOptions> loaded = LoadConfigFile(path.string());
+  ASSERT_FALSE(loaded.ok());
+  const std::string& m = loaded.status().message();
+  EXPECT_NE(m.find("is an OpenRatSLAM configuration (line 2: section [ratslam])"),
+            std::string::npos)
+      << m;
+  EXPECT_NE(m.find("ratslam import-openratslam " + path.string()), std::string::npos) << m;
+  // A key alone gives it away too.
+  std::ofstream(path) << "topic_root = irat_red\n";
+  loaded = LoadConfigFile(path.string());
+  ASSERT_FALSE(loaded.ok());
+  EXPECT_NE(loaded.status().message().find("line 1: key topic_root"), std::string::npos)
+      << loaded.status().message();
+  // A typo in one of our files is not mistaken for one.
+  std::ofstream(path) << "[wifi]\nmatch_treshold = 0.5\n";
+  loaded = LoadConfigFile(path.string());
+  ASSERT_FALSE(loaded.ok());
+  EXPECT_EQ(loaded.status().message().find("OpenRatSLAM"), std::string::npos)
+      << loaded.status().message();
+  std::filesystem::remove(path);
+}
+
 }  // namespace
 }  // namespace ratslam
