@@ -105,6 +105,14 @@ TEST_F(ReplayEndToEndTest, DemoDataClosesLoopsAndBeatsOdometry) {
     ++edges;
   EXPECT_EQ(vertices, s["experiences"].get<size_t>());
   EXPECT_EQ(edges, s["links"].get<size_t>());
+  // The first vertex is fixed, once; each loop closure's edge is marked by a comment line.
+  EXPECT_EQ(g2o.find("FIX "), g2o.rfind("FIX "));
+  EXPECT_NE(g2o.find("\nFIX 0\n"), std::string::npos);
+  size_t marked = 0;
+  for (size_t p = g2o.find("# loop_closure link"); p != std::string::npos;
+       p = g2o.find("# loop_closure link", p + 1))
+    ++marked;
+  EXPECT_EQ(marked, s["loop_closures"].get<size_t>());
 }
 
 // The Wi-Fi RatSLAM paper's 12x9 camera templates (eq. 7) through the fused front end, camera

@@ -343,15 +343,22 @@ StatusOr<RunSummary> WriteRunOutputs(OutputFolder& folder, const ReplayPipeline&
     files.emplace_back("ground_truth_tum.txt", ground_truth.str());
   }
 
-  // g2o: poses, and each link as a relative pose in its source's frame; unit information.
+  // g2o: poses, the first one fixed (the gauge: without it an optimiser may move the whole map),
+  // and each link as a relative pose in its source's frame; unit information.
   std::ostringstream g2o;
   for (const Experience& e : map.experiences()) {
     g2o << "VERTEX_SE2 " << e.id << ' ' << Num(e.x_m) << ' ' << Num(e.y_m) << ' '
         << Num(e.theta_rad) << '\n';
   }
+  if (!map.experiences().empty()) g2o << "FIX 0\n";
   for (const Link& l : map.links()) {
-    // g2o skips comment lines; they say which edges Wi-Fi sequence loop closure made.
-    if (l.wifi_sequence) g2o << "# wifi_sequence link " << l.id << '\n';
+    // g2o skips comment lines; they say which edges closed loops (RatSLAM's own, or Wi-Fi
+    // sequence loop closure's); the others are odometry.
+    if (l.wifi_sequence) {
+      g2o << "# wifi_sequence link " << l.id << '\n';
+    } else if (l.loop_closure) {
+      g2o << "# loop_closure link " << l.id << '\n';
+    }
     g2o << "EDGE_SE2 " << l.from << ' ' << l.to << ' '
         << Num(l.distance_m * std::cos(l.heading_rad)) << ' '
         << Num(l.distance_m * std::sin(l.heading_rad)) << ' ' << Num(l.facing_rad)
