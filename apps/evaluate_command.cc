@@ -5,6 +5,7 @@
 
 #include "apps/cli.h"
 #include "common/output_folder.h"
+#include "common/provenance.h"
 #include "render/renderer.h"
 #include "session/evaluation_session.h"
 #include "viewer/localisation_figure.h"
@@ -55,6 +56,7 @@ int EvaluateCommand(int argc, char** argv) {
   options.map_path = args->values.at("--map");
   options.query_path = args->values.at("--query");
   options.lenient = args->lenient;
+  options.provenance = {ShellCommandLine(argc, argv), UtcNowIso8601()};
   const std::string out_path = args->values.at("--out");
   auto fail = [](const Status& s) {
     std::cerr << "ratslam evaluate: " << s.message() << "\n";

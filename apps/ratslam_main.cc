@@ -22,6 +22,8 @@
 #include "apps/wifi_sequence_images.h"
 #include "common/file_util.h"
 #include "common/output_folder.h"
+#include "common/provenance.h"
+#include "common/version.h"
 #include "fusion/io/config.h"
 #include "fusion/io/map_file.h"
 #include "fusion/io/run_outputs.h"
@@ -226,6 +228,7 @@ int Replay(int argc, char** argv) {
   if (!options) return kExitError;
   request.session.pipeline = *options;
   request.session.data = args->all["--data"];
+  request.session.provenance = {ShellCommandLine(argc, argv), UtcNowIso8601()};
   request.session.lenient = args->lenient;
   request.out = args->values["--out"];
   request.session.save_map = args->values.count("--save-map") ? args->values["--save-map"] : "";
@@ -280,6 +283,7 @@ int Demo(int argc, char** argv) {
   request.session.pipeline = DemoPipelineOptions();
   request.session.config_path = "(built-in demo configuration, as configs/demo.toml)";
   request.session.data = {data};
+  request.session.provenance = {ShellCommandLine(argc, argv), UtcNowIso8601()};
   request.out = out;
   request.quiet = args->quiet;
   request.render = true;
@@ -411,6 +415,11 @@ int Dispatch(int argc, char** argv) {
   if (command == "simulate") return SimulateCommand(argc, argv);
   if (command == "sweep") return SweepCommand(argc, argv);
   if (command == "import") return ImportCommand(argc, argv);
+  if (command == "--version" || command == "version") {
+    std::cout << "ratslam " << RatslamVersion() << " (commit " << RatslamCommit() << ", "
+              << RatslamBuildType() << " build)\n";
+    return kExitOk;
+  }
   if (command == "--help" || command == "help" || command == "-h") {
     std::cout << kUsage;
     return kExitOk;

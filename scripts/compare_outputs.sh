@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Runs the shipped configs with two `ratslam` binaries and reports every output file that differs
-# (summary/evaluation JSON compared without wall times). For refactors that must keep outputs
+# (summary/evaluation JSON compared without wall times and the provenance `run` object). For refactors that must keep outputs
 # bit-identical:
 #   git worktree add /tmp/old HEAD~1 && BUILD_DIR=/tmp/old-build BUILD_TARGET=ratslam \
 #     bash /tmp/old/scripts/build.sh && bash scripts/compare_outputs.sh /tmp/old-build/apps/ratslam build/apps/ratslam
@@ -12,7 +12,7 @@ old=$(realpath "$1")
 new=$(realpath "$2")
 work=${3:-$(mktemp -d)}
 data=$root/../shared/data
-ignore="wall_seconds frames_per_second query_time_ms wall_time_s ${IGNORE_KEYS:-}"
+ignore="wall_seconds frames_per_second query_time_ms wall_time_s run ${IGNORE_KEYS:-}"
 
 run_all() {  # binary, folder
   local b=$1 o=$2 c=$root/configs r=$data/ipin2023-t3/IPIN2023_T3_TrainingTrial01

@@ -11,6 +11,7 @@
 
 #include "common/number_text.h"
 #include "fusion/io/config.h"
+#include "fusion/io/provenance_json.h"
 #include "fusion/io/visual_model_file.h"
 #include "session/evaluation_baselines.h"
 #include "session/evaluation_nodes.h"
@@ -209,6 +210,10 @@ Status EvaluationSession::WriteOutputs() {
   j["query_time_ms"] = result_.query_time_ms;
   result_.wall_time_s = clock_->Seconds() - started_s_;
   j["wall_time_s"] = result_.wall_time_s;
+  std::vector<std::string> inputs = {options_.map_path};
+  if (options_.query_path != options_.map_path) inputs.push_back(options_.query_path);
+  j["run"] =
+      RunObject(options_.provenance, inputs, std::nullopt, ConfigFingerprint(options_.pipeline));
   result_.json = j.dump(2) + "\n";
 
   // Numbers in shortest round-trip form; error_m is numeric (inf for another floor, empty for a

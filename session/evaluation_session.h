@@ -16,6 +16,7 @@
 #include "common/clock.h"
 #include "common/output_folder.h"
 #include "common/progress.h"
+#include "common/provenance.h"
 #include "common/status.h"
 #include "fusion/fabmap/evaluation.h"
 #include "fusion/fabmap/localiser.h"
@@ -29,8 +30,9 @@ struct EvaluationSessionOptions {
   PipelineOptions pipeline;  // [fabmap...] sections, [evaluation], and [pdr] for phone logs
   std::string config_path;   // as given, for evaluation.json
   std::string map_path;
-  std::string query_path;  // may name the same data set as map_path: then it is split
-  bool lenient = false;    // skip (and count) malformed lines of phone logs and CSVs
+  std::string query_path;    // may name the same data set as map_path: then it is split
+  bool lenient = false;      // skip (and count) malformed lines of phone logs and CSVs
+  RunProvenance provenance;  // command line and start time, for evaluation.json's `run`
 };
 
 struct EvaluationResult {

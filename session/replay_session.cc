@@ -127,6 +127,8 @@ Status ReplaySession::WriteOutputs() {
   info.config_path = options_.config_path;
   info.config_fingerprint = fingerprint_;
   info.resumed_from = options_.load_map;
+  info.provenance = options_.provenance;
+  info.inputs = options_.data;
   StatusOr<RunSummary> summary = WriteRunOutputs(*env_.out, *pipeline_, *dataset_, info);
   if (summary.ok()) {
     result_.summary = std::move(summary).value();

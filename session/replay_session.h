@@ -21,6 +21,7 @@
 #include "common/clock.h"
 #include "common/output_folder.h"
 #include "common/progress.h"
+#include "common/provenance.h"
 #include "common/status.h"
 #include "fusion/io/run_outputs.h"
 #include "fusion/replay_pipeline.h"
@@ -37,6 +38,7 @@ struct ReplaySessionOptions {
   std::string load_map;           // resume from this map file
   std::string save_map;           // save the final state here
   double until_s = std::numeric_limits<double>::infinity();  // stop after this data time
+  RunProvenance provenance;  // command line and start time, for summary.json's `run`
 };
 
 // What the session needs from outside. `out` is required; the others may be null (system clock,

@@ -10,6 +10,7 @@
 #include "common/circular.h"
 #include "common/geometry.h"
 #include "common/number_text.h"
+#include "fusion/io/provenance_json.h"
 #include "fusion/io/run_columns.h"
 
 namespace ratslam {
@@ -274,11 +275,10 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
   j["frames_per_second"] =
       info.wall_seconds > 0 ? static_cast<double>(info.frames_this_run) / info.wall_seconds : 0.0;
   j["config"] = info.config_path.empty() ? "(defaults)" : info.config_path;
-  char fingerprint[20];
-  std::snprintf(fingerprint, sizeof fingerprint, "%016llx",
-                static_cast<unsigned long long>(info.config_fingerprint));
-  j["config_fingerprint"] = fingerprint;
+  j["config_fingerprint"] = FingerprintHex(info.config_fingerprint);
   if (!info.resumed_from.empty()) j["resumed_from"] = info.resumed_from;
+  // A replay draws no random number outside its configuration's own seeds.
+  j["run"] = RunObject(info.provenance, info.inputs, std::nullopt, info.config_fingerprint);
   if (s.map_ate_m) j["map_ate_m"] = *s.map_ate_m;
   if (s.trajectory_ate_m) j["trajectory_ate_m"] = *s.trajectory_ate_m;
   if (s.odometry_ate_m) j["odometry_ate_m"] = *s.odometry_ate_m;

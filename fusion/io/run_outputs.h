@@ -8,6 +8,7 @@
 #include <string>
 
 #include "common/output_folder.h"
+#include "common/provenance.h"
 #include "common/status.h"
 #include "fusion/replay_pipeline.h"
 
@@ -19,7 +20,9 @@ struct RunInfo {
   bool interrupted = false;      // stopped by a signal
   std::string config_path;       // as given, or empty for built-in defaults
   uint64_t config_fingerprint = 0;
-  std::string resumed_from;  // map file, or empty
+  std::string resumed_from;         // map file, or empty
+  RunProvenance provenance;         // command line and start time, for summary.json's `run`
+  std::vector<std::string> inputs;  // the data paths, as given
 };
 
 struct RunSummary {
