@@ -105,17 +105,10 @@ nlohmann::ordered_json ErrorSummary(std::vector<double> all) {
 // A point of the Wi-Fi map's frame in the ground truth's frame (the same unless the map is a
 // run's), and back.
 Point2 MapToTruth(const WifiGpMap& map, const Point2& p) {
-  const auto& a = map.truth_from_map();
-  if (!a) return p;
-  const double c = std::cos(a->rotation_rad), s = std::sin(a->rotation_rad);
-  return {c * p.x - s * p.y + a->translation_x_m, s * p.x + c * p.y + a->translation_y_m};
+  return map.truth_from_map() ? Apply(*map.truth_from_map(), p) : p;
 }
 Point2 TruthToMap(const WifiGpMap& map, const Point2& p) {
-  const auto& a = map.truth_from_map();
-  if (!a) return p;
-  const double c = std::cos(a->rotation_rad), s = std::sin(a->rotation_rad);
-  const double x = p.x - a->translation_x_m, y = p.y - a->translation_y_m;
-  return {c * x + s * y, -s * x + c * y};
+  return map.truth_from_map() ? ApplyInverse(*map.truth_from_map(), p) : p;
 }
 
 // What locate and call share: options, the Wi-Fi map and the phone log read in its frame.

@@ -49,6 +49,18 @@ struct RigidAlignment2D {
   size_t points = 0;
 };
 
+// The alignment applied to a point of the estimate's frame, and its inverse (a truth point back
+// into the estimate's frame).
+inline Point2 Apply(const RigidAlignment2D& a, const Point2& p) {
+  const double c = std::cos(a.rotation_rad), s = std::sin(a.rotation_rad);
+  return {c * p.x - s * p.y + a.translation_x_m, s * p.x + c * p.y + a.translation_y_m};
+}
+inline Point2 ApplyInverse(const RigidAlignment2D& a, const Point2& p) {
+  const double c = std::cos(a.rotation_rad), s = std::sin(a.rotation_rad);
+  const double x = p.x - a.translation_x_m, y = p.y - a.translation_y_m;
+  return {c * x + s * y, -s * x + c * y};
+}
+
 // Best rigid transform taking `estimate` onto `truth` (same length, paired by index) in the
 // least-squares sense; nullopt for fewer than 2 pairs or mismatched lengths.
 std::optional<RigidAlignment2D> AlignRigid2D(const std::vector<Point2>& estimate,

@@ -29,6 +29,21 @@ TEST(AlignRigid2DTest, RecoversKnownRotationAndTranslation) {
   EXPECT_NEAR(a->rmse_m, 0.0, 1e-12);
 }
 
+TEST(AlignRigid2DTest, ApplyMovesTheEstimateOntoTheTruthAndBack) {
+  const std::vector<Point2> truth = {{0, 0}, {4, 0}, {4, 3}, {1, 7}};
+  const std::vector<Point2> estimate = {{5, 1}, {5, 5}, {2, 5}, {-2, 2}};  // truth turned 90 deg
+  auto a = AlignRigid2D(estimate, truth);
+  ASSERT_TRUE(a.has_value());
+  for (size_t i = 0; i < truth.size(); ++i) {
+    const Point2 on_truth = Apply(*a, estimate[i]);
+    EXPECT_NEAR(on_truth.x, truth[i].x, 1e-12);
+    EXPECT_NEAR(on_truth.y, truth[i].y, 1e-12);
+    const Point2 back = ApplyInverse(*a, truth[i]);
+    EXPECT_NEAR(back.x, estimate[i].x, 1e-12);
+    EXPECT_NEAR(back.y, estimate[i].y, 1e-12);
+  }
+}
+
 TEST(AlignRigid2DTest, RmseOfKnownResidual) {
   // Two points 2 m apart estimated 4 m apart (no rotation can fix scale): residual 1 m each.
   auto a = AlignRigid2D({{-2, 0}, {2, 0}}, {{-1, 0}, {1, 0}});

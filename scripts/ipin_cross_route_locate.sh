@@ -27,41 +27,40 @@ def cell(x):
 print(f"| {sys.argv[2]} | {j.get('count', 0) + j.get('wrong_floor', 0)} | {cell(j)} | {cell(j['knn_baseline'])} |")
 PY
 }
+map_of() {  # output map, routes...: a map from repetitions 01 and 02 of the routes
+  local map=$1 a=() r
+  shift
+  for r in "$@"; do a+=(--data "$(log "$r" 01)" --data "$(log "$r" 02)"); done
+  "$bin" wifi-map "${a[@]}" --out "$map" > /dev/null
+}
+locate_row() {  # map, route, repetition, output folder, label
+  "$bin" locate --quiet --wifi-map "$1" --data "$(log "$2" "$3")" --out "$4"
+  row "$4/summary.json" "$5"
+}
 echo "| located (map) | scans with truth | filter mean / median / p90 m | 3-NN mean / median / p90 m |"
 echo "|---|---|---|---|"
 for group in "01 02 03" "21 22 23"; do
   read -r -a routes <<< "$group"
-  args=()
-  for r in "${routes[@]}"; do args+=(--data "$(log "$r" 01)" --data "$(log "$r" 02)"); done
-  "$bin" wifi-map "${args[@]}" --out "$out/floor${routes[0]}.wifimap" > /dev/null
+  map_of "$out/floor${routes[0]}.wifimap" "${routes[@]}"
   for r in "${routes[@]}"; do
     for rep in 03 04; do
-      "$bin" locate --quiet --wifi-map "$out/floor${routes[0]}.wifimap" --data "$(log "$r" "$rep")" \
-        --out "$out/floor-route$r-rep$rep"
-      row "$out/floor-route$r-rep$rep/summary.json" "route $r rep$rep (map: routes ${routes[*]})"
+      locate_row "$out/floor${routes[0]}.wifimap" "$r" "$rep" "$out/floor-route$r-rep$rep" \
+        "route $r rep$rep (map: routes ${routes[*]})"
     done
   done
 done
 for group in "01 02 03" "21 22 23"; do
   read -r -a routes <<< "$group"
   for r in "${routes[@]}"; do
-    args=()
     others=()
-    for o in "${routes[@]}"; do
-      [[ $o == "$r" ]] && continue
-      others+=("$o")
-      args+=(--data "$(log "$o" 01)" --data "$(log "$o" 02)")
-    done
-    "$bin" wifi-map "${args[@]}" --out "$out/without$r.wifimap" > /dev/null
+    for o in "${routes[@]}"; do [[ $o == "$r" ]] || others+=("$o"); done
+    map_of "$out/without$r.wifimap" "${others[@]}"
     for rep in 03 04; do
-      "$bin" locate --quiet --wifi-map "$out/without$r.wifimap" --data "$(log "$r" "$rep")" \
-        --out "$out/route$r-rep$rep"
-      row "$out/route$r-rep$rep/summary.json" "route $r rep$rep (map: routes ${others[*]})"
+      locate_row "$out/without$r.wifimap" "$r" "$rep" "$out/route$r-rep$rep" \
+        "route $r rep$rep (map: routes ${others[*]})"
     done
   done
 done
-args=()
-for r in 01 02 03 21 22 23; do args+=(--data "$(log "$r" 01)" --data "$(log "$r" 02)"); done
-"$bin" wifi-map "${args[@]}" --out "$out/both-floors.wifimap" > /dev/null
-"$bin" locate --quiet --wifi-map "$out/both-floors.wifimap" --data "$(log 51 02)" --out "$out/route51"
-row "$out/route51/summary.json" "route 51 rep02, floors 0, -1, -2 (map: all six routes, floors 0 and -2)"
+map_of "$out/both-floors.wifimap" 01 02 03 21 22 23
+locate_row "$out/both-floors.wifimap" 51 02 "$out/route51" \
+  "route 51 rep02, floors 0, -1, -2 (map: all six routes, floors 0 and -2)"

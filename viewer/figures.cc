@@ -165,12 +165,9 @@ std::vector<Point2> AlignGroundTruthToMap(const std::vector<Point2>& map_points,
   // AlignRigid2D maps its first argument onto its second: align truth onto the map.
   const std::optional<RigidAlignment2D> a = AlignRigid2D(truth_points, map_points);
   if (!a) return {};
-  const double c = std::cos(a->rotation_rad), s = std::sin(a->rotation_rad);
   std::vector<Point2> out;
   out.reserve(truth_path.size());
-  for (const Point2& p : truth_path) {
-    out.push_back({c * p.x - s * p.y + a->translation_x_m, s * p.x + c * p.y + a->translation_y_m});
-  }
+  for (const Point2& p : truth_path) out.push_back(Apply(*a, p));
   return out;
 }
 

@@ -291,12 +291,16 @@ void ParticleFilter::ApplyWalls(const std::vector<Point2>& before) {
   if (any) Normalise();
 }
 
-void ParticleFilter::Step(double forward_m, double heading_rad) {
+std::vector<Point2> ParticleFilter::PositionsBeforeMove() const {
   std::vector<Point2> before;
-  if (!map_.walls().empty()) {
-    before.reserve(particles_.size());
-    for (const Particle& p : particles_) before.push_back({p.x_m, p.y_m});
-  }
+  if (map_.walls().empty()) return before;  // nothing to cross
+  before.reserve(particles_.size());
+  for (const Particle& p : particles_) before.push_back({p.x_m, p.y_m});
+  return before;
+}
+
+void ParticleFilter::Step(double forward_m, double heading_rad) {
+  const std::vector<Point2> before = PositionsBeforeMove();
   for (Particle& p : particles_) {
     p.heading_offset_rad += random_.Gaussian(0.0, options_.heading_offset_walk_rad);
     const double heading =
@@ -310,11 +314,7 @@ void ParticleFilter::Step(double forward_m, double heading_rad) {
 
 void ParticleFilter::Diffuse(double dt_s) {
   const double sigma = options_.random_walk_m_per_s * std::sqrt(std::max(dt_s, 0.0));
-  std::vector<Point2> before;
-  if (!map_.walls().empty()) {
-    before.reserve(particles_.size());
-    for (const Particle& p : particles_) before.push_back({p.x_m, p.y_m});
-  }
+  const std::vector<Point2> before = PositionsBeforeMove();
   for (Particle& p : particles_) {
     p.x_m += random_.Gaussian(0.0, sigma);
     p.y_m += random_.Gaussian(0.0, sigma);

@@ -172,6 +172,9 @@ class ParticleFilter {
   void Resample();
   // Whether the move from `a` to `b` on `floor` crosses a wall the map knows.
   bool CrossesWall(int floor, const Point2& a, const Point2& b) const;
+  // The particles' positions before a move, when the map has walls to check it against (else
+  // empty).
+  std::vector<Point2> PositionsBeforeMove() const;
   // Penalises the particles whose move from `before` crossed a wall.
   void ApplyWalls(const std::vector<Point2>& before);
   // Sensor resetting (see the header comment) for a scan's known readings.
