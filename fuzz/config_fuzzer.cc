@@ -41,6 +41,13 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (options.status().message().rfind("fuzz.toml", 0) != 0) {
       fuzz::InvariantFailed("error does not name the file: " + options.status().message());
     }
+    // From a file, a text that fails may be recognised as an OpenRatSLAM INI: still an error
+    // naming the file.
+    const std::string path = fuzz::WriteScratchFile("config.toml", data, size);
+    StatusOr<PipelineOptions> loaded = LoadConfigFile(path);
+    if (loaded.ok() || loaded.status().message().rfind(path, 0) != 0) {
+      fuzz::InvariantFailed("a file that does not parse loaded, or its error lacks the path");
+    }
     return 0;
   }
   std::string error;
