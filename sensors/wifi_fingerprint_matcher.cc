@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <stdexcept>
 #include <utility>
@@ -71,56 +72,105 @@ double WifiFingerprintMatcher::Weight(const Fingerprint& q, const Fingerprint& j
          (common + e + m);
 }
 
-template <typename Visit>
-void WifiFingerprintMatcher::ForEachCandidate(const Fingerprint& query, Visit&& visit) const {
-  if (options_.offset_invariant) {
-    ForEachCandidateOf<true>(query, std::forward<Visit>(visit));
-  } else {
-    ForEachCandidateOf<false>(query, std::forward<Visit>(visit));
+template <bool kOffsetInvariant, typename Finish>
+void WifiFingerprintMatcher::Scan(const Fingerprint& query, Finish&& finish) const {
+  const uint32_t n = size();
+  // The query's indexed APs, with their penalty and a cursor into their posting list.
+  lists_.clear();
+  double extra_total = 0.0;
+  for (size_t a = 0; a < query.ap_ids.size(); ++a) {
+    const double extra = Penalty2(query.rssi_dbm[a]);
+    extra_total += extra;
+    if (query.ap_ids[a] >= postings_.size()) continue;
+    const std::vector<Posting>& list = postings_[query.ap_ids[a]];
+    if (!list.empty()) {
+      lists_.push_back(
+          {list.data(), list.data(), list.data() + list.size(), query.rssi_dbm[a], extra});
+    }
+  }
+  // When the query's lists hold many postings per stored fingerprint (one building: all share
+  // APs), fingerprints go in blocks of kBlock ids, so that the block's sums stay in the L1 cache
+  // while every list adds to them (posting lists are in id order); otherwise (a campus) in one
+  // block. Within a fingerprint the sums run over the query's APs in order, as the pairwise
+  // formula does, so the blocks change no result.
+  size_t total = 0;
+  for (const ListCursor& list : lists_) total += static_cast<size_t>(list.end - list.next);
+  const uint32_t block = total * 4 >= n ? kBlock : std::max<uint32_t>(n, 1);
+  if (acc_.size() < block) acc_.resize(block);
+  if (kOffsetInvariant && diff_.size() < block) diff_.resize(block, 0.0);
+  for (uint32_t base = 0; base < n && total > 0; base += block) {
+    const uint32_t limit = base + block;
+    const uint32_t slots = std::min(block, n - base);
+    size_t count = 0;
+    for (ListCursor& list : lists_) {
+      list.stop =
+          limit >= n
+              ? list.end
+              : std::lower_bound(list.next, list.end, limit,
+                                 [](const Posting& p, uint32_t id) { return p.fingerprint < id; });
+      count += static_cast<size_t>(list.stop - list.next);
+    }
+    if (count == 0) continue;
+    // A block most of whose fingerprints are touched (one building: all share APs) is cheaper to
+    // scan whole afterwards than to track with a branch per posting; a sparse one (a campus) is
+    // the other way round.
+    const bool dense = count * 4 >= slots;
+    touched_.clear();
+    for (ListCursor& list : lists_) {
+      for (const Posting* p = list.next; p != list.stop; ++p) {
+        const uint32_t slot = p->fingerprint - base;
+        Accumulator& acc = acc_[slot];
+        if (!dense && acc.common == 0) touched_.push_back(slot);
+        ++acc.common;
+        const double d = list.s - p->rssi_dbm;
+        acc.hit += d * d;
+        if constexpr (kOffsetInvariant) diff_[slot] += d;
+        acc.extra_common += list.extra;
+        acc.miss_common += p->penalty2;
+      }
+      list.next = list.stop;
+    }
+    auto complete = [&](uint32_t slot) {
+      Accumulator& acc = acc_[slot];
+      Candidate c;
+      c.id = base + slot;
+      c.h = acc.common;
+      c.hit = acc.hit;
+      if constexpr (kOffsetInvariant) {
+        c.hit = std::max(0.0, c.hit - diff_[slot] * diff_[slot] / c.h);
+        diff_[slot] = 0.0;
+      }
+      c.extra = std::max(0.0, extra_total - acc.extra_common);
+      c.miss = std::max(0.0, miss_penalty_total_[c.id] - acc.miss_common);
+      finish(c);
+      acc = Accumulator();
+    };
+    if (dense) {
+      for (uint32_t slot = 0; slot < slots; ++slot) {
+        if (acc_[slot].common != 0) complete(slot);
+      }
+    } else {
+      for (uint32_t slot : touched_) complete(slot);
+    }
   }
 }
 
-template <bool kOffsetInvariant, typename Visit>
-void WifiFingerprintMatcher::ForEachCandidateOf(const Fingerprint& query, Visit&& visit) const {
-  const size_t n = state_.fingerprints.size();
-  if (common_.size() < n) {
-    common_.resize(n, 0);
-    hit_sum_.resize(n, 0.0);
-    if (kOffsetInvariant) diff_sum_.resize(n, 0.0);
-    extra_common_.resize(n, 0.0);
-    miss_common_.resize(n, 0.0);
-  }
-  touched_.clear();
-  double extra_total = 0.0;
-  for (size_t a = 0; a < query.ap_ids.size(); ++a) {
-    const double s = query.rssi_dbm[a];
-    const double extra = Penalty2(s);
-    extra_total += extra;
-    if (query.ap_ids[a] >= postings_.size()) continue;
-    for (const Posting& p : postings_[query.ap_ids[a]]) {
-      if (common_[p.fingerprint]++ == 0) touched_.push_back(p.fingerprint);
-      const double d = s - p.rssi_dbm;
-      hit_sum_[p.fingerprint] += d * d;
-      if constexpr (kOffsetInvariant) diff_sum_[p.fingerprint] += d;
-      extra_common_[p.fingerprint] += extra;
-      miss_common_[p.fingerprint] += p.penalty2;
-    }
-  }
+double WifiFingerprintMatcher::Exponent(const Candidate& c) const {
   const double two_sigma2 = 2.0 * options_.kernel_variance_dbm2;
-  const double query_size = static_cast<double>(query.ap_ids.size());
-  for (uint32_t id : touched_) {
-    const double h = common_[id];
-    const double e = query_size - h;
-    const double m = static_cast<double>(state_.fingerprints[id].ap_ids.size()) - h;
-    const double extra = std::max(0.0, extra_total - extra_common_[id]);
-    const double miss = std::max(0.0, miss_penalty_total_[id] - miss_common_[id]);
-    double hit = hit_sum_[id];
-    if constexpr (kOffsetInvariant) hit = std::max(0.0, hit - diff_sum_[id] * diff_sum_[id] / h);
-    visit(id, std::exp(-hit / (two_sigma2 * h) - extra / two_sigma2 - miss / two_sigma2) * h /
-                  (h + e + m));
-    common_[id] = 0;
-    hit_sum_[id] = extra_common_[id] = miss_common_[id] = 0.0;
-    if constexpr (kOffsetInvariant) diff_sum_[id] = 0.0;
+  return -c.hit / (two_sigma2 * c.h) - c.extra / two_sigma2 - c.miss / two_sigma2;
+}
+
+template <typename Visit>
+void WifiFingerprintMatcher::ForEachCandidate(const Fingerprint& query, Visit&& visit) const {
+  auto finish = [&](const Candidate& c) {
+    const double e = static_cast<double>(query.ap_ids.size()) - c.h;
+    const double m = static_cast<double>(sizes_[c.id]) - c.h;
+    visit(c.id, std::exp(Exponent(c)) * c.h / (c.h + e + m));
+  };
+  if (options_.offset_invariant) {
+    Scan<true>(query, finish);
+  } else {
+    Scan<false>(query, finish);
   }
 }
 
@@ -132,14 +182,34 @@ std::vector<double> WifiFingerprintMatcher::Weights(const Fingerprint& query) co
 
 WifiMatch WifiFingerprintMatcher::Best(const Fingerprint& query) const {
   WifiMatch best;
-  ForEachCandidate(query, [&best](uint32_t id, double w) {
+  // w = exp(x) * H / (H + E + M) <= exp(x): a fingerprint whose exponent x is below log(best)
+  // cannot win, and its exp is skipped. The margin of 1e-9 covers the rounding of exp, of the
+  // log and of the product (each within a few ulps), so the answer is the exhaustive one.
+  double skip_below = -std::numeric_limits<double>::infinity();
+  const double inv_two_sigma2 = 1.0 / (2.0 * options_.kernel_variance_dbm2);
+  auto finish = [&](const Candidate& c) {
+    // The penalties alone (hit >= 0) bound x from above: most candidates stop here, before the
+    // divisions. The margin covers the reciprocal's rounding.
+    if (!(-(c.extra + c.miss) * inv_two_sigma2 >= skip_below - 1e-9)) return;
+    const double x = Exponent(c);
+    if (!(x >= skip_below)) return;
+    const uint32_t id = c.id;
+    const double e = static_cast<double>(query.ap_ids.size()) - c.h;
+    const double m = static_cast<double>(sizes_[id]) - c.h;
+    const double w = std::exp(x) * c.h / (c.h + e + m);
     // Ties go to the older template, independent of the order the index visits them in.
     if (w > best.weight ||
         (w == best.weight && best.id >= 0 && id < static_cast<uint32_t>(best.id))) {
       best.weight = w;
       best.id = static_cast<int32_t>(id);
+      if (w > 0.0) skip_below = std::log(w) - 1e-9;
     }
-  });
+  };
+  if (options_.offset_invariant) {
+    Scan<true>(query, finish);
+  } else {
+    Scan<false>(query, finish);
+  }
   return best;
 }
 
@@ -153,6 +223,7 @@ void WifiFingerprintMatcher::Index(uint32_t id) {
     miss_total += penalty2;
   }
   miss_penalty_total_.push_back(miss_total);
+  sizes_.push_back(static_cast<uint32_t>(f.ap_ids.size()));
 }
 
 uint32_t WifiFingerprintMatcher::Add(const Fingerprint& fingerprint) {
@@ -178,6 +249,7 @@ Status WifiFingerprintMatcher::SetState(State state) {
   for (uint32_t i = 0; i < state_.bssids.size(); ++i) bssid_ids_[state_.bssids[i]] = i;
   postings_.assign(state_.bssids.size(), {});
   miss_penalty_total_.clear();
+  sizes_.clear();
   for (uint32_t id = 0; id < state_.fingerprints.size(); ++id) Index(id);
   return Status::Ok();
 }

@@ -107,12 +107,29 @@ class WifiFingerprintMatcher {
     double penalty2;  // P(rssi)^2, precomputed for eq. 5
   };
   double Penalty2(double rssi_dbm) const;
+  // Per stored fingerprint, sums over the APs it shares with the query (one record, so a posting
+  // costs one cache line).
+  struct alignas(32) Accumulator {
+    double hit = 0.0;           // sum of d^2, d the RSSI difference
+    double extra_common = 0.0;  // sum of the query's P^2 over the shared APs
+    double miss_common = 0.0;   // sum of the stored fingerprint's P^2 over the shared APs
+    uint32_t common = 0;
+  };
+  // A stored fingerprint sharing H APs with the query: the sums of eqs. 3-5 (hit around the mean
+  // with offset_invariant).
+  struct Candidate {
+    uint32_t id;
+    double h, hit, extra, miss;
+  };
+  // Visits every stored fingerprint sharing an AP with the query, block by block of ids:
+  // finish(candidate). Compiled once per hit term so the plain one pays nothing for the other.
+  template <bool kOffsetInvariant, typename Finish>
+  void Scan(const Fingerprint& query, Finish&& finish) const;
+  // The exponent of eq. 6: the log of w_hit^(1/H) w_extra w_miss.
+  double Exponent(const Candidate& c) const;
   // Visits every stored fingerprint sharing an AP with the query: visit(id, weight).
   template <typename Visit>
   void ForEachCandidate(const Fingerprint& query, Visit&& visit) const;
-  // The loop itself, compiled once per hit term so the plain one pays nothing for the other.
-  template <bool kOffsetInvariant, typename Visit>
-  void ForEachCandidateOf(const Fingerprint& query, Visit&& visit) const;
   void Index(uint32_t id);
 
   WifiMatcherOptions options_;
@@ -120,9 +137,20 @@ class WifiFingerprintMatcher {
   std::unordered_map<std::string, uint32_t> bssid_ids_;
   std::vector<std::vector<Posting>> postings_;  // by AP id
   std::vector<double> miss_penalty_total_;      // by fingerprint: sum of P(s)^2 of all its APs
-  mutable std::vector<uint32_t> touched_;       // scratch for queries
-  mutable std::vector<uint32_t> common_;
-  mutable std::vector<double> hit_sum_, diff_sum_, extra_common_, miss_common_;
+  std::vector<uint32_t> sizes_;                 // by fingerprint: its number of APs
+  // Scratch for queries: sums per fingerprint of the block being scanned (zero outside a scan),
+  // the query's posting lists.
+  static constexpr uint32_t kBlock = 512;
+  mutable std::vector<Accumulator> acc_;
+  mutable std::vector<double> diff_;       // sum of d (offset_invariant)
+  mutable std::vector<uint32_t> touched_;  // of a sparse block
+  struct ListCursor {
+    const Posting* next;
+    const Posting* stop;  // the first posting past the block being scanned
+    const Posting* end;
+    double s, extra;
+  };
+  mutable std::vector<ListCursor> lists_;
 };
 
 }  // namespace ratslam
