@@ -254,38 +254,45 @@ double FabmapModel::UnknownLogLikelihood(const Active& active) const {
   return sum;
 }
 
-LocalisationResult FabmapModel::Normalise(const std::vector<double>& log_likelihood,
+LocalisationResult FabmapModel::Normalise(std::vector<double> log_likelihood,
                                           double unknown_log_likelihood) const {
   LocalisationResult result;
   const size_t n = log_likelihood.size();
   const double log_new = std::log(options_.p_new_place) + unknown_log_likelihood;
   const double log_place_prior =
       n > 0 ? std::log((1.0 - options_.p_new_place) / static_cast<double>(n)) : 0.0;
+  double* p = log_likelihood.data();
   size_t best = 0;
   for (size_t i = 1; i < n; ++i) {
-    if (log_likelihood[i] > log_likelihood[best]) best = i;
+    if (p[i] > p[best]) best = i;
   }
-  const double top = n > 0 ? std::max(log_new, log_likelihood[best] + log_place_prior) : log_new;
+  const double best_log_likelihood = n > 0 ? p[best] : 0.0;
+  const double top = n > 0 ? std::max(log_new, best_log_likelihood + log_place_prior) : log_new;
   const double new_weight = std::exp(log_new - top);
   double total = new_weight;
-  result.place_probability.resize(n);
-  double* p = result.place_probability.data();
   // A place e^-40 (4e-18) below the best changes no sum in double precision: it costs no exp
-  // and its probability is reported as 0.
+  // and its probability is reported as 0. The others are few: they alone are rescaled below.
   constexpr double kUnderflow = -40.0;
+  std::vector<uint32_t> kept;  // local: Localise stays safe to call from several threads
   for (size_t i = 0; i < n; ++i) {
-    const double relative = log_likelihood[i] + log_place_prior - top;
-    p[i] = relative < kUnderflow ? 0.0 : std::exp(relative);
-    total += p[i];
+    const double relative = p[i] + log_place_prior - top;
+    if (relative < kUnderflow) {
+      p[i] = 0.0;
+    } else {
+      p[i] = std::exp(relative);
+      total += p[i];
+      kept.push_back(static_cast<uint32_t>(i));
+    }
   }
   const double inverse = 1.0 / total;
-  for (size_t i = 0; i < n; ++i) p[i] *= inverse;
+  for (uint32_t i : kept) p[i] *= inverse;
   result.new_place_probability = new_weight * inverse;
   result.best_probability = result.new_place_probability;
   if (n > 0 && p[best] > result.best_probability) {  // a tie goes to the new place
     result.best_probability = p[best];
     result.best_place = static_cast<int64_t>(best);
   }
+  result.place_probability = std::move(log_likelihood);
   return result;
 }
 
@@ -293,7 +300,8 @@ LocalisationResult FabmapModel::Localise(const Observation& z) const {
   const Active active = ActiveWords(z);
   std::vector<double> log_likelihood;
   IndexLogLikelihoods(mapped_, active, &log_likelihood);
-  return Normalise(log_likelihood, UnknownLogLikelihood(active));
+  const double unknown = UnknownLogLikelihood(active);
+  return Normalise(std::move(log_likelihood), unknown);
 }
 
 LocalisationResult FabmapModel::LocaliseAmong(const Observation& z,
@@ -304,7 +312,7 @@ LocalisationResult FabmapModel::LocaliseAmong(const Observation& z,
   std::vector<double> subset;
   subset.reserve(candidates.size());
   for (uint32_t c : candidates) subset.push_back(all.at(c));
-  LocalisationResult result = Normalise(subset, UnknownLogLikelihood(active));
+  LocalisationResult result = Normalise(std::move(subset), UnknownLogLikelihood(active));
   if (result.best_place >= 0) result.best_place = candidates[result.best_place];
   return result;
 }

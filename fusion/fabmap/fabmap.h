@@ -142,7 +142,9 @@ class FabmapModel {
   double UnknownLogLikelihood(const Active& active) const;
   void IndexLogLikelihoods(const PlaceIndex& index, const Active& active,
                            std::vector<double>* out) const;
-  LocalisationResult Normalise(const std::vector<double>& log_likelihood,
+  // Turns per-place log-likelihoods into the posterior, in place: the vector becomes the result's
+  // place_probability (no second allocation; only places above the underflow are rescaled).
+  LocalisationResult Normalise(std::vector<double> log_likelihood,
                                double unknown_log_likelihood) const;
 
   ChowLiuTree tree_;
