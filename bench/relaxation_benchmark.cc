@@ -5,8 +5,9 @@
 //  - BM_LongRun: a run of N frames, each adding an experience and relaxing, on a route that goes
 //    round a 400-experience loop and links back to the previous lap every 50 frames; time per frame
 //    in the first and second half of the run, for the full scheme (the baseline) and the
-//    incremental one. Flat cost per frame means a ratio near 1. Every lap closing onto the last
-//    with 0.2 rad of drift is the incremental scheme's worst case: its region never settles.
+//    incremental one, and for least squares at loop closures. Flat cost per frame means a ratio
+//    near 1. Every lap closing onto the last with 0.2 rad of drift is the incremental scheme's
+//    worst case: its region never settles.
 #include <benchmark/benchmark.h>
 
 #include <chrono>
@@ -36,12 +37,13 @@ void BM_FullRelaxation(benchmark::State& state) {
 }
 BENCHMARK(BM_FullRelaxation)->Arg(1000)->Arg(10000)->Arg(100000)->Unit(benchmark::kMicrosecond);
 
-// Arguments: scheme (0 full, 1 incremental), frames.
+// Arguments: scheme (0 full, 1 incremental, 2 least squares), frames.
 void BM_LongRun(benchmark::State& state) {
   constexpr int kLap = 400;
   ExperienceMapOptions options;
-  options.relaxation_scheme =
-      state.range(0) == 0 ? RelaxationScheme::kFull : RelaxationScheme::kIncremental;
+  options.relaxation_scheme = state.range(0) == 0   ? RelaxationScheme::kFull
+                              : state.range(0) == 1 ? RelaxationScheme::kIncremental
+                                                    : RelaxationScheme::kLeastSquares;
   const int n = static_cast<int>(state.range(1));
   using Clock = std::chrono::steady_clock;
   double first_s = 0.0, second_s = 0.0;
@@ -74,13 +76,16 @@ void BM_LongRun(benchmark::State& state) {
   state.counters["link_updates_per_frame"] = static_cast<double>(updates) / n;
 }
 BENCHMARK(BM_LongRun)
-    ->ArgNames({"incremental", "frames"})
+    ->ArgNames({"scheme", "frames"})
     ->Args({0, 1000})
     ->Args({0, 2000})
     ->Args({0, 4000})
     ->Args({1, 1000})
     ->Args({1, 2000})
     ->Args({1, 4000})
+    ->Args({2, 1000})
+    ->Args({2, 2000})
+    ->Args({2, 4000})
     ->UseManualTime()
     ->Iterations(1)
     ->Unit(benchmark::kMillisecond);

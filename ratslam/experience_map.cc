@@ -14,13 +14,23 @@
 namespace ratslam {
 
 std::string ToString(RelaxationScheme scheme) {
-  return scheme == RelaxationScheme::kFull ? "full" : "incremental";
+  switch (scheme) {
+    case RelaxationScheme::kFull:
+      return "full";
+    case RelaxationScheme::kIncremental:
+      return "incremental";
+    case RelaxationScheme::kLeastSquares:
+      return "least_squares";
+  }
+  return "incremental";
 }
 
 StatusOr<RelaxationScheme> RelaxationSchemeFromString(const std::string& name) {
   if (name == "full") return RelaxationScheme::kFull;
   if (name == "incremental") return RelaxationScheme::kIncremental;
-  return Status::Error("unknown relaxation scheme \"" + name + "\" (full, incremental)");
+  if (name == "least_squares") return RelaxationScheme::kLeastSquares;
+  return Status::Error("unknown relaxation scheme \"" + name +
+                       "\" (full, incremental, least_squares)");
 }
 
 bool ExperienceMapOptions::IsValid(std::string* error) const {
@@ -69,10 +79,19 @@ void ExperienceMap::AddLink(uint32_t from, uint32_t to, double time_s,
   state_.links.push_back(link);
   link_cos_.push_back(std::cos(link.heading_rad));
   link_sin_.push_back(std::sin(link.heading_rad));
-  // The newest id: the region stays ascending.
-  const bool incremental = options_.relaxation_scheme == RelaxationScheme::kIncremental;
-  if (incremental) state_.relaxation_pending_links.push_back(link.id);
-  in_region_.push_back(incremental ? 1 : 0);
+  // The newest id: the region stays ascending. Least squares waits for a loop closure.
+  const bool pending =
+      options_.relaxation_scheme == RelaxationScheme::kIncremental ||
+      (options_.relaxation_scheme == RelaxationScheme::kLeastSquares && loop_closure);
+  if (pending) state_.relaxation_pending_links.push_back(link.id);
+  in_region_.push_back(pending ? 1 : 0);
+  if (options_.relaxation_scheme == RelaxationScheme::kLeastSquares && !loop_closure) {
+    // `to` is new, a leaf: the least-squares optimum satisfies its one link exactly. Its
+    // position already does; its facing takes the link's (the compass difference when there is
+    // a compass), so dead reckoning goes on from the corrected heading.
+    Experience& b = state_.experiences[to];
+    b.theta_rad = WrapAngle(state_.experiences[from].theta_rad + link.facing_rad);
+  }
 }
 
 uint32_t ExperienceMap::CreateExperience(uint32_t template_id, const PoseCellPosition& pose_cells,
@@ -162,11 +181,29 @@ StatusOr<bool> ExperienceMap::LinkTo(uint32_t id, double time_s,
 }
 
 void ExperienceMap::Relax() {
-  if (options_.relaxation_scheme == RelaxationScheme::kFull) {
-    RelaxFull();
-  } else {
-    RelaxIncremental();
+  switch (options_.relaxation_scheme) {
+    case RelaxationScheme::kFull:
+      RelaxFull();
+      break;
+    case RelaxationScheme::kIncremental:
+      RelaxIncremental();
+      break;
+    case RelaxationScheme::kLeastSquares:
+      RelaxLeastSquares();
+      break;
   }
+}
+
+void ExperienceMap::RelaxLeastSquares() {
+  if (state_.relaxation_pending_links.empty()) return;
+  ++least_squares_runs_;
+  // The first experience stays put, as with anchor_first_experience: the gauge.
+  if (!OptimisePoseGraph(&state_.experiences, state_.links, options_.Noise()).ok()) {
+    ++least_squares_failures_;
+    return;  // the map is unchanged; the pending closure is retried at the next action
+  }
+  for (uint32_t l : state_.relaxation_pending_links) in_region_[l] = 0;
+  state_.relaxation_pending_links.clear();
 }
 
 ExperienceMap::EndMotion ExperienceMap::UpdateLink(const Link& l, double cos_direction,

@@ -12,6 +12,7 @@
 #include "common/schema.h"
 #include "common/status.h"
 #include "ratslam/pose_cell_network.h"
+#include "ratslam/pose_graph.h"
 
 namespace ratslam {
 
@@ -31,7 +32,12 @@ inline constexpr double kMaxCoordinate = 1e12;
 //    after a pass over a fixed set of links converge. A frame that only extends the map costs
 //    one link update; a loop closure costs passes over the loop and a fringe around it. The
 //    rotation of each experience is read once per pass (sin/cos per experience, not per link).
-enum class RelaxationScheme { kFull, kIncremental };
+//  - kLeastSquares: no relaxation passes; after an action that added a loop closure (the
+//    spine's or Wi-Fi sequence loop closure's), the whole graph is optimised by sparse least
+//    squares (ratslam/pose_graph.h) with the links' information from link_sigma_m,
+//    link_sigma_m_per_m and link_sigma_rad. A new experience placed by odometry satisfies its
+//    link exactly, so nothing else needs work; each closure costs a sparse solve over the map.
+enum class RelaxationScheme { kFull, kIncremental, kLeastSquares };
 std::string ToString(RelaxationScheme scheme);
 StatusOr<RelaxationScheme> RelaxationSchemeFromString(const std::string& name);
 
@@ -42,6 +48,10 @@ struct ExperienceMapOptions {
   RelaxationScheme relaxation_scheme = RelaxationScheme::kIncremental;  // see RelaxationScheme
   double relaxation_tolerance_m = 1e-4;    // kIncremental: movement that grows the region
   double relaxation_tolerance_rad = 1e-5;  // kIncremental: rotation that grows the region
+  // A link's noise: the information matrix of kLeastSquares and of the g2o output.
+  double link_sigma_m = 0.05;
+  double link_sigma_m_per_m = 0.05;
+  double link_sigma_rad = 0.05;
 
   bool IsValid(std::string* error) const;
 
@@ -56,8 +66,8 @@ struct ExperienceMapOptions {
     v("anchor_first_experience", anchor_first_experience,
       "keep experience 0 fixed during relaxation", schema::Any());
     v("relaxation_scheme", relaxation_scheme,
-      "full (every link in every pass, as OpenRatSLAM) or incremental (only links whose ends "
-      "moved)",
+      "full (every link in every pass, as OpenRatSLAM), incremental (only links whose ends "
+      "moved) or least_squares (sparse least-squares optimisation of the graph at loop closures)",
       schema::Any());
     v("relaxation_tolerance_m", relaxation_tolerance_m,
       "incremental: movement of an experience that adds its links to the relaxed region",
@@ -65,7 +75,16 @@ struct ExperienceMapOptions {
     v("relaxation_tolerance_rad", relaxation_tolerance_rad,
       "incremental: rotation of an experience that adds its links to the relaxed region",
       schema::Unit("rad").Positive());
+    v("link_sigma_m", link_sigma_m,
+      "translation noise of a link (plus link_sigma_m_per_m of its length): the information "
+      "matrix of least_squares and of experience_map.g2o",
+      schema::Unit("m").Positive());
+    v("link_sigma_m_per_m", link_sigma_m_per_m,
+      "translation noise of a link per metre of its length", schema::Unit("m/m").NonNegative());
+    v("link_sigma_rad", link_sigma_rad, "rotation noise of a link", schema::Unit("rad").Positive());
   }
+  // The link noise model these options describe.
+  LinkNoise Noise() const { return {link_sigma_m, link_sigma_m_per_m, link_sigma_rad}; }
 };
 
 struct Experience {
@@ -144,6 +163,10 @@ class ExperienceMap {
   void Relax();
   // Link updates made by Relax since construction (not saved): a measure of relaxation cost.
   uint64_t relaxation_link_updates() const { return link_updates_; }
+  // kLeastSquares: optimisations run and failed (not saved). A failed one leaves the map as it
+  // was and is retried at the next action.
+  uint64_t least_squares_runs() const { return least_squares_runs_; }
+  uint64_t least_squares_failures() const { return least_squares_failures_; }
 
   // The pose of the current experience composed with the offset since it.
   void CurrentPose(double* x_m, double* y_m, double* theta_rad) const;
@@ -160,6 +183,7 @@ class ExperienceMap {
   std::optional<uint32_t> current() const { return state_.current; }
   const LocalOffset& offset() const { return state_.offset; }
   const State& state() const { return state_; }
+  const ExperienceMapOptions& options() const { return options_; }
   // Restores a state; fails, changing nothing, on an id that points nowhere (a link's ends, an
   // experience's links, the current experience) or a non-finite or out-of-range number.
   Status SetState(State state);
@@ -171,6 +195,7 @@ class ExperienceMap {
 
   void RelaxFull();
   void RelaxIncremental();
+  void RelaxLeastSquares();
   // Moves both ends of link `l` towards agreement, given the cosine and sine of the link's
   // direction (from's rotation plus heading_rad). Returns the movement of each end: metres
   // (|dx| + |dy|) and radians.
@@ -197,6 +222,8 @@ class ExperienceMap {
   std::vector<char> in_region_;  // per link: in relaxation_pending_links
   uint64_t pass_ = 0;
   uint64_t link_updates_ = 0;
+  uint64_t least_squares_runs_ = 0;
+  uint64_t least_squares_failures_ = 0;
 };
 
 }  // namespace ratslam

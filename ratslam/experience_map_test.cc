@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 
 #include "common/circular.h"
@@ -358,10 +359,43 @@ TEST(RelaxationSchemeTest, SetStateRefusesInconsistentRelaxationWork) {
 }
 
 TEST(RelaxationSchemeTest, SchemeNamesRoundTrip) {
-  for (RelaxationScheme s : {RelaxationScheme::kFull, RelaxationScheme::kIncremental}) {
+  for (RelaxationScheme s :
+       {RelaxationScheme::kFull, RelaxationScheme::kIncremental, RelaxationScheme::kLeastSquares}) {
     EXPECT_EQ(RelaxationSchemeFromString(ToString(s)).value(), s);
   }
   EXPECT_FALSE(RelaxationSchemeFromString("fast").ok());
+}
+
+// The weighted squared residual of a map's links (the least-squares objective), evaluated by the
+// optimiser with no iteration.
+double GraphCost(const ExperienceMap& map) {
+  std::vector<Experience> copy = map.experiences();
+  return OptimisePoseGraph(&copy, map.links(), map.options().Noise(), 0)->initial_cost;
+}
+
+// Least squares works only at loop closures (no link updates; one optimisation per closure), and
+// its map minimises the objective: its cost is below what ten full relaxation passes per action
+// leave on the same route.
+TEST(RelaxationSchemeTest, LeastSquaresOptimisesAtClosuresOnly) {
+  ExperienceMap full = DriveLongRoute(Scheme(RelaxationScheme::kFull), 400);
+  ExperienceMap ls = DriveLongRoute(Scheme(RelaxationScheme::kLeastSquares), 400);
+  EXPECT_EQ(ls.relaxation_link_updates(), 0u);
+  EXPECT_EQ(ls.least_squares_runs(), 8u);  // the closures at 80, 120, ..., 360
+  EXPECT_EQ(ls.least_squares_failures(), 0u);
+  EXPECT_TRUE(ls.state().relaxation_pending_links.empty());
+  EXPECT_LT(GraphCost(ls), GraphCost(full)) << GraphCost(ls) << " vs " << GraphCost(full);
+}
+
+TEST(RelaxationSchemeTest, LeastSquaresIsAsAccurateAsFull) {
+  uint64_t updates = 0;
+  const double dead_reckoning = LapsMapError(RelaxationScheme::kFull, 1, &updates);
+  const double full = LapsMapError(RelaxationScheme::kFull, 6, &updates);
+  const double ls = LapsMapError(RelaxationScheme::kLeastSquares, 6, &updates);
+  EXPECT_EQ(updates, 0u);
+  EXPECT_LT(ls, 0.5 * dead_reckoning) << ls << " vs " << dead_reckoning;
+  EXPECT_LE(ls, 1.02 * full + 1e-3) << ls << " vs " << full;
+  std::printf("laps map error: dead reckoning %.4f m, full %.4f m, least squares %.4f m\n",
+              dead_reckoning, full, ls);
 }
 
 }  // namespace

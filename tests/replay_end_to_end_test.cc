@@ -113,6 +113,45 @@ TEST_F(ReplayEndToEndTest, DemoDataClosesLoopsAndBeatsOdometry) {
        p = g2o.find("# loop_closure link", p + 1))
     ++marked;
   EXPECT_EQ(marked, s["loop_closures"].get<size_t>());
+  // Each edge's information matrix is the default link noise's (s_t = 0.05 m + 5 % of the
+  // edge's length, s_r = 0.05 rad), recomputed here from the edge's own translation.
+  std::istringstream lines(g2o);
+  std::string line;
+  size_t checked = 0;
+  while (std::getline(lines, line)) {
+    if (line.rfind("EDGE_SE2 ", 0) != 0) continue;
+    std::istringstream in(line.substr(9));
+    double from, to, dx, dy, dtheta, i11, i12, i13, i22, i23, i33;
+    ASSERT_TRUE(in >> from >> to >> dx >> dy >> dtheta >> i11 >> i12 >> i13 >> i22 >> i23 >> i33)
+        << line;
+    const double st = 0.05 + 0.05 * std::hypot(dx, dy);
+    ASSERT_NEAR(i11, 1.0 / (st * st), 1e-9 * i11) << line;
+    ASSERT_EQ(i11, i22) << line;
+    ASSERT_EQ(i12, 0.0);
+    ASSERT_EQ(i13, 0.0);
+    ASSERT_EQ(i23, 0.0);
+    ASSERT_NEAR(i33, 400.0, 1e-9) << line;
+    ++checked;
+  }
+  EXPECT_EQ(checked, edges);
+}
+
+// The synthetic loop's configuration with least-squares optimisation at loop closures instead of
+// relaxation: the map beats odometry by as much as the relaxed one must.
+TEST_F(ReplayEndToEndTest, LeastSquaresSchemeClosesLoopsAndBeatsOdometry) {
+  std::string toml = Slurp(config_);
+  const std::string from = "relaxation_scheme = \"incremental\"";
+  const size_t at = toml.find(from);
+  if (at == std::string::npos) {
+    toml += "\n[experience_map]\nrelaxation_scheme = \"least_squares\"\n";
+  } else {
+    toml.replace(at, from.size(), "relaxation_scheme = \"least_squares\"");
+  }
+  const nlohmann::json s = ReplayWithConfig("least_squares", toml);
+  ASSERT_FALSE(s.empty());
+  EXPECT_GT(s["loop_closures"].get<int>(), 10);
+  const double map_ate = s["map_ate_m"], odometry_ate = s["odometry_ate_m"];
+  EXPECT_LT(map_ate, 0.2 * odometry_ate) << "map " << map_ate << " odometry " << odometry_ate;
 }
 
 // The Wi-Fi RatSLAM paper's 12x9 camera templates (eq. 7) through the fused front end, camera

@@ -257,6 +257,9 @@ constexpr AddedKey kKeysAddedAfter[] = {
     {4, "local_view.decay_restore_per_s"},
     {4, "local_view.skip_recent_s"},
     {4, "wifi.offset_invariant"},
+    {6, "experience_map.link_sigma_m"},
+    {6, "experience_map.link_sigma_m_per_m"},
+    {6, "experience_map.link_sigma_rad"},
 };
 
 // Whole sections added after a map format version: older maps resume only with every key at its

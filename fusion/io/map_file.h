@@ -21,8 +21,11 @@ namespace ratslam {
 // configurations have the PDR's orientation test (maps of format 4 resume only with it off,
 // pdr.min_orientation_steadiness = 0). Version 6 adds Wi-Fi sequence loop closure (its state
 // and the links it made); its configurations have the [wifi_sequence] section (maps of format 5
-// and older resume with it off; fixture tests/data/map-v5-synthetic.map).
-inline constexpr uint32_t kMapFormatVersion = 6;
+// and older resume with it off; fixture tests/data/map-v5-synthetic.map). Version 7 changes no
+// state: its configurations have the link noise keys experience_map.link_sigma_* (the
+// least_squares relaxation scheme and the g2o information), which older maps resume with at
+// their defaults.
+inline constexpr uint32_t kMapFormatVersion = 7;
 inline constexpr uint32_t kOldestMapFormatVersion = 2;
 
 struct MapFile {

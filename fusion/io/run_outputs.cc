@@ -344,13 +344,15 @@ StatusOr<RunSummary> WriteRunOutputs(OutputFolder& folder, const ReplayPipeline&
   }
 
   // g2o: poses, the first one fixed (the gauge: without it an optimiser may move the whole map),
-  // and each link as a relative pose in its source's frame; unit information.
+  // and each link as a relative pose in its source's frame, with the information matrix of the
+  // configured link noise (experience_map.link_sigma_*), the one least_squares relaxation uses.
   std::ostringstream g2o;
   for (const Experience& e : map.experiences()) {
     g2o << "VERTEX_SE2 " << e.id << ' ' << Num(e.x_m) << ' ' << Num(e.y_m) << ' '
         << Num(e.theta_rad) << '\n';
   }
   if (!map.experiences().empty()) g2o << "FIX 0\n";
+  const LinkNoise noise = map.options().Noise();
   for (const Link& l : map.links()) {
     // g2o skips comment lines; they say which edges closed loops (RatSLAM's own, or Wi-Fi
     // sequence loop closure's); the others are odometry.
@@ -361,8 +363,9 @@ StatusOr<RunSummary> WriteRunOutputs(OutputFolder& folder, const ReplayPipeline&
     }
     g2o << "EDGE_SE2 " << l.from << ' ' << l.to << ' '
         << Num(l.distance_m * std::cos(l.heading_rad)) << ' '
-        << Num(l.distance_m * std::sin(l.heading_rad)) << ' ' << Num(l.facing_rad)
-        << " 1 0 0 1 0 1\n";
+        << Num(l.distance_m * std::sin(l.heading_rad)) << ' ' << Num(l.facing_rad);
+    for (double v : noise.Information(l.distance_m)) g2o << ' ' << Num(v);
+    g2o << '\n';
   }
   files.emplace_back("experience_map.g2o", g2o.str());
 
