@@ -76,7 +76,7 @@ const char kUsage[] =
     "  ratslam render experience-map --run O [--data D] [--out F] [--size WxH]\n"
     "                 [--color time|session] [--sessions T1,T2,...]\n"
     "  ratslam render template-graph --run O [--out F] [--size WxH] [--spans A-B:label,...]\n"
-    "  ratslam render pose-cells --map F [--config C] --out F\n"
+    "  ratslam render pose-cells --map F --out F [--config C]   (default: the map's own config)\n"
     "  ratslam render similarity --data D [--data D2 ...] [--config C] --out F [--frames N]\n"
     "                 [--sensor camera|wifi]\n"
     "  ratslam render wifi-map --wifi-map W --out F [--ap BSSID] [--floor N]\n"

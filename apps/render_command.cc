@@ -26,7 +26,8 @@ const char kRenderUsage[] =
     "  ratslam render experience-map --run O [--data D] [--out F] [--size WxH]\n"
     "                 [--color time|session] [--sessions T1,T2,...]\n"
     "  ratslam render template-graph --run O [--out F] [--size WxH] [--spans A-B:label,...]\n"
-    "  ratslam render pose-cells --map F [--config C] --out F\n"
+    "  ratslam render pose-cells --map F --out F [--config C]   (the map's own configuration\n"
+    "                 unless --config is given; maps of format 2 need --config)\n"
     "  ratslam render similarity --data D [--data D2 ...] [--config C] --out F [--frames N]\n"
     "                 [--sensor camera|wifi]\n"
     "  ratslam render wifi-map --wifi-map W --out F [--ap BSSID] [--floor N]\n";
@@ -162,10 +163,23 @@ int RenderPoseCells(const Arguments& args) {
   if (!args.values.count("--map") || !args.values.count("--out")) {
     return Fail(std::string("--map and --out are required\n") + kRenderUsage);
   }
-  auto options = LoadOptions(args);
-  if (!options) return kExitError;
-  StatusOr<MapFile> map = LoadMapFile(args.values.at("--map"));
+  const std::string& map_path = args.values.at("--map");
+  StatusOr<MapFile> map = LoadMapFile(map_path);
   if (!map.ok()) return Fail(map.status().message());
+  // The map carries the configuration that made it (format 3 on); --config overrides it.
+  std::optional<PipelineOptions> options;
+  if (args.values.count("--config") || map->config.empty()) {
+    if (!args.values.count("--config")) {
+      return Fail(map_path + ": a map of format " + std::to_string(map->format_version) +
+                  " holds no configuration: pass the --config it was made with");
+    }
+    options = LoadOptions(args);
+    if (!options) return kExitError;
+  } else {
+    StatusOr<PipelineOptions> from_map = ParseMapConfig(map->config, map->format_version);
+    if (!from_map.ok()) return Fail(map_path + ": " + from_map.status().message());
+    options = *from_map;
+  }
   PoseCellNetwork network(options->ratslam.pose_cells);
   Status restored = network.SetState(map->state.ratslam.pose_cells);
   if (!restored.ok()) {

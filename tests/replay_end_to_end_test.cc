@@ -507,6 +507,22 @@ TEST_F(ReplayEndToEndTest, RenderWritesImagesFromRunsAndMaps) {
                 .exit_code,
             0);
   ExpectPicture(cells, 1200, 620);
+  // Without --config the map's own configuration (the same one here) draws the same picture; a
+  // format-2 map holds none and must be told.
+  const fs::path own = root_ / "cells_own_config.png";
+  ASSERT_EQ(
+      RunRatslam("render pose-cells --map " + (out / "m.map").string() + " --out " + own.string(),
+                 root_)
+          .exit_code,
+      0);
+  EXPECT_EQ(Slurp(own), Slurp(cells));
+  const Result v2 = RunRatslam(
+      "render pose-cells --map " +
+          (fs::path(RATSLAM_SOURCE_DIR) / "tests" / "data" / "map-v2-synthetic.map").string() +
+          " --out " + (root_ / "v2.png").string(),
+      root_);
+  EXPECT_NE(v2.exit_code, 0);
+  EXPECT_NE(v2.err.find("holds no configuration: pass the --config"), std::string::npos) << v2.err;
   const fs::path similarity = root_ / "similarity.png";
   ASSERT_EQ(RunRatslam("render similarity --data " + (root_ / "data").string() + " --config " +
                            config_ + " --frames 200 --out " + similarity.string(),
