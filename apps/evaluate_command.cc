@@ -4,6 +4,7 @@
 #include <string>
 
 #include "apps/cli.h"
+#include "common/number_text.h"
 #include "common/output_folder.h"
 #include "common/provenance.h"
 #include "render/renderer.h"
@@ -84,6 +85,23 @@ int EvaluateCommand(int argc, char** argv) {
       curves, "FABMAP " + fabmap::ToString(mode) + ": " + std::to_string(m.queries) + " queries, " +
                   std::to_string(r.map.size()) + " mapped places");
   if (Status s = RenderToPng(figure, (*out)->Path("localisation.png")); !s.ok()) return fail(s);
+  {
+    std::vector<std::string> labels;
+    std::vector<std::vector<double>> recall, precision;
+    for (size_t k = 0; k < m.distances_m.size(); ++k) {
+      labels.push_back("correct: best mapped place within " + ShortestNumber(m.distances_m[k]) +
+                       " m");
+      recall.emplace_back();
+      precision.emplace_back();
+      for (const fabmap::PrecisionRecallPoint& p : r.precision_recall) {
+        recall.back().push_back(p.recall[k]);
+        precision.back().push_back(p.precision[k]);
+      }
+    }
+    const Scene pr = PrecisionRecallScene(
+        labels, recall, precision, "FABMAP " + fabmap::ToString(mode) + ": precision and recall");
+    if (Status s = RenderToPng(pr, (*out)->Path("pr_curve.png")); !s.ok()) return fail(s);
+  }
 
   std::printf("%-12s %6s %6s %6s %6s | %6s %6s %6s %6s | %6s %6s\n", "mode", "c2", "c5", "c10",
               "c20", "m2", "m5", "m10", "m20", "reject", "floor");

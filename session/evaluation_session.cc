@@ -160,12 +160,21 @@ Status EvaluationSession::Localise() {
   if (!localiser_) return Status::Error("evaluation session: Localise before Prepare");
   const bool vision = fabmap::UsesVision(mode());
   result_.matches.clear();
+  result_.match_probability.clear();
+  result_.new_place_probability.clear();
+  result_.best_mapped_place.clear();
+  result_.best_mapped_probability.clear();
   const double start = clock_->Seconds();
   for (size_t i = 0; i < result_.queries.size(); ++i) {
     fabmap::Query q;
     if (vision) q.visual = query_words_[i];
     q.wifi = result_.queries[i].wifi;
-    result_.matches.push_back(localiser_->Localise(q).best_place);
+    const fabmap::LocalisationResult r = localiser_->Localise(q);
+    result_.matches.push_back(r.best_place);
+    result_.match_probability.push_back(r.best_probability);
+    result_.new_place_probability.push_back(r.new_place_probability);
+    result_.best_mapped_place.push_back(r.best_mapped_place);
+    result_.best_mapped_probability.push_back(r.best_mapped_probability);
     progress_->Update({"queries", i + 1, result_.queries.size()});
   }
   progress_->Finish();
@@ -173,6 +182,19 @@ Status EvaluationSession::Localise() {
       1000.0 * (clock_->Seconds() - start) / static_cast<double>(result_.queries.size());
   result_.metrics =
       fabmap::ComputeMetrics(result_.map, result_.queries, result_.matches, kDistancesM);
+  {
+    // The best mapped place's error (infinity on another floor) and posterior (NaN: no place).
+    const fabmap::EvaluationMetrics best = fabmap::ComputeMetrics(
+        result_.map, result_.queries, result_.best_mapped_place, kDistancesM);
+    std::vector<double> probability = result_.best_mapped_probability;
+    for (size_t i = 0; i < probability.size(); ++i) {
+      if (result_.best_mapped_place[i] < 0) probability[i] = std::nan("");
+    }
+    result_.precision_recall = fabmap::PrecisionRecallCurve(
+        probability, best.errors_m,
+        fabmap::NearestPlaceDistances(result_.map, result_.queries, kDistancesM.back()),
+        kDistancesM);
+  }
   result_.baselines.clear();
   const bool map_has_wifi = std::any_of(result_.map.begin(), result_.map.end(),
                                         [](const fabmap::EvaluationNode& n) { return n.wifi; });
@@ -201,6 +223,18 @@ Status EvaluationSession::WriteOutputs() {
   AddRates(m, &j);
   j["nearest_place_within_m"] =
       ByDistance(fabmap::NearestPlaceWithin(result_.map, result_.queries, kDistancesM));
+  {
+    // Average precision of the precision-recall curve (pr_curve.csv): sum of precision times
+    // the recall gained at each point.
+    std::vector<double> average(kDistancesM.size(), 0.0), last_recall(kDistancesM.size(), 0.0);
+    for (const fabmap::PrecisionRecallPoint& p : result_.precision_recall) {
+      for (size_t k = 0; k < kDistancesM.size(); ++k) {
+        average[k] += p.precision[k] * (p.recall[k] - last_recall[k]);
+        last_recall[k] = p.recall[k];
+      }
+    }
+    j["average_precision_within_m"] = ByDistance(average);
+  }
   j["baselines"] = nlohmann::ordered_json::object();
   for (const auto& [name, b] : result_.baselines) AddRates(b, &j["baselines"][name]);
   j["wifi_words"] = result_.wifi_words;
@@ -219,7 +253,8 @@ Status EvaluationSession::WriteOutputs() {
   // Numbers in shortest round-trip form; error_m is numeric (inf for another floor, empty for a
   // rejection) and status says which case it is.
   std::ostringstream csv;
-  csv << "query,x_m,y_m,floor,match,match_x_m,match_y_m,match_floor,error_m,status\n";
+  csv << "query,x_m,y_m,floor,match,match_x_m,match_y_m,match_floor,error_m,status,"
+         "match_probability,new_place_probability,best_mapped_place,best_mapped_probability\n";
   for (size_t i = 0; i < result_.queries.size(); ++i) {
     const auto& q = result_.queries[i];
     const int64_t match = result_.matches[i];
@@ -236,9 +271,31 @@ Status EvaluationSession::WriteOutputs() {
         << (std::isnan(e)   ? "rejected"
             : std::isinf(e) ? "other_floor"
                             : "located")
-        << '\n';
+        << ',' << ShortestNumber(result_.match_probability[i]) << ','
+        << ShortestNumber(result_.new_place_probability[i]) << ',' << result_.best_mapped_place[i]
+        << ',';
+    if (result_.best_mapped_place[i] >= 0)
+      csv << ShortestNumber(result_.best_mapped_probability[i]);
+    csv << '\n';
   }
-  return out_->Write({{"evaluation.json", result_.json}, {"queries.csv", csv.str()}});
+  // Precision-recall: one row per distinct best-mapped-place posterior, highest first.
+  std::ostringstream pr;
+  pr << "threshold,accepted";
+  for (double d : kDistancesM) {
+    const std::string k = ShortestNumber(d);
+    pr << ",correct_within_" << k << "m,precision_" << k << "m,recall_" << k << "m";
+  }
+  pr << '\n';
+  for (const fabmap::PrecisionRecallPoint& p : result_.precision_recall) {
+    pr << ShortestNumber(p.threshold) << ',' << p.accepted;
+    for (size_t k = 0; k < kDistancesM.size(); ++k) {
+      pr << ',' << p.correct[k] << ',' << ShortestNumber(p.precision[k]) << ','
+         << ShortestNumber(p.recall[k]);
+    }
+    pr << '\n';
+  }
+  return out_->Write(
+      {{"evaluation.json", result_.json}, {"queries.csv", csv.str()}, {"pr_curve.csv", pr.str()}});
 }
 
 StatusOr<EvaluationResult> EvaluationSession::Run() {

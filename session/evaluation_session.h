@@ -38,6 +38,13 @@ struct EvaluationSessionOptions {
 struct EvaluationResult {
   std::vector<fabmap::EvaluationNode> map, queries;
   std::vector<int64_t> matches;  // per query: map index, or -1 for a new place (rejection)
+  // Per query, FABMAP's posteriors: of the chosen hypothesis (the match, or the new place), of
+  // the new place, and the best mapped place (-1: none) with its posterior.
+  std::vector<double> match_probability, new_place_probability;
+  std::vector<int64_t> best_mapped_place;
+  std::vector<double> best_mapped_probability;
+  // Precision and recall of accepting the best mapped place above each posterior (pr_curve.csv).
+  std::vector<fabmap::PrecisionRecallPoint> precision_recall;
   fabmap::EvaluationMetrics metrics;
   size_t wifi_words = 0, visual_words = 0;
   size_t wifi_map_scans = 0;   // map scans that define the Wi-Fi words

@@ -6,6 +6,7 @@
 // 80 % for an answer drawn at random among 5 floors).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -115,15 +116,32 @@ TEST(EvaluateEndToEndTest, FingerprintRowsAllLearnTheWifiTree) {
   std::ifstream csv(out / "queries.csv");
   std::string line;
   std::getline(csv, line);
-  EXPECT_EQ(line, "query,x_m,y_m,floor,match,match_x_m,match_y_m,match_floor,error_m,status");
+  EXPECT_EQ(line,
+            "query,x_m,y_m,floor,match,match_x_m,match_y_m,match_floor,error_m,status,"
+            "match_probability,new_place_probability,best_mapped_place,best_mapped_probability");
   size_t located = 0, rows = 0;
+  std::vector<double> best_mapped;  // posteriors of the rows that have a best mapped place
   while (std::getline(csv, line)) {
     std::vector<std::string> f;
     std::stringstream fields(line);
     for (std::string x; std::getline(fields, x, ',');) f.push_back(x);
-    if (f.size() == 9) f.push_back("");  // a trailing empty field
-    ASSERT_EQ(f.size(), 10u) << line;
+    if (f.size() == 13) f.push_back("");  // a trailing empty field
+    ASSERT_EQ(f.size(), 14u) << line;
     ++rows;
+    // Posteriors: the chosen hypothesis is the match (then also the best mapped place) or the
+    // new place; every posterior is a probability.
+    // strtod, not stod: a posterior can be subnormal (stod throws on underflow).
+    const double chosen = std::strtod(f[10].c_str(), nullptr);
+    const double new_place = std::strtod(f[11].c_str(), nullptr);
+    EXPECT_TRUE(chosen >= 0 && chosen <= 1 && new_place >= 0 && new_place <= 1) << line;
+    if (f[4] != "-1") {
+      EXPECT_EQ(f[12], f[4]) << line;
+      EXPECT_EQ(f[13], f[10]) << line;
+      EXPECT_GT(chosen, new_place) << line;
+    } else {
+      EXPECT_EQ(chosen, new_place) << line;
+    }
+    if (f[12] != "-1") best_mapped.push_back(std::strtod(f[13].c_str(), nullptr));
     if (f[9] != "located") {
       EXPECT_TRUE(f[9] == "rejected" ? f[8].empty() : (f[9] == "other_floor" && f[8] == "inf"))
           << line;
@@ -136,6 +154,35 @@ TEST(EvaluateEndToEndTest, FingerprintRowsAllLearnTheWifiTree) {
   }
   EXPECT_EQ(rows, j["queries"].get<size_t>());
   EXPECT_GT(located, rows / 2);
+  // pr_curve.csv: thresholds fall, acceptances and recalls grow; each row accepts exactly the
+  // queries whose best mapped posterior (from queries.csv) reaches its threshold.
+  std::ifstream pr(out / "pr_curve.csv");
+  std::getline(pr, line);
+  EXPECT_EQ(line.rfind("threshold,accepted,correct_within_2m,precision_2m,recall_2m,", 0), 0u);
+  double last_threshold = 2.0, last_recall = 0.0;
+  size_t last_accepted = 0, points = 0;
+  while (std::getline(pr, line)) {
+    std::vector<std::string> f;
+    std::stringstream fields(line);
+    for (std::string x; std::getline(fields, x, ',');) f.push_back(x);
+    ASSERT_EQ(f.size(), 14u) << line;
+    const double threshold = std::strtod(f[0].c_str(), nullptr), recall_5 = std::stod(f[7]);
+    const size_t accepted = std::stoul(f[1]);
+    EXPECT_LT(threshold, last_threshold) << line;
+    EXPECT_GT(accepted, last_accepted) << line;
+    EXPECT_GE(recall_5, last_recall) << line;
+    EXPECT_EQ(accepted,
+              static_cast<size_t>(std::count_if(best_mapped.begin(), best_mapped.end(),
+                                                [&](double p) { return p >= threshold; })))
+        << line;
+    last_threshold = threshold;
+    last_accepted = accepted;
+    last_recall = recall_5;
+    ++points;
+  }
+  EXPECT_GT(points, 1u);
+  EXPECT_EQ(last_accepted, best_mapped.size());
+  EXPECT_TRUE(fs::exists(out / "pr_curve.png"));
   fs::remove_all(out);
 }
 

@@ -61,4 +61,46 @@ Scene LocalisationCurvesScene(const std::vector<LocalisationCurve>& curves,
   return scene;
 }
 
+Scene PrecisionRecallScene(const std::vector<std::string>& labels,
+                           const std::vector<std::vector<double>>& recall,
+                           const std::vector<std::vector<double>>& precision,
+                           const std::string& title) {
+  const float panel = 560, left = 90, top = 104;
+  const float legend_h = 28.0f * static_cast<float>(labels.size());
+  Scene scene(static_cast<int>(left + panel + 60), static_cast<int>(top + panel + 90 + legend_h),
+              Rgba{255, 255, 255, 255});
+  scene.Text({20, 32}, title, 20, kInk);
+  scene.Text({20, 58}, "a query is accepted when its best place's posterior >= a threshold", 14,
+             kInk);
+  auto to_px = [&](double r, double p) {
+    return ScenePoint{static_cast<float>(left + panel * r),
+                      static_cast<float>(top + panel * (1 - p))};
+  };
+  for (int k = 0; k <= 5; ++k) {
+    const double v = k / 5.0;
+    char text[16];
+    std::snprintf(text, sizeof text, "%d", k * 20);
+    scene.Line(to_px(0, v), to_px(1, v), 1.0f, kGrid);
+    scene.Text({left - 10, to_px(0, v).y + 5}, text, 15, kInk, TextAnchor::kRight);
+    scene.Line(to_px(v, 0), to_px(v, 1), 1.0f, kGrid);
+    scene.Text({to_px(v, 0).x, top + panel + 24}, text, 15, kInk, TextAnchor::kCenter);
+  }
+  scene.Line(to_px(0, 0), to_px(1, 0), 1.5f, kInk);
+  scene.Line(to_px(0, 0), to_px(0, 1), 1.5f, kInk);
+  scene.Text({left + panel / 2, top + panel + 52}, "recall (%)", 16, kInk, TextAnchor::kCenter);
+  scene.Text({left, top - 14}, "precision (%)", 16, kInk);
+  for (size_t c = 0; c < labels.size() && c < recall.size() && c < precision.size(); ++c) {
+    std::vector<ScenePoint> line;
+    for (size_t i = 0; i < recall[c].size() && i < precision[c].size(); ++i) {
+      line.push_back(to_px(recall[c][i], precision[c][i]));
+    }
+    if (line.size() == 1) line.push_back(line.front());
+    if (!line.empty()) scene.Polyline(line, 2.5f, CategoryColor(static_cast<int>(c)));
+    const float y = top + panel + 80 + 28.0f * c;
+    scene.Rect(left, y - 10, 28, 6, CategoryColor(static_cast<int>(c)));
+    scene.Text({left + 38, y - 2}, labels[c], 16, kInk);
+  }
+  return scene;
+}
+
 }  // namespace ratslam

@@ -19,6 +19,13 @@ struct LocalisationCurve {
 Scene LocalisationCurvesScene(const std::vector<LocalisationCurve>& curves,
                               const std::string& title, double max_distance_m = 30.0);
 
+// Precision (y) against recall (x), both 0..100 %, one curve per distance d of `labels`:
+// `recall[k]` and `precision[k]` are the points of curve k, from the highest threshold down.
+Scene PrecisionRecallScene(const std::vector<std::string>& labels,
+                           const std::vector<std::vector<double>>& recall,
+                           const std::vector<std::vector<double>>& precision,
+                           const std::string& title);
+
 }  // namespace ratslam
 
 #endif  // RATSLAM_VIEWER_LOCALISATION_FIGURE_H_

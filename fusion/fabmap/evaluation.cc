@@ -111,31 +111,80 @@ EvaluationMetrics ComputeMetrics(const std::vector<EvaluationNode>& queries,
   return m;
 }
 
-std::vector<double> NearestPlaceWithin(const std::vector<EvaluationNode>& map,
-                                       const std::vector<EvaluationNode>& queries,
-                                       const std::vector<double>& distances_m) {
-  std::vector<double> within(distances_m.size(), 0.0);
-  if (queries.empty()) return within;
-  // Map places by floor, sorted by x, so each query scans only the x window of the largest d.
+std::vector<double> NearestPlaceDistances(const std::vector<EvaluationNode>& map,
+                                          const std::vector<EvaluationNode>& queries,
+                                          double reach_m) {
+  std::vector<double> nearest(queries.size(), std::numeric_limits<double>::infinity());
+  // Map places by floor, sorted by x, so each query scans only the x window of the reach.
   std::map<int, std::vector<std::pair<double, double>>> by_floor;
   for (const EvaluationNode& n : map) by_floor[n.floor].push_back({n.x_m, n.y_m});
   for (auto& [floor, places] : by_floor) std::sort(places.begin(), places.end());
-  const double reach =
-      distances_m.empty() ? 0.0 : *std::max_element(distances_m.begin(), distances_m.end());
-  for (const EvaluationNode& q : queries) {
+  for (size_t i = 0; i < queries.size(); ++i) {
+    const EvaluationNode& q = queries[i];
     const auto it = by_floor.find(q.floor);
     if (it == by_floor.end()) continue;
     const auto& places = it->second;
     double best = std::numeric_limits<double>::infinity();
     auto p = std::lower_bound(places.begin(), places.end(),
-                              std::make_pair(q.x_m - reach, -std::numeric_limits<double>::max()));
-    for (; p != places.end() && p->first <= q.x_m + reach; ++p) {
+                              std::make_pair(q.x_m - reach_m, -std::numeric_limits<double>::max()));
+    for (; p != places.end() && p->first <= q.x_m + reach_m; ++p) {
       best = std::min(best, std::hypot(p->first - q.x_m, p->second - q.y_m));
     }
+    if (best <= reach_m) nearest[i] = best;
+  }
+  return nearest;
+}
+
+std::vector<double> NearestPlaceWithin(const std::vector<EvaluationNode>& map,
+                                       const std::vector<EvaluationNode>& queries,
+                                       const std::vector<double>& distances_m) {
+  std::vector<double> within(distances_m.size(), 0.0);
+  if (queries.empty()) return within;
+  const double reach =
+      distances_m.empty() ? 0.0 : *std::max_element(distances_m.begin(), distances_m.end());
+  for (double best : NearestPlaceDistances(map, queries, reach)) {
     for (size_t k = 0; k < distances_m.size(); ++k) within[k] += best <= distances_m[k];
   }
   for (double& w : within) w /= static_cast<double>(queries.size());
   return within;
+}
+
+std::vector<PrecisionRecallPoint> PrecisionRecallCurve(const std::vector<double>& best_probability,
+                                                       const std::vector<double>& best_error_m,
+                                                       const std::vector<double>& nearest_m,
+                                                       const std::vector<double>& distances_m) {
+  const size_t n = best_probability.size();
+  const size_t nd = distances_m.size();
+  std::vector<size_t> localisable(nd, 0);
+  for (size_t i = 0; i < n && i < nearest_m.size(); ++i) {
+    for (size_t k = 0; k < nd; ++k) localisable[k] += nearest_m[i] <= distances_m[k];
+  }
+  std::vector<size_t> order;
+  for (size_t i = 0; i < n; ++i) {
+    if (!std::isnan(best_probability[i])) order.push_back(i);
+  }
+  // Highest posterior first; equal posteriors are accepted together (one point per value).
+  std::stable_sort(order.begin(), order.end(),
+                   [&](size_t a, size_t b) { return best_probability[a] > best_probability[b]; });
+  std::vector<PrecisionRecallPoint> curve;
+  std::vector<size_t> correct(nd, 0);
+  for (size_t j = 0; j < order.size(); ++j) {
+    const size_t i = order[j];
+    for (size_t k = 0; k < nd; ++k) correct[k] += best_error_m[i] <= distances_m[k];
+    if (j + 1 < order.size() && best_probability[order[j + 1]] == best_probability[i]) continue;
+    PrecisionRecallPoint p;
+    p.threshold = best_probability[i];
+    p.accepted = j + 1;
+    p.correct = correct;
+    for (size_t k = 0; k < nd; ++k) {
+      p.precision.push_back(static_cast<double>(correct[k]) / static_cast<double>(p.accepted));
+      p.recall.push_back(localisable[k] == 0 ? 0.0
+                                             : static_cast<double>(correct[k]) /
+                                                   static_cast<double>(localisable[k]));
+    }
+    curve.push_back(std::move(p));
+  }
+  return curve;
 }
 
 }  // namespace ratslam::fabmap

@@ -104,6 +104,33 @@ EvaluationMetrics ComputeMetrics(const std::vector<EvaluationNode>& queries,
                                  const std::vector<Estimate>& estimates,
                                  const std::vector<double>& distances_m);
 
+// One point of a precision-recall curve: a query is accepted when the posterior of its best
+// mapped place reaches `threshold`; it is correct when that place is on the query's floor within
+// d. Precision = correct / accepted; recall = correct / the queries that have a map place on their
+// floor within d (those a localiser could get right). Precision is 1 where nothing is accepted.
+struct PrecisionRecallPoint {
+  double threshold = 0.0;
+  size_t accepted = 0;
+  std::vector<size_t> correct;  // per d
+  std::vector<double> precision, recall;
+};
+
+// The curve over every distinct best-place posterior, from the highest (fewest accepted) down
+// (all accepted); openFABMAP's most used output. `best_probability[i]` is query i's best mapped
+// place's posterior (NaN: no place, never accepted), `best_error_m[i]` that place's distance
+// (infinity on another floor), `nearest_m[i]` the distance of the nearest map place on the
+// query's floor (infinity: none).
+std::vector<PrecisionRecallPoint> PrecisionRecallCurve(const std::vector<double>& best_probability,
+                                                       const std::vector<double>& best_error_m,
+                                                       const std::vector<double>& nearest_m,
+                                                       const std::vector<double>& distances_m);
+
+// Per query, the distance to the nearest map place on its floor when it is at most `reach_m`
+// (infinity otherwise, and when the floor has no place).
+std::vector<double> NearestPlaceDistances(const std::vector<EvaluationNode>& map,
+                                          const std::vector<EvaluationNode>& queries,
+                                          double reach_m);
+
 }  // namespace ratslam::fabmap
 
 #endif  // RATSLAM_FUSION_FABMAP_EVALUATION_H_

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <limits>
 
 namespace ratslam::fabmap {
 namespace {
@@ -116,6 +117,45 @@ TEST(EvaluationTest, SplitBySessionAndFirstSession) {
   EXPECT_EQ(by_node.map.size(), 6u);  // 15 nodes at 0.4
   EXPECT_EQ(by_node.map.size() + by_node.queries.size(), nodes.size());
   EXPECT_FALSE(SplitUnitFromString("nodes").ok());
+}
+
+// Hand-worked: five queries, best-place posteriors 0.9, 0.8, 0.8, 0.3 and none; errors 1, 30, 4,
+// 3 m; the last query has no map place on its floor. Equal posteriors are accepted together.
+TEST(PrecisionRecallTest, HandWorkedCurve) {
+  const double inf = std::numeric_limits<double>::infinity();
+  const auto curve = PrecisionRecallCurve({0.9, 0.8, 0.8, 0.3, std::nan("")}, {1, 30, 4, 3, inf},
+                                          {0.5, 1, 2, 1, inf}, {2, 5});
+  ASSERT_EQ(curve.size(), 3u);
+  const size_t accepted[3] = {1, 3, 4};
+  const double threshold[3] = {0.9, 0.8, 0.3};
+  const double precision[3][2] = {{1, 1}, {1.0 / 3, 2.0 / 3}, {0.25, 0.75}};
+  const double recall[3][2] = {{0.25, 0.25}, {0.25, 0.5}, {0.25, 0.75}};
+  for (int p = 0; p < 3; ++p) {
+    EXPECT_EQ(curve[p].threshold, threshold[p]);
+    EXPECT_EQ(curve[p].accepted, accepted[p]);
+    for (int k = 0; k < 2; ++k) {
+      EXPECT_DOUBLE_EQ(curve[p].precision[k], precision[p][k]) << p << ' ' << k;
+      EXPECT_DOUBLE_EQ(curve[p].recall[k], recall[p][k]) << p << ' ' << k;
+    }
+  }
+  EXPECT_TRUE(PrecisionRecallCurve({}, {}, {}, {2}).empty());
+}
+
+// NearestPlaceDistances: per query, the nearest place on its own floor within the reach.
+TEST(PrecisionRecallTest, NearestPlaceDistancesRespectFloorAndReach) {
+  std::vector<EvaluationNode> map(3), queries(3);
+  map[0].x_m = 0;
+  map[1].x_m = 10;
+  map[2].x_m = 3;
+  map[2].floor = 1;
+  queries[0].x_m = 1;  // 1 m from place 0
+  queries[1].x_m = 3;
+  queries[1].floor = 1;  // on place 2
+  queries[2].x_m = 40;   // 30 m from place 1: beyond a 20 m reach
+  const std::vector<double> d = NearestPlaceDistances(map, queries, 20);
+  EXPECT_DOUBLE_EQ(d[0], 1.0);
+  EXPECT_DOUBLE_EQ(d[1], 0.0);
+  EXPECT_TRUE(std::isinf(d[2]));
 }
 
 }  // namespace

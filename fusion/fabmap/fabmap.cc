@@ -288,6 +288,10 @@ LocalisationResult FabmapModel::Normalise(std::vector<double> log_likelihood,
   for (uint32_t i : kept) p[i] *= inverse;
   result.new_place_probability = new_weight * inverse;
   result.best_probability = result.new_place_probability;
+  if (n > 0) {
+    result.best_mapped_place = static_cast<int64_t>(best);
+    result.best_mapped_probability = p[best];
+  }
   if (n > 0 && p[best] > result.best_probability) {  // a tie goes to the new place
     result.best_probability = p[best];
     result.best_place = static_cast<int64_t>(best);
@@ -314,6 +318,9 @@ LocalisationResult FabmapModel::LocaliseAmong(const Observation& z,
   for (uint32_t c : candidates) subset.push_back(all.at(c));
   LocalisationResult result = Normalise(std::move(subset), UnknownLogLikelihood(active));
   if (result.best_place >= 0) result.best_place = candidates[result.best_place];
+  if (result.best_mapped_place >= 0) {
+    result.best_mapped_place = candidates[result.best_mapped_place];
+  }
   return result;
 }
 

@@ -89,6 +89,10 @@ struct LocalisationResult {
   double best_probability = 0.0;  // posterior of the arg-max hypothesis
   double new_place_probability = 0.0;
   std::vector<double> place_probability;  // per mapped place (or per candidate, in order)
+  // The most probable mapped place (a place id; -1 when there is none) and its posterior, whether
+  // or not the new place beats it: what a precision-recall curve thresholds.
+  int64_t best_mapped_place = -1;
+  double best_mapped_probability = 0.0;
 };
 
 class FabmapModel {

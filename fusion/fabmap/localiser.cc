@@ -221,6 +221,11 @@ LocalisationResult Localiser::Localise(const Query& query) const {
       fused.best_probability = fused.new_place_probability;
       for (uint32_t i = 0; i < places_; ++i) {
         fused.place_probability[i] /= total;
+        if (fused.best_mapped_place < 0 ||
+            fused.place_probability[i] > fused.best_mapped_probability) {
+          fused.best_mapped_place = i;
+          fused.best_mapped_probability = fused.place_probability[i];
+        }
         if (fused.place_probability[i] > fused.best_probability) {
           fused.best_probability = fused.place_probability[i];
           fused.best_place = i;
@@ -232,11 +237,17 @@ LocalisationResult Localiser::Localise(const Query& query) const {
       return vision_->LocaliseAmong(visual, WifiCandidates(WifiWords(query)));
     case FabmapMode::kWifiCheck: {
       LocalisationResult r = vision_->Localise(visual);
-      if (r.best_place >= 0) {
+      // The best mapped place is the visual match whenever there is one (both are the arg-max).
+      if (r.best_mapped_place >= 0) {
         const std::vector<uint32_t> candidates = WifiCandidates(WifiWords(query));
-        if (std::find(candidates.begin(), candidates.end(), r.best_place) == candidates.end()) {
-          r.best_place = -1;  // Wi-Fi does not confirm the visual match: rejected
-          r.best_probability = r.new_place_probability;
+        if (std::find(candidates.begin(), candidates.end(), r.best_mapped_place) ==
+            candidates.end()) {
+          if (r.best_place >= 0) {
+            r.best_place = -1;  // Wi-Fi does not confirm the visual match: rejected
+            r.best_probability = r.new_place_probability;
+          }
+          r.best_mapped_place = -1;  // and at any threshold
+          r.best_mapped_probability = 0.0;
         }
       }
       return r;
