@@ -79,8 +79,18 @@ int EvaluateCommand(int argc, char** argv) {
   if (Status s = session.WriteOutputs(); !s.ok()) return fail(s);
   const EvaluationResult& r = session.result();
   const fabmap::EvaluationMetrics& m = r.metrics;
-  std::vector<LocalisationCurve> curves = {{fabmap::ToString(mode), m.errors_m}};
-  for (const auto& [name, b] : r.baselines) curves.push_back({"baseline " + name, b.errors_m});
+  // The curves cannot show rejections and floor mistakes (neither is within nor beyond any d on
+  // the floor): the labels give their rates.
+  const auto label = [](const std::string& name, const fabmap::EvaluationMetrics& x) {
+    char rates[96];
+    std::snprintf(rates, sizeof rates, " (rejected %.1f %%, other floor %.1f %%)",
+                  100 * x.rejection_rate, 100 * x.floor_mistake_rate);
+    return name + rates;
+  };
+  std::vector<LocalisationCurve> curves = {{label(fabmap::ToString(mode), m), m.errors_m}};
+  for (const auto& [name, b] : r.baselines) {
+    curves.push_back({label("baseline " + name, b), b.errors_m});
+  }
   const Scene figure = LocalisationCurvesScene(
       curves, "FABMAP " + fabmap::ToString(mode) + ": " + std::to_string(m.queries) + " queries, " +
                   std::to_string(r.map.size()) + " mapped places");

@@ -109,7 +109,7 @@ TEST(GoldenImageTest, ExperienceMapShowsEveryLinkTitleAndLegend) {
   EXPECT_TRUE(HasText(scene, "golden"));
   EXPECT_TRUE(HasText(scene, "12 experiences, 12 links, 1 loop closure"));
   EXPECT_TRUE(HasText(scene, "loop closure"));
-  EXPECT_TRUE(HasText(scene, "ground truth"));
+  EXPECT_TRUE(HasText(scene, "ground truth (rigidly aligned)"));
 
   StatusOr<std::unique_ptr<SceneRenderer>> renderer = CreateOsMesaRenderer();
   if (!renderer.ok()) GTEST_SKIP() << "OSMesa unavailable: " << renderer.status().message();

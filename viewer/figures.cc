@@ -142,7 +142,8 @@ Rgba SequentialColor(double t) {
 }
 
 Rgba CategoryColor(int index) {
-  static const Rgba kColors[] = {{31, 119, 180, 255},  {214, 39, 40, 255},  {44, 160, 44, 255},
+  // No red: red marks loop closures (a second session in red read as one big loop closure).
+  static const Rgba kColors[] = {{31, 119, 180, 255},  {188, 189, 34, 255}, {44, 160, 44, 255},
                                  {148, 103, 189, 255}, {255, 127, 14, 255}, {23, 190, 207, 255},
                                  {140, 86, 75, 255},   {227, 119, 194, 255}};
   const int n = static_cast<int>(std::size(kColors));
@@ -205,9 +206,11 @@ Scene ExperienceMapScene(const ExperienceMapImageData& data,
   // beside the scale bar when it fits there, further rows stack above it.
   std::vector<LegendItem> items;
   if (data.ground_truth.size() > 1) {
-    items.push_back({38 + TextWidthPx("ground truth", 14), [](Scene& s, float x, float y) {
+    // The truth is drawn in the map's frame after a rigid fit (AlignGroundTruthToMap): say so.
+    static const char* const kTruthLabel = "ground truth (rigidly aligned)";
+    items.push_back({38 + TextWidthPx(kTruthLabel, 14), [](Scene& s, float x, float y) {
                        s.Line({x, y}, {x + 30, y}, 2.0f, kGroundTruth);
-                       s.Text({x + 38, y + 5}, "ground truth", 14, kInk);
+                       s.Text({x + 38, y + 5}, kTruthLabel, 14, kInk);
                      }});
   }
   items.push_back({38 + TextWidthPx("loop closure", 14), [](Scene& s, float x, float y) {

@@ -132,5 +132,16 @@ TEST(TemplateGraphSceneTest, EmptyInputStillGivesAFigure) {
   EXPECT_FALSE(scene.texts().empty());
 }
 
+// Session and curve colours never read as the loop-closure red (220, 50, 32): in multi-session
+// maps the second session was drawn in a red two units from it.
+TEST(CategoryColorTest, NoCategoryLooksLikeTheLoopClosureRed) {
+  for (int i = 0; i < 16; ++i) {
+    const Rgba c = CategoryColor(i);
+    const double distance =
+        std::sqrt(std::pow(c.r - 220.0, 2) + std::pow(c.g - 50.0, 2) + std::pow(c.b - 32.0, 2));
+    EXPECT_GT(distance, 80.0) << "category " << i;  // the old red was 16 away
+  }
+}
+
 }  // namespace
 }  // namespace ratslam
