@@ -507,6 +507,31 @@ Scene PoseCellScene(const PoseCellNetwork& network, const PoseCellImageOptions& 
   std::snprintf(label, sizeof label, "best pose: x %.2f, y %.2f, theta %.2f cells (%.0f deg)",
                 best.x, best.y, best.theta, best.theta * 360.0 / nt);
   scene.Text({left, static_cast<float>(options.height_px - 16)}, label, 15, kInk);
+  // Colour bar under the ring: both panels run from zero to their own largest sum.
+  {
+    // Under the ring, above the best-pose line (which runs under both panels at small widths).
+    const float bar_w = std::max(80.0f, std::min(300.0f, options.width_px * 0.5f - 160.0f));
+    const float bar_left = center.x - bar_w / 2;
+    const float bar_h = 12;
+    const float bar_top = static_cast<float>(options.height_px) - 46;
+    SceneImage bar;
+    bar.left = bar_left;
+    bar.top = bar_top;
+    bar.width = bar_w;
+    bar.height = bar_h;
+    bar.pixels_wide = 256;
+    bar.pixels_high = 1;
+    for (int i = 0; i < 256; ++i) {
+      const Rgba c = SequentialColor(i / 255.0);
+      bar.rgba.insert(bar.rgba.end(), {c.r, c.g, c.b, 255});
+    }
+    scene.Image(std::move(bar));
+    scene.Text({bar_left - 8, bar_top + 11}, "0", 14, kInk, TextAnchor::kRight);
+    scene.Text({bar_left + bar_w + 8, bar_top + 11}, "max", 14, kInk, TextAnchor::kLeft);
+    char caption[128];
+    std::snprintf(caption, sizeof caption, "max: x-y %.3g, heading %.3g", xy_max, theta_max);
+    scene.Text({center.x, bar_top - 8}, caption, 14, kInk, TextAnchor::kCenter);
+  }
   scene.Text({center.x, top - 30}, "heading (activity summed over x, y)", 15, kInk,
              TextAnchor::kCenter);
   scene.Text({20, 26},
