@@ -160,12 +160,17 @@ double WifiFingerprintMatcher::Exponent(const Candidate& c) const {
   return -c.hit / (two_sigma2 * c.h) - c.extra / two_sigma2 - c.miss / two_sigma2;
 }
 
+double WifiFingerprintMatcher::CandidateWeight(const Candidate& c, double exponent,
+                                               size_t query_size) const {
+  const double e = static_cast<double>(query_size) - c.h;
+  const double m = static_cast<double>(sizes_[c.id]) - c.h;
+  return std::exp(exponent) * c.h / (c.h + e + m);
+}
+
 template <typename Visit>
 void WifiFingerprintMatcher::ForEachCandidate(const Fingerprint& query, Visit&& visit) const {
   auto finish = [&](const Candidate& c) {
-    const double e = static_cast<double>(query.ap_ids.size()) - c.h;
-    const double m = static_cast<double>(sizes_[c.id]) - c.h;
-    visit(c.id, std::exp(Exponent(c)) * c.h / (c.h + e + m));
+    visit(c.id, CandidateWeight(c, Exponent(c), query.ap_ids.size()));
   };
   if (options_.offset_invariant) {
     Scan<true>(query, finish);
@@ -194,9 +199,7 @@ WifiMatch WifiFingerprintMatcher::Best(const Fingerprint& query) const {
     const double x = Exponent(c);
     if (!(x >= skip_below)) return;
     const uint32_t id = c.id;
-    const double e = static_cast<double>(query.ap_ids.size()) - c.h;
-    const double m = static_cast<double>(sizes_[id]) - c.h;
-    const double w = std::exp(x) * c.h / (c.h + e + m);
+    const double w = CandidateWeight(c, x, query.ap_ids.size());
     // Ties go to the older template, independent of the order the index visits them in.
     if (w > best.weight ||
         (w == best.weight && best.id >= 0 && id < static_cast<uint32_t>(best.id))) {

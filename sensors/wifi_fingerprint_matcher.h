@@ -127,6 +127,8 @@ class WifiFingerprintMatcher {
   void Scan(const Fingerprint& query, Finish&& finish) const;
   // The exponent of eq. 6: the log of w_hit^(1/H) w_extra w_miss.
   double Exponent(const Candidate& c) const;
+  // w of eq. 6 from that exponent: exp(x) H / (H + E + M).
+  double CandidateWeight(const Candidate& c, double exponent, size_t query_size) const;
   // Visits every stored fingerprint sharing an AP with the query: visit(id, weight).
   template <typename Visit>
   void ForEachCandidate(const Fingerprint& query, Visit&& visit) const;

@@ -514,18 +514,7 @@ Scene PoseCellScene(const PoseCellNetwork& network, const PoseCellImageOptions& 
     const float bar_left = center.x - bar_w / 2;
     const float bar_h = 12;
     const float bar_top = static_cast<float>(options.height_px) - 46;
-    SceneImage bar;
-    bar.left = bar_left;
-    bar.top = bar_top;
-    bar.width = bar_w;
-    bar.height = bar_h;
-    bar.pixels_wide = 256;
-    bar.pixels_high = 1;
-    for (int i = 0; i < 256; ++i) {
-      const Rgba c = SequentialColor(i / 255.0);
-      bar.rgba.insert(bar.rgba.end(), {c.r, c.g, c.b, 255});
-    }
-    scene.Image(std::move(bar));
+    scene.Image(ColorBar(bar_left, bar_top, bar_w, bar_h));
     scene.Text({bar_left - 8, bar_top + 11}, "0", 14, kInk, TextAnchor::kRight);
     scene.Text({bar_left + bar_w + 8, bar_top + 11}, "max", 14, kInk, TextAnchor::kLeft);
     char caption[128];
