@@ -22,7 +22,7 @@ inline constexpr int kExitUsage = 2;
 inline constexpr int kExitInternal = 70;  // a bug or an exhausted machine (EX_SOFTWARE)
 inline constexpr int kExitInterrupted = 130;
 
-// Parsed "--flag value" pairs and bare flags.
+// A command's options after parsing (apps/command_line.h): "--flag value" pairs and bare flags.
 struct Arguments {
   std::map<std::string, std::string> values;            // the last value of each flag
   std::map<std::string, std::vector<std::string>> all;  // every value, for repeatable flags
@@ -30,37 +30,14 @@ struct Arguments {
   bool quiet = false;
   bool render = false;
   bool lenient = false;
-};
+  std::string command_line;  // as typed, for provenance
 
-inline std::optional<Arguments> ParseArguments(int argc, char** argv, int first,
-                                               const std::vector<std::string>& flags_with_values) {
-  Arguments args;
-  for (int i = first; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--quiet") {
-      args.quiet = true;
-    } else if (a == "--render") {
-      args.render = true;
-    } else if (a == "--lenient") {
-      args.lenient = true;
-    } else if (a.rfind("--", 0) == 0) {
-      if (std::find(flags_with_values.begin(), flags_with_values.end(), a) ==
-          flags_with_values.end()) {
-        std::cerr << "ratslam: unknown option " << a << "\n";
-        return std::nullopt;
-      }
-      if (i + 1 >= argc) {
-        std::cerr << "ratslam: " << a << " needs a value\n";
-        return std::nullopt;
-      }
-      args.values[a] = argv[++i];
-      args.all[a].push_back(args.values[a]);
-    } else {
-      args.positional.push_back(a);
-    }
+  // The value of `flag`, or "" when it was not given.
+  std::string Value(const std::string& flag) const {
+    auto it = values.find(flag);
+    return it == values.end() ? std::string() : it->second;
   }
-  return args;
-}
+};
 
 inline std::optional<double> ParseNumber(const std::string& flag, const std::string& text) {
   char* end = nullptr;
@@ -103,13 +80,15 @@ inline std::optional<PipelineOptions> LoadOptions(const Arguments& args,
 }
 
 // `ratslam render ...` (render_command.cc).
-int RenderCommand(int argc, char** argv);
-int EvaluateCommand(int argc, char** argv);
-int WifiMapCommand(int argc, char** argv);
-int LocateCommand(int argc, char** argv);
-int CallCommand(int argc, char** argv);
-int SimulateCommand(int argc, char** argv);
-int SweepCommand(int argc, char** argv);
+// `what`: experience-map, template-graph, pose-cells, similarity or wifi-map.
+int RenderCommand(const std::string& what, const Arguments& args);
+int EvaluateCommand(const Arguments& args);
+int WifiMapCommand(const Arguments& args);
+int LocateCommand(const Arguments& args);
+int CallCommand(const Arguments& args);
+int SimulateCommand(const Arguments& args);
+// `action`: plan, run, task, collect or submit.
+int SweepCommand(const std::string& action, const Arguments& args);
 // Simulates `world` into the replay data set `out` (with world.toml, simulation.json and
 // ground_truth.png); `dataset` receives it.
 namespace sim {

@@ -42,14 +42,8 @@ class StepProgress : public ProgressSink {
 
 }  // namespace
 
-int EvaluateCommand(int argc, char** argv) {
-  const auto args = ParseArguments(argc, argv, 2, {"--config", "--map", "--query", "--out"});
-  if (!args || !args->values.count("--map") || !args->values.count("--query") ||
-      !args->values.count("--out")) {
-    std::cerr << "usage: ratslam evaluate [--config C] --map M --query Q --out O [--lenient] "
-                 "[--quiet]\n";
-    return kExitUsage;
-  }
+int EvaluateCommand(const Arguments& parsed) {
+  const Arguments* args = &parsed;
   EvaluationSessionOptions options;
   const auto pipeline = LoadOptions(*args, &options.config_path);
   if (!pipeline) return kExitError;
@@ -57,7 +51,7 @@ int EvaluateCommand(int argc, char** argv) {
   options.map_path = args->values.at("--map");
   options.query_path = args->values.at("--query");
   options.lenient = args->lenient;
-  options.provenance = {ShellCommandLine(argc, argv), UtcNowIso8601()};
+  options.provenance = {args->command_line, UtcNowIso8601()};
   const std::string out_path = args->values.at("--out");
   auto fail = [](const Status& s) {
     std::cerr << "ratslam evaluate: " << s.message() << "\n";

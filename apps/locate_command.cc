@@ -241,17 +241,8 @@ Status SamplesFromRun(const std::string& run_folder, const std::vector<std::stri
 
 }  // namespace
 
-int WifiMapCommand(int argc, char** argv) {
-  const auto args = ParseArguments(argc, argv, 2, {"--data", "--out", "--config", "--run"});
-  if (!args || !args->all.count("--data") || !args->values.count("--out")) {
-    std::cerr << "usage: ratslam wifi-map --data D [--data D2 ...] --out W [--config C] "
-                 "[--lenient]\n"
-                 "       ratslam wifi-map --run RUN_FOLDER --data D [--data D2 ...] --out W "
-                 "[--config C]\n"
-                 "  (--run: positions from the run's trajectory_tum.txt, in its map's frame; "
-                 "--data as given to that replay)\n";
-    return kExitUsage;
-  }
+int WifiMapCommand(const Arguments& parsed) {
+  const Arguments* args = &parsed;
   const std::optional<LocateOptions> options = LoadLocateOptions(*args, "wifi-map");
   if (!options) return kExitError;
   auto fail = [](const Status& s) {
@@ -337,14 +328,8 @@ int WifiMapCommand(int argc, char** argv) {
   return kExitOk;
 }
 
-int LocateCommand(int argc, char** argv) {
-  const auto args = ParseArguments(argc, argv, 2, {"--wifi-map", "--data", "--out", "--config"});
-  if (!args || !args->values.count("--wifi-map") || !args->values.count("--data") ||
-      !args->values.count("--out")) {
-    std::cerr << "usage: ratslam locate --wifi-map W --data PHONE_LOG --out O [--config C] "
-                 "[--lenient] [--quiet]\n";
-    return kExitUsage;
-  }
+int LocateCommand(const Arguments& parsed) {
+  const Arguments* args = &parsed;
   auto fail = [](const Status& s) {
     if (!s.message().empty()) std::cerr << "ratslam locate: " << s.message() << "\n";
     return kExitError;
@@ -512,18 +497,8 @@ StatusOr<RobotMap> LoadRobotMap(const std::string& path) {
 
 }  // namespace
 
-int CallCommand(int argc, char** argv) {
-  const auto args =
-      ParseArguments(argc, argv, 2, {"--map", "--wifi-map", "--data", "--at", "--out", "--config"});
-  if (!args || !args->positional.empty() || !args->values.count("--map") ||
-      !args->values.count("--wifi-map") || !args->values.count("--data") ||
-      !args->values.count("--at") || !args->values.count("--out")) {
-    std::cerr << "usage: ratslam call --map RUN_FOLDER|MAP_FILE --wifi-map W --data PHONE_LOG "
-                 "--at T --out O [--config C] [--lenient] [--quiet]\n"
-                 "  Locates the phone up to time T (the log's seconds) and plans the route the "
-                 "robot at its current experience takes to visit every candidate location.\n";
-    return kExitUsage;
-  }
+int CallCommand(const Arguments& parsed) {
+  const Arguments* args = &parsed;
   auto fail = [](const Status& s) {
     if (!s.message().empty()) std::cerr << "ratslam call: " << s.message() << "\n";
     return kExitError;

@@ -14,10 +14,13 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "apps/cli.h"
+#include "apps/command_line.h"
 #include "apps/demo_config.h"
+#include "apps/output_guard.h"
 #include "apps/progress.h"
 #include "apps/wifi_sequence_images.h"
 #include "common/file_util.h"
@@ -48,62 +51,6 @@ namespace fs = std::filesystem;
 std::atomic<bool> g_stop_requested{false};
 
 extern "C" void OnSignal(int) { g_stop_requested.store(true); }
-
-const char kUsage[] =
-    "usage:\n"
-    "  ratslam replay --data D [--data D2 ...] --out O [--config C] [--save-map F]\n"
-    "                 [--load-map F] [--until T] [--render] [--animate N] [--lenient] [--quiet]\n"
-    "      Replays data set D (a replay-format folder or an IPIN log; several --data make one\n"
-    "      multi-session run) and writes the map, trajectory and summary into O. --until T stops "
-    "after data time T seconds; --save-map F saves the\n"
-    "      whole state to F; --load-map F resumes from F. Ctrl-C stops cleanly and saves.\n"
-    "      --render also writes experience_map.png, template_graph.png and pose_cells.png\n"
-    "      (and with [wifi_sequence] wifi_sequence_similarity.png and wifi_sequence_pairs.png);\n"
-    "      --animate N writes an experience-map frame every N events to O/animation/.\n"
-    "      --lenient skips and counts malformed lines of phone logs instead of failing.\n"
-    "  ratslam import --data D [--data D2 ...] --out F [--config C] [--lenient]\n"
-    "      Converts data sets (IPIN logs, ...) to the replay format in folder F.\n"
-    "  ratslam demo --out O [--quiet]\n"
-    "      Simulates the built-in day_night world (camera, Wi-Fi, compass, odometry) into\n"
-    "      O/data, replays it into O with the fused front end and renders the images.\n"
-    "  ratslam print-config [locate] [--config C]\n"
-    "      Prints the resolved configuration (the defaults when no file is given); with\n"
-    "      `locate`, that of wifi-map and locate.\n"
-    "  ratslam import-openratslam FILE.ini\n"
-    "      Converts an OpenRatSLAM configuration file to ours (TOML on stdout).\n"
-    "  ratslam synthesize --out D [--seed S] [--laps N]\n"
-    "      Writes the built-in synthetic camera loop into D (configs/synthetic.toml).\n"
-    "  ratslam render experience-map --run O [--data D] [--out F] [--size WxH]\n"
-    "                 [--color time|session] [--sessions T1,T2,...]\n"
-    "  ratslam render template-graph --run O [--out F] [--size WxH] [--spans A-B:label,...]\n"
-    "  ratslam render pose-cells --map F --out F [--config C]   (default: the map's own config)\n"
-    "  ratslam render similarity --data D [--data D2 ...] [--config C] --out F [--frames N]\n"
-    "                 [--sensor camera|wifi]\n"
-    "  ratslam render wifi-map --wifi-map W --out F [--ap BSSID] [--floor N]\n"
-    "      Images from a run folder, a saved map, or a data set (PNG).\n"
-    "  ratslam evaluate [--config C] --map M --query Q --out O [--lenient] [--quiet]\n"
-    "      FABMAP localisation benchmark: maps M, localises every node of Q, writes\n"
-    "      evaluation.json, queries.csv and localisation.png to O. M and Q may be the same\n"
-    "      data set: [evaluation] split and map_fraction then divide it.\n"
-    "  ratslam wifi-map --data D [--data D2 ...] --out W [--config C] [--lenient]\n"
-    "      Gaussian-process Wi-Fi maps (per AP, mean and variance grids) from data sets with\n"
-    "      ground truth into the file W ([wifi_map] in C). With --run RUN_FOLDER (and --data\n"
-    "      as that replay had it), positions come from the run's final map instead, in its\n"
-    "      frame.\n"
-    "  ratslam locate --wifi-map W --data PHONE_LOG --out O [--config C] [--lenient] [--quiet]\n"
-    "      Locates a phone in W with a particle filter ([particle_filter], [pdr]): writes\n"
-    "      trajectory_tum.txt, errors.csv and cumulative_error.png (with ground truth),\n"
-    "      candidates.csv, summary.json.\n"
-    "  ratslam call --map RUN_FOLDER|MAP_FILE --wifi-map W --data PHONE_LOG --at T --out O\n"
-    "      Locates the phone up to time T and plans the robot's route from its current\n"
-    "      experience through every candidate location: call.json, route.csv, call.png.\n"
-    "  ratslam simulate --world NAME|FILE --out D [--seed S] [--quiet]\n"
-    "      Simulates a world (built in: office, circular, day_night, aliased_floors,\n"
-    "      apartment; or a world TOML file) into the replay data set D, with world.toml,\n"
-    "      simulation.json and ground_truth.png.\n"
-    "  ratslam sweep plan S --out DIR | run DIR [--jobs N] | task DIR [--index I] | collect DIR\n"
-    "      Parameter sweeps (configs/README.md, \"Sweeps\"): plan a sweep file into DIR, run its\n"
-    "      tasks as separate processes (resumable), run one task of a cluster array, collect.\n";
 
 struct ReplayRequest {
   ReplaySessionOptions session;
@@ -214,32 +161,25 @@ int RunReplay(const ReplayRequest& request) {
   return kExitOk;
 }
 
-int Replay(int argc, char** argv) {
-  auto args = ParseArguments(
-      argc, argv, 2,
-      {"--config", "--data", "--out", "--save-map", "--load-map", "--until", "--animate"});
-  if (!args || !args->positional.empty() || !args->values.count("--data") ||
-      !args->values.count("--out")) {
-    std::cerr << kUsage;
-    return kExitUsage;
-  }
+int Replay(const Arguments& parsed) {
+  const Arguments* args = &parsed;
   ReplayRequest request;
   auto options = LoadOptions(*args, &request.session.config_path);
   if (!options) return kExitError;
   request.session.pipeline = *options;
-  request.session.data = args->all["--data"];
-  request.session.provenance = {ShellCommandLine(argc, argv), UtcNowIso8601()};
+  request.session.data = args->all.at("--data");
+  request.session.provenance = {args->command_line, UtcNowIso8601()};
   request.session.lenient = args->lenient;
-  request.out = args->values["--out"];
-  request.session.save_map = args->values.count("--save-map") ? args->values["--save-map"] : "";
-  request.session.load_map = args->values.count("--load-map") ? args->values["--load-map"] : "";
+  request.out = args->values.at("--out");
+  request.session.save_map = args->Value("--save-map");
+  request.session.load_map = args->Value("--load-map");
   if (args->values.count("--until")) {
-    auto until = ParseNumber("--until", args->values["--until"]);
+    auto until = ParseNumber("--until", args->values.at("--until"));
     if (!until) return kExitUsage;
     request.session.until_s = *until;
   }
   if (args->values.count("--animate")) {
-    auto every = ParseInteger("--animate", args->values["--animate"], 1, int64_t{1} << 53);
+    auto every = ParseInteger("--animate", args->values.at("--animate"), 1, int64_t{1} << 53);
     if (!every) return kExitUsage;
     request.animate_every = static_cast<uint64_t>(*every);
   }
@@ -259,13 +199,9 @@ int Synthesize(const SyntheticOptions& options, const std::string& folder) {
   return kExitOk;
 }
 
-int Demo(int argc, char** argv) {
-  auto args = ParseArguments(argc, argv, 2, {"--out"});
-  if (!args || !args->positional.empty() || !args->values.count("--out")) {
-    std::cerr << kUsage;
-    return kExitUsage;
-  }
-  const std::string out = args->values["--out"];
+int Demo(const Arguments& parsed) {
+  const Arguments* args = &parsed;
+  const std::string out = args->values.at("--out");
   const std::string data = (fs::path(out) / "data").string();
   // The demo's data: a built-in simulated world with camera, Wi-Fi, compass and odometry.
   auto world = sim::BuiltInWorld(DemoWorldName());
@@ -283,20 +219,16 @@ int Demo(int argc, char** argv) {
   request.session.pipeline = DemoPipelineOptions();
   request.session.config_path = "(built-in demo configuration, as configs/demo.toml)";
   request.session.data = {data};
-  request.session.provenance = {ShellCommandLine(argc, argv), UtcNowIso8601()};
+  request.session.provenance = {args->command_line, UtcNowIso8601()};
   request.out = out;
   request.quiet = args->quiet;
   request.render = true;
   return RunReplay(request);
 }
 
-int PrintConfigCommand(int argc, char** argv) {
-  auto args = ParseArguments(argc, argv, 2, {"--config"});
-  const bool locate = args && args->positional == std::vector<std::string>{"locate"};
-  if (!args || (!args->positional.empty() && !locate)) {
-    std::cerr << kUsage;
-    return kExitUsage;
-  }
+int PrintConfigCommand(const Arguments& parsed) {
+  const Arguments* args = &parsed;
+  const bool locate = args->positional == std::vector<std::string>{"locate"};
   if (locate) {  // the configuration of wifi-map and locate
     LocateOptions o;
     if (args->values.count("--config")) {
@@ -317,12 +249,8 @@ int PrintConfigCommand(int argc, char** argv) {
   return kExitOk;
 }
 
-int ImportOpenRatslam(int argc, char** argv) {
-  auto args = ParseArguments(argc, argv, 2, {});
-  if (!args || args->positional.size() != 1) {
-    std::cerr << kUsage;
-    return kExitUsage;
-  }
+int ImportOpenRatslam(const Arguments& parsed) {
+  const Arguments* args = &parsed;
   StatusOr<ImportedConfig> imported = ImportOpenRatslamIni(args->positional[0]);
   if (!imported.ok()) {
     std::cerr << "ratslam: " << imported.status().message() << "\n";
@@ -337,20 +265,15 @@ int ImportOpenRatslam(int argc, char** argv) {
   return kExitOk;
 }
 
-int ImportCommand(int argc, char** argv) {
-  auto args = ParseArguments(argc, argv, 2, {"--data", "--out", "--config"});
-  if (!args || !args->positional.empty() || !args->values.count("--data") ||
-      !args->values.count("--out")) {
-    std::cerr << kUsage;
-    return kExitUsage;
-  }
+int ImportCommand(const Arguments& parsed) {
+  const Arguments* args = &parsed;
   std::string config_path;
   auto options = LoadOptions(*args, &config_path);
   if (!options) return kExitError;
   PhoneLogOptions phone;
   phone.lenient = args->lenient;
   phone.pdr = options->pdr;
-  StatusOr<Dataset> d = LoadSessions(args->all["--data"], phone);
+  StatusOr<Dataset> d = LoadSessions(args->all.at("--data"), phone);
   if (!d.ok()) {
     std::cerr << "ratslam: " << d.status().message() << "\n";
     return kExitError;
@@ -359,35 +282,32 @@ int ImportCommand(int argc, char** argv) {
     std::cerr << "ratslam: import copies no images; convert image data sets by hand\n";
     return kExitError;
   }
-  Status written = WriteDataset(d.value(), args->values["--out"]);
+  Status written = WriteDataset(d.value(), args->values.at("--out"));
   if (!written.ok()) {
     std::cerr << "ratslam: " << written.message() << "\n";
     return kExitError;
   }
   std::cerr << "ratslam: wrote '" << d->name << "' (" << d->odometry.size() << " odometry rows, "
             << d->wifi.size() << " Wi-Fi scans, " << d->compass.size() << " compass rows, "
-            << d->ground_truth.size() << " ground-truth rows) to " << args->values["--out"] << "\n";
+            << d->ground_truth.size() << " ground-truth rows) to " << args->values.at("--out")
+            << "\n";
   return kExitOk;
 }
 
-int SynthesizeCommand(int argc, char** argv) {
-  auto args = ParseArguments(argc, argv, 2, {"--out", "--seed", "--laps"});
-  if (!args || !args->positional.empty() || !args->values.count("--out")) {
-    std::cerr << kUsage;
-    return kExitUsage;
-  }
+int SynthesizeCommand(const Arguments& parsed) {
+  const Arguments* args = &parsed;
   SyntheticOptions options = DemoSyntheticOptions();
   if (args->values.count("--seed")) {
-    auto seed = ParseInteger("--seed", args->values["--seed"], 0, int64_t{1} << 53);
+    auto seed = ParseInteger("--seed", args->values.at("--seed"), 0, int64_t{1} << 53);
     if (!seed) return kExitUsage;
     options.seed = static_cast<uint64_t>(*seed);
   }
   if (args->values.count("--laps")) {
-    auto laps = ParseInteger("--laps", args->values["--laps"], 1, 1000);
+    auto laps = ParseInteger("--laps", args->values.at("--laps"), 1, 1000);
     if (!laps) return kExitUsage;
     options.laps = static_cast<int>(*laps);
   }
-  return Synthesize(options, args->values["--out"]);
+  return Synthesize(options, args->values.at("--out"));
 }
 
 }  // namespace
@@ -395,37 +315,70 @@ int SynthesizeCommand(int argc, char** argv) {
 
 namespace {
 
+// Runs a command that writes into the folder --out under an OutputGuard: a folder holding an
+// earlier run's outputs is refused without --overwrite, and the run's files are listed after it.
+int RunGuarded(int (*handler)(const ratslam::Arguments&), const ratslam::Arguments& args) {
+  using namespace ratslam;
+  const std::string folder = args.Value("--out");
+  std::vector<std::string> inputs;
+  for (const char* flag : {"--data", "--load-map", "--config", "--map", "--query", "--wifi-map"}) {
+    if (auto it = args.all.find(flag); it != args.all.end()) {
+      inputs.insert(inputs.end(), it->second.begin(), it->second.end());
+    }
+  }
+  StatusOr<OutputGuard> guard =
+      OutputGuard::Begin(folder, args.values.count("--overwrite") > 0, inputs);
+  if (!guard.ok()) {
+    std::cerr << "ratslam: " << guard.status().message() << "\n";
+    return kExitError;
+  }
+  const int code = handler(args);
+  StatusOr<std::vector<std::string>> removed = guard->Finish(code == kExitOk);
+  if (!removed.ok()) {
+    std::cerr << "ratslam: the list of outputs was not written: " << removed.status().message()
+              << "\n";
+    return code == kExitOk ? kExitError : code;
+  }
+  if (!removed->empty() && !args.quiet) {
+    std::cerr << "ratslam: --overwrite removed " << removed->size()
+              << " file(s) of the earlier run that this run did not write again\n";
+  }
+  return code;
+}
+
 int Dispatch(int argc, char** argv) {
   using namespace ratslam;
-  if (argc < 2) {
-    std::cerr << kUsage;
-    return kExitUsage;
+  std::variant<ParsedCommand, int> parsed = ParseCommandLine(argc, argv, std::cout, std::cerr);
+  if (const int* code = std::get_if<int>(&parsed)) return *code;
+  ParsedCommand& command = std::get<ParsedCommand>(parsed);
+  command.args.command_line = ShellCommandLine(argc, argv);
+  const std::map<std::string, int (*)(const Arguments&)> handlers = {
+      {"replay", Replay},
+      {"demo", Demo},
+      {"print-config", PrintConfigCommand},
+      {"import-openratslam", ImportOpenRatslam},
+      {"synthesize", SynthesizeCommand},
+      {"evaluate", EvaluateCommand},
+      {"wifi-map", WifiMapCommand},
+      {"locate", LocateCommand},
+      {"call", CallCommand},
+      {"simulate", SimulateCommand},
+      {"import", ImportCommand},
+  };
+  if (auto it = handlers.find(command.command); it != handlers.end()) {
+    if (command.args.Value("--out").empty() || command.command == "wifi-map") {
+      return it->second(command.args);  // wifi-map's --out is a file
+    }
+    return RunGuarded(it->second, command.args);
   }
-  const std::string command = argv[1];
-  if (command == "replay") return Replay(argc, argv);
-  if (command == "demo") return Demo(argc, argv);
-  if (command == "print-config") return PrintConfigCommand(argc, argv);
-  if (command == "import-openratslam") return ImportOpenRatslam(argc, argv);
-  if (command == "synthesize") return SynthesizeCommand(argc, argv);
-  if (command == "render") return RenderCommand(argc, argv);
-  if (command == "evaluate") return EvaluateCommand(argc, argv);
-  if (command == "wifi-map") return WifiMapCommand(argc, argv);
-  if (command == "locate") return LocateCommand(argc, argv);
-  if (command == "call") return CallCommand(argc, argv);
-  if (command == "simulate") return SimulateCommand(argc, argv);
-  if (command == "sweep") return SweepCommand(argc, argv);
-  if (command == "import") return ImportCommand(argc, argv);
-  if (command == "--version" || command == "version") {
-    std::cout << "ratslam " << RatslamVersion() << " (commit " << RatslamCommit() << ", "
-              << RatslamBuildType() << " build)\n";
-    return kExitOk;
+  if (command.command.rfind("render ", 0) == 0) {
+    return RenderCommand(command.command.substr(7), command.args);
   }
-  if (command == "--help" || command == "help" || command == "-h") {
-    std::cout << kUsage;
-    return kExitOk;
+  if (command.command.rfind("sweep ", 0) == 0) {
+    return SweepCommand(command.command.substr(6), command.args);
   }
-  std::cerr << "ratslam: unknown command '" << command << "'\n" << kUsage;
-  return kExitUsage;
+  std::cerr << "ratslam: internal error: no handler for '" << command.command << "'\n";
+  return kExitInternal;
 }
 
 }  // namespace

@@ -21,17 +21,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const char kRenderUsage[] =
-    "usage:\n"
-    "  ratslam render experience-map --run O [--data D] [--out F] [--size WxH]\n"
-    "                 [--color time|session] [--sessions T1,T2,...]\n"
-    "  ratslam render template-graph --run O [--out F] [--size WxH] [--spans A-B:label,...]\n"
-    "  ratslam render pose-cells --map F --out F [--config C]   (the map's own configuration\n"
-    "                 unless --config is given; maps of format 2 need --config)\n"
-    "  ratslam render similarity --data D [--data D2 ...] [--config C] --out F [--frames N]\n"
-    "                 [--sensor camera|wifi]\n"
-    "  ratslam render wifi-map --wifi-map W --out F [--ap BSSID] [--floor N]\n";
-
 int Fail(const std::string& message) {
   std::cerr << "ratslam: " << message << "\n";
   return kExitError;
@@ -92,7 +81,6 @@ Status Write(const Scene& scene, const std::string& path) {
 }
 
 int RenderExperienceMap(const Arguments& args) {
-  if (!args.values.count("--run")) return Fail(std::string("--run is required\n") + kRenderUsage);
   const std::string run_folder = args.values.at("--run");
   StatusOr<RunFolder> run = ReadRunFolder(run_folder);
   if (!run.ok()) return Fail(run.status().message());
@@ -137,7 +125,6 @@ int RenderExperienceMap(const Arguments& args) {
 }
 
 int RenderTemplateGraph(const Arguments& args) {
-  if (!args.values.count("--run")) return Fail(std::string("--run is required\n") + kRenderUsage);
   const std::string run_folder = args.values.at("--run");
   StatusOr<RunFolder> run = ReadRunFolder(run_folder);
   if (!run.ok()) return Fail(run.status().message());
@@ -160,9 +147,6 @@ int RenderTemplateGraph(const Arguments& args) {
 }
 
 int RenderPoseCells(const Arguments& args) {
-  if (!args.values.count("--map") || !args.values.count("--out")) {
-    return Fail(std::string("--map and --out are required\n") + kRenderUsage);
-  }
   const std::string& map_path = args.values.at("--map");
   StatusOr<MapFile> map = LoadMapFile(map_path);
   if (!map.ok()) return Fail(map.status().message());
@@ -193,9 +177,6 @@ int RenderPoseCells(const Arguments& args) {
 }
 
 int RenderSimilarity(const Arguments& args) {
-  if (!args.values.count("--data") || !args.values.count("--out")) {
-    return Fail(std::string("--data and --out are required\n") + kRenderUsage);
-  }
   auto options = LoadOptions(args);
   if (!options) return kExitError;
   int frames = 600;
@@ -229,9 +210,6 @@ int RenderSimilarity(const Arguments& args) {
 
 // The GP mean and variance of one AP (Kudo and Miura, fig. 15), with the training scans.
 int RenderWifiMap(const Arguments& args) {
-  if (!args.values.count("--wifi-map") || !args.values.count("--out")) {
-    return Fail(std::string("--wifi-map and --out are required\n") + kRenderUsage);
-  }
   const std::string path = args.values.at("--wifi-map");
   StatusOr<WifiGpMap> map = WifiGpMap::Load(path);
   if (!map.ok()) return Fail(map.status().message());
@@ -282,27 +260,15 @@ int RenderWifiMap(const Arguments& args) {
 
 }  // namespace
 
-int RenderCommand(int argc, char** argv) {
-  if (argc < 3) {
-    std::cerr << kRenderUsage;
-    return kExitUsage;
-  }
-  const std::string what = argv[2];
-  auto args = ParseArguments(
-      argc, argv, 3,
-      {"--run", "--data", "--out", "--size", "--color", "--sessions", "--spans", "--map",
-       "--config", "--frames", "--sensor", "--wifi-map", "--ap", "--floor"});
-  if (!args || !args->positional.empty()) {
-    std::cerr << kRenderUsage;
-    return kExitUsage;
-  }
+int RenderCommand(const std::string& what, const Arguments& parsed) {
+  const Arguments* args = &parsed;
   if (what == "experience-map") return RenderExperienceMap(*args);
   if (what == "template-graph") return RenderTemplateGraph(*args);
   if (what == "pose-cells") return RenderPoseCells(*args);
   if (what == "similarity") return RenderSimilarity(*args);
   if (what == "wifi-map") return RenderWifiMap(*args);
-  std::cerr << "ratslam: unknown image '" << what << "'\n" << kRenderUsage;
-  return kExitUsage;
+  std::cerr << "ratslam: internal error: unknown image '" << what << "'\n";
+  return kExitInternal;
 }
 
 }  // namespace ratslam

@@ -53,12 +53,8 @@ Status SimulateWorld(const sim::World& world, uint64_t seed, const std::string& 
   return WriteFileAtomically((fs::path(out) / "simulation.json").string(), j.dump(2) + "\n");
 }
 
-int SimulateCommand(int argc, char** argv) {
-  const auto args = ParseArguments(argc, argv, 2, {"--world", "--out", "--seed"});
-  if (!args || !args->values.count("--world") || !args->values.count("--out")) {
-    std::cerr << "usage: ratslam simulate --world NAME|FILE --out D [--seed S] [--quiet]\n";
-    return kExitUsage;
-  }
+int SimulateCommand(const Arguments& parsed) {
+  const Arguments* args = &parsed;
   uint64_t seed = 1;
   if (args->values.count("--seed")) {
     const auto s = ParseInteger("--seed", args->values.at("--seed"), 0, int64_t{1} << 53);

@@ -20,18 +20,6 @@
 namespace ratslam {
 namespace {
 
-const char kSweepUsage[] =
-    "usage:\n"
-    "  ratslam sweep plan SWEEP.toml --out DIR   expand the sweep into DIR's task table\n"
-    "  ratslam sweep run DIR [--jobs N]          run every pending task, N at a time\n"
-    "  ratslam sweep task DIR [--index I]        run one task (I from SLURM_ARRAY_TASK_ID,\n"
-    "                                            PBS_ARRAY_INDEX or SGE_TASK_ID when absent)\n"
-    "  ratslam sweep collect DIR                 results.csv/json, points.csv, best.toml\n"
-    "  ratslam sweep submit DIR --slurm [--partition P] [--time T] [--mem M]\n"
-    "                 [--max-parallel K] [--chunk C] [--sbatch-arg A ...] [--dry-run]\n"
-    "      a Slurm job array over the pending tasks (C tasks per element) and a collect job\n"
-    "      after it (afterany); --dry-run writes and prints the scripts without submitting\n";
-
 std::atomic<bool> g_sweep_stop{false};
 extern "C" void OnSweepSignal(int) { g_sweep_stop.store(true); }
 
@@ -140,55 +128,27 @@ int Fail(const Status& s) {
 
 }  // namespace
 
-int SweepCommand(int argc, char** argv) {
-  const std::string action = argc > 2 ? argv[2] : "";
-  // Bare flags of `submit`, taken out before the common parser sees them.
-  bool slurm = false, dry_run = false;
-  std::vector<char*> kept;
-  for (int i = 0; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (i >= 3 && a == "--slurm") {
-      slurm = true;
-    } else if (i >= 3 && a == "--dry-run") {
-      dry_run = true;
-    } else {
-      kept.push_back(argv[i]);
-    }
-  }
-  if ((slurm || dry_run) && action != "submit") {
-    std::cerr << kSweepUsage;
-    return kExitUsage;
-  }
-  auto args = ParseArguments(static_cast<int>(kept.size()), kept.data(), 3,
-                             {"--out", "--jobs", "--index", "--chunk", "--partition", "--time",
-                              "--mem", "--max-parallel", "--sbatch-arg"});
-  if (!args || args->positional.size() != 1 ||
-      (action != "plan" && action != "run" && action != "task" && action != "collect" &&
-       action != "submit")) {
-    std::cerr << kSweepUsage;
-    return kExitUsage;
-  }
+int SweepCommand(const std::string& action, const Arguments& parsed) {
+  const Arguments* args = &parsed;
+  const bool slurm = args->values.count("--slurm") > 0;
+  const bool dry_run = args->values.count("--dry-run") > 0;
   const std::string& target = args->positional[0];
   if (action == "plan") {
-    if (!args->values.count("--out")) {
-      std::cerr << kSweepUsage;
-      return kExitUsage;
-    }
     StatusOr<sweep::SweepSpec> spec = sweep::LoadSweepFile(target);
     if (!spec.ok()) return Fail(spec.status());
     StatusOr<sweep::Plan> plan = sweep::MakePlan(*spec);
     if (!plan.ok()) return Fail(plan.status());
-    Status written = sweep::WritePlan(*plan, args->values["--out"]);
+    Status written = sweep::WritePlan(*plan, args->values.at("--out"));
     if (!written.ok()) return Fail(written);
     std::cout << plan->tasks.size() << " tasks (" << plan->points << " points x "
-              << spec->datasets.size() << " data sets) in " << args->values["--out"] << "\n";
+              << spec->datasets.size() << " data sets) in " << args->values.at("--out") << "\n";
     return kExitOk;
   }
   if (action == "run") {
     sweep::RunOptions options;
     options.program = ThisProgram();
     if (args->values.count("--jobs")) {
-      auto jobs = ParseInteger("--jobs", args->values["--jobs"], 1, 1024);
+      auto jobs = ParseInteger("--jobs", args->values.at("--jobs"), 1, 1024);
       if (!jobs) return kExitUsage;
       options.jobs = static_cast<int>(*jobs);
     }
@@ -209,7 +169,7 @@ int SweepCommand(int argc, char** argv) {
   if (action == "task") {
     int64_t index = -1;
     if (args->values.count("--index")) {
-      auto i = ParseInteger("--index", args->values["--index"], 0, 1 << 30);
+      auto i = ParseInteger("--index", args->values.at("--index"), 0, 1 << 30);
       if (!i) return kExitUsage;
       index = *i;
     } else {
@@ -229,7 +189,7 @@ int SweepCommand(int argc, char** argv) {
     }
     int64_t chunk = 1;
     if (args->values.count("--chunk")) {
-      auto c = ParseInteger("--chunk", args->values["--chunk"], 1, 1 << 20);
+      auto c = ParseInteger("--chunk", args->values.at("--chunk"), 1, 1 << 20);
       if (!c) return kExitUsage;
       chunk = *c;
     }
@@ -252,17 +212,17 @@ int SweepCommand(int argc, char** argv) {
     }
     sweep::SlurmOptions options;
     options.program = ThisProgram();
-    options.partition = args->values["--partition"];
-    options.time = args->values["--time"];
-    options.mem = args->values["--mem"];
-    options.sbatch_args = args->all["--sbatch-arg"];
+    options.partition = args->Value("--partition");
+    options.time = args->Value("--time");
+    options.mem = args->Value("--mem");
+    if (args->all.count("--sbatch-arg")) options.sbatch_args = args->all.at("--sbatch-arg");
     if (args->values.count("--max-parallel")) {
-      auto k = ParseInteger("--max-parallel", args->values["--max-parallel"], 1, 1 << 20);
+      auto k = ParseInteger("--max-parallel", args->values.at("--max-parallel"), 1, 1 << 20);
       if (!k) return kExitUsage;
       options.max_parallel = static_cast<int>(*k);
     }
     if (args->values.count("--chunk")) {
-      auto c = ParseInteger("--chunk", args->values["--chunk"], 1, 1 << 20);
+      auto c = ParseInteger("--chunk", args->values.at("--chunk"), 1, 1 << 20);
       if (!c) return kExitUsage;
       options.chunk = static_cast<int>(*c);
     }

@@ -33,7 +33,7 @@ for ((r = 0; r < repeats; r++)); do
   i=0
   for f in "$data"/*.txt; do
     "$program" replay --config "$work/s/runs/00000/config.toml" --data "$f" \
-      --out "$work/bare/$i" --quiet >/dev/null 2>&1
+      --out "$work/bare/$i" --overwrite --quiet >/dev/null 2>&1
     i=$((i + 1))
   done
   bare_times+=("$(calc "$(now) - $start")")

@@ -5,4 +5,4 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 BUILD_TARGET=ratslam bash scripts/build.sh
-./build/apps/ratslam demo --out "${1:-out/demo}"
+./build/apps/ratslam demo --overwrite --out "${1:-out/demo}"

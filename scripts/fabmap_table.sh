@@ -19,7 +19,7 @@ run_set() {  # name base-config data-path
       local dir="$out/$name-b$b-$enc"
       mkdir -p "$dir"
       sed -e "s/^bins = .*/bins = $b/" -e "s/^encoding = .*/encoding = \"$enc\"/" "$base" > "$dir/input.toml"
-      "$build/apps/ratslam" evaluate --config "$dir/input.toml" --map "$path" --query "$path" \
+      "$build/apps/ratslam" evaluate --overwrite --config "$dir/input.toml" --map "$path" --query "$path" \
         --out "$dir" --quiet > /dev/null
       row "$dir/evaluation.json" "$b" "$enc"
     done

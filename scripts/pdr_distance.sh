@@ -13,8 +13,8 @@ mkdir -p "$out"
 printf '[pdr]\nmin_orientation_steadiness = 0.0\n' > "$out/off.toml"
 for f in "$data"/IPIN2023_T3_TrainingTrial*.txt; do
   name=$(basename "$f" .txt)
-  "$build/apps/ratslam" import --config "$out/off.toml" --data "$f" --out "$out/before/$name" > /dev/null 2>&1
-  "$build/apps/ratslam" import ${config:+--config "$config"} --data "$f" --out "$out/after/$name" > /dev/null 2>&1
+  "$build/apps/ratslam" import --overwrite --config "$out/off.toml" --data "$f" --out "$out/before/$name" > /dev/null 2>&1
+  "$build/apps/ratslam" import --overwrite ${config:+--config "$config"} --data "$f" --out "$out/after/$name" > /dev/null 2>&1
 done
 /usr/bin/python3 - "$out" <<'PY'
 import csv, glob, math, os, sys

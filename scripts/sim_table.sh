@@ -29,7 +29,7 @@ for w in "${worlds[@]}"; do
     tag="$w-${name// /}"
     sed -e "s/^use_camera = .*/use_camera = $cam/" -e "s/^use_wifi = .*/use_wifi = $wifi/" \
         -e "s/^use_compass = .*/use_compass = $comp/" configs/sim-fused.toml > "$out/$tag.toml"
-    "$ratslam" replay --quiet --config "$out/$tag.toml" --data "$out/sim-$w" --out "$out/replay-$tag" > /dev/null
+    "$ratslam" replay --quiet --overwrite --config "$out/$tag.toml" --data "$out/sim-$w" --out "$out/replay-$tag" > /dev/null
     cell=$(python3 - "$out/replay-$tag/summary.json" <<'PY'
 import json, sys
 j = json.load(open(sys.argv[1]))
@@ -58,7 +58,7 @@ for w in day_night aliased_floors apartment; do
     if [[ -f "$model" ]]; then
       sed -i -e "s|^training_images = .*|file = \"$model\"|" "$cfg"
     fi
-    "$ratslam" evaluate --quiet --config "$cfg" --map "$out/sim-$w" --query "$out/sim-$w" --out "$out/evaluate-$w-$m" > /dev/null
+    "$ratslam" evaluate --quiet --overwrite --config "$cfg" --map "$out/sim-$w" --query "$out/sim-$w" --out "$out/evaluate-$w-$m" > /dev/null
     [[ -f "$model" ]] || cp "$out/evaluate-$w-$m/visual_model.bin" "$model"
     cell=$(python3 - "$out/evaluate-$w-$m/evaluation.json" <<'PY'
 import json, sys

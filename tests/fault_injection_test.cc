@@ -58,12 +58,19 @@ TEST(FaultInjectionTest, KillDuringSaveNeverLeavesATornMap) {
   ASSERT_TRUE(WriteSyntheticDataset(DemoSyntheticOptions(), (dir / "data").string()).ok());
   const std::string config = std::string(RATSLAM_SOURCE_DIR) + "/configs/synthetic.toml";
   auto replay = [&](double until, const fs::path& map) {
-    return std::vector<std::string>{"replay",     "--quiet",
-                                    "--config",   config,
-                                    "--data",     (dir / "data").string(),
-                                    "--out",      (dir / "out").string(),
-                                    "--until",    std::to_string(until),
-                                    "--save-map", map.string()};
+    return std::vector<std::string>{"replay",
+                                    "--quiet",
+                                    "--overwrite",
+                                    "--config",
+                                    config,
+                                    "--data",
+                                    (dir / "data").string(),
+                                    "--out",
+                                    (dir / "out").string(),
+                                    "--until",
+                                    std::to_string(until),
+                                    "--save-map",
+                                    map.string()};
   };
   // The two complete maps a save may leave: the earlier one (t = 100 s) and the new (t = 200 s).
   const fs::path early = dir / "early.map", late = dir / "late.map";

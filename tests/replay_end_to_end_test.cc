@@ -84,6 +84,28 @@ class ReplayEndToEndTest : public ::testing::Test {
 fs::path ReplayEndToEndTest::root_;
 std::string ReplayEndToEndTest::config_;
 
+// A second run into a folder with an earlier run's outputs is refused unless --overwrite; then
+// the folder holds exactly the new run's files (the earlier images are gone) and the user's own.
+TEST_F(ReplayEndToEndTest, AnEarlierRunsOutputsAreReplacedOnlyWithOverwrite) {
+  const fs::path out = root_ / "twice";
+  ASSERT_EQ(RunRatslam(ReplayArgs(out) + " --until 30 --render", root_).exit_code, 0);
+  ASSERT_TRUE(fs::exists(out / "experience_map.png"));
+  std::ofstream(out / "my_notes.txt") << "kept";
+  const std::string first_summary = Slurp(out / "summary.json");
+  const Result refused = RunRatslam(ReplayArgs(out) + " --until 40", root_);
+  EXPECT_EQ(refused.exit_code, 1);
+  EXPECT_NE(refused.err.find("holds the outputs of an earlier run"), std::string::npos)
+      << refused.err;
+  EXPECT_EQ(Slurp(out / "summary.json"), first_summary);  // untouched
+  const Result r = RunRatslam(ReplayArgs(out) + " --until 40 --overwrite", root_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_FALSE(fs::exists(out / "experience_map.png"));
+  EXPECT_FALSE(fs::exists(out / "pose_cells.png"));
+  EXPECT_EQ(Slurp(out / "my_notes.txt"), "kept");
+  EXPECT_NE(Slurp(out / "summary.json"), first_summary);
+  for (const char* name : kOutputs) EXPECT_TRUE(fs::exists(out / name)) << name;
+}
+
 TEST_F(ReplayEndToEndTest, DemoDataClosesLoopsAndBeatsOdometry) {
   const fs::path out = root_ / "full";
   ASSERT_EQ(RunRatslam(ReplayArgs(out), root_).exit_code, 0);

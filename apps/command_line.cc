@@ -1,0 +1,610 @@
+#include "apps/command_line.h"
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <memory>
+#include <set>
+#include <sstream>
+
+#include "common/toml_binder.h"
+#include "common/version.h"
+
+namespace ratslam {
+namespace {
+
+// What an option's value must be.
+enum class Kind {
+  kText,    // any text (paths, names)
+  kNumber,  // a finite decimal number
+  kWhole,   // a whole number in [min, max]
+  kSize,    // WIDTHxHEIGHT in pixels
+  kFlag,    // no value
+};
+
+struct OptionSpec {
+  std::string name;        // "--out", or a positional's name ("FILE")
+  std::string value_name;  // "O", shown in the usage
+  std::string help;
+  bool required = false;
+  bool repeatable = false;  // may be given several times (--data D --data D2)
+  Kind kind = Kind::kText;
+  int64_t min = 0, max = 0;          // kWhole
+  std::vector<std::string> choices;  // kText: the allowed values, when fixed
+};
+
+struct CommandSpec {
+  std::string path;  // "render pose-cells"
+  std::string summary;
+  std::string description;  // more than the summary, for --help; may be empty
+  std::vector<OptionSpec> options;
+  std::vector<OptionSpec> positionals;
+};
+
+constexpr int64_t kSeedMax = int64_t{1} << 53;  // exact in a double, as the map files keep it
+
+OptionSpec Option(std::string name, std::string value_name, std::string help, Kind kind) {
+  OptionSpec o;
+  o.name = std::move(name);
+  o.value_name = std::move(value_name);
+  o.help = std::move(help);
+  o.kind = kind;
+  return o;
+}
+OptionSpec Flag(std::string name, std::string help) {
+  return Option(std::move(name), "", std::move(help), Kind::kFlag);
+}
+OptionSpec Text(std::string name, std::string value_name, std::string help, bool required = false,
+                bool repeatable = false) {
+  OptionSpec o = Option(std::move(name), std::move(value_name), std::move(help), Kind::kText);
+  o.required = required;
+  o.repeatable = repeatable;
+  return o;
+}
+OptionSpec Whole(std::string name, std::string value_name, std::string help, int64_t min,
+                 int64_t max) {
+  OptionSpec o = Option(std::move(name), std::move(value_name), std::move(help), Kind::kWhole);
+  o.min = min;
+  o.max = max;
+  return o;
+}
+OptionSpec Number(std::string name, std::string value_name, std::string help,
+                  bool required = false) {
+  OptionSpec o = Option(std::move(name), std::move(value_name), std::move(help), Kind::kNumber);
+  o.required = required;
+  return o;
+}
+OptionSpec Choice(std::string name, std::string value_name, std::string help,
+                  std::vector<std::string> choices) {
+  OptionSpec o = Option(std::move(name), std::move(value_name), std::move(help), Kind::kText);
+  o.choices = std::move(choices);
+  return o;
+}
+OptionSpec Size() {
+  return Option("--size", "WxH", "image size in pixels (e.g. 1600x1200)", Kind::kSize);
+}
+
+const OptionSpec kQuiet = Flag("--quiet", "no progress on stderr and no summary on stdout");
+const OptionSpec kLenient =
+    Flag("--lenient", "skip and count malformed lines of phone logs instead of failing");
+const OptionSpec kOverwrite = Flag(
+    "--overwrite", "replace an earlier run's outputs in the output folder (refused without it)");
+const OptionSpec kConfig = Text("--config", "C", "configuration file (TOML); default: built in");
+
+// The one table of commands.
+const std::vector<CommandSpec>& Commands() {
+  static const std::vector<CommandSpec> commands = {
+      {"replay",
+       "replay data sets into a map, a trajectory and a summary",
+       "Replays data set D (a replay-format folder or a phone log; several --data make one "
+       "multi-session run) and writes the map, trajectory and summary into O. Ctrl-C stops "
+       "cleanly and saves the state.",
+       {Text("--data", "D", "data set to replay; repeat for a multi-session run", true, true),
+        Text("--out", "O", "output folder", true), kOverwrite, kConfig,
+        Text("--save-map", "F", "save the whole state to F at the end"),
+        Text("--load-map", "F", "resume from the state saved in F"),
+        Number("--until", "T", "stop after data time T seconds"),
+        Flag("--render", "also write the run's images (experience map, template graph, ...)"),
+        Whole("--animate", "N", "write an experience-map frame every N events to O/animation/", 1,
+              kSeedMax),
+        kLenient, kQuiet},
+       {}},
+      {"import",
+       "convert data sets (phone logs, ...) to the replay format",
+       "Converts data sets to the replay format in folder F (one multi-session data set when "
+       "--data is repeated).",
+       {Text("--data", "D", "data set to convert; repeat to join sessions", true, true),
+        Text("--out", "F", "output folder", true), kOverwrite, kConfig, kLenient},
+       {}},
+      {"demo",
+       "simulate the built-in day_night world and replay it",
+       "Simulates the built-in day_night world (camera, Wi-Fi, compass, odometry) into O/data, "
+       "replays it into O with the fused front end and renders the images.",
+       {Text("--out", "O", "output folder", true), kOverwrite, kQuiet},
+       {}},
+      {"print-config",
+       "print the resolved configuration",
+       "Prints the resolved configuration (the defaults when no file is given); with `locate`, "
+       "that of wifi-map and locate.",
+       {kConfig},
+       {Choice("WHICH", "WHICH", "`locate` for the configuration of wifi-map and locate",
+               {"locate"})}},
+      {"import-openratslam",
+       "convert an OpenRatSLAM configuration file to ours",
+       "Converts an OpenRatSLAM configuration file (INI) to ours; the TOML goes to stdout.",
+       {},
+       {Text("FILE", "FILE", "the OpenRatSLAM .ini or config.txt", true)}},
+      {"synthesize",
+       "write the built-in synthetic camera loop",
+       "Writes the built-in synthetic camera loop into D (replay it with "
+       "configs/synthetic.toml).",
+       {Text("--out", "D", "output folder", true), kOverwrite,
+        Whole("--seed", "S", "random seed", 0, kSeedMax),
+        Whole("--laps", "N", "laps of the loop", 1, 1000)},
+       {}},
+      {"render", "images from a run folder, a saved map, a data set or a Wi-Fi map", "", {}, {}},
+      {"render experience-map",
+       "the experience map of a run",
+       "",
+       {Text("--run", "O", "run folder (written by replay)", true),
+        Text("--data", "D", "the run's data set, for ground truth; default: the one it names"),
+        Text("--out", "F", "image file; default: O/experience_map.png"), Size(),
+        Choice("--color", "BY", "colour the experiences by time or by session",
+               {"time", "session"}),
+        Text("--sessions", "T1,T2,...", "session start times in seconds, comma-separated")},
+       {}},
+      {"render template-graph",
+       "template ids over time, with labelled spans",
+       "",
+       {Text("--run", "O", "run folder (written by replay)", true),
+        Text("--out", "F", "image file; default: O/template_graph.png"), Size(),
+        Text("--spans", "A-B:label,...", "time spans to shade and label, comma-separated")},
+       {}},
+      {"render pose-cells",
+       "the pose-cell activity of a saved map",
+       "Draws the pose-cell network of a saved map with the map's own configuration (maps of "
+       "format 2 carry none and need --config).",
+       {Text("--map", "F", "saved map (replay --save-map)", true),
+        Text("--out", "F", "image file", true), kConfig},
+       {}},
+      {"render similarity",
+       "the frame-by-frame similarity matrix of a data set",
+       "",
+       {Text("--data", "D", "data set; repeat for several sessions", true, true),
+        Text("--out", "F", "image file", true), kConfig,
+        Whole("--frames", "N", "frames to compare (evenly spaced)", 2, 5000),
+        Choice("--sensor", "S", "the sensor to compare", {"camera", "wifi"})},
+       {}},
+      {"render wifi-map",
+       "one access point's Gaussian-process Wi-Fi map",
+       "",
+       {Text("--wifi-map", "W", "Wi-Fi map file (ratslam wifi-map)", true),
+        Text("--out", "F", "image file", true),
+        Text("--ap", "BSSID", "access point; default: the one with the largest grid"),
+        Whole("--floor", "N", "floor; default: the AP's first", -1000, 1000)},
+       {}},
+      {"evaluate",
+       "FABMAP localisation benchmark",
+       "Maps M, localises every node of Q and writes evaluation.json, queries.csv, "
+       "pr_curve.csv, localisation.png and pr_curve.png to O. M and Q may be the same data set: "
+       "[evaluation] split and map_fraction then divide it.",
+       {kConfig, Text("--map", "M", "data set to map", true),
+        Text("--query", "Q", "data set to localise", true),
+        Text("--out", "O", "output folder", true), kOverwrite, kLenient, kQuiet},
+       {}},
+      {"wifi-map",
+       "fit Gaussian-process Wi-Fi maps",
+       "Fits a Gaussian process per access point (mean and variance grids, [wifi_map] in C) from "
+       "data sets with ground truth into the file W. With --run, positions come from that run's "
+       "final map instead (give --data as the replay had it).",
+       {Text("--data", "D", "data set; repeat for several", true, true),
+        Text("--out", "W", "Wi-Fi map file to write", true), kConfig,
+        Text("--run", "RUN_FOLDER", "take positions from this run's map"), kLenient},
+       {}},
+      {"locate",
+       "locate a phone in a Wi-Fi map with a particle filter",
+       "Locates a phone in W with a particle filter ([particle_filter], [pdr]): writes "
+       "trajectory_tum.txt, errors.csv and cumulative_error.png (with ground truth), "
+       "candidates.csv and summary.json.",
+       {Text("--wifi-map", "W", "Wi-Fi map file", true),
+        Text("--data", "PHONE_LOG", "the phone's log", true),
+        Text("--out", "O", "output folder", true), kOverwrite, kConfig, kLenient, kQuiet},
+       {}},
+      {"call",
+       "locate a phone and plan the robot's route to it",
+       "Locates the phone up to time T and plans the robot's route from its current experience "
+       "through every candidate location: call.json, route.csv, call.png.",
+       {Text("--map", "RUN", "run folder or saved map", true),
+        Text("--wifi-map", "W", "Wi-Fi map file", true),
+        Text("--data", "PHONE_LOG", "the phone's log", true),
+        Number("--at", "T", "the time of the call, seconds of the phone's log", true),
+        Text("--out", "O", "output folder", true), kOverwrite, kConfig, kLenient, kQuiet},
+       {}},
+      {"simulate",
+       "simulate a world into a replay data set",
+       "Simulates a world (built in: office, circular, day_night, aliased_floors, apartment; or "
+       "a world TOML file) into the replay data set D, with world.toml, simulation.json and "
+       "ground_truth.png.",
+       {Text("--world", "NAME|FILE", "built-in world name or world file", true),
+        Text("--out", "D", "output folder", true), kOverwrite,
+        Whole("--seed", "S", "random seed", 0, kSeedMax), kQuiet},
+       {}},
+      {"sweep", "parameter sweeps (configs/README.md, \"Sweeps\")", "", {}, {}},
+      {"sweep plan",
+       "expand a sweep file into a folder's task table",
+       "",
+       {Text("--out", "DIR", "sweep folder to create", true)},
+       {Text("SWEEP", "SWEEP.toml", "sweep file", true)}},
+      {"sweep run",
+       "run every pending task, N at a time (resumable)",
+       "",
+       {Whole("--jobs", "N", "tasks at a time", 1, 1024), kQuiet},
+       {Text("DIR", "DIR", "sweep folder", true)}},
+      {"sweep task",
+       "run one task of a cluster array",
+       "Runs one task (or a chunk of them). The index comes from --index, else from "
+       "SLURM_ARRAY_TASK_ID, PBS_ARRAY_INDEX or SGE_TASK_ID.",
+       {Whole("--index", "I", "array index", 0, int64_t{1} << 30),
+        Whole("--chunk", "C", "tasks per array index", 1, int64_t{1} << 20)},
+       {Text("DIR", "DIR", "sweep folder", true)}},
+      {"sweep collect",
+       "collect results.csv/json, points.csv, best.toml and the plots",
+       "",
+       {},
+       {Text("DIR", "DIR", "sweep folder", true)}},
+      {"sweep submit",
+       "submit a Slurm job array over the pending tasks",
+       "Writes and submits a Slurm job array over the pending tasks (C tasks per element) and a "
+       "collect job after it (afterany).",
+       {Flag("--slurm", "submit to Slurm (the only scheduler supported)"),
+        Text("--partition", "P", "Slurm partition"),
+        Text("--time", "T", "time limit per array element"),
+        Text("--mem", "M", "memory per array element"),
+        Whole("--max-parallel", "K", "array elements at a time", 1, int64_t{1} << 20),
+        Whole("--chunk", "C", "tasks per array element", 1, int64_t{1} << 20),
+        Text("--sbatch-arg", "A", "extra sbatch argument; repeatable", false, true),
+        Flag("--dry-run", "write and print the scripts without submitting")},
+       {Text("DIR", "DIR", "sweep folder", true)}},
+      {"completion",
+       "print a bash completion script",
+       "Prints a bash completion script for ratslam: `source <(ratslam completion)`.",
+       {},
+       {}},
+  };
+  return commands;
+}
+
+// `text` broken into lines of at most `width` characters at spaces.
+std::string Wrap(const std::string& text, size_t width) {
+  std::istringstream in(text);
+  std::string word, line, out;
+  while (in >> word) {
+    if (!line.empty() && line.size() + 1 + word.size() > width) {
+      out += line + "\n";
+      line.clear();
+    }
+    line += (line.empty() ? "" : " ") + word;
+  }
+  return out + line;
+}
+
+CLI::Validator WholeValidator(int64_t min, int64_t max) {
+  return CLI::Validator(
+      [min, max](std::string& text) -> std::string {
+        const std::string want =
+            "expected a whole number in " + std::to_string(min) + ".." + std::to_string(max);
+        char* end = nullptr;
+        errno = 0;
+        const long long value = std::strtoll(text.c_str(), &end, 10);
+        if (text.empty() || *end != '\0' || errno == ERANGE || value < min || value > max) {
+          return want + ", got '" + text + "'";
+        }
+        return "";
+      },
+      "");
+}
+
+CLI::Validator NumberValidator() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        char* end = nullptr;
+        const double value = std::strtod(text.c_str(), &end);
+        if (text.empty() || *end != '\0' || !std::isfinite(value)) {
+          return "expected a finite number, got '" + text + "'";
+        }
+        return "";
+      },
+      "");
+}
+
+CLI::Validator SizeValidator() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        int w = 0, h = 0;
+        char x = 0;
+        std::istringstream in(text);
+        if (!(in >> w >> x >> h) || x != 'x' || !in.eof() || w < 64 || h < 64 || w > 16384 ||
+            h > 16384) {
+          return "expected WIDTHxHEIGHT with each side in 64..16384, got '" + text + "'";
+        }
+        return "";
+      },
+      "");
+}
+
+CLI::Validator ChoiceValidator(std::vector<std::string> choices) {
+  return CLI::Validator(
+      [choices](std::string& text) -> std::string {
+        if (std::find(choices.begin(), choices.end(), text) != choices.end()) return "";
+        std::string list;
+        for (const std::string& c : choices) list += (list.empty() ? "" : ", ") + c;
+        std::set<std::string> known(choices.begin(), choices.end());
+        return "'" + text + "' is not one of " + list + schema::DidYouMean(text, known);
+      },
+      "");
+}
+
+struct Built {
+  std::unique_ptr<CLI::App> app;
+  std::map<std::string, CLI::App*> by_path;
+};
+
+void AddOption(CLI::App* sub, const OptionSpec& spec) {
+  const bool positional = spec.name[0] != '-';
+  if (spec.kind == Kind::kFlag) {
+    sub->add_flag(spec.name, spec.help);
+    return;
+  }
+  CLI::Option* option = nullptr;
+  if (spec.repeatable) {
+    option = sub->add_option(spec.name, spec.help)
+                 ->expected(1)
+                 ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  } else {
+    option = sub->add_option(spec.name, spec.help)->expected(1);
+  }
+  option->type_name(spec.value_name);
+  if (spec.required) option->required();
+  if (positional) option->type_name("");
+  switch (spec.kind) {
+    case Kind::kWhole:
+      option->check(WholeValidator(spec.min, spec.max));
+      break;
+    case Kind::kNumber:
+      option->check(NumberValidator());
+      break;
+    case Kind::kSize:
+      option->check(SizeValidator());
+      break;
+    default:
+      if (!spec.choices.empty()) option->check(ChoiceValidator(spec.choices));
+      break;
+  }
+}
+
+Built Build() {
+  Built built;
+  built.app = std::make_unique<CLI::App>(
+      "Multi-sensor RatSLAM: replay data sets, render experience maps, sweep parameters.",
+      "ratslam");
+  CLI::App* app = built.app.get();
+  app->require_subcommand(1);
+  app->set_version_flag("--version", "ratslam " + RatslamVersion() + " (commit " + RatslamCommit() +
+                                         ", " + RatslamBuildType() + " build)");
+  for (const CommandSpec& c : Commands()) {
+    CLI::App* parent = app;
+    std::string leaf = c.path;
+    if (const size_t space = c.path.rfind(' '); space != std::string::npos) {
+      parent = built.by_path.at(c.path.substr(0, space));
+      leaf = c.path.substr(space + 1);
+    }
+    CLI::App* sub = parent->add_subcommand(leaf, c.summary);
+    if (!c.description.empty()) sub->footer(Wrap(c.description, 96));
+    for (const OptionSpec& o : c.options) AddOption(sub, o);
+    for (const OptionSpec& o : c.positionals) AddOption(sub, o);
+    built.by_path[c.path] = sub;
+  }
+  for (auto& [path, sub] : built.by_path) {
+    if (!sub->get_subcommands({}).empty()) sub->require_subcommand(1);
+  }
+  return built;
+}
+
+const CommandSpec& SpecOf(const std::string& path) {
+  for (const CommandSpec& c : Commands()) {
+    if (c.path == path) return c;
+  }
+  static const CommandSpec none;
+  return none;
+}
+
+// The deepest sub-command that the parser entered (the top-level app when none).
+std::pair<CLI::App*, std::string> Deepest(CLI::App* app) {
+  CLI::App* at = app;
+  std::string path;
+  for (;;) {
+    std::vector<CLI::App*> parsed = at->get_subcommands();
+    if (parsed.empty()) break;
+    at = parsed.front();
+    path += (path.empty() ? "" : " ") + at->get_name();
+  }
+  return {at, path};
+}
+
+// The names a misspelling of `word` could have meant in `at`: its options and sub-commands.
+std::string Suggest(const std::string& word, CLI::App* at) {
+  std::set<std::string> known;
+  if (word.rfind("-", 0) == 0) {
+    for (const CLI::Option* o : at->get_options()) {
+      for (const std::string& n : o->get_lnames()) known.insert("--" + n);
+    }
+  } else {
+    for (const CLI::App* s : at->get_subcommands({})) known.insert(s->get_name());
+  }
+  const std::string bare = word.substr(0, word.find('='));
+  return schema::DidYouMean(bare, known);
+}
+
+ParsedCommand Collect(CLI::App* at, const std::string& path) {
+  ParsedCommand parsed;
+  parsed.command = path;
+  const CommandSpec& spec = SpecOf(path);
+  for (const OptionSpec& o : spec.options) {
+    const CLI::Option* option = at->get_option(o.name);
+    if (option->count() == 0) continue;
+    if (o.kind == Kind::kFlag) {
+      if (o.name == "--quiet") {
+        parsed.args.quiet = true;
+      } else if (o.name == "--render") {
+        parsed.args.render = true;
+      } else if (o.name == "--lenient") {
+        parsed.args.lenient = true;
+      } else {
+        parsed.args.values[o.name] = "true";
+      }
+      continue;
+    }
+    for (const std::string& value : option->results()) {
+      parsed.args.values[o.name] = value;
+      parsed.args.all[o.name].push_back(value);
+    }
+  }
+  for (const OptionSpec& o : spec.positionals) {
+    const CLI::Option* option = at->get_option(o.name);
+    for (const std::string& value : option->results()) parsed.args.positional.push_back(value);
+  }
+  return parsed;
+}
+
+std::string HelpOf(const Built& built, const std::string& path) {
+  const size_t space = path.rfind(' ');
+  const std::string parents = space == std::string::npos ? "" : " " + path.substr(0, space);
+  return built.by_path.at(path)->help("ratslam" + parents);
+}
+
+}  // namespace
+
+std::variant<ParsedCommand, int> ParseCommandLine(int argc, const char* const* argv,
+                                                  std::ostream& out, std::ostream& err) {
+  // `ratslam help [CMD ...]` is `ratslam [CMD ...] --help`.
+  std::vector<std::string> words;
+  for (int i = 1; i < argc; ++i) words.emplace_back(argv[i]);
+  if (!words.empty() && words.front() == "help") {
+    words.erase(words.begin());
+    words.emplace_back("--help");
+  }
+  if (!words.empty() && words.front() == "version") words.front() = "--version";
+  Built built = Build();
+  CLI::App* app = built.app.get();
+  try {
+    std::vector<std::string> reversed(words.rbegin(), words.rend());
+    app->parse(reversed);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) {
+      // --help, --help-all, --version: CLI11 writes them.
+      return app->exit(e, out, err);
+    }
+    auto [at, path] = Deepest(app);
+    const std::string who = path.empty() ? "ratslam" : "ratslam " + path;
+    std::string message = e.what();
+    // An unknown word explains the other errors (a misspelt --data makes --data missing), so it
+    // is reported first.
+    const std::vector<std::string> extras = at->remaining();
+    if (!extras.empty()) {
+      const std::string& first = extras.front();
+      if (first.rfind("-", 0) == 0) {
+        message = "unknown option '" + first + "'" + Suggest(first, at);
+      } else if (!at->get_subcommands({}).empty()) {
+        message = "unknown command '" + first + "'" + Suggest(first, at);
+      } else {
+        message = "unexpected argument '" + first + "'";
+      }
+    } else if (dynamic_cast<const CLI::ArgumentMismatch*>(&e) != nullptr &&
+               message.find("At Most 1 required") != std::string::npos) {
+      message =
+          message.substr(0, message.find(':')) + ": given more than once (it takes one value)";
+    } else if (dynamic_cast<const CLI::ArgumentMismatch*>(&e) != nullptr &&
+               message.find(" missing") != std::string::npos) {
+      message = message.substr(0, message.find(':')) + ": needs a value";
+    } else if (dynamic_cast<const CLI::RequiredError*>(&e) != nullptr &&
+               !at->get_subcommands({}).empty() && at->get_subcommands().empty()) {
+      std::string names;
+      for (const CLI::App* s : at->get_subcommands({})) {
+        names += (names.empty() ? "" : ", ") + s->get_name();
+      }
+      message = "a command is required: one of " + names;
+    }
+    err << who << ": " << message << "\n"
+        << "Run '" << who << " --help' for the options.\n";
+    return kExitUsage;
+  }
+  auto [at, path] = Deepest(app);
+  if (path == "completion") {
+    out << BashCompletion();
+    return kExitOk;
+  }
+  return Collect(at, path);
+}
+
+std::vector<std::string> CommandPaths() {
+  std::vector<std::string> paths;
+  for (const CommandSpec& c : Commands()) paths.push_back(c.path);
+  return paths;
+}
+
+std::string CommandReference() {
+  Built built = Build();
+  std::ostringstream s;
+  s << "```text\n" << built.app->help() << "```\n";
+  for (const CommandSpec& c : Commands()) {
+    if (c.options.empty() && c.positionals.empty() && c.path != "completion") continue;
+    s << "\n```text\n" << HelpOf(built, c.path) << "```\n";
+  }
+  return s.str();
+}
+
+std::string BashCompletion() {
+  // For each command path, its words: sub-commands, then options.
+  std::ostringstream s;
+  s << "# bash completion for ratslam (generated by `ratslam completion`)\n"
+    << "_ratslam() {\n"
+    << "  local cur=\"${COMP_WORDS[COMP_CWORD]}\" path=\"\" w i\n"
+    << "  for ((i = 1; i < COMP_CWORD; i++)); do\n"
+    << "    w=\"${COMP_WORDS[i]}\"\n"
+    << "    case \"$w\" in -*) continue ;; esac\n"
+    << "    case \"${path:+$path }$w\" in\n      ";
+  std::string alternatives;
+  for (const CommandSpec& c : Commands()) {
+    alternatives += (alternatives.empty() ? "" : "|") + std::string("\"") + c.path + "\"";
+  }
+  s << alternatives << ") path=\"${path:+$path }$w\" ;;\n"
+    << "    esac\n"
+    << "  done\n"
+    << "  local words=\"\"\n"
+    << "  case \"$path\" in\n";
+  std::map<std::string, std::string> words;
+  words[""] = "--help --version";
+  for (const CommandSpec& c : Commands()) {
+    const size_t space = c.path.rfind(' ');
+    const std::string parent = space == std::string::npos ? "" : c.path.substr(0, space);
+    const std::string leaf = space == std::string::npos ? c.path : c.path.substr(space + 1);
+    words[parent] += " " + leaf;
+    std::string& mine = words[c.path];
+    mine += "--help";
+    for (const OptionSpec& o : c.options) mine += " " + o.name;
+  }
+  for (const auto& [path, list] : words) {
+    s << "    \"" << path << "\") words=\"" << list << "\" ;;\n";
+  }
+  s << "  esac\n"
+    << "  COMPREPLY=($(compgen -W \"$words\" -- \"$cur\"))\n"
+    << "  case \"$cur\" in -*) ;; *) [[ ${#COMPREPLY[@]} -eq 0 ]] && COMPREPLY=($(compgen -f -- "
+       "\"$cur\")) ;; esac\n"
+    << "  return 0\n"
+    << "}\n"
+    << "complete -o filenames -F _ratslam ratslam\n";
+  return s.str();
+}
+
+}  // namespace ratslam

@@ -1,0 +1,209 @@
+#include "apps/command_line.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "common/version.h"
+
+namespace ratslam {
+namespace {
+
+struct Outcome {
+  std::variant<ParsedCommand, int> result;
+  std::string out, err;
+  int code() const { return std::holds_alternative<int>(result) ? std::get<int>(result) : -1; }
+  const ParsedCommand& command() const { return std::get<ParsedCommand>(result); }
+};
+
+// Splits `line` at spaces (no quoting needed here) and parses it as `ratslam line`.
+Outcome Parse(const std::string& line) {
+  std::vector<std::string> words{"ratslam"};
+  std::istringstream in(line);
+  for (std::string w; in >> w;) words.push_back(w);
+  std::vector<const char*> argv;
+  for (const std::string& w : words) argv.push_back(w.c_str());
+  std::ostringstream out, err;
+  Outcome o{ParseCommandLine(static_cast<int>(argv.size()), argv.data(), out, err), "", ""};
+  o.out = out.str();
+  o.err = err.str();
+  return o;
+}
+
+TEST(CommandLineTest, EveryCommandHasHelpWithBothSpellings) {
+  for (const std::string& path : CommandPaths()) {
+    for (const char* flag : {"--help", "-h"}) {
+      const Outcome o = Parse(path + " " + flag);
+      EXPECT_EQ(o.code(), kExitOk) << path << " " << flag << ": " << o.err;
+      EXPECT_NE(o.out.find("Usage: ratslam " + path), std::string::npos) << path << "\n" << o.out;
+      EXPECT_TRUE(o.err.empty()) << o.err;
+    }
+    const Outcome help = Parse("help " + path);
+    EXPECT_EQ(help.code(), kExitOk) << path;
+    EXPECT_NE(help.out.find("Usage: ratslam " + path), std::string::npos) << path;
+  }
+}
+
+TEST(CommandLineTest, HelpIsNotTakenForAFileName) {
+  // Before CLI11, `import-openratslam -h` tried to open a file named "-h".
+  const Outcome o = Parse("import-openratslam -h");
+  EXPECT_EQ(o.code(), kExitOk);
+  EXPECT_NE(o.out.find("FILE"), std::string::npos);
+}
+
+TEST(CommandLineTest, VersionNamesVersionCommitAndBuildType) {
+  for (const char* line : {"--version", "version"}) {
+    const Outcome o = Parse(line);
+    EXPECT_EQ(o.code(), kExitOk);
+    EXPECT_NE(o.out.find("ratslam " + RatslamVersion()), std::string::npos) << o.out;
+    EXPECT_NE(o.out.find(RatslamCommit()), std::string::npos) << o.out;
+    EXPECT_NE(o.out.find(RatslamBuildType()), std::string::npos) << o.out;
+  }
+}
+
+TEST(CommandLineTest, NoCommandIsAUsageErrorListingTheCommands) {
+  const Outcome o = Parse("");
+  EXPECT_EQ(o.code(), kExitUsage);
+  EXPECT_NE(o.err.find("one of replay, import"), std::string::npos) << o.err;
+}
+
+TEST(CommandLineTest, ValuesBothSpellingsAndRepeatedOptions) {
+  const Outcome o = Parse("replay --data=a --data b --out=o --until 12.5 --render --quiet");
+  ASSERT_EQ(o.code(), -1) << o.err;
+  const ParsedCommand& c = o.command();
+  EXPECT_EQ(c.command, "replay");
+  EXPECT_EQ(c.args.all.at("--data"), (std::vector<std::string>{"a", "b"}));
+  EXPECT_EQ(c.args.values.at("--out"), "o");
+  EXPECT_EQ(c.args.values.at("--until"), "12.5");
+  EXPECT_TRUE(c.args.render);
+  EXPECT_TRUE(c.args.quiet);
+  EXPECT_FALSE(c.args.lenient);
+  EXPECT_EQ(c.args.Value("--config"), "");
+}
+
+TEST(CommandLineTest, NestedCommandsPositionalsAndOtherFlags) {
+  const Outcome o = Parse("sweep submit DIR --slurm --chunk 4 --sbatch-arg=-A --sbatch-arg x");
+  ASSERT_EQ(o.code(), -1) << o.err;
+  EXPECT_EQ(o.command().command, "sweep submit");
+  EXPECT_EQ(o.command().args.positional, std::vector<std::string>{"DIR"});
+  EXPECT_EQ(o.command().args.values.count("--slurm"), 1u);
+  EXPECT_EQ(o.command().args.values.count("--dry-run"), 0u);
+  EXPECT_EQ(o.command().args.all.at("--sbatch-arg"), (std::vector<std::string>{"-A", "x"}));
+  const Outcome p = Parse("print-config locate");
+  ASSERT_EQ(p.code(), -1) << p.err;
+  EXPECT_EQ(p.command().args.positional, std::vector<std::string>{"locate"});
+}
+
+// Each bad line, and a piece of the message it must give; all are usage errors (exit 2).
+TEST(CommandLineTest, UsageErrorsSayWhatIsWrong) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"synthesize --out d --seed -1", "--seed: expected a whole number in 0..9007199254740992"},
+      {"synthesize --out d --seed 1.5", "got '1.5'"},
+      {"synthesize --out d --seed 1e3", "got '1e3'"},
+      {"synthesize --out d --laps 0", "--laps: expected a whole number in 1..1000"},
+      {"synthesize --out d --seed 99999999999999999999", "--seed: expected a whole number"},
+      {"replay --data a --out o --until soon", "--until: expected a finite number, got 'soon'"},
+      {"replay --data a --out o --until nan", "--until: expected a finite number"},
+      {"call --map m --wifi-map w --data d --out o --at inf", "--at: expected a finite number"},
+      {"render experience-map --run r --size 100", "--size: expected WIDTHxHEIGHT"},
+      {"render experience-map --run r --size 32x32", "--size: expected WIDTHxHEIGHT"},
+      {"render experience-map --run r --color sesion", "(did you mean 'session'?)"},
+      {"print-config --render", "ratslam print-config: unknown option '--render'"},
+      {"import --data d --out o --quiet", "unknown option '--quiet'"},
+      {"replay --dta x --out y", "unknown option '--dta' (did you mean '--data'?)"},
+      {"replay --data x --out y --outt z", "(did you mean '--out'?)"},
+      {"replya --data x", "unknown command 'replya' (did you mean 'replay'?)"},
+      {"render pose-cell --map m --out o",
+       "unknown command 'pose-cell' (did you mean "
+       "'pose-cells'?)"},
+      {"render", "a command is required: one of experience-map"},
+      {"replay --out o", "--data is required"},
+      {"replay --data a b --out o", "unexpected argument 'b'"},
+      {"replay --data a --out o --out p", "--out: given more than once"},
+      {"replay --data a --out", "--out: needs a value"},
+      {"print-config other", "'other' is not one of locate"},
+      {"sweep run", "DIR is required"},
+      {"import-openratslam a.ini b.ini", "unexpected argument 'b.ini'"},
+  };
+  for (const auto& [line, expected] : cases) {
+    const Outcome o = Parse(line);
+    EXPECT_EQ(o.code(), kExitUsage) << line;
+    EXPECT_NE(o.err.find(expected), std::string::npos) << line << "\n" << o.err;
+    EXPECT_NE(o.err.find("--help' for the options"), std::string::npos) << line << "\n" << o.err;
+    EXPECT_TRUE(o.out.empty()) << line;
+  }
+}
+
+TEST(CommandLineTest, TheLimitsOfARangeAreAccepted) {
+  for (const char* line :
+       {"synthesize --out d --seed 0", "synthesize --out d --seed 9007199254740992",
+        "synthesize --out d --laps 1000",
+        "render similarity --data d --out f "
+        "--frames 2",
+        "render wifi-map --wifi-map w --out f --floor -1000",
+        "render experience-map --run r --size 64x16384"}) {
+    const Outcome o = Parse(line);
+    EXPECT_EQ(o.code(), -1) << line << "\n" << o.err;
+  }
+}
+
+// The README's command reference is this program's help, so the two cannot drift apart.
+// RATSLAM_UPDATE_README=1 rewrites the README's block (then review the diff).
+TEST(CommandLineTest, ReadmeCarriesTheCurrentCommandReference) {
+  std::ifstream in(std::string(RATSLAM_SOURCE_DIR) + "/README.md");
+  ASSERT_TRUE(in) << "README.md not found";
+  std::stringstream s;
+  s << in.rdbuf();
+  const std::string readme = s.str();
+  const std::string begin = "<!-- command reference: begin -->\n";
+  const std::string end = "<!-- command reference: end -->";
+  const size_t a = readme.find(begin);
+  const size_t b = readme.find(end);
+  ASSERT_NE(a, std::string::npos) << "README.md has no '" << begin << "' marker";
+  ASSERT_NE(b, std::string::npos);
+  if (std::getenv("RATSLAM_UPDATE_README") != nullptr) {
+    std::ofstream(std::string(RATSLAM_SOURCE_DIR) + "/README.md")
+        << readme.substr(0, a + begin.size()) << CommandReference() << readme.substr(b);
+    GTEST_SKIP() << "README.md rewritten";
+  }
+  EXPECT_EQ(readme.substr(a + begin.size(), b - a - begin.size()), CommandReference())
+      << "README.md's command reference is out of date: rerun this test with "
+         "RATSLAM_UPDATE_README=1";
+}
+
+// The completion script is valid bash and completes commands, sub-commands and options.
+TEST(CommandLineTest, BashCompletionCompletes) {
+  const std::filesystem::path script =
+      std::filesystem::temp_directory_path() / "ratslam_completion_test.bash";
+  {
+    std::ofstream out(script);
+    out << BashCompletion();
+  }
+  auto complete = [&](const std::string& words) {
+    const std::filesystem::path result = script.string() + ".out";
+    const std::string command = "bash -c 'source " + script.string() + " && COMP_WORDS=(" + words +
+                                ") && COMP_CWORD=$((${#COMP_WORDS[@]} - 1)) && _ratslam && echo "
+                                "\"${COMPREPLY[*]}\"' > " +
+                                result.string() + " 2>&1";
+    EXPECT_EQ(std::system(command.c_str()), 0) << command;
+    std::ifstream in(result);
+    std::string line;
+    std::getline(in, line);
+    return line;
+  };
+  EXPECT_EQ(complete("ratslam rep"), "replay");
+  EXPECT_EQ(complete("ratslam render pose"), "pose-cells");
+  EXPECT_EQ(complete("ratslam replay --data x --lo"), "--load-map");
+  EXPECT_EQ(complete("ratslam sweep submit DIR --sl"), "--slurm");
+  EXPECT_EQ(complete("ratslam print-config --"), "--help --config");
+  std::filesystem::remove(script);
+}
+
+}  // namespace
+}  // namespace ratslam
