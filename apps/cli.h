@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "fusion/io/config.h"
+#include "viewer/figure_output.h"
 
 namespace ratslam {
 
@@ -77,6 +78,25 @@ inline std::optional<PipelineOptions> LoadOptions(const Arguments& args,
     return std::nullopt;
   }
   return options.value();
+}
+
+// --format and --width-mm of the figure commands: the formats asked for (none: the one the
+// output's extension names) and the page width of vector figures.
+struct FigureOptions {
+  std::optional<std::vector<FigureFormat>> formats;
+  double width_mm = kOneColumnMm;
+};
+inline StatusOr<FigureOptions> FigureOptionsOf(const Arguments& args) {
+  FigureOptions o;
+  if (auto it = args.values.find("--format"); it != args.values.end()) {
+    StatusOr<std::vector<FigureFormat>> formats = ParseFigureFormats(it->second);
+    if (!formats.ok()) return formats.status().WithContext("--format");
+    o.formats = *formats;
+  }
+  if (auto it = args.values.find("--width-mm"); it != args.values.end()) {
+    o.width_mm = std::strtod(it->second.c_str(), nullptr);  // checked by the parser
+  }
+  return o;
 }
 
 // `ratslam render ...` (render_command.cc).

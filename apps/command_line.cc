@@ -32,6 +32,7 @@ struct OptionSpec {
   Kind kind = Kind::kText;
   int64_t min = 0, max = 0;          // kWhole
   std::vector<std::string> choices;  // kText: the allowed values, when fixed
+  bool list = false;                 // a comma-separated list of choices
 };
 
 struct CommandSpec {
@@ -81,11 +82,30 @@ OptionSpec Choice(std::string name, std::string value_name, std::string help,
   o.choices = std::move(choices);
   return o;
 }
+OptionSpec Formats(std::string help =
+                       "figure formats, comma-separated: png, pdf, svg "
+                       "(default: the one --out's extension names)") {
+  OptionSpec o = Option("--format", "LIST", std::move(help), Kind::kText);
+  o.choices = {"png", "pdf", "svg"};
+  o.repeatable = false;
+  o.list = true;
+  return o;
+}
+OptionSpec WidthMm() {
+  OptionSpec o =
+      Option("--width-mm", "MM", "page width of PDF and SVG figures (default 88)", Kind::kNumber);
+  o.min = 20;
+  o.max = 2000;
+  return o;
+}
 OptionSpec Size() {
   return Option("--size", "WxH", "image size in pixels (e.g. 1600x1200)", Kind::kSize);
 }
 
 const OptionSpec kQuiet = Flag("--quiet", "no progress on stderr and no summary on stdout");
+const OptionSpec kJson = Flag("--json",
+                              "print summary.json on stdout even on a terminal (the default when "
+                              "stdout is not one)");
 const OptionSpec kLenient =
     Flag("--lenient", "skip and count malformed lines of phone logs instead of failing");
 const OptionSpec kOverwrite = Flag(
@@ -108,7 +128,8 @@ const std::vector<CommandSpec>& Commands() {
         Flag("--render", "also write the run's images (experience map, template graph, ...)"),
         Whole("--animate", "N", "write an experience-map frame every N events to O/animation/", 1,
               kSeedMax),
-        kLenient, kQuiet},
+        Formats("formats of the --render images: png, pdf, svg, comma-separated (default png)"),
+        WidthMm(), kLenient, kQuiet, kJson},
        {}},
       {"import",
        "convert data sets (phone logs, ...) to the replay format",
@@ -121,7 +142,7 @@ const std::vector<CommandSpec>& Commands() {
        "simulate the built-in day_night world and replay it",
        "Simulates the built-in day_night world (camera, Wi-Fi, compass, odometry) into O/data, "
        "replays it into O with the fused front end and renders the images.",
-       {Text("--out", "O", "output folder", true), kOverwrite, kQuiet},
+       {Text("--out", "O", "output folder", true), kOverwrite, kQuiet, kJson},
        {}},
       {"print-config",
        "print the resolved configuration",
@@ -152,21 +173,23 @@ const std::vector<CommandSpec>& Commands() {
         Text("--out", "F", "image file; default: O/experience_map.png"), Size(),
         Choice("--color", "BY", "colour the experiences by time or by session",
                {"time", "session"}),
-        Text("--sessions", "T1,T2,...", "session start times in seconds, comma-separated")},
+        Text("--sessions", "T1,T2,...", "session start times in seconds, comma-separated"),
+        Formats(), WidthMm()},
        {}},
       {"render template-graph",
        "template ids over time, with labelled spans",
        "",
        {Text("--run", "O", "run folder (written by replay)", true),
         Text("--out", "F", "image file; default: O/template_graph.png"), Size(),
-        Text("--spans", "A-B:label,...", "time spans to shade and label, comma-separated")},
+        Text("--spans", "A-B:label,...", "time spans to shade and label, comma-separated"),
+        Formats(), WidthMm()},
        {}},
       {"render pose-cells",
        "the pose-cell activity of a saved map",
        "Draws the pose-cell network of a saved map with the map's own configuration (maps of "
        "format 2 carry none and need --config).",
        {Text("--map", "F", "saved map (replay --save-map)", true),
-        Text("--out", "F", "image file", true), kConfig},
+        Text("--out", "F", "image file", true), kConfig, Formats(), WidthMm()},
        {}},
       {"render similarity",
        "the frame-by-frame similarity matrix of a data set",
@@ -174,7 +197,7 @@ const std::vector<CommandSpec>& Commands() {
        {Text("--data", "D", "data set; repeat for several sessions", true, true),
         Text("--out", "F", "image file", true), kConfig,
         Whole("--frames", "N", "frames to compare (evenly spaced)", 2, 5000),
-        Choice("--sensor", "S", "the sensor to compare", {"camera", "wifi"})},
+        Choice("--sensor", "S", "the sensor to compare", {"camera", "wifi"}), Formats(), WidthMm()},
        {}},
       {"render wifi-map",
        "one access point's Gaussian-process Wi-Fi map",
@@ -182,7 +205,7 @@ const std::vector<CommandSpec>& Commands() {
        {Text("--wifi-map", "W", "Wi-Fi map file (ratslam wifi-map)", true),
         Text("--out", "F", "image file", true),
         Text("--ap", "BSSID", "access point; default: the one with the largest grid"),
-        Whole("--floor", "N", "floor; default: the AP's first", -1000, 1000)},
+        Whole("--floor", "N", "floor; default: the AP's first", -1000, 1000), Formats(), WidthMm()},
        {}},
       {"evaluate",
        "FABMAP localisation benchmark",
@@ -305,13 +328,18 @@ CLI::Validator WholeValidator(int64_t min, int64_t max) {
       "");
 }
 
-CLI::Validator NumberValidator() {
+// A finite number; within [min, max] unless min == max.
+CLI::Validator NumberValidator(int64_t min, int64_t max) {
   return CLI::Validator(
-      [](std::string& text) -> std::string {
+      [min, max](std::string& text) -> std::string {
         char* end = nullptr;
         const double value = std::strtod(text.c_str(), &end);
         if (text.empty() || *end != '\0' || !std::isfinite(value)) {
           return "expected a finite number, got '" + text + "'";
+        }
+        if (min != max && (value < static_cast<double>(min) || value > static_cast<double>(max))) {
+          return "expected a number in " + std::to_string(min) + ".." + std::to_string(max) +
+                 ", got '" + text + "'";
         }
         return "";
       },
@@ -333,14 +361,28 @@ CLI::Validator SizeValidator() {
       "");
 }
 
-CLI::Validator ChoiceValidator(std::vector<std::string> choices) {
+// One of `choices`, or with `list` a comma-separated list of distinct ones.
+CLI::Validator ChoiceValidator(std::vector<std::string> choices, bool list) {
   return CLI::Validator(
-      [choices](std::string& text) -> std::string {
-        if (std::find(choices.begin(), choices.end(), text) != choices.end()) return "";
-        std::string list;
-        for (const std::string& c : choices) list += (list.empty() ? "" : ", ") + c;
-        std::set<std::string> known(choices.begin(), choices.end());
-        return "'" + text + "' is not one of " + list + schema::DidYouMean(text, known);
+      [choices, list](std::string& text) -> std::string {
+        std::vector<std::string> items;
+        if (list) {
+          std::istringstream in(text);
+          for (std::string item; std::getline(in, item, ',');) items.push_back(item);
+          if (items.empty() || text.back() == ',') items.push_back("");
+        } else {
+          items.push_back(text);
+        }
+        std::set<std::string> seen;
+        for (const std::string& item : items) {
+          if (!seen.insert(item).second) return "'" + item + "' given twice";
+          if (std::find(choices.begin(), choices.end(), item) != choices.end()) continue;
+          std::string names;
+          for (const std::string& c : choices) names += (names.empty() ? "" : ", ") + c;
+          std::set<std::string> known(choices.begin(), choices.end());
+          return "'" + item + "' is not one of " + names + schema::DidYouMean(item, known);
+        }
+        return "";
       },
       "");
 }
@@ -372,13 +414,13 @@ void AddOption(CLI::App* sub, const OptionSpec& spec) {
       option->check(WholeValidator(spec.min, spec.max));
       break;
     case Kind::kNumber:
-      option->check(NumberValidator());
+      option->check(NumberValidator(spec.min, spec.max));
       break;
     case Kind::kSize:
       option->check(SizeValidator());
       break;
     default:
-      if (!spec.choices.empty()) option->check(ChoiceValidator(spec.choices));
+      if (!spec.choices.empty()) option->check(ChoiceValidator(spec.choices, spec.list));
       break;
   }
 }

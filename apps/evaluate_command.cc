@@ -4,6 +4,7 @@
 #include <string>
 
 #include "apps/cli.h"
+#include "apps/progress.h"
 #include "common/number_text.h"
 #include "common/output_folder.h"
 #include "common/provenance.h"
@@ -12,35 +13,6 @@
 #include "viewer/localisation_figure.h"
 
 namespace ratslam {
-
-namespace {
-
-// Progress lines on stderr: every tenth of each phase.
-class StepProgress : public ProgressSink {
- public:
-  explicit StepProgress(bool quiet) : quiet_(quiet) {}
-  void Update(const ProgressUpdate& u) override {
-    if (quiet_ || u.total == 0) return;
-    if (u.phase != phase_) {
-      phase_ = u.phase;
-      last_ = static_cast<size_t>(-1);
-    }
-    const size_t decile = u.done * 10 / u.total;
-    if (decile != last_) {
-      last_ = decile;
-      std::fprintf(stderr, "evaluate: %s %llu/%llu\n", u.phase.c_str(),
-                   static_cast<unsigned long long>(u.done),
-                   static_cast<unsigned long long>(u.total));
-    }
-  }
-
- private:
-  bool quiet_;
-  std::string phase_;
-  size_t last_ = static_cast<size_t>(-1);
-};
-
-}  // namespace
 
 int EvaluateCommand(const Arguments& parsed) {
   const Arguments* args = &parsed;
@@ -59,7 +31,7 @@ int EvaluateCommand(const Arguments& parsed) {
   };
   auto out = DiskFolder::Open(out_path);
   if (!out.ok()) return fail(out.status());
-  StepProgress progress(args->quiet);
+  ProgressPrinter progress(stderr, args->quiet);
   EvaluationSession session(options, out->get(), nullptr, &progress);
   if (Status s = session.Load(); !s.ok()) return fail(s);
   const fabmap::FabmapMode mode = session.mode();

@@ -2,37 +2,101 @@
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
+
 namespace ratslam {
 
-ProgressPrinter::ProgressPrinter(std::FILE* stream, bool quiet)
-    : stream_(stream), quiet_(quiet), terminal_(::isatty(::fileno(stream)) != 0) {}
+ProgressPrinter::ProgressPrinter(std::FILE* stream, bool quiet, int terminal, const Clock* clock)
+    : stream_(stream),
+      quiet_(quiet),
+      terminal_(terminal >= 0 ? terminal != 0 : ::isatty(::fileno(stream)) != 0),
+      clock_(clock ? clock : &steady_) {}
+
+std::string ProgressPrinter::Duration(double seconds) {
+  const long total = std::lround(std::max(0.0, seconds));
+  char buffer[32];
+  if (total >= 3600) {
+    std::snprintf(buffer, sizeof buffer, "%ldh%02ldm", total / 3600, total / 60 % 60);
+  } else if (total >= 60) {
+    std::snprintf(buffer, sizeof buffer, "%ldm%02lds", total / 60, total % 60);
+  } else {
+    std::snprintf(buffer, sizeof buffer, "%ld s", total);
+  }
+  return buffer;
+}
 
 void ProgressPrinter::Update(const ProgressUpdate& p) {
-  if (quiet_ || p.total == 0) return;
-  const double fraction = static_cast<double>(p.done) / p.total;
-  if (terminal_) {
-    constexpr int kWidth = 40;
-    const int filled = static_cast<int>(fraction * kWidth);
-    std::fprintf(stream_, "\r[%s%s] %5.1f%%  %llu/%llu events  t=%.1f s",
-                 std::string(filled, '#').c_str(), std::string(kWidth - filled, ' ').c_str(),
-                 100.0 * fraction, static_cast<unsigned long long>(p.done),
-                 static_cast<unsigned long long>(p.total), p.data_time_s);
-    std::fflush(stream_);
-    drew_bar_ = true;
-    return;
+  if (quiet_) return;
+  const size_t comma = p.phase.find(',');
+  const std::string phase = p.phase.substr(0, comma);
+  const std::string detail = comma == std::string::npos ? "" : p.phase.substr(comma + 1);
+  const double now = clock_->Seconds();
+  bool print = terminal_;
+  if (phase != phase_ || last_tenth_ < 0) {
+    if (drew_) Finish();
+    phase_ = phase;
+    phase_start_s_ = now;
+    first_done_ = p.done;
+    last_tenth_ = -1;
+    print = true;
   }
-  const int decile = static_cast<int>(fraction * 10);
-  if (decile > last_decile_) {
-    last_decile_ = decile;
-    std::fprintf(stream_, "progress: %3d%%  %llu/%llu events  data time %.1f s\n", decile * 10,
-                 static_cast<unsigned long long>(p.done), static_cast<unsigned long long>(p.total),
-                 p.data_time_s);
+  if (detail != detail_) print = true;
+  detail_ = detail;
+  const int tenth = p.total > 0 ? static_cast<int>(p.done * 10 / p.total) : -1;
+  if (tenth > last_tenth_) print = true;
+  last_tenth_ = std::max(last_tenth_, tenth);
+  last_ = p;
+  if (print) Print(p, now, !terminal_);
+}
+
+void ProgressPrinter::Print(const ProgressUpdate& p, double now, bool end_line) {
+  const double elapsed = now - phase_start_s_;
+  std::string line = phase_ + ":";
+  char buffer[160];
+  if (p.total > 0) {
+    std::snprintf(buffer, sizeof buffer, " %5.1f%% %llu/%llu", 100.0 * p.done / p.total,
+                  static_cast<unsigned long long>(p.done),
+                  static_cast<unsigned long long>(p.total));
+  } else {
+    std::snprintf(buffer, sizeof buffer, " %llu", static_cast<unsigned long long>(p.done));
   }
+  line += buffer;
+  if (p.data_time_s >= 0) {
+    std::snprintf(buffer, sizeof buffer, ", data time %.1f s", p.data_time_s);
+    line += buffer;
+  }
+  line += ", " + Duration(elapsed) + " elapsed";
+  const uint64_t fresh = p.done - std::min(p.done, first_done_);
+  if (fresh > 0 && elapsed > 0) {
+    const double rate = fresh / elapsed;
+    std::snprintf(buffer, sizeof buffer, rate >= 100 ? ", %.0f/s" : ", %.3g/s", rate);
+    line += buffer;
+    if (p.total > p.done) line += ", ETA " + Duration((p.total - p.done) / rate);
+  }
+  if (!detail_.empty()) line += "," + detail_;
+  if (terminal_ && !end_line) {
+    // Redrawn in place; the padding clears a longer previous line.
+    std::fprintf(stream_, "\r%-100s", line.c_str());
+    drew_ = true;
+  } else {
+    std::fprintf(stream_, "%s%s\n", drew_ ? "\r" : "", line.c_str());
+    drew_ = false;
+  }
+  std::fflush(stream_);
 }
 
 void ProgressPrinter::Finish() {
-  if (drew_bar_) std::fprintf(stream_, "\n");
-  drew_bar_ = false;
+  if (quiet_) return;
+  if (drew_) {
+    std::fprintf(stream_, "\n");
+    drew_ = false;
+  } else if (!terminal_ && !phase_.empty() && last_.total > 0 && last_.done < last_.total) {
+    // A phase that ended early (interrupted) says where.
+    Print(last_, clock_->Seconds(), true);
+  }
+  last_tenth_ = -1;
+  phase_.clear();
 }
 
 }  // namespace ratslam

@@ -1,5 +1,7 @@
 // The `ratslam` command line: replay a data set, run the demo, print or import configurations,
 // and write the built-in synthetic data set.
+#include <unistd.h>
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -58,7 +60,32 @@ struct ReplayRequest {
   bool quiet = false;
   bool render = false;         // write experience_map.png, template_graph.png, pose_cells.png
   uint64_t animate_every = 0;  // events between animation frames; 0: no animation
+  bool json = false;           // the summary as JSON on stdout even on a terminal
+  std::vector<FigureFormat> formats{FigureFormat::kPng};  // of the --render images
+  double width_mm = kOneColumnMm;
 };
+
+// The end of a run on a terminal: what was built and how good it is, in three lines.
+std::string HumanSummary(const RunSummary& s, const std::string& out) {
+  char line[256];
+  std::string text;
+  std::snprintf(line, sizeof line,
+                "ratslam: %llu frames: %llu templates, %llu experiences, %llu loop closures\n",
+                static_cast<unsigned long long>(s.frames),
+                static_cast<unsigned long long>(s.templates),
+                static_cast<unsigned long long>(s.experiences),
+                static_cast<unsigned long long>(s.loop_closures));
+  text += line;
+  if (s.map_ate_m && s.odometry_ate_m) {
+    std::snprintf(line, sizeof line,
+                  "ratslam: map error %.2f m against %.2f m for dead reckoning (ATE over %zu "
+                  "points, rigid fit)\n",
+                  *s.map_ate_m, *s.odometry_ate_m, s.ate_points);
+    text += line;
+  }
+  text += "ratslam: outputs in " + out + " (summary.json; --json prints it here)\n";
+  return text;
+}
 
 // Parses nothing and decides nothing: runs a replay session and reports what it did.
 int RunReplay(const ReplayRequest& request) {
@@ -124,15 +151,25 @@ int RunReplay(const ReplayRequest& request) {
   const ReplayResult& result = session.result();
 
   int exit_code = kExitOk;
-  if (result.summary) std::cout << result.summary->json;
+  if (result.summary) {
+    if (request.json || !::isatty(STDOUT_FILENO)) {
+      std::cout << result.summary->json;
+    } else if (!request.quiet) {
+      std::cout << HumanSummary(*result.summary, request.out);
+    }
+  }
   if (!result.outputs.ok()) exit_code = fail(result.outputs);
   if (!result.save.ok()) exit_code = fail(result.save);
   if (request.render && result.outputs.ok()) {
-    StatusOr<std::unique_ptr<SceneRenderer>> renderer = CreateOsMesaRenderer();
-    Status rendered = renderer.ok() ? WriteRunImages(*renderer.value(), session.pipeline().View(),
-                                                     session.dataset(), request.out)
+    const bool png = std::find(request.formats.begin(), request.formats.end(),
+                               FigureFormat::kPng) != request.formats.end();
+    StatusOr<std::unique_ptr<SceneRenderer>> renderer =
+        png ? CreateOsMesaRenderer() : StatusOr<std::unique_ptr<SceneRenderer>>(nullptr);
+    Status rendered = renderer.ok() ? WriteRunImages(renderer->get(), session.pipeline().View(),
+                                                     session.dataset(), request.out,
+                                                     request.formats, request.width_mm)
                                     : renderer.status();
-    if (rendered.ok() && session.pipeline().wifi_sequence().options().enabled) {
+    if (rendered.ok() && png && session.pipeline().wifi_sequence().options().enabled) {
       rendered = WriteWifiSequenceImages(*renderer.value(), session.pipeline(), request.out);
     }
     if (!rendered.ok()) exit_code = fail(rendered.WithContext("images not written"));
@@ -185,6 +222,14 @@ int Replay(const Arguments& parsed) {
   }
   request.quiet = args->quiet;
   request.render = args->render;
+  request.json = args->values.count("--json") > 0;
+  StatusOr<FigureOptions> figure = FigureOptionsOf(*args);
+  if (!figure.ok()) {
+    std::cerr << "ratslam: " << figure.status().message() << "\n";
+    return kExitUsage;
+  }
+  if (figure->formats) request.formats = *figure->formats;
+  request.width_mm = figure->width_mm;
   return RunReplay(request);
 }
 
@@ -222,6 +267,7 @@ int Demo(const Arguments& parsed) {
   request.session.provenance = {args->command_line, UtcNowIso8601()};
   request.out = out;
   request.quiet = args->quiet;
+  request.json = args->values.count("--json") > 0;
   request.render = true;
   return RunReplay(request);
 }

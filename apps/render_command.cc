@@ -12,6 +12,7 @@
 #include "sensors/dataset/dataset.h"
 #include "sensors/dataset/dataset_loader.h"
 #include "sensors/dataset/image_loader.h"
+#include "viewer/figure_output.h"
 #include "viewer/figures.h"
 #include "viewer/run_images.h"
 #include "viewer/similarity.h"
@@ -74,10 +75,25 @@ std::optional<std::vector<TimeSpan>> ParseSpans(const std::string& text) {
   return spans;
 }
 
-Status Write(const Scene& scene, const std::string& path) {
-  Status status = RenderToPng(scene, path);
-  if (status.ok()) std::cerr << "ratslam: wrote " << path << "\n";
-  return status;
+// Writes the figure `build` makes to --out, in the formats --format names (else the one --out's
+// extension names): PNG at width_px x height_px, PDF and SVG laid out for --width-mm.
+Status Write(const Arguments& args, const std::string& out, const SceneBuilder& build, int width_px,
+             int height_px) {
+  StatusOr<FigureOptions> figure = FigureOptionsOf(args);
+  if (!figure.ok()) return figure.status();
+  const std::vector<FigureTarget> targets =
+      FigureTargets(out, figure->formats ? &*figure->formats : nullptr);
+  std::unique_ptr<SceneRenderer> renderer;
+  for (const FigureTarget& t : targets) {
+    if (t.format != FigureFormat::kPng || renderer) continue;
+    StatusOr<std::unique_ptr<SceneRenderer>> made = CreateOsMesaRenderer();
+    if (!made.ok()) return made.status();
+    renderer = std::move(made.value());
+  }
+  RATSLAM_RETURN_IF_ERROR(
+      WriteFigure(renderer.get(), build, width_px, height_px, targets, figure->width_mm));
+  for (const FigureTarget& t : targets) std::cerr << "ratslam: wrote " << t.path << "\n";
+  return Status::Ok();
 }
 
 int RenderExperienceMap(const Arguments& args) {
@@ -120,7 +136,11 @@ int RenderExperienceMap(const Arguments& args) {
   const std::string out = args.values.count("--out")
                               ? args.values.at("--out")
                               : (fs::path(run_folder) / "experience_map.png").string();
-  Status status = Write(ExperienceMapScene(data, options), out);
+  Status status =
+      Write(args, out,
+            Sized(options,
+                  [&](const ExperienceMapImageOptions& o) { return ExperienceMapScene(data, o); }),
+            options.width_px, options.height_px);
   return status.ok() ? kExitOk : Fail(status.message());
 }
 
@@ -142,7 +162,11 @@ int RenderTemplateGraph(const Arguments& args) {
   const std::string out = args.values.count("--out")
                               ? args.values.at("--out")
                               : (fs::path(run_folder) / "template_graph.png").string();
-  Status status = Write(TemplateGraphScene(points, options), out);
+  Status status = Write(
+      args, out,
+      Sized(options,
+            [&](const TemplateGraphImageOptions& o) { return TemplateGraphScene(points, o); }),
+      options.width_px, options.height_px);
   return status.ok() ? kExitOk : Fail(status.message());
 }
 
@@ -172,7 +196,11 @@ int RenderPoseCells(const Arguments& args) {
   }
   PoseCellImageOptions image_options;
   image_options.title = "pose-cell activity (" + map->dataset_name + ", summed over theta)";
-  Status status = Write(PoseCellScene(network, image_options), args.values.at("--out"));
+  Status status =
+      Write(args, args.values.at("--out"),
+            Sized(image_options,
+                  [&](const PoseCellImageOptions& o) { return PoseCellScene(network, o); }),
+            image_options.width_px, image_options.height_px);
   return status.ok() ? kExitOk : Fail(status.message());
 }
 
@@ -203,8 +231,17 @@ int RenderSimilarity(const Arguments& args) {
     image_options.value_label = "weight w";
   }
   if (!m.ok()) return Fail(m.status().message());
-  Status status =
-      Write(SimilarityMatrixScene(m->values, m->times_s, image_options), args.values.at("--out"));
+  // The matrix's side sets the figure's size; the margins around it are fixed.
+  const Scene natural = SimilarityMatrixScene(m->values, m->times_s, image_options);
+  const int margins = natural.width() - image_options.size_px;
+  Status status = Write(
+      args, args.values.at("--out"),
+      [&](int w, int) {
+        SimilarityImageOptions o = image_options;
+        o.size_px = std::max(100, w - margins);
+        return SimilarityMatrixScene(m->values, m->times_s, o);
+      },
+      natural.width(), natural.height());
   return status.ok() ? kExitOk : Fail(status.message());
 }
 
@@ -251,10 +288,17 @@ int RenderWifiMap(const Arguments& args) {
   for (const WifiMapSample& s : map->training_samples()) {
     if (s.floor == floor) points.push_back(s.position);
   }
-  Status status = Write(GridFieldsScene({mean, variance}, points,
-                                        "Wi-Fi map of " + map->bssids()[ap] + ", floor " +
-                                            std::to_string(floor) + " (dots: training scans)"),
-                        args.values.at("--out"));
+  const std::string title = "Wi-Fi map of " + map->bssids()[ap] + ", floor " +
+                            std::to_string(floor) + " (dots: training scans)";
+  const Scene natural = GridFieldsScene({mean, variance}, points, title);
+  Status status = Write(
+      args, args.values.at("--out"),
+      [&](int w, int) {
+        // Two panels of `panel` pixels plus fixed margins; the panel follows the width.
+        const int panel = std::max(100, 700 - (natural.width() - w) / 2);
+        return GridFieldsScene({mean, variance}, points, title, panel);
+      },
+      natural.width(), natural.height());
   return status.ok() ? kExitOk : Fail(status.message());
 }
 

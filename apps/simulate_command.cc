@@ -1,11 +1,14 @@
 // `ratslam simulate`: a simulated world written as a replay data set.
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <nlohmann/json.hpp>
 
 #include "apps/cli.h"
+#include "apps/progress.h"
 #include "common/file_util.h"
 #include "render/renderer.h"
 #include "sim/simulator.h"
@@ -27,12 +30,17 @@ Status SimulateWorld(const sim::World& world, uint64_t seed, const std::string& 
   auto renderer = CreateOsMesaViewRenderer();
   if (!renderer.ok()) return renderer.status();
   sim::SimulationReport report;
+  ProgressPrinter progress(stderr, quiet);
   RATSLAM_RETURN_IF_ERROR(sim::Simulate(
       world, seed, renderer->get(), (fs::path(out) / "images").string(), dataset, &report,
       [&](double fraction) {
-        if (!quiet)
-          std::fprintf(stderr, "simulate: %s %3.0f%%\n", world.name.c_str(), 100 * fraction);
+        ProgressUpdate u;
+        u.phase = "simulate " + world.name;
+        u.total = 1000;
+        u.done = static_cast<uint64_t>(std::lround(std::clamp(fraction, 0.0, 1.0) * 1000));
+        progress.Update(u);
       }));
+  progress.Finish();
   RATSLAM_RETURN_IF_ERROR(WriteDataset(*dataset, out));
   RATSLAM_RETURN_IF_ERROR(
       WriteFileAtomically((fs::path(out) / "world.toml").string(),

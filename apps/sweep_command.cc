@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "apps/cli.h"
+#include "apps/progress.h"
 #include "render/renderer.h"
 #include "sweep/sweep.h"
 #include "viewer/sweep_figures.h"
@@ -29,64 +30,6 @@ std::string ThisProgram() {
   const ssize_t n = readlink("/proc/self/exe", buffer, sizeof buffer - 1);
   return n > 0 ? std::string(buffer, static_cast<size_t>(n)) : std::string("ratslam");
 }
-
-// Done of total, failures and running tasks, elapsed time and ETA: redrawn in place on a
-// terminal, else a line per percent of the tasks (and for every failure).
-class SweepProgress : public ProgressSink {
- public:
-  explicit SweepProgress(bool quiet)
-      : quiet_(quiet), terminal_(isatty(STDERR_FILENO)), start_(std::chrono::steady_clock::now()) {}
-  void Update(const ProgressUpdate& p) override {
-    if (quiet_ || p.total == 0) return;
-    if (!started_) {
-      started_ = true;
-      first_done_ = p.done;  // tasks finished by earlier runs do not count for the ETA
-    }
-    const uint64_t percent = p.done * 100 / p.total;
-    const bool new_failure =
-        p.phase.substr(0, p.phase.find(',')) != last_phase_.substr(0, last_phase_.find(','));
-    if (!terminal_ && percent == last_percent_ && !new_failure) return;
-    last_percent_ = percent;
-    last_phase_ = p.phase;
-    const double elapsed =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-    const uint64_t fresh = p.done - std::min(p.done, first_done_);
-    const std::string eta =
-        p.done >= p.total ? Duration(0.0)
-        : fresh > 0
-            ? Duration(elapsed / static_cast<double>(fresh) * static_cast<double>(p.total - p.done))
-            : std::string(1, '?');
-    std::fprintf(stderr, "%s%s: %llu/%llu, %s elapsed, ETA %s%s", terminal_ ? "\r" : "",
-                 p.phase.c_str(), static_cast<unsigned long long>(p.done),
-                 static_cast<unsigned long long>(p.total), Duration(elapsed).c_str(), eta.c_str(),
-                 terminal_ ? "   " : "\n");
-    drew_ = terminal_;
-  }
-  void Finish() override {
-    if (drew_) std::fprintf(stderr, "\n");
-    drew_ = false;
-  }
-
- private:
-  static std::string Duration(double s) {
-    const long total = static_cast<long>(s + 0.5);
-    char buffer[32];
-    if (total >= 3600) {
-      std::snprintf(buffer, sizeof buffer, "%ldh%02ldm", total / 3600, total / 60 % 60);
-    } else {
-      std::snprintf(buffer, sizeof buffer, "%ldm%02lds", total / 60, total % 60);
-    }
-    return buffer;
-  }
-  bool quiet_;
-  bool terminal_;
-  std::chrono::steady_clock::time_point start_;
-  bool started_ = false;
-  bool drew_ = false;
-  uint64_t first_done_ = 0;
-  uint64_t last_percent_ = 101;
-  std::string last_phase_;
-};
 
 // The sweep's figures from its collected points, into DIR/plots/.
 Status DrawSweepPlots(const std::string& dir, const sweep::CollectReport& report) {
@@ -152,7 +95,7 @@ int SweepCommand(const std::string& action, const Arguments& parsed) {
       if (!jobs) return kExitUsage;
       options.jobs = static_cast<int>(*jobs);
     }
-    SweepProgress progress(args->quiet);
+    ProgressPrinter progress(stderr, args->quiet);
     options.progress = &progress;
     options.stop_requested = &g_sweep_stop;
     std::signal(SIGINT, OnSweepSignal);

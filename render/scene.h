@@ -36,6 +36,20 @@ struct SceneText {
   TextAnchor anchor = TextAnchor::kLeft;
 };
 
+// A drawing operation as the figure asked for it, for vector backends (PDF, SVG), which draw
+// true strokes, circles and rectangles instead of the triangles an OpenGL backend needs.
+struct SceneShape {
+  enum class Kind { kLine, kPolyline, kDisc, kRing, kRect, kTriangle };
+  Kind kind = Kind::kTriangle;
+  // kLine, kPolyline: the points; kDisc, kRing: the centre; kRect: top-left and bottom-right;
+  // kTriangle: the three corners.
+  std::vector<ScenePoint> points;
+  float width_px = 0;                        // kLine, kPolyline: stroke width
+  float radius_px = 0, inner_radius_px = 0;  // kDisc: radius; kRing: outer and inner
+  float start_rad = 0, end_rad = 0;          // kRing: counter-clockwise on screen
+  Rgba color;
+};
+
 class Scene {
  public:
   Scene(int width_px, int height_px, Rgba background)
@@ -52,6 +66,8 @@ class Scene {
   void Image(SceneImage image) { images_.push_back(std::move(image)); }
   void Text(ScenePoint position, std::string text, float height_px, Rgba color,
             TextAnchor anchor = TextAnchor::kLeft);
+  // Draws `other` (without its background) with its origin at (dx, dy): panels side by side.
+  void Append(const Scene& other, float dx, float dy);
 
   struct Vertex {
     float x, y;
@@ -62,13 +78,19 @@ class Scene {
   Rgba background() const { return background_; }
   // Triangles (three vertices each), drawn in order after the images.
   const std::vector<Vertex>& triangles() const { return triangles_; }
+  // The same drawing as the shapes it was made of, in the same order.
+  const std::vector<SceneShape>& shapes() const { return shapes_; }
   const std::vector<SceneImage>& images() const { return images_; }
   const std::vector<SceneText>& texts() const { return texts_; }
 
  private:
   int width_, height_;
   Rgba background_;
+  void AddTriangle(ScenePoint a, ScenePoint b, ScenePoint c, Rgba color);
+  void AddLine(ScenePoint a, ScenePoint b, float width_px, Rgba color);
+
   std::vector<Vertex> triangles_;
+  std::vector<SceneShape> shapes_;
   std::vector<SceneImage> images_;
   std::vector<SceneText> texts_;
 };

@@ -875,8 +875,8 @@ Status RunQueue(const Plan& plan, const std::string& dir, const std::vector<int>
   auto stopping = [&] { return options.stop_requested && options.stop_requested->load(); };
   auto show = [&] {
     if (!options.progress) return;
-    options.progress->Update({"sweep (" + std::to_string(report->failed) + " failed, " +
-                                  std::to_string(running.size()) + " running)",
+    // "sweep, N failed": the failures are a detail of the phase (see apps/progress.h).
+    options.progress->Update({"sweep, " + std::to_string(report->failed) + " failed",
                               static_cast<uint64_t>(report->done + report->skipped),
                               static_cast<uint64_t>(total)});
   };

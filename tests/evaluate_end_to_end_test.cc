@@ -16,8 +16,11 @@
 #include <string>
 #include <vector>
 
+#include "tests/documented_keys.h"
+
 namespace {
 namespace fs = std::filesystem;
+namespace e2e = ratslam::e2e;
 
 fs::path Scratch(const std::string& name) {
   return fs::temp_directory_path() / ("ratslam_" + name + "_" + std::to_string(::getpid()));
@@ -34,6 +37,8 @@ TEST(EvaluateEndToEndTest, MicrosoftWalksWifiOnly) {
   ASSERT_EQ(std::system(command.c_str()), 0) << command;
   std::ifstream in(out / "evaluation.json");
   const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_TRUE(e2e::UndocumentedKeys(j).empty())
+      << "not in configs/README.md: " << e2e::Join(e2e::UndocumentedKeys(j));
   EXPECT_EQ(j["mode"], "wifi");
   EXPECT_GT(j["queries"].get<int>(), 500);
   const double rejected = j["rejection_rate"];

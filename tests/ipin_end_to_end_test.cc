@@ -21,6 +21,7 @@
 #include <utility>
 
 #include "sensors/dataset/dataset_loader.h"
+#include "tests/documented_keys.h"
 
 namespace ratslam {
 namespace {
@@ -40,6 +41,8 @@ TEST(IpinEndToEndTest, WifiRatslamClosesOutAndBackLoops) {
   ASSERT_EQ(std::system(command.c_str()), 0) << command;
   std::ifstream in(out / "summary.json");
   const nlohmann::json s = nlohmann::json::parse(in);
+  EXPECT_TRUE(e2e::UndocumentedKeys(s).empty())
+      << "not in configs/README.md: " << e2e::Join(e2e::UndocumentedKeys(s));
   const double within_10 = s["match_rate_within_m"]["10"];
   const int matches = s["matches"];
 

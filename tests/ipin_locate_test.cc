@@ -23,6 +23,7 @@
 #include "common/text_file.h"
 #include "fusion/phone_localisation/wifi_gp_map.h"
 #include "sensors/dataset/csv.h"
+#include "tests/documented_keys.h"
 #include "tests/run_ratslam.h"
 
 namespace ratslam {
@@ -53,6 +54,8 @@ TEST(IpinLocateTest, AParticleFilterLocatesAnotherPhoneInTheWifiMap) {
   ASSERT_EQ(located.exit_code, 0) << located.err;
   std::ifstream in(root / "o" / "summary.json");
   const nlohmann::json s = nlohmann::json::parse(in);
+  EXPECT_TRUE(e2e::UndocumentedKeys(s).empty())
+      << "not in configs/README.md: " << e2e::Join(e2e::UndocumentedKeys(s));
   ASSERT_GT(s["count"].get<int>(), 30);
   EXPECT_EQ(s["wrong_floor"], 0);
 
@@ -162,6 +165,8 @@ TEST(IpinLocateTest, ARunsMapLocatesThePhoneAndTheRobotIsCalled) {
   ASSERT_EQ(located.exit_code, 0) << located.err;
   std::ifstream in(root / "o" / "summary.json");
   const nlohmann::json s = nlohmann::json::parse(in);
+  EXPECT_TRUE(e2e::UndocumentedKeys(s).empty())
+      << "not in configs/README.md: " << e2e::Join(e2e::UndocumentedKeys(s));
   EXPECT_TRUE(s["errors_after_map_alignment"].get<bool>());
   EXPECT_GT(fs::file_size(root / "o" / "cumulative_error.png"), 10000u);
   // Chance: a uniform draw over the map's cells, moved into the truth's frame.
@@ -208,6 +213,9 @@ TEST(IpinLocateTest, ARunsMapLocatesThePhoneAndTheRobotIsCalled) {
     return nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
   };
   const nlohmann::json c = call(run, "c");
+  EXPECT_TRUE(e2e::UndocumentedKeys(c).empty())
+      << "not in configs/README.md: " << e2e::Join(e2e::UndocumentedKeys(c));
+
   ASSERT_TRUE(c.is_object());
   EXPECT_GT(fs::file_size(root / "c" / "call.png"), 10000u);
   EXPECT_LT(c["nearest_candidate_error_m"].get<double>(), 0.3 * chance);

@@ -23,6 +23,7 @@
 
 #include "sensors/dataset/csv.h"
 #include "sensors/dataset/dataset_loader.h"
+#include "tests/documented_keys.h"
 
 namespace ratslam {
 namespace {
@@ -36,7 +37,10 @@ nlohmann::json Replay(const std::string& config, const std::vector<fs::path>& lo
   command += " --out " + out.string() + " > /dev/null";
   EXPECT_EQ(std::system(command.c_str()), 0) << command;
   std::ifstream in(out / "summary.json");
-  return nlohmann::json::parse(in);
+  const nlohmann::json s = nlohmann::json::parse(in);
+  EXPECT_TRUE(e2e::UndocumentedKeys(s).empty())
+      << "not in configs/README.md: " << e2e::Join(e2e::UndocumentedKeys(s));
+  return s;
 }
 
 class IpinWifiSequenceTest : public testing::TestWithParam<const char*> {};

@@ -15,6 +15,7 @@
 #include "render/image.h"
 #include "render/renderer.h"
 #include "sensors/dataset/synthetic_dataset.h"
+#include "tests/documented_keys.h"
 #include "tests/run_ratslam.h"
 
 namespace ratslam {
@@ -106,10 +107,35 @@ TEST_F(ReplayEndToEndTest, AnEarlierRunsOutputsAreReplacedOnlyWithOverwrite) {
   for (const char* name : kOutputs) EXPECT_TRUE(fs::exists(out / name)) << name;
 }
 
+// --render --format pdf,svg writes vector figures (no PNG) on a page --width-mm wide, and
+// `render` picks the format from --out's extension.
+TEST_F(ReplayEndToEndTest, VectorFiguresFromReplayAndRender) {
+  const fs::path out = root_ / "vector";
+  const Result r =
+      RunRatslam(ReplayArgs(out) + " --until 60 --render --format pdf,svg --width-mm 180", root_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const char* name : {"experience_map", "template_graph", "pose_cells"}) {
+    const std::string pdf = Slurp(out / (std::string(name) + ".pdf"));
+    EXPECT_EQ(pdf.rfind("%PDF-", 0), 0u) << name;
+    EXPECT_NE(pdf.find("/FontFile"), std::string::npos) << name;  // text in an embedded font
+    const std::string svg = Slurp(out / (std::string(name) + ".svg"));
+    EXPECT_NE(svg.find("width=\"510.236"), std::string::npos) << name;  // 180 mm in points
+    EXPECT_NE(svg.find("xlink:href=\"#glyph"), std::string::npos) << name;
+    EXPECT_FALSE(fs::exists(out / (std::string(name) + ".png"))) << name;
+  }
+  const Result rendered = RunRatslam(
+      "render template-graph --run " + out.string() + " --out " + (root_ / "tg.svg").string(),
+      root_);
+  ASSERT_EQ(rendered.exit_code, 0) << rendered.err;
+  EXPECT_NE(Slurp(root_ / "tg.svg").find("width=\"249.4488"), std::string::npos);  // 88 mm
+}
+
 TEST_F(ReplayEndToEndTest, DemoDataClosesLoopsAndBeatsOdometry) {
   const fs::path out = root_ / "full";
   ASSERT_EQ(RunRatslam(ReplayArgs(out), root_).exit_code, 0);
   const nlohmann::json s = Summary(out);
+  EXPECT_TRUE(e2e::UndocumentedKeys(s).empty())
+      << "not in configs/README.md: " << e2e::Join(e2e::UndocumentedKeys(s));
   EXPECT_EQ(s["finished"], true);
   EXPECT_EQ(s["frames"], 3634);
   EXPECT_GT(s["loop_closures"].get<int>(), 10);

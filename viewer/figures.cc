@@ -69,7 +69,11 @@ struct PlotArea {
 
 void DrawAxes(Scene& scene, const PlotArea& p, const std::string& x_label,
               const std::string& y_label, bool grid = true) {
-  const double x_step = NiceStep(p.x1 - p.x0, 8), y_step = NiceStep(p.y1 - p.y0, 6);
+  // At most 8 x and 6 y ticks, fewer on small plots (vector figures are laid out small): a tick
+  // label needs about 50 px across and 40 px up.
+  const int x_ticks = std::clamp(static_cast<int>(p.width / 50), 2, 8);
+  const int y_ticks = std::clamp(static_cast<int>(p.height / 40), 2, 6);
+  const double x_step = NiceStep(p.x1 - p.x0, x_ticks), y_step = NiceStep(p.y1 - p.y0, y_ticks);
   for (double x = std::ceil(p.x0 / x_step) * x_step; x <= p.x1 + 1e-9; x += x_step) {
     const ScenePoint a = p.Map(x, p.y0);
     if (grid) scene.Line({a.x, p.top}, {a.x, p.top + p.height}, 1.0f, kGrid);
@@ -521,8 +525,7 @@ Scene PoseCellScene(const PoseCellNetwork& network, const PoseCellImageOptions& 
     std::snprintf(caption, sizeof caption, "max: x-y %.3g, heading %.3g", xy_max, theta_max);
     scene.Text({center.x, bar_top - 8}, caption, 14, kInk, TextAnchor::kCenter);
   }
-  scene.Text({center.x, top - 30}, "heading (activity summed over x, y)", 15, kInk,
-             TextAnchor::kCenter);
+  scene.Text({center.x, top - 30}, "heading (summed over x, y)", 15, kInk, TextAnchor::kCenter);
   scene.Text({20, 26},
              options.title.empty() ? "pose-cell activity (summed over theta)" : options.title, 18,
              kInk);
@@ -642,8 +645,8 @@ Scene SequencePairsScene(const SequencePairsData& data, const std::string& title
 }
 
 Scene GridFieldsScene(const std::vector<GridField>& fields, const std::vector<Point2>& points,
-                      const std::string& title) {
-  const int panel = 700, top = 70, bar = 90, bottom = 50;
+                      const std::string& title, int panel_px) {
+  const int panel = panel_px, top = 70, bar = 90, bottom = 50;
   const int n = std::max<int>(1, static_cast<int>(fields.size()));
   Scene scene(n * (panel + bar), top + panel + bottom, kWhite);
   scene.Text({20, 26}, title, 18, kInk);

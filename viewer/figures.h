@@ -148,8 +148,9 @@ struct GridField {
 };
 // The fields side by side at one scale (each with a colour bar from its lowest to its highest
 // value), `points` (e.g. where the data was taken) as dots on every panel, a scale bar.
+// `panel_px` is each panel's side.
 Scene GridFieldsScene(const std::vector<GridField>& fields, const std::vector<Point2>& points,
-                      const std::string& title);
+                      const std::string& title, int panel_px = 700);
 
 // An n x n matrix (row-major, values in [0, 1]) sampled at `times_s` as a heat map.
 Scene SimilarityMatrixScene(const std::vector<float>& matrix, const std::vector<double>& times_s,

@@ -6,6 +6,7 @@
 #include <set>
 
 #include "common/geometry.h"
+#include "render/vector_figure.h"
 
 namespace ratslam {
 
@@ -54,14 +55,13 @@ std::vector<int> ExperienceFloors(const std::vector<Experience>& experiences,
   return floors;
 }
 
-StatusOr<RgbaImage> RenderExperienceMapByFloor(SceneRenderer& renderer,
-                                               const ExperienceMapImageData& data,
-                                               const std::vector<int>& experience_floors,
-                                               const std::vector<int>& ground_truth_floors,
-                                               const ExperienceMapImageOptions& panel) {
+std::vector<Scene> ExperienceMapFloorScenes(const ExperienceMapImageData& data,
+                                            const std::vector<int>& experience_floors,
+                                            const std::vector<int>& ground_truth_floors,
+                                            const ExperienceMapImageOptions& panel) {
   std::set<int> distinct(experience_floors.begin(), experience_floors.end());
   if (distinct.size() <= 1 || experience_floors.size() != data.experiences.size()) {
-    return renderer.Render(ExperienceMapScene(data, panel));
+    return {ExperienceMapScene(data, panel)};
   }
   // One view for all panels: the bounds of everything.
   WorldBounds bounds{1e300, 1e300, -1e300, -1e300};
@@ -77,7 +77,7 @@ StatusOr<RgbaImage> RenderExperienceMapByFloor(SceneRenderer& renderer,
     times = {std::min(times.first, e.time_s), std::max(times.second, e.time_s)};
   }
   for (const Point2& p : data.ground_truth) include(p.x, p.y);
-  std::vector<RgbaImage> panels;
+  std::vector<Scene> panels;
   for (int floor : distinct) {
     ExperienceMapImageData subset;
     std::vector<int64_t> new_id(data.experiences.size(), -1);
@@ -105,10 +105,24 @@ StatusOr<RgbaImage> RenderExperienceMapByFloor(SceneRenderer& renderer,
     options.bounds = bounds;
     options.time_range_s = times;
     options.title = panel.title + ", floor " + std::to_string(floor);
-    StatusOr<RgbaImage> image = renderer.Render(ExperienceMapScene(subset, options));
+    panels.push_back(ExperienceMapScene(subset, options));
+  }
+  return panels;
+}
+
+StatusOr<RgbaImage> RenderExperienceMapByFloor(SceneRenderer& renderer,
+                                               const ExperienceMapImageData& data,
+                                               const std::vector<int>& experience_floors,
+                                               const std::vector<int>& ground_truth_floors,
+                                               const ExperienceMapImageOptions& panel) {
+  std::vector<RgbaImage> panels;
+  for (const Scene& scene :
+       ExperienceMapFloorScenes(data, experience_floors, ground_truth_floors, panel)) {
+    StatusOr<RgbaImage> image = renderer.Render(scene);
     if (!image.ok()) return image.status();
     panels.push_back(std::move(image.value()));
   }
+  if (panels.size() == 1) return std::move(panels.front());
   // Side by side.
   RgbaImage out;
   out.height = panel.height_px;
@@ -133,13 +147,15 @@ std::vector<TemplateGraphPoint> TemplateGraphOf(const RunView& run) {
   return points;
 }
 
-Status WriteRunImages(SceneRenderer& renderer, const RunView& run, const Dataset& dataset,
-                      const std::string& folder) {
+Status WriteRunImages(SceneRenderer* renderer, const RunView& run, const Dataset& dataset,
+                      const std::string& folder, const std::vector<FigureFormat>& formats,
+                      double width_mm) {
   namespace fs = std::filesystem;
-  auto write = [&](const Scene& scene, const char* name) -> Status {
-    StatusOr<RgbaImage> image = renderer.Render(scene);
-    if (!image.ok()) return image.status().WithContext(name);
-    return WritePng(image.value(), (fs::path(folder) / name).string());
+  auto targets = [&](const char* name) {
+    return FigureTargets((fs::path(folder) / name).string(), &formats);
+  };
+  auto write = [&](const SceneBuilder& build, int w, int h, const char* name) -> Status {
+    return WriteFigure(renderer, build, w, h, targets(name), width_mm).WithContext(name);
   };
   ExperienceMapImageOptions map_options;
   map_options.title = "experience map (" + dataset.name + ")";
@@ -156,12 +172,32 @@ Status WriteRunImages(SceneRenderer& renderer, const RunView& run, const Dataset
     map_data.ground_truth =
         GroundTruthInMapFrame(map_data.experiences, dataset,
                               trajectory.empty() ? -1.0 : trajectory.back().time_s, &truth_floors);
-    StatusOr<RgbaImage> image = RenderExperienceMapByFloor(
-        renderer, map_data, ExperienceFloors(map_data.experiences, dataset), truth_floors,
-        map_options);
-    if (!image.ok()) return image.status().WithContext("experience_map.png");
-    RATSLAM_RETURN_IF_ERROR(
-        WritePng(image.value(), (fs::path(folder) / "experience_map.png").string()));
+    const std::vector<int> floors = ExperienceFloors(map_data.experiences, dataset);
+    for (const FigureTarget& target : targets("experience_map.png")) {
+      if (target.format == FigureFormat::kPng) {
+        if (renderer == nullptr) return Status::Error(target.path + ": no PNG renderer");
+        StatusOr<RgbaImage> image =
+            RenderExperienceMapByFloor(*renderer, map_data, floors, truth_floors, map_options);
+        if (!image.ok()) return image.status().WithContext("experience_map.png");
+        RATSLAM_RETURN_IF_ERROR(WritePng(image.value(), target.path));
+        continue;
+      }
+      // Vector: one panel per floor, stacked (a column of a paper is narrow), each laid out
+      // for the page width.
+      const auto [w, h] = VectorLayoutSize(map_options.width_px, map_options.height_px, width_mm);
+      ExperienceMapImageOptions panel = map_options;
+      panel.width_px = w;
+      panel.height_px = h;
+      const std::vector<Scene> scenes =
+          ExperienceMapFloorScenes(map_data, floors, truth_floors, panel);
+      Scene scene(w, h * static_cast<int>(scenes.size()), {255, 255, 255, 255});
+      for (size_t k = 0; k < scenes.size(); ++k) {
+        scene.Append(scenes[k], 0.0f, static_cast<float>(k * h));
+      }
+      RATSLAM_RETURN_IF_ERROR(WriteVectorFigure(
+          scene, target.path,
+          target.format == FigureFormat::kPdf ? VectorFormat::kPdf : VectorFormat::kSvg, width_mm));
+    }
   }
   TemplateGraphImageOptions graph_options;
   graph_options.title = "template graph (" + dataset.name + ")";
@@ -171,9 +207,16 @@ Status WriteRunImages(SceneRenderer& renderer, const RunView& run, const Dataset
         i + 1 < sessions.size() ? sessions[i + 1] : std::numeric_limits<double>::infinity();
     graph_options.shaded_spans.push_back({sessions[i], end, "session " + std::to_string(i + 1)});
   }
-  RATSLAM_RETURN_IF_ERROR(
-      write(TemplateGraphScene(TemplateGraphOf(run), graph_options), "template_graph.png"));
-  return write(PoseCellScene(run.pose_cells, {}), "pose_cells.png");
+  const std::vector<TemplateGraphPoint> points = TemplateGraphOf(run);
+  RATSLAM_RETURN_IF_ERROR(write(
+      Sized(graph_options,
+            [&](const TemplateGraphImageOptions& o) { return TemplateGraphScene(points, o); }),
+      graph_options.width_px, graph_options.height_px, "template_graph.png"));
+  const PoseCellImageOptions cell_options;
+  return write(
+      Sized(cell_options,
+            [&](const PoseCellImageOptions& o) { return PoseCellScene(run.pose_cells, o); }),
+      cell_options.width_px, cell_options.height_px, "pose_cells.png");
 }
 
 }  // namespace ratslam

@@ -9,6 +9,7 @@
 #include "ratslam/records.h"
 #include "render/renderer.h"
 #include "sensors/dataset/dataset.h"
+#include "viewer/figure_output.h"
 #include "viewer/figures.h"
 
 namespace ratslam {
@@ -38,9 +39,18 @@ ExperienceMapImageData ExperienceMapDataOf(const RunView& run, const Dataset& da
 // One template-graph point per view frame.
 std::vector<TemplateGraphPoint> TemplateGraphOf(const RunView& run);
 
-// Writes experience_map.png, template_graph.png and pose_cells.png into `folder`.
-Status WriteRunImages(SceneRenderer& renderer, const RunView& run, const Dataset& dataset,
-                      const std::string& folder);
+// The experience-map panels of RenderExperienceMapByFloor, as scenes (one without floors).
+std::vector<Scene> ExperienceMapFloorScenes(const ExperienceMapImageData& data,
+                                            const std::vector<int>& experience_floors,
+                                            const std::vector<int>& ground_truth_floors,
+                                            const ExperienceMapImageOptions& panel);
+
+// Writes experience_map, template_graph and pose_cells into `folder` in each of `formats` (PNG
+// through `renderer`, which may be null without PNG; PDF and SVG on pages `width_mm` wide).
+Status WriteRunImages(SceneRenderer* renderer, const RunView& run, const Dataset& dataset,
+                      const std::string& folder,
+                      const std::vector<FigureFormat>& formats = {FigureFormat::kPng},
+                      double width_mm = kOneColumnMm);
 
 }  // namespace ratslam
 

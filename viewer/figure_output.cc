@@ -1,0 +1,90 @@
+#include "viewer/figure_output.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+
+#include "render/image.h"
+
+namespace ratslam {
+
+StatusOr<std::vector<FigureFormat>> ParseFigureFormats(const std::string& list) {
+  std::vector<FigureFormat> formats;
+  std::istringstream in(list);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    FigureFormat f;
+    if (item == "png") {
+      f = FigureFormat::kPng;
+    } else if (item == "pdf") {
+      f = FigureFormat::kPdf;
+    } else if (item == "svg") {
+      f = FigureFormat::kSvg;
+    } else {
+      return Status::Error("unknown figure format '" + item + "' (png, pdf or svg)");
+    }
+    if (std::find(formats.begin(), formats.end(), f) != formats.end()) {
+      return Status::Error("figure format '" + item + "' given twice");
+    }
+    formats.push_back(f);
+  }
+  if (formats.empty()) return Status::Error("no figure format (png, pdf or svg)");
+  return formats;
+}
+
+const char* FigureExtension(FigureFormat format) {
+  switch (format) {
+    case FigureFormat::kPdf:
+      return ".pdf";
+    case FigureFormat::kSvg:
+      return ".svg";
+    default:
+      return ".png";
+  }
+}
+
+FigureFormat FormatOfPath(const std::string& path) {
+  const std::string ext = std::filesystem::path(path).extension().string();
+  if (ext == ".pdf") return FigureFormat::kPdf;
+  if (ext == ".svg") return FigureFormat::kSvg;
+  return FigureFormat::kPng;
+}
+
+std::pair<int, int> VectorLayoutSize(int width_px, int height_px, double width_mm) {
+  const int w = VectorLayoutWidthPx(width_mm);
+  const int h = std::max(
+      1, static_cast<int>(std::lround(static_cast<double>(w) * height_px / std::max(1, width_px))));
+  return {w, h};
+}
+
+std::vector<FigureTarget> FigureTargets(const std::string& path,
+                                        const std::vector<FigureFormat>* formats) {
+  if (formats == nullptr) return {{FormatOfPath(path), path}};
+  std::filesystem::path stem(path);
+  const std::string ext = stem.extension().string();
+  if (ext == ".png" || ext == ".pdf" || ext == ".svg") stem.replace_extension();
+  std::vector<FigureTarget> targets;
+  for (FigureFormat f : *formats) targets.push_back({f, stem.string() + FigureExtension(f)});
+  return targets;
+}
+
+Status WriteFigure(SceneRenderer* renderer, const SceneBuilder& build, int width_px, int height_px,
+                   const std::vector<FigureTarget>& targets, double width_mm) {
+  for (const FigureTarget& target : targets) {
+    if (target.format == FigureFormat::kPng) {
+      if (renderer == nullptr) return Status::Error(target.path + ": no PNG renderer");
+      StatusOr<RgbaImage> image = renderer->Render(build(width_px, height_px));
+      if (!image.ok()) return image.status().WithContext(target.path);
+      RATSLAM_RETURN_IF_ERROR(WritePng(image.value(), target.path));
+    } else {
+      const auto [w, h] = VectorLayoutSize(width_px, height_px, width_mm);
+      RATSLAM_RETURN_IF_ERROR(WriteVectorFigure(
+          build(w, h), target.path,
+          target.format == FigureFormat::kPdf ? VectorFormat::kPdf : VectorFormat::kSvg, width_mm));
+    }
+  }
+  return Status();
+}
+
+}  // namespace ratslam
