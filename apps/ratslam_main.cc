@@ -65,6 +65,22 @@ struct ReplayRequest {
   double width_mm = kOneColumnMm;
 };
 
+// The first and last time of any stream of the data set: the colour range of animation frames.
+std::pair<double, double> DataTimeSpan(const Dataset& d) {
+  double first = std::numeric_limits<double>::infinity();
+  double last = -std::numeric_limits<double>::infinity();
+  auto include = [&](double t) {
+    first = std::min(first, t);
+    last = std::max(last, t);
+  };
+  for (const auto& r : d.odometry) include(r.time_s);
+  for (const auto& r : d.images) include(r.time_s);
+  for (const auto& r : d.wifi) include(r.time_s);
+  for (const auto& r : d.compass) include(r.time_s);
+  if (!(first < last)) return {0.0, 1.0};
+  return {first, last};
+}
+
 // The end of a run on a terminal: what was built and how good it is, in three lines.
 std::string HumanSummary(const RunSummary& s, const std::string& out) {
   char line[256];
@@ -131,6 +147,9 @@ int RunReplay(const ReplayRequest& request) {
       std::snprintf(title, sizeof title, "%s  t = %.1f s", session.dataset().name.c_str(),
                     p.state().trajectory.empty() ? 0.0 : p.state().trajectory.back().time_s);
       options.title = title;
+      // One colour scale for the whole animation (each frame used to stretch it over its own
+      // experiences, so a colour meant a different time in every frame).
+      options.time_range_s = DataTimeSpan(session.dataset());
       StatusOr<RgbaImage> frame = animation_renderer->Render(
           ExperienceMapScene(ExperienceMapDataOf(p.View(), session.dataset()), options));
       if (!frame.ok()) return frame.status();

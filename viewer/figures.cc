@@ -88,7 +88,10 @@ void DrawAxes(Scene& scene, const PlotArea& p, const std::string& x_label,
   }
   scene.Line({p.left, p.top + p.height}, {p.left + p.width, p.top + p.height}, 1.5f, kInk);
   scene.Line({p.left, p.top}, {p.left, p.top + p.height}, 1.5f, kInk);
-  scene.Text({p.left + p.width / 2, p.top + p.height + 48}, x_label, 16, kInk, TextAnchor::kCenter);
+  if (!x_label.empty()) {
+    scene.Text({p.left + p.width / 2, p.top + p.height + 48}, x_label, 16, kInk,
+               TextAnchor::kCenter);
+  }
   scene.Text({p.left - 10, p.top - 14}, y_label, 16, kInk, TextAnchor::kLeft);
 }
 
@@ -368,12 +371,10 @@ Scene ExperienceMapScene(const ExperienceMapImageData& data,
 Scene TemplateGraphScene(const std::vector<TemplateGraphPoint>& points,
                          const TemplateGraphImageOptions& options) {
   Scene scene(options.width_px, options.height_px, kWhite);
-  double t0 = std::numeric_limits<double>::infinity(), t1 = -t0, id_max = 1;
+  double t0 = std::numeric_limits<double>::infinity(), t1 = -t0;
   for (const TemplateGraphPoint& p : points) {
     t0 = std::min(t0, p.time_s);
     t1 = std::max(t1, p.time_s);
-    id_max = std::max(
-        {id_max, static_cast<double>(p.template_id), static_cast<double>(p.experience_id)});
   }
   if (!std::isfinite(t0)) t0 = 0, t1 = 1;
   if (t1 <= t0) t1 = t0 + 1;
@@ -405,27 +406,39 @@ Scene TemplateGraphScene(const std::vector<TemplateGraphPoint>& points,
   const float right = static_cast<float>(options.width_px) - 30;
   const std::vector<std::vector<size_t>> rows = FlowRows(items, right - 20);
   for (size_t r = 0; r < rows.size(); ++r) DrawRow(scene, items, rows[r], right, 52 + 24.0f * r);
+  // Two panels over one time axis: template ids above, experience ids below (on one axis the
+  // experience dots hid under the template circles, their ids being nearly the same).
   const float plot_top = 52 + 24.0f * rows.size() + 30;
-  PlotArea plot{80,
-                plot_top,
-                static_cast<float>(options.width_px - 110),
-                static_cast<float>(options.height_px) - plot_top - 70,
-                t0,
-                t1,
-                0,
-                id_max * 1.02};
-  for (const TimeSpan& span : options.shaded_spans) {
-    const ScenePoint a = plot.Map(std::max(span.start_s, t0), 0);
-    const ScenePoint b = plot.Map(std::min(span.end_s, t1), 0);
-    if (b.x <= a.x) continue;
-    scene.Rect(a.x, plot.top, b.x - a.x, plot.height, {200, 210, 235, 110});
-    scene.Text({0.5f * (a.x + b.x), plot.top + 20}, span.label, 14, kInk, TextAnchor::kCenter);
+  const float gap = 72;  // the upper panel's tick labels and the lower panel's axis title
+  const float both = static_cast<float>(options.height_px) - plot_top - 70;
+  const float panel_h = std::max(20.0f, (both - gap) / 2);
+  double template_max = 1, experience_max = 1;
+  for (const TemplateGraphPoint& p : points) {
+    template_max = std::max(template_max, static_cast<double>(p.template_id));
+    experience_max = std::max(experience_max, static_cast<double>(p.experience_id));
   }
-  DrawAxes(scene, plot, "time (s)", "template id (circles), experience id (dots)");
+  const float plot_w = static_cast<float>(options.width_px - 110);
+  const PlotArea upper{80, plot_top, plot_w, panel_h, t0, t1, 0, template_max * 1.02};
+  const PlotArea lower{80, plot_top + panel_h + gap, plot_w, panel_h, t0, t1,
+                       0,  experience_max * 1.02};
+  // Spans alternate two shades, so adjacent spans stay apart.
+  const Rgba span_shades[2] = {{200, 210, 235, 110}, {235, 215, 185, 110}};
+  for (size_t k = 0; k < options.shaded_spans.size(); ++k) {
+    const TimeSpan& span = options.shaded_spans[k];
+    const ScenePoint a = upper.Map(std::max(span.start_s, t0), 0);
+    const ScenePoint b = upper.Map(std::min(span.end_s, t1), 0);
+    if (b.x <= a.x) continue;
+    for (const PlotArea* plot : {&upper, &lower}) {
+      scene.Rect(a.x, plot->top, b.x - a.x, plot->height, span_shades[k % 2]);
+    }
+    scene.Text({0.5f * (a.x + b.x), upper.top + 20}, span.label, 14, kInk, TextAnchor::kCenter);
+  }
+  DrawAxes(scene, upper, "", "template id");
+  DrawAxes(scene, lower, "time (s)", "experience id");
   const bool many = points.size() > 20000;
   for (const TemplateGraphPoint& p : points) {
     const Rgba c = source_colors[static_cast<int>(p.source)];
-    const ScenePoint at = plot.Map(p.time_s, p.template_id);
+    const ScenePoint at = upper.Map(p.time_s, p.template_id);
     if (p.source == DecisionSource::kNew) {
       scene.Disc(at, many ? 1.0f : 1.8f, c, 8);
     } else {
@@ -435,7 +448,7 @@ Scene TemplateGraphScene(const std::vector<TemplateGraphPoint>& points,
   }
   for (const TemplateGraphPoint& p : points) {
     if (p.experience_id < 0) continue;
-    scene.Disc(plot.Map(p.time_s, static_cast<double>(p.experience_id)), many ? 0.8f : 1.3f,
+    scene.Disc(lower.Map(p.time_s, static_cast<double>(p.experience_id)), many ? 1.0f : 1.8f,
                kExperienceColor, 6);
   }
   scene.Text({20, 26}, options.title.empty() ? "template graph" : options.title, 18, kInk);

@@ -91,12 +91,13 @@ struct TimeSpan {
 
 struct TemplateGraphImageOptions {
   int width_px = 1600;
-  int height_px = 900;
+  int height_px = 1200;
   std::vector<TimeSpan> shaded_spans;  // e.g. sessions, day and night
   std::string title;
 };
 
-// Template id (circles, coloured by the deciding sensor) and experience id (dots) against time.
+// Template id (circles, coloured by the deciding sensor; upper panel) and experience id (dots;
+// lower panel) against one time axis; shaded spans alternate two shades.
 Scene TemplateGraphScene(const std::vector<TemplateGraphPoint>& points,
                          const TemplateGraphImageOptions& options);
 

@@ -132,6 +132,46 @@ TEST(TemplateGraphSceneTest, EmptyInputStillGivesAFigure) {
   EXPECT_FALSE(scene.texts().empty());
 }
 
+// Template ids and experience ids are nearly equal in a camera run; on one axis the experience
+// dots hid under the template circles. Now each has its own panel: no dot sits on a circle.
+TEST(TemplateGraphSceneTest, ExperienceIdsDoNotHideUnderTemplateIds) {
+  std::vector<TemplateGraphPoint> points;
+  for (uint32_t i = 0; i < 40; ++i) points.push_back({double(i), i, i, DecisionSource::kCamera});
+  const Scene scene = TemplateGraphScene(points, {});
+  std::vector<ScenePoint> circles, dots;
+  for (const SceneShape& s : scene.shapes()) {
+    if (s.kind == SceneShape::Kind::kRing && s.radius_px < 10) circles.push_back(s.points[0]);
+    if (s.kind == SceneShape::Kind::kDisc && s.color.r == 230 && s.color.g == 110) {
+      dots.push_back(s.points[0]);
+    }
+  }
+  ASSERT_EQ(circles.size(), 40u + 1u);  // and the legend's
+  ASSERT_EQ(dots.size(), 40u + 1u);     // and the legend's
+  for (const ScenePoint& c : circles) {
+    for (const ScenePoint& d : dots) {
+      EXPECT_GT(std::hypot(c.x - d.x, c.y - d.y), 8.0f) << c.x << "," << c.y;
+    }
+  }
+}
+
+// Adjacent spans (sessions, day and night) get different shades, so their border shows.
+TEST(TemplateGraphSceneTest, AdjacentSpansHaveDifferentShades) {
+  std::vector<TemplateGraphPoint> points = {{0, 0, 0, DecisionSource::kNew},
+                                            {30, 1, 1, DecisionSource::kNew}};
+  TemplateGraphImageOptions options;
+  options.shaded_spans = {{0, 10, "a"}, {10, 20, "b"}, {20, 30, "c"}};
+  const Scene scene = TemplateGraphScene(points, options);
+  std::vector<Rgba> shades;  // per panel, in order: a, a, b, b, c, c
+  for (const SceneShape& s : scene.shapes()) {
+    if (s.kind == SceneShape::Kind::kRect && s.color.a == 110) shades.push_back(s.color);
+  }
+  ASSERT_EQ(shades.size(), 6u);
+  auto same = [](Rgba x, Rgba y) { return x.r == y.r && x.g == y.g && x.b == y.b; };
+  EXPECT_FALSE(same(shades[0], shades[2]));
+  EXPECT_FALSE(same(shades[2], shades[4]));
+  EXPECT_TRUE(same(shades[0], shades[1]));  // one span, one shade in both panels
+}
+
 // Session and curve colours never read as the loop-closure red (220, 50, 32): in multi-session
 // maps the second session was drawn in a red two units from it.
 TEST(CategoryColorTest, NoCategoryLooksLikeTheLoopClosureRed) {
