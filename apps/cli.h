@@ -6,13 +6,16 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <functional>
 #include <iostream>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "fusion/io/config.h"
+#include "render/renderer.h"
 #include "viewer/figure_output.h"
 
 namespace ratslam {
@@ -40,11 +43,18 @@ struct Arguments {
   }
 };
 
+// "ratslam CMD: ", the one prefix of every message a command prints (main sets it once the
+// command is known; usage errors use the same form).
+inline std::string& MessagePrefix() {
+  static std::string prefix = "ratslam: ";
+  return prefix;
+}
+
 inline std::optional<double> ParseNumber(const std::string& flag, const std::string& text) {
   char* end = nullptr;
   const double value = std::strtod(text.c_str(), &end);
   if (text.empty() || *end != '\0' || !std::isfinite(value)) {
-    std::cerr << "ratslam: " << flag << ": not a number: '" << text << "'\n";
+    std::cerr << MessagePrefix() << flag << ": not a number: '" << text << "'\n";
     return std::nullopt;
   }
   return value;
@@ -58,7 +68,7 @@ inline std::optional<int64_t> ParseInteger(const std::string& flag, const std::s
   if (!value) return std::nullopt;
   if (*value != std::floor(*value) || *value < static_cast<double>(min) ||
       *value > static_cast<double>(max)) {
-    std::cerr << "ratslam: " << flag << ": expected a whole number in " << min << ".." << max
+    std::cerr << MessagePrefix() << flag << ": expected a whole number in " << min << ".." << max
               << ", got '" << text << "'\n";
     return std::nullopt;
   }
@@ -74,7 +84,7 @@ inline std::optional<PipelineOptions> LoadOptions(const Arguments& args,
   if (path) *path = it->second;
   StatusOr<PipelineOptions> options = LoadConfigFile(it->second);
   if (!options.ok()) {
-    std::cerr << "ratslam: " << options.status().message() << "\n";
+    std::cerr << MessagePrefix() << options.status().message() << "\n";
     return std::nullopt;
   }
   return options.value();
@@ -97,6 +107,27 @@ inline StatusOr<FigureOptions> FigureOptionsOf(const Arguments& args) {
     o.width_mm = std::strtod(it->second.c_str(), nullptr);  // checked by the parser
   }
   return o;
+}
+
+// Writes a command's figure (natural size, see WriteNaturalFigure) as `png_path` and, with
+// --format, as the same stem in each format asked for; --width-mm sets the vector page.
+// `default_width_mm` is the page width without --width-mm (two-panel figures need two columns).
+inline Status WriteCommandFigure(const Arguments& args, const std::string& png_path,
+                                 const std::function<Scene(int width_px)>& build,
+                                 double default_width_mm = kOneColumnMm) {
+  StatusOr<FigureOptions> figure = FigureOptionsOf(args);
+  if (figure.ok() && !args.values.count("--width-mm")) figure->width_mm = default_width_mm;
+  if (!figure.ok()) return figure.status();
+  const std::vector<FigureTarget> targets =
+      FigureTargets(png_path, figure->formats ? &*figure->formats : nullptr);
+  std::unique_ptr<SceneRenderer> renderer;
+  for (const FigureTarget& t : targets) {
+    if (t.format != FigureFormat::kPng || renderer) continue;
+    StatusOr<std::unique_ptr<SceneRenderer>> made = CreateOsMesaRenderer();
+    if (!made.ok()) return made.status();
+    renderer = std::move(made.value());
+  }
+  return WriteNaturalFigure(renderer.get(), build, targets, figure->width_mm);
 }
 
 // `ratslam render ...` (render_command.cc).

@@ -91,9 +91,8 @@ OptionSpec Formats(std::string help =
   o.list = true;
   return o;
 }
-OptionSpec WidthMm() {
-  OptionSpec o =
-      Option("--width-mm", "MM", "page width of PDF and SVG figures (default 88)", Kind::kNumber);
+OptionSpec WidthMm(std::string help = "page width of PDF and SVG figures (default 88)") {
+  OptionSpec o = Option("--width-mm", "MM", std::move(help), Kind::kNumber);
   o.min = 20;
   o.max = 2000;
   return o;
@@ -214,7 +213,9 @@ const std::vector<CommandSpec>& Commands() {
        "[evaluation] split and map_fraction then divide it.",
        {kConfig, Text("--map", "M", "data set to map", true),
         Text("--query", "Q", "data set to localise", true),
-        Text("--out", "O", "output folder", true), kOverwrite, kLenient, kQuiet},
+        Text("--out", "O", "output folder", true), kOverwrite, kLenient, kQuiet,
+        Formats("formats of the figures: png, pdf, svg, comma-separated (default png)"),
+        WidthMm("page width of PDF and SVG figures (default 180: two panels)")},
        {}},
       {"wifi-map",
        "fit Gaussian-process Wi-Fi maps",
@@ -232,7 +233,9 @@ const std::vector<CommandSpec>& Commands() {
        "candidates.csv and summary.json.",
        {Text("--wifi-map", "W", "Wi-Fi map file", true),
         Text("--data", "PHONE_LOG", "the phone's log", true),
-        Text("--out", "O", "output folder", true), kOverwrite, kConfig, kLenient, kQuiet},
+        Text("--out", "O", "output folder", true), kOverwrite, kConfig, kLenient, kQuiet,
+        Formats("formats of the figures: png, pdf, svg, comma-separated (default png)"),
+        WidthMm("page width of PDF and SVG figures (default 180: two panels)")},
        {}},
       {"call",
        "locate a phone and plan the robot's route to it",

@@ -26,7 +26,7 @@ int EvaluateCommand(const Arguments& parsed) {
   options.provenance = {args->command_line, UtcNowIso8601()};
   const std::string out_path = args->values.at("--out");
   auto fail = [](const Status& s) {
-    std::cerr << "ratslam evaluate: " << s.message() << "\n";
+    std::cerr << MessagePrefix() << s.message() << "\n";
     return kExitError;
   };
   auto out = DiskFolder::Open(out_path);
@@ -57,10 +57,14 @@ int EvaluateCommand(const Arguments& parsed) {
   for (const auto& [name, b] : r.baselines) {
     curves.push_back({label("baseline " + name, b), b.errors_m});
   }
-  const Scene figure = LocalisationCurvesScene(
-      curves, "FABMAP " + fabmap::ToString(mode) + ": " + std::to_string(m.queries) + " queries, " +
-                  std::to_string(r.map.size()) + " mapped places");
-  if (Status s = RenderToPng(figure, (*out)->Path("localisation.png")); !s.ok()) return fail(s);
+  const std::string title = "FABMAP " + fabmap::ToString(mode) + ": " + std::to_string(m.queries) +
+                            " queries, " + std::to_string(r.map.size()) + " mapped places";
+  if (Status s = WriteCommandFigure(
+          *args, (*out)->Path("localisation.png"),
+          [&](int w) { return LocalisationCurvesScene(curves, title, 30.0, w); }, kTwoColumnMm);
+      !s.ok()) {
+    return fail(s);
+  }
   {
     std::vector<std::string> labels;
     std::vector<std::vector<double>> recall, precision;
@@ -74,9 +78,13 @@ int EvaluateCommand(const Arguments& parsed) {
         precision.back().push_back(p.precision[k]);
       }
     }
-    const Scene pr = PrecisionRecallScene(
-        labels, recall, precision, "FABMAP " + fabmap::ToString(mode) + ": precision and recall");
-    if (Status s = RenderToPng(pr, (*out)->Path("pr_curve.png")); !s.ok()) return fail(s);
+    const std::string pr_title = "FABMAP " + fabmap::ToString(mode) + ": precision and recall";
+    if (Status s = WriteCommandFigure(
+            *args, (*out)->Path("pr_curve.png"),
+            [&](int w) { return PrecisionRecallScene(labels, recall, precision, pr_title, w); });
+        !s.ok()) {
+      return fail(s);
+    }
   }
 
   std::printf("%-12s %6s %6s %6s %6s | %6s %6s %6s %6s | %6s %6s\n", "mode", "c2", "c5", "c10",

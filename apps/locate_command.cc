@@ -246,7 +246,7 @@ int WifiMapCommand(const Arguments& parsed) {
   const std::optional<LocateOptions> options = LoadLocateOptions(*args, "wifi-map");
   if (!options) return kExitError;
   auto fail = [](const Status& s) {
-    std::cerr << "ratslam wifi-map: " << s.message() << "\n";
+    std::cerr << MessagePrefix() << s.message() << "\n";
     return kExitError;
   };
   const auto start = std::chrono::steady_clock::now();
@@ -331,7 +331,7 @@ int WifiMapCommand(const Arguments& parsed) {
 int LocateCommand(const Arguments& parsed) {
   const Arguments* args = &parsed;
   auto fail = [](const Status& s) {
-    if (!s.message().empty()) std::cerr << "ratslam locate: " << s.message() << "\n";
+    if (!s.message().empty()) std::cerr << MessagePrefix() << s.message() << "\n";
     return kExitError;
   };
   StatusOr<PhoneSetup> setup = SetUpPhone(*args, "locate");
@@ -447,11 +447,14 @@ int LocateCommand(const Arguments& parsed) {
   if (!written.ok()) return fail(written);
   if (!filter_errors.empty()) {
     // The paper's fig. 16: the share of scans located within d, beside the 3-NN baseline.
-    const Scene figure = LocalisationCurvesScene(
-        {{"particle filter (" + ToString(options->particle_filter.likelihood) + ")", filter_errors},
-         {"weighted 3-NN fingerprints", knn_errors}},
-        d.name + ": " + std::to_string(filter_errors.size()) + " scans with ground truth");
-    Status drawn = RenderToPng(figure, folder.value()->Path("cumulative_error.png"));
+    const std::vector<LocalisationCurve> curves = {
+        {"particle filter (" + ToString(options->particle_filter.likelihood) + ")", filter_errors},
+        {"weighted 3-NN fingerprints", knn_errors}};
+    const std::string title =
+        d.name + ": " + std::to_string(filter_errors.size()) + " scans with ground truth";
+    Status drawn = WriteCommandFigure(
+        *args, folder.value()->Path("cumulative_error.png"),
+        [&](int w) { return LocalisationCurvesScene(curves, title, 30.0, w); }, kTwoColumnMm);
     if (!drawn.ok()) return fail(drawn);
   }
   if (!args->quiet) std::cout << summary;
@@ -500,7 +503,7 @@ StatusOr<RobotMap> LoadRobotMap(const std::string& path) {
 int CallCommand(const Arguments& parsed) {
   const Arguments* args = &parsed;
   auto fail = [](const Status& s) {
-    if (!s.message().empty()) std::cerr << "ratslam call: " << s.message() << "\n";
+    if (!s.message().empty()) std::cerr << MessagePrefix() << s.message() << "\n";
     return kExitError;
   };
   const std::optional<double> at = ParseNumber("--at", args->values.at("--at"));
@@ -517,7 +520,7 @@ int CallCommand(const Arguments& parsed) {
                               ShortestNumber(d.wifi.front().time_s) + " s)"));
   }
   if (!map.truth_from_map() && !args->quiet) {
-    std::cerr << "ratslam call: note: " << args->values.at("--wifi-map")
+    std::cerr << MessagePrefix() << "note: " << args->values.at("--wifi-map")
               << " was made from ground truth, not from a run: its frame is the robot map's "
                  "only if the map was drawn in the truth's frame (make it with wifi-map --run)\n";
   }

@@ -85,28 +85,27 @@ std::pair<double, double> DataTimeSpan(const Dataset& d) {
 std::string HumanSummary(const RunSummary& s, const std::string& out) {
   char line[256];
   std::string text;
-  std::snprintf(line, sizeof line,
-                "ratslam: %llu frames: %llu templates, %llu experiences, %llu loop closures\n",
-                static_cast<unsigned long long>(s.frames),
-                static_cast<unsigned long long>(s.templates),
-                static_cast<unsigned long long>(s.experiences),
-                static_cast<unsigned long long>(s.loop_closures));
+  std::snprintf(
+      line, sizeof line, "%s%llu frames: %llu templates, %llu experiences, %llu loop closures\n",
+      MessagePrefix().c_str(), static_cast<unsigned long long>(s.frames),
+      static_cast<unsigned long long>(s.templates), static_cast<unsigned long long>(s.experiences),
+      static_cast<unsigned long long>(s.loop_closures));
   text += line;
   if (s.map_ate_m && s.odometry_ate_m) {
     std::snprintf(line, sizeof line,
-                  "ratslam: map error %.2f m against %.2f m for dead reckoning (ATE over %zu "
+                  "%smap error %.2f m against %.2f m for dead reckoning (ATE over %zu "
                   "points, rigid fit)\n",
-                  *s.map_ate_m, *s.odometry_ate_m, s.ate_points);
+                  MessagePrefix().c_str(), *s.map_ate_m, *s.odometry_ate_m, s.ate_points);
     text += line;
   }
-  text += "ratslam: outputs in " + out + " (summary.json; --json prints it here)\n";
+  text += MessagePrefix() + "outputs in " + out + " (summary.json; --json prints it here)\n";
   return text;
 }
 
 // Parses nothing and decides nothing: runs a replay session and reports what it did.
 int RunReplay(const ReplayRequest& request) {
   auto fail = [](const Status& s) {
-    std::cerr << "ratslam: " << s.message() << "\n";
+    std::cerr << MessagePrefix() << s.message() << "\n";
     return kExitError;
   };
   StatusOr<std::unique_ptr<DiskFolder>> out = DiskFolder::Open(request.out);
@@ -161,7 +160,7 @@ int RunReplay(const ReplayRequest& request) {
   (void)session.Replay(checkpoint);
   if (animation) {
     const bool video = animation->Close();
-    std::cerr << "ratslam: wrote " << animation->frames() << " animation frames"
+    std::cerr << MessagePrefix() << "wrote " << animation->frames() << " animation frames"
               << (video ? " and animation.avi" : " (no video writer available)") << " to "
               << (fs::path(request.out) / "animation").string() << "\n";
   }
@@ -194,22 +193,24 @@ int RunReplay(const ReplayRequest& request) {
     if (!rendered.ok()) exit_code = fail(rendered.WithContext("images not written"));
   }
   if (!result.replay.ok()) {
-    std::cerr << "ratslam: " << result.replay.message() << "\n";
+    std::cerr << MessagePrefix() << result.replay.message() << "\n";
     if (result.outputs.ok()) {
-      std::cerr << "ratslam: outputs up to the last complete event are in " << request.out << "\n";
+      std::cerr << MessagePrefix() << "outputs up to the last complete event are in " << request.out
+                << "\n";
     }
     if (!result.saved_map.empty()) {
-      std::cerr << "ratslam: the state is saved in " << result.saved_map << "\n";
+      std::cerr << MessagePrefix() << "the state is saved in " << result.saved_map << "\n";
     }
     return kExitError;
   }
   if (exit_code != kExitOk) return exit_code;
   if (result.interrupted) {
-    std::cerr << "ratslam: interrupted; state saved in " << result.saved_map << "\n";
+    std::cerr << MessagePrefix() << "interrupted; state saved in " << result.saved_map << "\n";
     return kExitInterrupted;
   }
   if (result.summary && result.summary->frames == 0) {
-    std::cerr << "ratslam: the run processed no frame (no view for the front end to judge); "
+    std::cerr << MessagePrefix()
+              << "the run processed no frame (no view for the front end to judge); "
                  "the outputs in "
               << request.out << " hold dead reckoning only\n";
     return kExitError;
@@ -244,7 +245,7 @@ int Replay(const Arguments& parsed) {
   request.json = args->values.count("--json") > 0;
   StatusOr<FigureOptions> figure = FigureOptionsOf(*args);
   if (!figure.ok()) {
-    std::cerr << "ratslam: " << figure.status().message() << "\n";
+    std::cerr << MessagePrefix() << figure.status().message() << "\n";
     return kExitUsage;
   }
   if (figure->formats) request.formats = *figure->formats;
@@ -255,11 +256,11 @@ int Replay(const Arguments& parsed) {
 int Synthesize(const SyntheticOptions& options, const std::string& folder) {
   StatusOr<Dataset> d = WriteSyntheticDataset(options, folder);
   if (!d.ok()) {
-    std::cerr << "ratslam: " << d.status().message() << "\n";
+    std::cerr << MessagePrefix() << d.status().message() << "\n";
     return kExitError;
   }
-  std::cerr << "ratslam: wrote " << d->images.size() << " frames of '" << d->name << "' to "
-            << folder << "\n";
+  std::cerr << MessagePrefix() << "wrote " << d->images.size() << " frames of '" << d->name
+            << "' to " << folder << "\n";
   return kExitOk;
 }
 
@@ -270,13 +271,13 @@ int Demo(const Arguments& parsed) {
   // The demo's data: a built-in simulated world with camera, Wi-Fi, compass and odometry.
   auto world = sim::BuiltInWorld(DemoWorldName());
   if (!world.ok()) {
-    std::cerr << "ratslam: " << world.status().message() << "\n";
+    std::cerr << MessagePrefix() << world.status().message() << "\n";
     return kExitError;
   }
   Dataset simulated;
   Status s = SimulateWorld(*world, 1, data, args->quiet, &simulated);
   if (!s.ok()) {
-    std::cerr << "ratslam: " << s.message() << "\n";
+    std::cerr << MessagePrefix() << s.message() << "\n";
     return kExitError;
   }
   ReplayRequest request;
@@ -299,7 +300,7 @@ int PrintConfigCommand(const Arguments& parsed) {
     if (args->values.count("--config")) {
       StatusOr<LocateOptions> loaded = LoadLocateConfigFile(args->values.at("--config"));
       if (!loaded.ok()) {
-        std::cerr << "ratslam: " << loaded.status().message() << "\n";
+        std::cerr << MessagePrefix() << loaded.status().message() << "\n";
         return kExitError;
       }
       o = *loaded;
@@ -318,13 +319,13 @@ int ImportOpenRatslam(const Arguments& parsed) {
   const Arguments* args = &parsed;
   StatusOr<ImportedConfig> imported = ImportOpenRatslamIni(args->positional[0]);
   if (!imported.ok()) {
-    std::cerr << "ratslam: " << imported.status().message() << "\n";
+    std::cerr << MessagePrefix() << imported.status().message() << "\n";
     return kExitError;
   }
   std::cout << "# Imported from " << args->positional[0] << ".\n";
   for (const std::string& note : imported->notes) {
     std::cout << "# " << note << "\n";
-    std::cerr << "ratslam: " << note << "\n";
+    std::cerr << MessagePrefix() << note << "\n";
   }
   std::cout << PrintConfig(imported->options);
   return kExitOk;
@@ -340,22 +341,22 @@ int ImportCommand(const Arguments& parsed) {
   phone.pdr = options->pdr;
   StatusOr<Dataset> d = LoadSessions(args->all.at("--data"), phone);
   if (!d.ok()) {
-    std::cerr << "ratslam: " << d.status().message() << "\n";
+    std::cerr << MessagePrefix() << d.status().message() << "\n";
     return kExitError;
   }
   if (!d->images.empty()) {
-    std::cerr << "ratslam: import copies no images; convert image data sets by hand\n";
+    std::cerr << MessagePrefix() << "import copies no images; convert image data sets by hand\n";
     return kExitError;
   }
   Status written = WriteDataset(d.value(), args->values.at("--out"));
   if (!written.ok()) {
-    std::cerr << "ratslam: " << written.message() << "\n";
+    std::cerr << MessagePrefix() << written.message() << "\n";
     return kExitError;
   }
-  std::cerr << "ratslam: wrote '" << d->name << "' (" << d->odometry.size() << " odometry rows, "
-            << d->wifi.size() << " Wi-Fi scans, " << d->compass.size() << " compass rows, "
-            << d->ground_truth.size() << " ground-truth rows) to " << args->values.at("--out")
-            << "\n";
+  std::cerr << MessagePrefix() << "wrote '" << d->name << "' (" << d->odometry.size()
+            << " odometry rows, " << d->wifi.size() << " Wi-Fi scans, " << d->compass.size()
+            << " compass rows, " << d->ground_truth.size() << " ground-truth rows) to "
+            << args->values.at("--out") << "\n";
   return kExitOk;
 }
 
@@ -394,18 +395,18 @@ int RunGuarded(int (*handler)(const ratslam::Arguments&), const ratslam::Argumen
   StatusOr<OutputGuard> guard =
       OutputGuard::Begin(folder, args.values.count("--overwrite") > 0, inputs);
   if (!guard.ok()) {
-    std::cerr << "ratslam: " << guard.status().message() << "\n";
+    std::cerr << MessagePrefix() << guard.status().message() << "\n";
     return kExitError;
   }
   const int code = handler(args);
   StatusOr<std::vector<std::string>> removed = guard->Finish(code == kExitOk);
   if (!removed.ok()) {
-    std::cerr << "ratslam: the list of outputs was not written: " << removed.status().message()
-              << "\n";
+    std::cerr << MessagePrefix()
+              << "the list of outputs was not written: " << removed.status().message() << "\n";
     return code == kExitOk ? kExitError : code;
   }
   if (!removed->empty() && !args.quiet) {
-    std::cerr << "ratslam: --overwrite removed " << removed->size()
+    std::cerr << MessagePrefix() << "--overwrite removed " << removed->size()
               << " file(s) of the earlier run that this run did not write again\n";
   }
   return code;
@@ -417,6 +418,7 @@ int Dispatch(int argc, char** argv) {
   if (const int* code = std::get_if<int>(&parsed)) return *code;
   ParsedCommand& command = std::get<ParsedCommand>(parsed);
   command.args.command_line = ShellCommandLine(argc, argv);
+  MessagePrefix() = "ratslam " + command.command + ": ";
   const std::map<std::string, int (*)(const Arguments&)> handlers = {
       {"replay", Replay},
       {"demo", Demo},
@@ -442,7 +444,7 @@ int Dispatch(int argc, char** argv) {
   if (command.command.rfind("sweep ", 0) == 0) {
     return SweepCommand(command.command.substr(6), command.args);
   }
-  std::cerr << "ratslam: internal error: no handler for '" << command.command << "'\n";
+  std::cerr << MessagePrefix() << "internal error: no handler for '" << command.command << "'\n";
   return kExitInternal;
 }
 
@@ -454,9 +456,9 @@ int main(int argc, char** argv) {
   try {
     return Dispatch(argc, argv);
   } catch (const std::bad_alloc&) {
-    std::cerr << "ratslam: out of memory\n";
+    std::cerr << ratslam::MessagePrefix() << "out of memory\n";
   } catch (const std::exception& e) {
-    std::cerr << "ratslam: internal error: " << e.what() << "\n";
+    std::cerr << ratslam::MessagePrefix() << "internal error: " << e.what() << "\n";
   }
   return ratslam::kExitInternal;
 }

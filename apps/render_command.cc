@@ -23,7 +23,7 @@ namespace {
 namespace fs = std::filesystem;
 
 int Fail(const std::string& message) {
-  std::cerr << "ratslam: " << message << "\n";
+  std::cerr << MessagePrefix() << message << "\n";
   return kExitError;
 }
 
@@ -34,8 +34,8 @@ bool ParseSize(const Arguments& args, int* width, int* height) {
   std::istringstream in(it->second);
   if (!(in >> *width >> x >> *height) || x != 'x' || *width < 64 || *height < 64 ||
       *width > 16384 || *height > 16384) {
-    std::cerr << "ratslam: --size must be WxH with 64..16384 pixels each, not '" << it->second
-              << "'\n";
+    std::cerr << MessagePrefix() << "--size must be WxH with 64..16384 pixels each, not '"
+              << it->second << "'\n";
     return false;
   }
   return true;
@@ -62,7 +62,7 @@ std::optional<std::vector<TimeSpan>> ParseSpans(const std::string& text) {
     const auto dash = item.find('-', 1);
     const auto colon = item.find(':');
     if (dash == std::string::npos) {
-      std::cerr << "ratslam: --spans item '" << item << "' is not START-END[:label]\n";
+      std::cerr << MessagePrefix() << "--spans item '" << item << "' is not START-END[:label]\n";
       return std::nullopt;
     }
     auto start = ParseNumber("--spans", item.substr(0, dash));
@@ -92,7 +92,7 @@ Status Write(const Arguments& args, const std::string& out, const SceneBuilder& 
   }
   RATSLAM_RETURN_IF_ERROR(
       WriteFigure(renderer.get(), build, width_px, height_px, targets, figure->width_mm));
-  for (const FigureTarget& t : targets) std::cerr << "ratslam: wrote " << t.path << "\n";
+  for (const FigureTarget& t : targets) std::cerr << MessagePrefix() << "wrote " << t.path << "\n";
   return Status::Ok();
 }
 
@@ -311,7 +311,7 @@ int RenderCommand(const std::string& what, const Arguments& parsed) {
   if (what == "pose-cells") return RenderPoseCells(*args);
   if (what == "similarity") return RenderSimilarity(*args);
   if (what == "wifi-map") return RenderWifiMap(*args);
-  std::cerr << "ratslam: internal error: unknown image '" << what << "'\n";
+  std::cerr << MessagePrefix() << "internal error: unknown image '" << what << "'\n";
   return kExitInternal;
 }
 

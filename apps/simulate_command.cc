@@ -71,13 +71,13 @@ int SimulateCommand(const Arguments& parsed) {
   }
   auto world = LoadWorld(args->values.at("--world"));
   if (!world.ok()) {
-    std::cerr << "ratslam simulate: " << world.status().message() << "\n";
+    std::cerr << MessagePrefix() << world.status().message() << "\n";
     return kExitError;
   }
   Dataset dataset;
   Status s = SimulateWorld(*world, seed, args->values.at("--out"), args->quiet, &dataset);
   if (!s.ok()) {
-    std::cerr << "ratslam simulate: " << s.message() << "\n";
+    std::cerr << MessagePrefix() << s.message() << "\n";
     return kExitError;
   }
   if (!args->quiet) {

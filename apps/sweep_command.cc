@@ -65,7 +65,7 @@ Status DrawSweepPlots(const std::string& dir, const sweep::CollectReport& report
 }
 
 int Fail(const Status& s) {
-  std::cerr << "ratslam sweep: " << s.message() << "\n";
+  std::cerr << MessagePrefix() << s.message() << "\n";
   return kExitError;
 }
 
@@ -125,7 +125,8 @@ int SweepCommand(const std::string& action, const Arguments& parsed) {
         break;
       }
       if (index < 0) {
-        std::cerr << "ratslam sweep task: no --index and no scheduler array index in the "
+        std::cerr << MessagePrefix()
+                  << "no --index and no scheduler array index in the "
                      "environment\n";
         return kExitUsage;
       }
@@ -149,7 +150,8 @@ int SweepCommand(const std::string& action, const Arguments& parsed) {
   }
   if (action == "submit") {
     if (!slurm) {
-      std::cerr << "ratslam sweep submit: only --slurm is supported (see configs/README.md for a "
+      std::cerr << MessagePrefix()
+                << "only --slurm is supported (see configs/README.md for a "
                    "GNU parallel recipe)\n";
       return kExitUsage;
     }

@@ -23,8 +23,9 @@ enum class VectorFormat { kPdf, kSvg };
 inline constexpr double kCapHeightPerEm = 0.729;
 // The smallest text size a journal accepts in a figure (7 pt at print size).
 inline constexpr double kMinTextPt = 7.0;
-// A one-column figure (88 mm), the default page width.
+// A one-column figure (88 mm), the default page width, and a two-column one (180 mm).
 inline constexpr double kOneColumnMm = 88.0;
+inline constexpr double kTwoColumnMm = 180.0;
 
 inline double MillimetresToPoints(double mm) { return mm / 25.4 * 72.0; }
 

@@ -30,10 +30,10 @@ TEST(EvaluateEndToEndTest, MicrosoftWalksWifiOnly) {
   const fs::path data = fs::path(RATSLAM_SHARED_DATA_DIR) / "msft-ilc20-site1";
   if (!fs::exists(data)) GTEST_SKIP() << "missing " << data;
   const fs::path out = Scratch("evaluate_msft");
-  const std::string command = std::string(RATSLAM_BINARY) + " evaluate --quiet --config " +
-                              RATSLAM_SOURCE_DIR + "/configs/msft-ilc20-wifi.toml --map " +
-                              data.string() + " --query " + data.string() + " --out " +
-                              out.string() + " > /dev/null";
+  const std::string command = std::string(RATSLAM_BINARY) +
+                              " evaluate --quiet --format png,pdf --config " + RATSLAM_SOURCE_DIR +
+                              "/configs/msft-ilc20-wifi.toml --map " + data.string() + " --query " +
+                              data.string() + " --out " + out.string() + " > /dev/null";
   ASSERT_EQ(std::system(command.c_str()), 0) << command;
   std::ifstream in(out / "evaluation.json");
   const nlohmann::json j = nlohmann::json::parse(in);
@@ -41,6 +41,15 @@ TEST(EvaluateEndToEndTest, MicrosoftWalksWifiOnly) {
       << "not in configs/README.md: " << e2e::Join(e2e::UndocumentedKeys(j));
   EXPECT_EQ(j["mode"], "wifi");
   EXPECT_GT(j["queries"].get<int>(), 500);
+  // --format png,pdf: both figures in both formats; the two-panel curves on a two-column page
+  // (180 mm = 510.236 pt), the precision-recall curve on one column (88 mm = 249.449 pt).
+  for (const char* name : {"localisation.png", "pr_curve.png"}) EXPECT_TRUE(fs::exists(out / name));
+  auto slurp = [](const fs::path& p) {
+    std::ifstream f(p, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(f), {});
+  };
+  EXPECT_NE(slurp(out / "localisation.pdf").find("/MediaBox [ 0 0 510.23"), std::string::npos);
+  EXPECT_NE(slurp(out / "pr_curve.pdf").find("/MediaBox [ 0 0 249.44"), std::string::npos);
   const double rejected = j["rejection_rate"];
   for (const char* d : {"2", "5", "10", "20"}) {
     const double correct = j["correct_within_m"][d];

@@ -534,7 +534,7 @@ TEST_F(ReplayEndToEndTest, RenderWritesImagesFromRunsAndMaps) {
                 .exit_code,
             0);
   ExpectPicture(out / "experience_map.png", 1600, 1200);
-  ExpectPicture(out / "template_graph.png", 1600, 900);
+  ExpectPicture(out / "template_graph.png", 1600, 1200);  // two panels
   ExpectPicture(out / "pose_cells.png", 1200, 620);
   // 7268 events, a frame every 2000 plus the last.
   ExpectPicture(out / "animation" / "frame_000000.png", 960, 720);

@@ -87,4 +87,21 @@ Status WriteFigure(SceneRenderer* renderer, const SceneBuilder& build, int width
   return Status();
 }
 
+Status WriteNaturalFigure(SceneRenderer* renderer, const std::function<Scene(int width_px)>& build,
+                          const std::vector<FigureTarget>& targets, double width_mm) {
+  for (const FigureTarget& target : targets) {
+    if (target.format == FigureFormat::kPng) {
+      if (renderer == nullptr) return Status::Error(target.path + ": no PNG renderer");
+      StatusOr<RgbaImage> image = renderer->Render(build(0));
+      if (!image.ok()) return image.status().WithContext(target.path);
+      RATSLAM_RETURN_IF_ERROR(WritePng(image.value(), target.path));
+    } else {
+      RATSLAM_RETURN_IF_ERROR(WriteVectorFigure(
+          build(VectorLayoutWidthPx(width_mm)), target.path,
+          target.format == FigureFormat::kPdf ? VectorFormat::kPdf : VectorFormat::kSvg, width_mm));
+    }
+  }
+  return Status::Ok();
+}
+
 }  // namespace ratslam

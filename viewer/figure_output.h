@@ -56,6 +56,11 @@ std::vector<FigureTarget> FigureTargets(const std::string& path,
 Status WriteFigure(SceneRenderer* renderer, const SceneBuilder& build, int width_px, int height_px,
                    const std::vector<FigureTarget>& targets, double width_mm = kOneColumnMm);
 
+// A figure with a natural size: `build(0)` makes the PNG's scene, `build(w)` a scene laid out
+// w pixels wide for PDF and SVG (w = VectorLayoutWidthPx(width_mm)).
+Status WriteNaturalFigure(SceneRenderer* renderer, const std::function<Scene(int width_px)>& build,
+                          const std::vector<FigureTarget>& targets, double width_mm = kOneColumnMm);
+
 // The vector layout's size for a figure whose PNG is width_px x height_px.
 std::pair<int, int> VectorLayoutSize(int width_px, int height_px, double width_mm);
 

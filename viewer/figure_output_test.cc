@@ -10,6 +10,7 @@
 #include "common/scratch_dir.h"
 #include "ratslam/pose_cell_network.h"
 #include "viewer/figures.h"
+#include "viewer/localisation_figure.h"
 
 namespace ratslam {
 namespace {
@@ -108,7 +109,9 @@ TEST(FigureOutputTest, EveryFiguresTextIsAtLeastSevenPointsInPrint) {
          {ExperienceMapScene(map, map_options), TemplateGraphScene(points, graph_options),
           PoseCellScene(network, cell_options),
           SimilarityMatrixScene(matrix, times, similarity_options),
-          GridFieldsScene({field, field}, {}, "t", w / 4)}) {
+          GridFieldsScene({field, field}, {}, "t", w / 4),
+          LocalisationCurvesScene({{"a", {1.0, 2.0}}}, "t", 30.0, w),
+          PrecisionRecallScene({"within 2 m"}, {{0.1, 0.5}}, {{0.9, 0.8}}, "t", w)}) {
       ASSERT_FALSE(scene.texts().empty());
       for (const SceneText& t : scene.texts()) {
         EXPECT_GE(TextPoints(t.height_px, scene.width(), width_mm), kMinTextPt - 1e-9)

@@ -1,5 +1,6 @@
 #include "viewer/localisation_figure.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -8,8 +9,11 @@
 namespace ratslam {
 
 Scene LocalisationCurvesScene(const std::vector<LocalisationCurve>& curves,
-                              const std::string& title, double max_distance_m) {
-  const float panel_w = 560, panel_h = 400, left0 = 90, top = 80, gap = 130;
+                              const std::string& title, double max_distance_m, int width_px) {
+  const float left0 = 90, top = 80, gap = 130;
+  // Each panel 560 x 400 at the natural width; narrower figures (vector layouts) shrink them.
+  const float panel_w = width_px > 0 ? std::max(120.0f, (width_px - left0 - gap - 40) / 2) : 560;
+  const float panel_h = panel_w * 400 / 560;
   const float legend_h = 28.0f * static_cast<float>(curves.size());
   Scene scene(static_cast<int>(left0 + 2 * panel_w + gap + 40),
               static_cast<int>(top + panel_h + 90 + legend_h), Rgba{255, 255, 255, 255});
@@ -30,7 +34,7 @@ Scene LocalisationCurvesScene(const std::vector<LocalisationCurve>& curves,
       std::snprintf(text, sizeof text, "%d", k * 20);
       scene.Text({left - 10, to_px(0, rate).y + 5}, text, 15, kInk, TextAnchor::kRight);
     }
-    const double step = NiceStep(max_distance_m, 6);
+    const double step = NiceStep(max_distance_m, std::clamp(static_cast<int>(panel_w / 50), 2, 6));
     for (double d = 0; d <= max_distance_m + 1e-9; d += step) {
       scene.Line(to_px(d, 0), to_px(d, 1), 1.0f, kGrid);
       char text[16];
@@ -64,14 +68,14 @@ Scene LocalisationCurvesScene(const std::vector<LocalisationCurve>& curves,
 Scene PrecisionRecallScene(const std::vector<std::string>& labels,
                            const std::vector<std::vector<double>>& recall,
                            const std::vector<std::vector<double>>& precision,
-                           const std::string& title) {
-  const float panel = 560, left = 90, top = 104;
+                           const std::string& title, int width_px) {
+  const float left = 90, top = 104;
+  const float panel = width_px > 0 ? std::max(200.0f, width_px - left - 60) : 560;
   const float legend_h = 28.0f * static_cast<float>(labels.size());
   Scene scene(static_cast<int>(left + panel + 60), static_cast<int>(top + panel + 90 + legend_h),
               Rgba{255, 255, 255, 255});
   scene.Text({20, 32}, title, 20, kInk);
-  scene.Text({20, 58}, "a query is accepted when its best place's posterior >= a threshold", 14,
-             kInk);
+  scene.Text({20, 58}, "accepted: the best place's posterior >= a threshold", 14, kInk);
   auto to_px = [&](double r, double p) {
     return ScenePoint{static_cast<float>(left + panel * r),
                       static_cast<float>(top + panel * (1 - p))};
