@@ -4,11 +4,12 @@
 #include <cairo-svg.h>
 #include <cairo.h>
 
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <map>
 #include <memory>
-#include <regex>
+#include <string>
 #include <vector>
 
 #include "common/file_util.h"
@@ -133,22 +134,38 @@ void DrawText(cairo_t* cr, const SceneText& t) {
 }
 
 // Cairo numbers SVG ids (surface33, image37, clip1) with counters global to the process, so a
-// second identical figure would differ. Renumbers them in order of first appearance.
+// second identical figure would differ. Renumbers them in order of first appearance, where they
+// are defined (id="...") and referred to (#...). (A hand-written scan: std::regex trips GCC 12's
+// maybe-uninitialized warning under the sanitizers.)
 std::string CanonicalSvgIds(const std::string& svg) {
-  static const std::regex kId("(id=\"|#)(surface|image|clip|mask|pattern|source)([0-9]+)");
+  static const char* const kKinds[] = {"surface", "image", "clip", "mask", "pattern", "source"};
   std::map<std::string, std::map<std::string, int>> renumbered;
   std::string out;
-  auto last = svg.cbegin();
-  for (std::sregex_iterator it(svg.begin(), svg.end(), kId), end; it != end; ++it) {
-    const std::smatch& m = *it;
-    out.append(last, m[0].first);
-    auto& numbers = renumbered[m[2].str()];
-    const auto [at, inserted] = numbers.emplace(m[3].str(), static_cast<int>(numbers.size()) + 1);
-    (void)inserted;
-    out += m[1].str() + m[2].str() + std::to_string(at->second);
-    last = m[0].second;
+  out.reserve(svg.size());
+  size_t i = 0;
+  while (i < svg.size()) {
+    size_t name = std::string::npos;  // where an id's name would start
+    if (svg.compare(i, 4, "id=\"") == 0) name = i + 4;
+    if (svg[i] == '#') name = i + 1;
+    bool replaced = false;
+    for (const char* kind : kKinds) {
+      if (name == std::string::npos) break;
+      const size_t length = std::char_traits<char>::length(kind);
+      if (svg.compare(name, length, kind) != 0) continue;
+      size_t end = name + length;
+      while (end < svg.size() && std::isdigit(static_cast<unsigned char>(svg[end]))) ++end;
+      if (end == name + length) continue;
+      std::map<std::string, int>& numbers = renumbered[kind];
+      const auto found = numbers.emplace(svg.substr(name + length, end - name - length),
+                                         static_cast<int>(numbers.size()) + 1);
+      out.append(svg, i, name - i);
+      out += kind + std::to_string(found.first->second);
+      i = end;
+      replaced = true;
+      break;
+    }
+    if (!replaced) out.push_back(svg[i++]);
   }
-  out.append(last, svg.cend());
   return out;
 }
 

@@ -2,10 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <regex>
 #include <sstream>
 #include <string>
 
@@ -21,6 +21,18 @@ std::string Slurp(const fs::path& path) {
   std::stringstream s;
   s << in.rdbuf();
   return s.str();
+}
+
+// The number after the first `key` in `text`, skipping `skip` numbers (NaN when there is none).
+double NumberAfter(const std::string& text, const std::string& key, int skip = 0) {
+  const size_t at = text.find(key);
+  if (at == std::string::npos) return std::nan("");
+  std::istringstream in(text.substr(at + key.size()));
+  double value = std::nan("");
+  for (int i = 0; i <= skip; ++i) {
+    if (!(in >> value)) return std::nan("");
+  }
+  return value;
 }
 
 size_t Count(const std::string& text, const std::string& what) {
@@ -75,12 +87,8 @@ TEST_F(VectorFigureTest, SvgHasOnePathPerShapeOneGlyphPerLetterAndThePageSize) {
   const std::string text = Slurp(svg);
   ASSERT_NE(text.find("<svg"), std::string::npos);
   // 88 mm wide; 800x600 keeps its aspect: 249.449 x 187.087 pt.
-  std::smatch m;
-  ASSERT_TRUE(
-      std::regex_search(text, m, std::regex("width=\"([0-9.]+)pt\" height=\"([0-9.]+)pt\"")))
-      << text.substr(0, 400);
-  EXPECT_NEAR(std::stod(m[1]), 249.449, 0.01);
-  EXPECT_NEAR(std::stod(m[2]), 187.087, 0.01);
+  EXPECT_NEAR(NumberAfter(text, " width=\""), 249.449, 0.01) << text.substr(0, 400);
+  EXPECT_NEAR(NumberAfter(text, " height=\""), 187.087, 0.01);
   // Outside the glyph definitions: the background rectangle, then one path per shape.
   const size_t defs_end = text.find("</defs>");
   const std::string body = defs_end == std::string::npos ? text : text.substr(defs_end);
@@ -98,11 +106,9 @@ TEST_F(VectorFigureTest, PdfHasThePageSizeAnEmbeddedFontAndTheImage) {
   const std::string text = Slurp(pdf);
   ASSERT_EQ(text.rfind("%PDF-", 0), 0u);
   EXPECT_NE(text.find("%%EOF"), std::string::npos);
-  std::smatch m;
-  ASSERT_TRUE(
-      std::regex_search(text, m, std::regex("/MediaBox \\[ *0 0 ([0-9.]+) ([0-9.]+) *\\]")));
-  EXPECT_NEAR(std::stod(m[1]), 510.236, 0.01);  // 180 mm
-  EXPECT_NEAR(std::stod(m[2]), 382.677, 0.01);
+  // "/MediaBox [ 0 0 W H ]": 180 mm wide.
+  EXPECT_NEAR(NumberAfter(text, "/MediaBox [", 2), 510.236, 0.01);
+  EXPECT_NEAR(NumberAfter(text, "/MediaBox [", 3), 382.677, 0.01);
   EXPECT_EQ(Count(text, "/Type /Page\n") + Count(text, "/Type /Page "), 1u);
   EXPECT_NE(text.find("DejaVuSans"), std::string::npos);
   EXPECT_NE(text.find("/FontFile"), std::string::npos);  // embedded, not referenced
