@@ -116,18 +116,13 @@ inline Status WriteCommandFigure(const Arguments& args, const std::string& png_p
                                  const std::function<Scene(int width_px)>& build,
                                  double default_width_mm = kOneColumnMm) {
   StatusOr<FigureOptions> figure = FigureOptionsOf(args);
-  if (figure.ok() && !args.values.count("--width-mm")) figure->width_mm = default_width_mm;
   if (!figure.ok()) return figure.status();
+  if (!args.values.count("--width-mm")) figure->width_mm = default_width_mm;
   const std::vector<FigureTarget> targets =
       FigureTargets(png_path, figure->formats ? &*figure->formats : nullptr);
-  std::unique_ptr<SceneRenderer> renderer;
-  for (const FigureTarget& t : targets) {
-    if (t.format != FigureFormat::kPng || renderer) continue;
-    StatusOr<std::unique_ptr<SceneRenderer>> made = CreateOsMesaRenderer();
-    if (!made.ok()) return made.status();
-    renderer = std::move(made.value());
-  }
-  return WriteNaturalFigure(renderer.get(), build, targets, figure->width_mm);
+  StatusOr<std::unique_ptr<SceneRenderer>> renderer = RendererFor(targets);
+  if (!renderer.ok()) return renderer.status();
+  return WriteNaturalFigure(renderer->get(), build, targets, figure->width_mm);
 }
 
 // `ratslam render ...` (render_command.cc).

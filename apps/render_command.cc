@@ -83,15 +83,10 @@ Status Write(const Arguments& args, const std::string& out, const SceneBuilder& 
   if (!figure.ok()) return figure.status();
   const std::vector<FigureTarget> targets =
       FigureTargets(out, figure->formats ? &*figure->formats : nullptr);
-  std::unique_ptr<SceneRenderer> renderer;
-  for (const FigureTarget& t : targets) {
-    if (t.format != FigureFormat::kPng || renderer) continue;
-    StatusOr<std::unique_ptr<SceneRenderer>> made = CreateOsMesaRenderer();
-    if (!made.ok()) return made.status();
-    renderer = std::move(made.value());
-  }
+  StatusOr<std::unique_ptr<SceneRenderer>> renderer = RendererFor(targets);
+  if (!renderer.ok()) return renderer.status();
   RATSLAM_RETURN_IF_ERROR(
-      WriteFigure(renderer.get(), build, width_px, height_px, targets, figure->width_mm));
+      WriteFigure(renderer->get(), build, width_px, height_px, targets, figure->width_mm));
   for (const FigureTarget& t : targets) std::cerr << MessagePrefix() << "wrote " << t.path << "\n";
   return Status::Ok();
 }

@@ -69,22 +69,27 @@ std::vector<FigureTarget> FigureTargets(const std::string& path,
   return targets;
 }
 
+VectorFormat VectorFormatOf(FigureFormat format) {
+  return format == FigureFormat::kPdf ? VectorFormat::kPdf : VectorFormat::kSvg;
+}
+
+StatusOr<std::unique_ptr<SceneRenderer>> RendererFor(const std::vector<FigureTarget>& targets) {
+  for (const FigureTarget& t : targets) {
+    if (t.format == FigureFormat::kPng) return CreateOsMesaRenderer();
+  }
+  return std::unique_ptr<SceneRenderer>();
+}
+
 Status WriteFigure(SceneRenderer* renderer, const SceneBuilder& build, int width_px, int height_px,
                    const std::vector<FigureTarget>& targets, double width_mm) {
-  for (const FigureTarget& target : targets) {
-    if (target.format == FigureFormat::kPng) {
-      if (renderer == nullptr) return Status::Error(target.path + ": no PNG renderer");
-      StatusOr<RgbaImage> image = renderer->Render(build(width_px, height_px));
-      if (!image.ok()) return image.status().WithContext(target.path);
-      RATSLAM_RETURN_IF_ERROR(WritePng(image.value(), target.path));
-    } else {
-      const auto [w, h] = VectorLayoutSize(width_px, height_px, width_mm);
-      RATSLAM_RETURN_IF_ERROR(WriteVectorFigure(
-          build(w, h), target.path,
-          target.format == FigureFormat::kPdf ? VectorFormat::kPdf : VectorFormat::kSvg, width_mm));
-    }
-  }
-  return Status();
+  return WriteNaturalFigure(
+      renderer,
+      [&](int layout_width_px) {
+        if (layout_width_px == 0) return build(width_px, height_px);
+        const auto [w, h] = VectorLayoutSize(width_px, height_px, width_mm);
+        return build(w, h);
+      },
+      targets, width_mm);
 }
 
 Status WriteNaturalFigure(SceneRenderer* renderer, const std::function<Scene(int width_px)>& build,
@@ -96,9 +101,8 @@ Status WriteNaturalFigure(SceneRenderer* renderer, const std::function<Scene(int
       if (!image.ok()) return image.status().WithContext(target.path);
       RATSLAM_RETURN_IF_ERROR(WritePng(image.value(), target.path));
     } else {
-      RATSLAM_RETURN_IF_ERROR(WriteVectorFigure(
-          build(VectorLayoutWidthPx(width_mm)), target.path,
-          target.format == FigureFormat::kPdf ? VectorFormat::kPdf : VectorFormat::kSvg, width_mm));
+      RATSLAM_RETURN_IF_ERROR(WriteVectorFigure(build(VectorLayoutWidthPx(width_mm)), target.path,
+                                                VectorFormatOf(target.format), width_mm));
     }
   }
   return Status::Ok();

@@ -6,6 +6,7 @@
 #define RATSLAM_VIEWER_FIGURE_OUTPUT_H_
 
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,18 @@ const char* FigureExtension(FigureFormat format);
 // The format a file name asks for by its extension (PNG when it names none we write).
 FigureFormat FormatOfPath(const std::string& path);
 
+// Where a figure goes: one file per format.
+struct FigureTarget {
+  FigureFormat format = FigureFormat::kPng;
+  std::string path;
+};
+
+// The Cairo format of a PDF or SVG figure.
+VectorFormat VectorFormatOf(FigureFormat format);
+
+// A PNG renderer (OSMesa) when some target is a PNG, else null: PDF and SVG need none.
+StatusOr<std::unique_ptr<SceneRenderer>> RendererFor(const std::vector<FigureTarget>& targets);
+
 // A figure laid out for a pixel size.
 using SceneBuilder = std::function<Scene(int width_px, int height_px)>;
 
@@ -40,11 +53,6 @@ SceneBuilder Sized(const Options& options, Draw draw) {
   };
 }
 
-// Where a figure goes: one file per format.
-struct FigureTarget {
-  FigureFormat format = FigureFormat::kPng;
-  std::string path;
-};
 // The files for `--out path`: with `formats` (--format), the path's stem plus each format's
 // extension; without, the path itself in the format its extension names.
 std::vector<FigureTarget> FigureTargets(const std::string& path,

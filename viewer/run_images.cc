@@ -194,9 +194,8 @@ Status WriteRunImages(SceneRenderer* renderer, const RunView& run, const Dataset
       for (size_t k = 0; k < scenes.size(); ++k) {
         scene.Append(scenes[k], 0.0f, static_cast<float>(k * h));
       }
-      RATSLAM_RETURN_IF_ERROR(WriteVectorFigure(
-          scene, target.path,
-          target.format == FigureFormat::kPdf ? VectorFormat::kPdf : VectorFormat::kSvg, width_mm));
+      RATSLAM_RETURN_IF_ERROR(
+          WriteVectorFigure(scene, target.path, VectorFormatOf(target.format), width_mm));
     }
   }
   TemplateGraphImageOptions graph_options;
