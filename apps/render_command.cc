@@ -77,10 +77,12 @@ std::optional<std::vector<TimeSpan>> ParseSpans(const std::string& text) {
 
 // Writes the figure `build` makes to --out, in the formats --format names (else the one --out's
 // extension names): PNG at width_px x height_px, PDF and SVG laid out for --width-mm.
+// `default_width_mm`: the page width without --width-mm (two-panel figures need two columns).
 Status Write(const Arguments& args, const std::string& out, const SceneBuilder& build, int width_px,
-             int height_px) {
+             int height_px, double default_width_mm = kOneColumnMm) {
   StatusOr<FigureOptions> figure = FigureOptionsOf(args);
   if (!figure.ok()) return figure.status();
+  if (!args.values.count("--width-mm")) figure->width_mm = default_width_mm;
   const std::vector<FigureTarget> targets =
       FigureTargets(out, figure->formats ? &*figure->formats : nullptr);
   StatusOr<std::unique_ptr<SceneRenderer>> renderer = RendererFor(targets);
@@ -293,7 +295,7 @@ int RenderWifiMap(const Arguments& args) {
         const int panel = std::max(100, 700 - (natural.width() - w) / 2);
         return GridFieldsScene({mean, variance}, points, title, panel);
       },
-      natural.width(), natural.height());
+      natural.width(), natural.height(), kTwoColumnMm);
   return status.ok() ? kExitOk : Fail(status.message());
 }
 
