@@ -612,42 +612,59 @@ int CallCommand(const Arguments& parsed) {
   for (const Point2& p : graph.nodes) grow(p);
   for (const Point2& p : candidates) grow(p);
   options.bounds = b;
-  options.title = "calling the robot at " + ShortestNumber(*at) + " s: route " +
-                  ShortestNumber(std::round(plan->length_m * 10) / 10) + " m through " +
-                  std::to_string(plan->stops.size()) + " stops for " +
-                  std::to_string(candidates.size()) + " candidates";
-  WorldToImage to_image;
-  Scene scene = ExperienceMapScene(image, options, &to_image);
-  const auto& particles = filter.particles();
-  const size_t every = std::max<size_t>(1, particles.size() / 3000);
-  for (size_t k = 0; k < particles.size(); k += every) {
-    scene.Disc(to_image(particles[k].x_m, particles[k].y_m), 1.6f, {120, 120, 120, 110}, 6);
-  }
-  std::vector<ScenePoint> line;
-  for (uint32_t e : plan->route) line.push_back(to_image(graph.nodes[e].x, graph.nodes[e].y));
-  scene.Polyline(line, 6.0f, {148, 103, 189, 230});  // purple: red marks loop closures
-  for (size_t k = 0; k < candidates.size(); ++k) {
-    const ScenePoint c = to_image(candidates[k].x, candidates[k].y);
-    const ScenePoint e =
-        to_image(graph.nodes[plan->serving_node[k]].x, graph.nodes[plan->serving_node[k]].y);
-    scene.Line(c, e, 1.5f, {255, 127, 14, 255});
-    scene.Disc(c, 9.0f, {255, 127, 14, 255}, 20);
-    scene.Text({c.x, c.y + 5.0f}, std::to_string(k + 1), 14.0f, {255, 255, 255, 255},
-               TextAnchor::kCenter);
-  }
-  const ScenePoint est = to_image(estimate.x_m, estimate.y_m);
-  scene.Ring(est, 10.0f, 14.0f, 0.0f, 6.2832f, {31, 119, 180, 255}, 24);
-  if (truth_on_map) {
-    const ScenePoint t = to_image(truth_on_map->x, truth_on_map->y);
-    scene.Line({t.x - 10, t.y - 10}, {t.x + 10, t.y + 10}, 3.0f, {44, 160, 44, 255});
-    scene.Line({t.x - 10, t.y + 10}, {t.x + 10, t.y - 10}, 3.0f, {44, 160, 44, 255});
-  }
-  scene.Text(
-      {20, 75},
-      "purple: robot route   orange: candidates (k-means, by weight)   grey: particles   blue "
-      "ring: estimate" +
-          std::string(truth_on_map ? "   green x: truth" : ""),
-      15.0f, kInk);
+  const std::string route_m = ShortestNumber(std::round(plan->length_m * 10) / 10);
+  const std::string stops = std::to_string(plan->stops.size());
+  const std::string candidate_count = std::to_string(candidates.size());
+  // Laid out at 1600 x 1200 for PNG, at the page's width for PDF and SVG (4:3 either way).
+  auto build = [&](int width_px) {
+    ExperienceMapImageOptions o = options;
+    if (width_px > 0) {
+      o.width_px = width_px;
+      o.height_px = width_px * 3 / 4;
+    }
+    o.title = o.width_px >= 1000
+                  ? "calling the robot at " + ShortestNumber(*at) + " s: route " + route_m +
+                        " m through " + stops + " stops for " + candidate_count + " candidates"
+                  : "call at " + ShortestNumber(*at) + " s: route " + route_m + " m, " + stops +
+                        " stops, " + candidate_count + " candidates";
+    WorldToImage to_image;
+    Scene scene = ExperienceMapScene(image, o, &to_image);
+    const auto& particles = filter.particles();
+    const size_t every = std::max<size_t>(1, particles.size() / 3000);
+    for (size_t k = 0; k < particles.size(); k += every) {
+      scene.Disc(to_image(particles[k].x_m, particles[k].y_m), 1.6f, {120, 120, 120, 110}, 6);
+    }
+    std::vector<ScenePoint> line;
+    for (uint32_t e : plan->route) line.push_back(to_image(graph.nodes[e].x, graph.nodes[e].y));
+    scene.Polyline(line, 6.0f, {148, 103, 189, 230});  // purple: red marks loop closures
+    for (size_t k = 0; k < candidates.size(); ++k) {
+      const ScenePoint c = to_image(candidates[k].x, candidates[k].y);
+      const ScenePoint e =
+          to_image(graph.nodes[plan->serving_node[k]].x, graph.nodes[plan->serving_node[k]].y);
+      scene.Line(c, e, 1.5f, {255, 127, 14, 255});
+      scene.Disc(c, 9.0f, {255, 127, 14, 255}, 20);
+      scene.Text({c.x, c.y + 5.0f}, std::to_string(k + 1), 14.0f, {255, 255, 255, 255},
+                 TextAnchor::kCenter);
+    }
+    const ScenePoint est = to_image(estimate.x_m, estimate.y_m);
+    scene.Ring(est, 10.0f, 14.0f, 0.0f, 6.2832f, {31, 119, 180, 255}, 24);
+    if (truth_on_map) {
+      const ScenePoint t = to_image(truth_on_map->x, truth_on_map->y);
+      scene.Line({t.x - 10, t.y - 10}, {t.x + 10, t.y + 10}, 3.0f, {44, 160, 44, 255});
+      scene.Line({t.x - 10, t.y + 10}, {t.x + 10, t.y - 10}, 3.0f, {44, 160, 44, 255});
+    }
+    const std::string particles_etc = "grey: particles   blue ring: estimate" +
+                                      std::string(truth_on_map ? "   green x: truth" : "");
+    if (o.width_px >= 1000) {
+      scene.Text({20, 75},
+                 "purple: robot route   orange: candidates (k-means, by weight)   " + particles_etc,
+                 15.0f, kInk);
+    } else {  // a narrow page: two shorter lines
+      scene.Text({20, 70}, "purple: route   orange: candidates (k-means)", 15.0f, kInk);
+      scene.Text({20, 90}, particles_etc, 15.0f, kInk);
+    }
+    return scene;
+  };
 
   const std::string summary = j.dump(2) + "\n";
   StatusOr<std::unique_ptr<DiskFolder>> folder = DiskFolder::Open(args->values.at("--out"));
@@ -656,7 +673,7 @@ int CallCommand(const Arguments& parsed) {
                                           {"route.csv", route.str()},
                                           {"call.json", summary}});
   if (!written.ok()) return fail(written);
-  Status drawn = RenderToPng(scene, folder.value()->Path("call.png"));
+  Status drawn = WriteCommandFigure(*args, folder.value()->Path("call.png"), build, kTwoColumnMm);
   if (!drawn.ok()) return fail(drawn);
   if (!args->quiet) std::cout << summary;
   return kExitOk;

@@ -170,7 +170,8 @@ int RunReplay(const ReplayRequest& request) {
 
   int exit_code = kExitOk;
   if (result.summary) {
-    if (request.json || !::isatty(STDOUT_FILENO)) {
+    // --json always prints; --quiet silences the default (JSON into a pipe, text on a terminal).
+    if (request.json || (!request.quiet && !::isatty(STDOUT_FILENO))) {
       std::cout << result.summary->json;
     } else if (!request.quiet) {
       std::cout << HumanSummary(*result.summary, request.out);
@@ -187,8 +188,9 @@ int RunReplay(const ReplayRequest& request) {
                                                      session.dataset(), request.out,
                                                      request.formats, request.width_mm)
                                     : renderer.status();
-    if (rendered.ok() && png && session.pipeline().wifi_sequence().options().enabled) {
-      rendered = WriteWifiSequenceImages(*renderer.value(), session.pipeline(), request.out);
+    if (rendered.ok() && session.pipeline().wifi_sequence().options().enabled) {
+      rendered = WriteWifiSequenceImages(renderer->get(), session.pipeline(), request.out,
+                                         request.formats, request.width_mm);
     }
     if (!rendered.ok()) exit_code = fail(rendered.WithContext("images not written"));
   }

@@ -31,8 +31,10 @@ std::string ThisProgram() {
   return n > 0 ? std::string(buffer, static_cast<size_t>(n)) : std::string("ratslam");
 }
 
-// The sweep's figures from its collected points, into DIR/plots/.
-Status DrawSweepPlots(const std::string& dir, const sweep::CollectReport& report) {
+// The sweep's figures from its collected points, into DIR/plots/, in the formats --format asks
+// for (PNG by default).
+Status DrawSweepPlots(const std::string& dir, const sweep::CollectReport& report,
+                      const Arguments& args) {
   StatusOr<sweep::Plan> plan = sweep::ReadPlan(dir);
   if (!plan.ok()) return plan.status();
   SweepFigureData data;
@@ -54,14 +56,18 @@ Status DrawSweepPlots(const std::string& dir, const sweep::CollectReport& report
   std::error_code ec;
   std::filesystem::create_directories(plots, ec);
   if (ec) return Status::Error(plots + ": cannot create folder: " + ec.message());
+  auto draw = [&](const char* name, const std::function<Scene(int)>& build) {
+    return WriteCommandFigure(args, plots + "/" + name, build);
+  };
   if (!data.keys.empty()) {
     RATSLAM_RETURN_IF_ERROR(
-        RenderToPng(SweepParameterScene(data), plots + "/objective_by_parameter.png"));
+        draw("objective_by_parameter.png", [&](int w) { return SweepParameterScene(data, w); }));
   }
   if (data.keys.size() >= 2) {
-    RATSLAM_RETURN_IF_ERROR(RenderToPng(SweepHeatmapScene(data, 0, 1), plots + "/heatmap.png"));
+    RATSLAM_RETURN_IF_ERROR(
+        draw("heatmap.png", [&](int w) { return SweepHeatmapScene(data, 0, 1, w); }));
   }
-  return RenderToPng(SweepParetoScene(data), plots + "/pareto.png");
+  return draw("pareto.png", [&](int w) { return SweepParetoScene(data, w); });
 }
 
 int Fail(const Status& s) {
@@ -188,7 +194,7 @@ int SweepCommand(const std::string& action, const Arguments& parsed) {
   }
   StatusOr<sweep::CollectReport> report = sweep::Collect(target);
   if (!report.ok()) return Fail(report.status());
-  if (Status drawn = DrawSweepPlots(target, *report); !drawn.ok()) return Fail(drawn);
+  if (Status drawn = DrawSweepPlots(target, *report, *args); !drawn.ok()) return Fail(drawn);
   std::cout << report->ok << " ok, " << report->failed << " failed, " << report->pending
             << " pending";
   if (report->eliminated > 0) std::cout << ", " << report->eliminated << " eliminated";

@@ -3,21 +3,22 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <vector>
 
-#include "render/image.h"
 #include "viewer/figures.h"
 
 namespace ratslam {
 
-Status WriteWifiSequenceImages(SceneRenderer& renderer, const ReplayPipeline& pipeline,
-                               const std::string& folder) {
+Status WriteWifiSequenceImages(SceneRenderer* renderer, const ReplayPipeline& pipeline,
+                               const std::string& folder, const std::vector<FigureFormat>& formats,
+                               double width_mm) {
   namespace fs = std::filesystem;
   const WifiSequenceLoopCloser& closer = pipeline.wifi_sequence();
-  auto write = [&](const Scene& scene, const char* name) -> Status {
-    StatusOr<RgbaImage> image = renderer.Render(scene);
-    if (!image.ok()) return image.status().WithContext(name);
-    return WritePng(image.value(), (fs::path(folder) / name).string());
+  auto write = [&](const std::function<Scene(int)>& build, const char* name) -> Status {
+    return WriteNaturalFigure(renderer, build,
+                              FigureTargets((fs::path(folder) / name).string(), &formats), width_mm)
+        .WithContext(name);
   };
   // Fig. 9: every `stride`-th scan, so that long runs stay within 1000 x 1000 cells.
   const size_t n = closer.size();
@@ -49,8 +50,15 @@ Status WriteWifiSequenceImages(SceneRenderer& renderer, const ReplayPipeline& pi
                                static_cast<int>(c.past_pose / stride), good ? verified : rejected});
     }
   }
-  RATSLAM_RETURN_IF_ERROR(
-      write(SimilarityMatrixScene(matrix, times, options), "wifi_sequence_similarity.png"));
+  // PNG: a 1000-pixel matrix; PDF and SVG: the matrix fills the page beside its colour bar.
+  RATSLAM_RETURN_IF_ERROR(write(
+      [&](int width_px) {
+        SimilarityImageOptions o = options;
+        if (width_px > 0) o.size_px = std::max(200, width_px - 190);
+        if (width_px > 0 && width_px < 900) o.title = "Wi-Fi similarity of scans (eqs. 1-4)";
+        return SimilarityMatrixScene(matrix, times, o);
+      },
+      "wifi_sequence_similarity.png"));
 
   // Fig. 10: the pairs on the final map.
   SequencePairsData pairs;
@@ -63,8 +71,11 @@ Status WriteWifiSequenceImages(SceneRenderer& renderer, const ReplayPipeline& pi
       pairs.pairs.push_back({c.current_pose, c.past_pose, loop.accepted && c.inlier});
     }
   }
-  return write(SequencePairsScene(pairs, "Wi-Fi sequence correspondences on the map"),
-               "wifi_sequence_pairs.png");
+  return write(
+      [&](int width_px) {
+        return SequencePairsScene(pairs, "Wi-Fi sequence correspondences on the map", width_px);
+      },
+      "wifi_sequence_pairs.png");
 }
 
 }  // namespace ratslam

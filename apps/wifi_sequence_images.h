@@ -3,19 +3,23 @@
 #define RATSLAM_APPS_WIFI_SEQUENCE_IMAGES_H_
 
 #include <string>
+#include <vector>
 
 #include "common/status.h"
 #include "fusion/replay_pipeline.h"
 #include "render/renderer.h"
+#include "viewer/figure_output.h"
 
 namespace ratslam {
 
 // Writes wifi_sequence_similarity.png (the smoothed similarity of every pair of scans, at most
 // 1000 x 1000 cells, with each loop's correspondences marked: verified, rejected) and
 // wifi_sequence_pairs.png (the correspondences on the final map before and after verification)
-// into `folder`.
-Status WriteWifiSequenceImages(SceneRenderer& renderer, const ReplayPipeline& pipeline,
-                               const std::string& folder);
+// into `folder`, in each of `formats` (PDF and SVG on a page `width_mm` wide). `renderer` may be
+// null when PNG is not among them.
+Status WriteWifiSequenceImages(SceneRenderer* renderer, const ReplayPipeline& pipeline,
+                               const std::string& folder, const std::vector<FigureFormat>& formats,
+                               double width_mm);
 
 }  // namespace ratslam
 

@@ -28,7 +28,13 @@ TOML
 tasks=$(($(wc -l <"$work/sweep/tasks.csv") - 1))
 # The recipe: one `sweep task` per index, two at a time.
 seq 0 $((tasks - 1)) | parallel --will-cite -j 2 -S : "$program" sweep task "$work/sweep" --index {} >/dev/null
-"$program" sweep collect "$work/sweep"
+"$program" sweep collect "$work/sweep" --format png,pdf
+for plot in objective_by_parameter heatmap pareto; do
+  for ext in png pdf; do
+    [[ -s $work/sweep/plots/$plot.$ext ]] || { echo "parallel check: FAILED: no plots/$plot.$ext" >&2; exit 1; }
+  done
+done
+head -c 5 "$work/sweep/plots/pareto.pdf" | grep -q '%PDF-' || { echo "parallel check: FAILED: pareto.pdf is no PDF" >&2; exit 1; }
 ok=$(grep -c '"status": "ok"' "$work/sweep/results.json" || true)
 if ((ok != tasks)); then
   echo "parallel check: FAILED: $ok of $tasks tasks succeeded" >&2

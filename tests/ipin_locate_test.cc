@@ -205,8 +205,8 @@ TEST(IpinLocateTest, ARunsMapLocatesThePhoneAndTheRobotIsCalled) {
   // Call the robot at 100 s, from the run folder and from the saved map: the same plan.
   auto call = [&](const std::string& robot_map, const std::string& out) {
     const Result called =
-        RunRatslam("call --quiet --map " + robot_map + " --wifi-map " + wifi + " --data " +
-                       log("03") + " --at 100 --out " + (root / out).string(),
+        RunRatslam("call --quiet --format png,pdf --map " + robot_map + " --wifi-map " + wifi +
+                       " --data " + log("03") + " --at 100 --out " + (root / out).string(),
                    root);
     EXPECT_EQ(called.exit_code, 0) << called.err;
     std::ifstream in(root / out / "call.json");
@@ -218,6 +218,12 @@ TEST(IpinLocateTest, ARunsMapLocatesThePhoneAndTheRobotIsCalled) {
 
   ASSERT_TRUE(c.is_object());
   EXPECT_GT(fs::file_size(root / "c" / "call.png"), 10000u);
+  {
+    std::ifstream pdf(root / "c" / "call.pdf", std::ios::binary);
+    std::string magic(5, '\0');
+    pdf.read(magic.data(), 5);
+    EXPECT_EQ(magic, "%PDF-");
+  }
   EXPECT_LT(c["nearest_candidate_error_m"].get<double>(), 0.3 * chance);
   StatusOr<CsvTable> ex = CsvTable::Read(
       run + "/experiences.csv", {"id", "x_m", "y_m"},

@@ -58,11 +58,16 @@ TEST_P(IpinWifiSequenceTest, VerifiedSequencesCloseLoopsOnRealWalks) {
       ("ratslam_ipin_sequence_" + std::string(GetParam()) + "_" + std::to_string(::getpid()));
   const std::string config =
       std::string(RATSLAM_SOURCE_DIR) + "/configs/ipin2023-wifi-sequence-alone.toml";
-  const nlohmann::json with = Replay(config, logs, out / "with", "--render");
-  // Figs. 9 and 10 beside the usual images.
-  for (const char* png : {"wifi_sequence_similarity.png", "wifi_sequence_pairs.png"}) {
-    ASSERT_TRUE(fs::exists(out / "with" / png)) << png;
-    EXPECT_GT(fs::file_size(out / "with" / png), 10000u) << png;
+  const nlohmann::json with = Replay(config, logs, out / "with", "--render --format png,svg");
+  // Figs. 9 and 10 beside the usual images, as PNG and as SVG (--format).
+  for (const char* name : {"wifi_sequence_similarity", "wifi_sequence_pairs"}) {
+    const fs::path png = out / "with" / (std::string(name) + ".png");
+    ASSERT_TRUE(fs::exists(png)) << png;
+    EXPECT_GT(fs::file_size(png), 10000u) << png;
+    std::ifstream svg(out / "with" / (std::string(name) + ".svg"));
+    std::stringstream svg_text;
+    svg_text << svg.rdbuf();
+    EXPECT_NE(svg_text.str().find("<svg"), std::string::npos) << name << ".svg";
   }
   // The same run without the loop closer: the shipped file with enabled = false.
   std::ifstream shipped(config);

@@ -107,6 +107,23 @@ TEST_F(ReplayEndToEndTest, AnEarlierRunsOutputsAreReplacedOnlyWithOverwrite) {
   for (const char* name : kOutputs) EXPECT_TRUE(fs::exists(out / name)) << name;
 }
 
+// Into a pipe a run prints summary.json on stdout, --quiet prints nothing there, and --json
+// prints it even with --quiet (RunRatslam's stdout is never a terminal).
+TEST_F(ReplayEndToEndTest, QuietSilencesStdoutAndJsonOverridesIt) {
+  const std::string args =
+      "replay --config " + config_ + " --data " + (root_ / "data").string() + " --until 20 --out ";
+  const Result piped = RunRatslam(args + (root_ / "piped").string(), root_);
+  ASSERT_EQ(piped.exit_code, 0) << piped.err;
+  EXPECT_EQ(piped.out, Slurp(root_ / "piped" / "summary.json"));
+  const Result quiet = RunRatslam(args + (root_ / "quiet").string() + " --quiet", root_);
+  ASSERT_EQ(quiet.exit_code, 0) << quiet.err;
+  EXPECT_EQ(quiet.out, "");
+  EXPECT_EQ(quiet.err, "");
+  const Result json = RunRatslam(args + (root_ / "json").string() + " --quiet --json", root_);
+  ASSERT_EQ(json.exit_code, 0) << json.err;
+  EXPECT_EQ(json.out, Slurp(root_ / "json" / "summary.json"));
+}
+
 // --render --format pdf,svg writes vector figures (no PNG) on a page --width-mm wide, and
 // `render` picks the format from --out's extension.
 TEST_F(ReplayEndToEndTest, VectorFiguresFromReplayAndRender) {

@@ -24,15 +24,16 @@ inline std::string Slurp(const std::filesystem::path& path) {
 struct Result {
   int exit_code;
   std::string err;  // what it printed on stderr
+  std::string out;  // what it printed on stdout
 };
 
 // Runs `ratslam arguments` with stdout and stderr in files of `scratch`.
 inline Result RunRatslam(const std::string& arguments, const std::filesystem::path& scratch) {
-  const std::filesystem::path err = scratch / "stderr.txt";
-  const std::string command = std::string(RATSLAM_BINARY) + " " + arguments + " > " +
-                              (scratch / "stdout.txt").string() + " 2> " + err.string();
+  const std::filesystem::path err = scratch / "stderr.txt", out = scratch / "stdout.txt";
+  const std::string command =
+      std::string(RATSLAM_BINARY) + " " + arguments + " > " + out.string() + " 2> " + err.string();
   const int status = std::system(command.c_str());
-  return {WEXITSTATUS(status), Slurp(err)};
+  return {WEXITSTATUS(status), Slurp(err), Slurp(out)};
 }
 
 }  // namespace ratslam::e2e

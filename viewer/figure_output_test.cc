@@ -9,8 +9,11 @@
 
 #include "common/scratch_dir.h"
 #include "ratslam/pose_cell_network.h"
+#include "render/image.h"
 #include "viewer/figures.h"
 #include "viewer/localisation_figure.h"
+#include "viewer/run_images.h"
+#include "viewer/sweep_figures.h"
 
 namespace ratslam {
 namespace {
@@ -117,6 +120,83 @@ TEST(FigureOutputTest, EveryFiguresTextIsAtLeastSevenPointsInPrint) {
         EXPECT_GE(TextPoints(t.height_px, scene.width(), width_mm), kMinTextPt - 1e-9)
             << "'" << t.text << "' (" << t.height_px << " px) in a scene " << scene.width()
             << " px wide printed " << width_mm << " mm wide";
+      }
+    }
+  }
+}
+
+// Laid out for a page, no text runs off it. TextWidthPx (the PNG font's metrics) bounds the PDF
+// font's width from above: DejaVu Sans set at the same cap height measures 90-97 % of it
+// (Cairo's text extents of our labels), so a text that fits here fits in both.
+TEST(FigureOutputTest, NoTextRunsOffAFigureLaidOutForAPage) {
+  SweepFigureData sweep;
+  sweep.title = "ipin2023-wifi-compass.toml";
+  sweep.objective = "mean map_ate_m";
+  sweep.keys = {"fused.recency_s", "local_view.injection_gain", "wifi.match_threshold"};
+  for (int i = 0; i < 27; ++i) {
+    sweep.points.push_back({{std::to_string(20 * (1 + i % 3)), std::to_string(0.05 * (1 + i / 9)),
+                             std::to_string(0.15 + 0.1 * (i / 3 % 3))},
+                            1.5 + 0.1 * i,
+                            0.2 + 0.01 * i});
+  }
+  sweep.best = 0;
+  SequencePairsData pairs;
+  for (int i = 0; i < 40; ++i) pairs.positions.push_back({0.5 * i, std::sin(0.3 * i)});
+  pairs.pairs = {{30, 2, true}, {31, 3, false}};
+  std::vector<float> matrix(100, 0.5f);
+  std::vector<double> times(10);
+  for (int i = 0; i < 10; ++i) times[i] = 100.0 * i;
+  ExperienceMapImageData map;
+  for (uint32_t i = 0; i < 20; ++i) {
+    Experience e;
+    e.id = i;
+    e.x_m = i;
+    e.time_s = 1234.567 * i;
+    map.experiences.push_back(e);
+  }
+  Link closure;
+  closure.from = 19;
+  closure.to = 0;
+  closure.loop_closure = true;
+  map.links.push_back(closure);
+  map.ground_truth = {{0, 0}, {19, 0}};  // its legend item too
+  std::vector<int> floors(20, 0);        // the second half of the map on floor 1
+  std::fill(floors.begin() + 10, floors.end(), 1);
+  for (double width_mm : {88.0, 180.0}) {
+    const int w = VectorLayoutWidthPx(width_mm);
+    SimilarityImageOptions similarity;
+    similarity.size_px = w - 190;  // as replay --render lays it out
+    similarity.title = "Wi-Fi similarity of scans (eqs. 1-4)";
+    similarity.legend = {{{220, 50, 32, 255}, "verified correspondence"},
+                         {{170, 170, 170, 255}, "DP pair not verified (light)"}};
+    ExperienceMapImageOptions map_options;
+    map_options.width_px = w;
+    map_options.height_px = w * 3 / 4;
+    map_options.title =
+        "experience map (IPIN2023_T3_TrainingTrial51_repetition02 and "
+        "IPIN2023_T3_TrainingTrial51_repetition03)";  // a data set's long name
+    TemplateGraphImageOptions graph_options;
+    graph_options.width_px = w;
+    graph_options.height_px = w;
+    graph_options.title = map_options.title;
+    for (const Scene& scene :
+         {SweepParameterScene(sweep, w), SweepHeatmapScene(sweep, 0, 1, w),
+          SweepParetoScene(sweep, w), SequencePairsScene(pairs, "Wi-Fi sequence pairs", w),
+          SimilarityMatrixScene(matrix, times, similarity), ExperienceMapScene(map, map_options),
+          TemplateGraphScene({{0.0, 1, 1, DecisionSource::kNew}}, graph_options),
+          ExperienceMapFloorsScene(map, floors, {}, map_options)}) {
+      ASSERT_FALSE(scene.texts().empty());
+      EXPECT_LE(scene.width(), w + 1) << "'" << scene.texts().front().text << "'";
+      for (const SceneText& t : scene.texts()) {
+        const float width = TextWidthPx(t.text, t.height_px);
+        const float left = t.anchor == TextAnchor::kLeft     ? t.position.x
+                           : t.anchor == TextAnchor::kCenter ? t.position.x - width / 2
+                                                             : t.position.x - width;
+        EXPECT_GE(left, 0.0f) << "'" << t.text << "' at " << width_mm << " mm";
+        EXPECT_LE(left + width, static_cast<float>(scene.width()))
+            << "'" << t.text << "' at " << width_mm << " mm (scene " << scene.width() << " px)";
+        EXPECT_GE(TextPoints(t.height_px, scene.width(), width_mm), kMinTextPt - 1e-9)
+            << "'" << t.text << "'";
       }
     }
   }

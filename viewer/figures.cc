@@ -179,6 +179,19 @@ std::vector<Point2> AlignGroundTruthToMap(const std::vector<Point2>& map_points,
   return out;
 }
 
+void FittedTitle(Scene& scene, ScenePoint position, const std::string& text, float height_px,
+                 float max_width_px, Rgba color) {
+  float h = height_px;
+  while (h > 13.0f && TextWidthPx(text, h) > max_width_px) h -= 1.0f;
+  std::string fitted = text;
+  // Elide the middle, a character at a time from the centre outwards.
+  for (size_t cut = 1; TextWidthPx(fitted, h) > max_width_px && cut + 2 < text.size(); ++cut) {
+    const size_t keep = text.size() - cut;
+    fitted = text.substr(0, (keep + 1) / 2) + "..." + text.substr(text.size() - keep / 2);
+  }
+  scene.Text(position, fitted, h, color);
+}
+
 Scene ExperienceMapScene(const ExperienceMapImageData& data,
                          const ExperienceMapImageOptions& options, WorldToImage* transform) {
   Scene scene(options.width_px, options.height_px, kWhite);
@@ -212,7 +225,8 @@ Scene ExperienceMapScene(const ExperienceMapImageData& data,
   // Legend items (a sample and a label each), flowed right to left into rows; the first row sits
   // beside the scale bar when it fits there, further rows stack above it.
   std::vector<LegendItem> items;
-  if (data.ground_truth.size() > 1) {
+  const ExperienceMapImageData& legend_data = options.legend_data ? *options.legend_data : data;
+  if (legend_data.ground_truth.size() > 1) {
     // The truth is drawn in the map's frame after a rigid fit (AlignGroundTruthToMap): say so.
     static const char* const kTruthLabel = "ground truth (rigidly aligned)";
     items.push_back({38 + TextWidthPx(kTruthLabel, 14), [](Scene& s, float x, float y) {
@@ -224,7 +238,7 @@ Scene ExperienceMapScene(const ExperienceMapImageData& data,
                      s.Line({x, y}, {x + 30, y}, 3.0f, kLoopClosure);
                      s.Text({x + 38, y + 5}, "loop closure", 14, kInk);
                    }});
-  if (std::any_of(data.links.begin(), data.links.end(),
+  if (std::any_of(legend_data.links.begin(), legend_data.links.end(),
                   [](const Link& l) { return l.wifi_sequence; })) {
     items.push_back({38 + TextWidthPx("Wi-Fi sequence link", 14), [](Scene& s, float x, float y) {
                        s.Line({x, y}, {x + 30, y}, 3.0f, kWifiSequence);
@@ -242,8 +256,11 @@ Scene ExperienceMapScene(const ExperienceMapImageData& data,
     t_last = options.time_range_s->second;
   }
   if (options.coloring == MapColoring::kTime && std::isfinite(t_first)) {
+    // The end labels are centred on the bar's ends: room for half the last one.
+    const float half_label = 0.5f * TextWidthPx(FormatNumber(t_last) + " s", 13);
     items.push_back(
-        {kColorBarWidth + 20, [t_first, t_last](Scene& s, float x, float y) {
+        {kColorBarWidth + std::max(20.0f, half_label + 6),
+         [t_first, t_last](Scene& s, float x, float y) {
            s.Image(ColorBar(x, y - 7, kColorBarWidth, 14));
            s.Text({x, y + 24}, FormatNumber(t_first) + " s", 13, kInk, TextAnchor::kCenter);
            s.Text({x + kColorBarWidth, y + 24}, FormatNumber(t_last) + " s", 13, kInk,
@@ -340,7 +357,8 @@ Scene ExperienceMapScene(const ExperienceMapImageData& data,
   }
 
   // Title, and the counts on a line of their own.
-  scene.Text({margin, 26}, options.title.empty() ? "experience map" : options.title, 18, kInk);
+  FittedTitle(scene, {margin, 26}, options.title.empty() ? "experience map" : options.title, 18,
+              w - 2 * margin);
   scene.Text({margin, 50},
              std::to_string(data.experiences.size()) + " experiences, " + std::to_string(n_links) +
                  " links, " + std::to_string(loop_closures) +
@@ -349,6 +367,7 @@ Scene ExperienceMapScene(const ExperienceMapImageData& data,
                                  : std::string()),
              14, kInk);
 
+  if (!options.legend) return scene;
   // Scale bar, bottom left: a nice length near a fifth of the plot width.
   const double bar_m = NiceStep(0.2 * plot_w / to_image.scale_px_per_m, 1);
   const float bar_px = static_cast<float>(bar_m * to_image.scale_px_per_m);
@@ -451,7 +470,8 @@ Scene TemplateGraphScene(const std::vector<TemplateGraphPoint>& points,
     scene.Disc(lower.Map(p.time_s, static_cast<double>(p.experience_id)), many ? 1.0f : 1.8f,
                kExperienceColor, 6);
   }
-  scene.Text({20, 26}, options.title.empty() ? "template graph" : options.title, 18, kInk);
+  FittedTitle(scene, {20, 26}, options.title.empty() ? "template graph" : options.title, 18,
+              options.width_px - 40.0f);
   return scene;
 }
 
@@ -612,8 +632,8 @@ Scene SimilarityMatrixScene(const std::vector<float>& matrix, const std::vector<
   return scene;
 }
 
-Scene SequencePairsScene(const SequencePairsData& data, const std::string& title) {
-  const int panel = 800, top = 80, margin = 30;
+Scene SequencePairsScene(const SequencePairsData& data, const std::string& title, int width_px) {
+  const int panel = width_px > 0 ? std::max(200, width_px / 2) : 800, top = 80, margin = 30;
   Scene scene(2 * panel, panel + top, kWhite);
   double min_x = std::numeric_limits<double>::infinity(), max_x = -min_x, min_y = min_x,
          max_y = -min_x;
@@ -648,12 +668,11 @@ Scene SequencePairsScene(const SequencePairsData& data, const std::string& title
       scene.Disc(to_image(a.x, a.y), 2.5f, kInk, 8);
     }
     scene.Text({p * panel + 20.0f, 58},
-               (p == 0 ? "DP correspondences before verification: " : "verified: ") +
-                   std::to_string(drawn),
+               (p == 0 ? "DP pairs before verification: " : "verified: ") + std::to_string(drawn),
                15, kInk);
   }
-  scene.Line({static_cast<float>(panel), top}, {static_cast<float>(panel), top + panel}, 1.0f,
-             kGrid);
+  scene.Line({static_cast<float>(panel), static_cast<float>(top)},
+             {static_cast<float>(panel), static_cast<float>(top + panel)}, 1.0f, kGrid);
   return scene;
 }
 

@@ -47,6 +47,12 @@ struct WorldBounds {
   double min_x_m = 0, min_y_m = 0, max_x_m = 0, max_y_m = 0;
 };
 
+// Draws a left-aligned title that fits `max_width_px`: smaller type first (down to 13 px, our
+// smallest), then the middle of the text elided with "..." (a long data-set name keeps its
+// start and end).
+void FittedTitle(Scene& scene, ScenePoint position, const std::string& text, float height_px,
+                 float max_width_px, Rgba color = kInk);
+
 struct ExperienceMapImageOptions {
   int width_px = 1600;
   int height_px = 1200;
@@ -55,6 +61,11 @@ struct ExperienceMapImageOptions {
   MapColoring coloring = MapColoring::kTime;
   std::vector<double> session_start_times_s;  // ascending; sessions for kSession colouring
   std::string title;
+  // Panels of a multi-floor figure: `legend` false leaves the scale bar and legend out (the
+  // band they take stays, so that every panel has the same scale); `legend_data`, when set,
+  // decides which legend items appear (the whole map's, not one floor's).
+  bool legend = true;
+  const struct ExperienceMapImageData* legend_data = nullptr;
 };
 
 struct ExperienceMapImageData {
@@ -135,8 +146,8 @@ struct SequencePairsData {
   std::vector<Pair> pairs;
 };
 // Two panels over the same view: every pair (left) and the verified ones (right); the scans'
-// track in grey.
-Scene SequencePairsScene(const SequencePairsData& data, const std::string& title);
+// track in grey. The panels are square and `width_px` wide together (0: 1600).
+Scene SequencePairsScene(const SequencePairsData& data, const std::string& title, int width_px = 0);
 
 // A field over the plane on a grid of cells (row-major from the south-west corner; NaN: no
 // value), drawn as a heat map with its own colour scale (e.g. a GP Wi-Fi map's mean or variance).

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "render/image.h"
 #include "render/renderer.h"
 #include "viewer/run_images.h"
 
@@ -98,32 +99,75 @@ TEST(ExperienceMapSceneTest, RenderedNodesAreWhereTheWorldSays) {
   EXPECT_FALSE(is_ink(t(0, 10)));  // mirrored position of node 2: would be inked if upside down
 }
 
-// Two floors: two panels at one scale; each shows only its own floor's experiences.
-TEST(ExperienceMapByFloorTest, OnePanelPerFloor) {
+// Two floors: two panels at one scale in the figure's size, under one title, with one legend;
+// each shows only its own floor's experiences.
+TEST(ExperienceMapByFloorTest, OnePanelPerFloorOneLegend) {
   StatusOr<std::unique_ptr<SceneRenderer>> renderer = CreateOsMesaRenderer();
   if (!renderer.ok()) GTEST_SKIP() << "OSMesa unavailable: " << renderer.status().message();
   ExperienceMapImageData data = LMap();  // (0,0) and (20,0) on floor 0, (20,10) on floor 1
+  data.links[0].loop_closure = true;
   ExperienceMapImageOptions options;
-  options.width_px = 400;
-  options.height_px = 300;
-  StatusOr<RgbaImage> image =
-      RenderExperienceMapByFloor(*renderer.value(), data, {0, 0, 1}, {}, options);
+  options.width_px = 800;
+  options.height_px = 400;
+  options.title = "the run";
+  FloorPanels layout;
+  const Scene scene = ExperienceMapFloorsScene(data, {0, 0, 1}, {}, options, 0, &layout);
+  EXPECT_EQ(scene.width(), 800);
+  EXPECT_EQ(scene.height(), 400);
+  // A 20 m x 10 m map in 800 x 400: side by side draws it larger than stacked.
+  ASSERT_EQ(layout.columns, 2);
+  EXPECT_EQ(layout.floors, (std::vector<int>{0, 1}));
+  auto count = [&](const std::string& text) {
+    return std::count_if(scene.texts().begin(), scene.texts().end(),
+                         [&](const SceneText& t) { return t.text == text; });
+  };
+  EXPECT_EQ(count("the run"), 1);
+  EXPECT_EQ(count("floor 0"), 1);
+  EXPECT_EQ(count("floor 1"), 1);
+  EXPECT_EQ(count("loop closure"), 1);  // one legend, though floor 1 has no loop closure
+  // A tall map stacks its panels.
+  FloorPanels tall;
+  ExperienceMapImageOptions narrow;
+  narrow.width_px = 400;
+  narrow.height_px = 800;
+  ExperienceMapFloorsScene(data, {0, 0, 1}, {}, narrow, 0, &tall);
+  EXPECT_EQ(tall.columns, 1);
+
+  StatusOr<RgbaImage> image = renderer.value()->Render(scene);
   ASSERT_TRUE(image.ok()) << image.status().message();
-  ASSERT_EQ(image->width, 800);
-  ASSERT_EQ(image->height, 300);
   // Both panels share the full map's view, so a world point maps to the same offset in each.
-  options.bounds = WorldBounds{0, 0, 20, 10};
+  ExperienceMapImageOptions panel;
+  panel.width_px = layout.panel_width_px;
+  panel.height_px = layout.panel_height_px;
+  panel.bounds = WorldBounds{0, 0, 20, 10};
   WorldToImage t;
-  ExperienceMapScene(data, options, &t);
-  auto ink = [&](ScenePoint p, int panel) {
-    const Rgba c = image->At(static_cast<int>(std::lround(p.x)) + 400 * panel,
-                             static_cast<int>(std::lround(p.y)));
+  ExperienceMapScene(data, panel, &t);
+  auto ink = [&](ScenePoint p, int k) {
+    const Rgba c = image->At(static_cast<int>(std::lround(p.x)) + layout.panel_width_px * k,
+                             static_cast<int>(std::lround(p.y)) + layout.top_px);
     return c.r + c.g + c.b < 600;
   };
   EXPECT_TRUE(ink(t(0, 0), 0));
   EXPECT_FALSE(ink(t(0, 0), 1));
   EXPECT_TRUE(ink(t(20, 10), 1));
   EXPECT_FALSE(ink(t(20, 10), 0));
+}
+
+// A title too long for its width is set smaller, then elided in the middle; a short one is kept.
+TEST(FittedTitleTest, ShrinksThenElidesTheMiddle) {
+  Scene scene(400, 100, {255, 255, 255, 255});
+  FittedTitle(scene, {10, 20}, "short", 18, 380);
+  const std::string name = "experience map (IPIN2023_T3_TrainingTrial51_repetition02, run 7)";
+  FittedTitle(scene, {10, 40}, name, 18, 380);
+  ASSERT_EQ(scene.texts().size(), 2u);
+  EXPECT_EQ(scene.texts()[0].text, "short");
+  EXPECT_EQ(scene.texts()[0].height_px, 18);
+  const SceneText& t = scene.texts()[1];
+  EXPECT_EQ(t.height_px, 13);
+  EXPECT_LE(TextWidthPx(t.text, t.height_px), 380);
+  EXPECT_NE(t.text.find("..."), std::string::npos);
+  EXPECT_EQ(t.text.substr(0, 15), "experience map ");  // the start and the end survive
+  EXPECT_EQ(t.text.substr(t.text.size() - 6), "run 7)");
 }
 
 TEST(TemplateGraphSceneTest, EmptyInputStillGivesAFigure) {

@@ -55,13 +55,15 @@ std::vector<int> ExperienceFloors(const std::vector<Experience>& experiences,
   return floors;
 }
 
-std::vector<Scene> ExperienceMapFloorScenes(const ExperienceMapImageData& data,
-                                            const std::vector<int>& experience_floors,
-                                            const std::vector<int>& ground_truth_floors,
-                                            const ExperienceMapImageOptions& panel) {
+Scene ExperienceMapFloorsScene(const ExperienceMapImageData& data,
+                               const std::vector<int>& experience_floors,
+                               const std::vector<int>& ground_truth_floors,
+                               const ExperienceMapImageOptions& figure, int columns,
+                               FloorPanels* layout) {
   std::set<int> distinct(experience_floors.begin(), experience_floors.end());
   if (distinct.size() <= 1 || experience_floors.size() != data.experiences.size()) {
-    return {ExperienceMapScene(data, panel)};
+    if (layout) *layout = {};
+    return ExperienceMapScene(data, figure);
   }
   // One view for all panels: the bounds of everything.
   WorldBounds bounds{1e300, 1e300, -1e300, -1e300};
@@ -77,7 +79,32 @@ std::vector<Scene> ExperienceMapFloorScenes(const ExperienceMapImageData& data,
     times = {std::min(times.first, e.time_s), std::max(times.second, e.time_s)};
   }
   for (const Point2& p : data.ground_truth) include(p.x, p.y);
-  std::vector<Scene> panels;
+  const double span_x = std::max(bounds.max_x_m - bounds.min_x_m, 1e-3);
+  const double span_y = std::max(bounds.max_y_m - bounds.min_y_m, 1e-3);
+
+  // The grid: the number of columns that draws the map largest in a panel (a panel's plot is
+  // its size less the bands ExperienceMapScene keeps: 2 x 30 px across, 66 + 60 px down).
+  const int n = static_cast<int>(distinct.size());
+  constexpr int kHeading = 34;  // the figure's title above the panels
+  const int w = figure.width_px, h = figure.height_px;
+  if (columns <= 0) {
+    double best = -1.0;
+    for (int c = 1; c <= n; ++c) {
+      const int rows = (n + c - 1) / c;
+      const double scale =
+          std::min((w / c - 60.0) / span_x, ((h - kHeading) / rows - 126.0) / span_y);
+      if (scale > best + 1e-12) best = scale, columns = c;
+    }
+  }
+  columns = std::min(columns, n);
+  const int rows = (n + columns - 1) / columns;
+  const int panel_w = w / columns, panel_h = (h - kHeading) / rows;
+  if (layout) *layout = {columns, panel_w, panel_h, kHeading, {distinct.begin(), distinct.end()}};
+
+  Scene scene(w, h, {255, 255, 255, 255});
+  FittedTitle(scene, {30, 24}, figure.title.empty() ? "experience map" : figure.title, 18,
+              w - 60.0f);
+  int k = 0;
   for (int floor : distinct) {
     ExperienceMapImageData subset;
     std::vector<int64_t> new_id(data.experiences.size(), -1);
@@ -90,10 +117,10 @@ std::vector<Scene> ExperienceMapFloorScenes(const ExperienceMapImageData& data,
     }
     for (const Link& l : data.links) {
       if (new_id[l.from] < 0 || new_id[l.to] < 0) continue;  // links between floors are left out
-      Link k = l;
-      k.from = static_cast<uint32_t>(new_id[l.from]);
-      k.to = static_cast<uint32_t>(new_id[l.to]);
-      subset.links.push_back(k);
+      Link link = l;
+      link.from = static_cast<uint32_t>(new_id[l.from]);
+      link.to = static_cast<uint32_t>(new_id[l.to]);
+      subset.links.push_back(link);
     }
     if (data.current && new_id[*data.current] >= 0) {
       subset.current = static_cast<uint32_t>(new_id[*data.current]);
@@ -101,41 +128,20 @@ std::vector<Scene> ExperienceMapFloorScenes(const ExperienceMapImageData& data,
     for (size_t i = 0; i < data.ground_truth.size() && i < ground_truth_floors.size(); ++i) {
       if (ground_truth_floors[i] == floor) subset.ground_truth.push_back(data.ground_truth[i]);
     }
-    ExperienceMapImageOptions options = panel;
+    ExperienceMapImageOptions options = figure;
+    options.width_px = panel_w;
+    options.height_px = panel_h;
     options.bounds = bounds;
     options.time_range_s = times;
-    options.title = panel.title + ", floor " + std::to_string(floor);
-    panels.push_back(ExperienceMapScene(subset, options));
+    options.title = "floor " + std::to_string(floor);
+    // One legend and scale bar for the figure (every panel has the same scale): in the last.
+    options.legend = k == n - 1;
+    options.legend_data = &data;
+    scene.Append(ExperienceMapScene(subset, options), static_cast<float>(k % columns * panel_w),
+                 static_cast<float>(kHeading + k / columns * panel_h));
+    ++k;
   }
-  return panels;
-}
-
-StatusOr<RgbaImage> RenderExperienceMapByFloor(SceneRenderer& renderer,
-                                               const ExperienceMapImageData& data,
-                                               const std::vector<int>& experience_floors,
-                                               const std::vector<int>& ground_truth_floors,
-                                               const ExperienceMapImageOptions& panel) {
-  std::vector<RgbaImage> panels;
-  for (const Scene& scene :
-       ExperienceMapFloorScenes(data, experience_floors, ground_truth_floors, panel)) {
-    StatusOr<RgbaImage> image = renderer.Render(scene);
-    if (!image.ok()) return image.status();
-    panels.push_back(std::move(image.value()));
-  }
-  if (panels.size() == 1) return std::move(panels.front());
-  // Side by side.
-  RgbaImage out;
-  out.height = panel.height_px;
-  out.width = panel.width_px * static_cast<int>(panels.size());
-  out.pixels.resize(static_cast<size_t>(out.width) * out.height * 4);
-  for (size_t k = 0; k < panels.size(); ++k) {
-    for (int y = 0; y < out.height; ++y) {
-      std::copy_n(&panels[k].pixels[static_cast<size_t>(y) * panel.width_px * 4],
-                  static_cast<size_t>(panel.width_px) * 4,
-                  &out.pixels[(static_cast<size_t>(y) * out.width + k * panel.width_px) * 4]);
-    }
-  }
-  return out;
+  return scene;
 }
 
 std::vector<TemplateGraphPoint> TemplateGraphOf(const RunView& run) {
@@ -177,25 +183,21 @@ Status WriteRunImages(SceneRenderer* renderer, const RunView& run, const Dataset
       if (target.format == FigureFormat::kPng) {
         if (renderer == nullptr) return Status::Error(target.path + ": no PNG renderer");
         StatusOr<RgbaImage> image =
-            RenderExperienceMapByFloor(*renderer, map_data, floors, truth_floors, map_options);
+            renderer->Render(ExperienceMapFloorsScene(map_data, floors, truth_floors, map_options));
         if (!image.ok()) return image.status().WithContext("experience_map.png");
         RATSLAM_RETURN_IF_ERROR(WritePng(image.value(), target.path));
         continue;
       }
-      // Vector: one panel per floor, stacked (a column of a paper is narrow), each laid out
-      // for the page width.
+      // Vector: one panel per floor, stacked (a column of a paper is narrow), each as large as
+      // a single-floor map on the page.
       const auto [w, h] = VectorLayoutSize(map_options.width_px, map_options.height_px, width_mm);
-      ExperienceMapImageOptions panel = map_options;
-      panel.width_px = w;
-      panel.height_px = h;
-      const std::vector<Scene> scenes =
-          ExperienceMapFloorScenes(map_data, floors, truth_floors, panel);
-      Scene scene(w, h * static_cast<int>(scenes.size()), {255, 255, 255, 255});
-      for (size_t k = 0; k < scenes.size(); ++k) {
-        scene.Append(scenes[k], 0.0f, static_cast<float>(k * h));
-      }
-      RATSLAM_RETURN_IF_ERROR(
-          WriteVectorFigure(scene, target.path, VectorFormatOf(target.format), width_mm));
+      const int panels = static_cast<int>(std::set<int>(floors.begin(), floors.end()).size());
+      ExperienceMapImageOptions page = map_options;
+      page.width_px = w;
+      page.height_px = panels > 1 ? 34 + panels * h : h;
+      RATSLAM_RETURN_IF_ERROR(WriteVectorFigure(
+          ExperienceMapFloorsScene(map_data, floors, truth_floors, page, /*columns=*/1),
+          target.path, VectorFormatOf(target.format), width_mm));
     }
   }
   TemplateGraphImageOptions graph_options;

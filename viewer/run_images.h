@@ -25,25 +25,28 @@ std::vector<Point2> GroundTruthInMapFrame(const std::vector<Experience>& experie
 std::vector<int> ExperienceFloors(const std::vector<Experience>& experiences,
                                   const Dataset& dataset);
 
-// One experience-map panel per floor, side by side at one scale, each showing that floor's
-// experiences, the links between them and that floor's ground truth. A single floor gives the
-// ordinary image. `panel` sets each panel's size.
-StatusOr<RgbaImage> RenderExperienceMapByFloor(SceneRenderer& renderer,
-                                               const ExperienceMapImageData& data,
-                                               const std::vector<int>& experience_floors,
-                                               const std::vector<int>& ground_truth_floors,
-                                               const ExperienceMapImageOptions& panel);
+// How ExperienceMapFloorsScene laid out its panels (columns 0: a single map, no panels).
+struct FloorPanels {
+  int columns = 0;
+  int panel_width_px = 0, panel_height_px = 0;
+  int top_px = 0;           // the first row's top; panel k is at column k % columns
+  std::vector<int> floors;  // ascending, one per panel
+};
+
+// One experience-map panel per floor, all at one scale, each showing that floor's experiences,
+// the links between them and that floor's ground truth, in a grid within `figure`'s size under
+// one title, with one legend and scale bar (in the last panel). `columns` 0 picks the grid that
+// draws the map largest. A single floor gives the ordinary map.
+Scene ExperienceMapFloorsScene(const ExperienceMapImageData& data,
+                               const std::vector<int>& experience_floors,
+                               const std::vector<int>& ground_truth_floors,
+                               const ExperienceMapImageOptions& figure, int columns = 0,
+                               FloorPanels* layout = nullptr);
 
 // The experience-map figure data of a run, with the ground truth (if any) aligned to the map.
 ExperienceMapImageData ExperienceMapDataOf(const RunView& run, const Dataset& dataset);
 // One template-graph point per view frame.
 std::vector<TemplateGraphPoint> TemplateGraphOf(const RunView& run);
-
-// The experience-map panels of RenderExperienceMapByFloor, as scenes (one without floors).
-std::vector<Scene> ExperienceMapFloorScenes(const ExperienceMapImageData& data,
-                                            const std::vector<int>& experience_floors,
-                                            const std::vector<int>& ground_truth_floors,
-                                            const ExperienceMapImageOptions& panel);
 
 // Writes experience_map, template_graph and pose_cells into `folder` in each of `formats` (PNG
 // through `renderer`, which may be null without PNG; PDF and SVG on pages `width_mm` wide).

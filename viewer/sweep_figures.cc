@@ -5,7 +5,10 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <string>
+#include <vector>
 
+#include "render/image.h"
 #include "viewer/figures.h"
 
 namespace ratslam {
@@ -103,17 +106,46 @@ std::string Goal(const SweepFigureData& data) {
   return data.objective + (data.minimize ? " (lower is better)" : " (higher is better)");
 }
 
+// The subtitle in lines that fit `width_px` (split after "; " first, else at a space).
+std::vector<std::string> SubtitleLines(const std::string& text, float width_px) {
+  const float room = width_px - 40;
+  if (TextWidthPx(text, 15) <= room) return {text};
+  if (size_t semi = text.find("; "); semi != std::string::npos) {
+    return {text.substr(0, semi + 1), text.substr(semi + 2)};
+  }
+  size_t cut = text.rfind(' ');
+  while (cut != std::string::npos && cut > 0 && TextWidthPx(text.substr(0, cut), 15) > room) {
+    cut = text.rfind(' ', cut - 1);
+  }
+  if (cut == std::string::npos || cut == 0) return {text};
+  return {text.substr(0, cut), text.substr(cut + 1)};
+}
+
+// The title and subtitle lines; returns how far the subtitle's extra lines push the plot down.
+float Heading(Scene& scene, const std::string& title, const std::vector<std::string>& lines) {
+  scene.Text({20, 32}, title, 20, kInk);
+  for (size_t i = 0; i < lines.size(); ++i) {
+    scene.Text({20, 58 + 20.0f * i}, lines[i], 15, kInk);
+  }
+  return 20.0f * (lines.size() - 1);
+}
+
 }  // namespace
 
-Scene SweepParameterScene(const SweepFigureData& data) {
+Scene SweepParameterScene(const SweepFigureData& data, int width_px) {
   const int panels = std::max<int>(1, static_cast<int>(data.keys.size()));
-  const int columns = std::min(panels, 3);
+  const float panel_w = 380, panel_h = 280, left0 = 90, gap_x = 110, gap_y = 110;
+  // Up to three panels a row, fewer when a given width holds fewer.
+  const int fit = width_px > 0 ? static_cast<int>((width_px - left0) / (panel_w + gap_x)) : 3;
+  const int columns = std::clamp(fit, 1, std::min(panels, 3));
   const int rows = (panels + columns - 1) / columns;
-  const float panel_w = 380, panel_h = 280, left0 = 90, top0 = 90, gap_x = 110, gap_y = 110;
-  Scene scene(static_cast<int>(left0 + columns * (panel_w + gap_x)),
-              static_cast<int>(top0 + rows * (panel_h + gap_y)), Rgba{255, 255, 255, 255});
-  scene.Text({20, 32}, data.title, 20, kInk);
-  scene.Text({20, 58}, Goal(data) + " of each point; the best in red", 15, kInk);
+  const float scene_w = left0 + columns * (panel_w + gap_x);
+  const std::vector<std::string> lines =
+      SubtitleLines(Goal(data) + " of each point; the best in red", scene_w);
+  const float top0 = 90 + 20.0f * (lines.size() - 1);
+  Scene scene(static_cast<int>(scene_w), static_cast<int>(top0 + rows * (panel_h + gap_y)),
+              Rgba{255, 255, 255, 255});
+  Heading(scene, data.title, lines);
   const Range range = ObjectiveRange(data);
   for (int k = 0; k < static_cast<int>(data.keys.size()); ++k) {
     const float left = left0 + (k % columns) * (panel_w + gap_x);
@@ -143,7 +175,7 @@ Scene SweepParameterScene(const SweepFigureData& data) {
   return scene;
 }
 
-Scene SweepHeatmapScene(const SweepFigureData& data, int a, int b) {
+Scene SweepHeatmapScene(const SweepFigureData& data, int a, int b, int width_px) {
   std::vector<std::string> xs, ys;
   for (const SweepFigurePoint& p : data.points) {
     xs.push_back(p.values.at(a));
@@ -152,14 +184,19 @@ Scene SweepHeatmapScene(const SweepFigureData& data, int a, int b) {
   const ValueAxis x_axis(xs), y_axis(ys);
   const auto& columns = x_axis.distinct();
   const auto& rows = y_axis.distinct();
-  const float cell_w = std::max(60.0f, 560.0f / columns.size());
+  const float left = 150;
+  // A given width sets the cells' width (at least wide enough for a 4-digit label).
+  const float cell_w =
+      width_px > 0 ? std::max(44.0f, (width_px - left - 60) / static_cast<float>(columns.size()))
+                   : std::max(60.0f, 560.0f / columns.size());
   const float cell_h = std::max(34.0f, 380.0f / rows.size());
-  const float left = 150, top = 120;
   const float width = cell_w * columns.size(), height = cell_h * rows.size();
-  Scene scene(std::max(760, static_cast<int>(left + width + 60)),
-              static_cast<int>(top + height + 90), Rgba{255, 255, 255, 255});
-  scene.Text({20, 32}, data.title, 20, kInk);
-  scene.Text({20, 58}, "best " + Goal(data) + " over the other parameters", 15, kInk);
+  const int scene_w = std::max(width_px > 0 ? width_px : 760, static_cast<int>(left + width + 60));
+  const std::vector<std::string> lines =
+      SubtitleLines("best " + Goal(data) + " over the other parameters", scene_w);
+  const float top = 120 + 20.0f * (lines.size() - 1);
+  Scene scene(scene_w, static_cast<int>(top + height + 90), Rgba{255, 255, 255, 255});
+  Heading(scene, data.title, lines);
   const Range range = ObjectiveRange(data);
   for (size_t c = 0; c < columns.size(); ++c) {
     for (size_t r = 0; r < rows.size(); ++r) {
@@ -196,12 +233,15 @@ Scene SweepHeatmapScene(const SweepFigureData& data, int a, int b) {
   return scene;
 }
 
-Scene SweepParetoScene(const SweepFigureData& data) {
-  const float left = 100, top = 90, width = 700, height = 420;
+Scene SweepParetoScene(const SweepFigureData& data, int width_px) {
+  const float left = 100, height = 420;
+  const float width = width_px > 0 ? std::max(300.0f, width_px - left - 60.0f) : 700.0f;
+  const std::vector<std::string> lines =
+      SubtitleLines(Goal(data) + " against run time; the Pareto front in red", left + width + 60);
+  const float top = 90 + 20.0f * (lines.size() - 1);
   Scene scene(static_cast<int>(left + width + 60), static_cast<int>(top + height + 90),
               Rgba{255, 255, 255, 255});
-  scene.Text({20, 32}, data.title, 20, kInk);
-  scene.Text({20, 58}, Goal(data) + " against run time; the Pareto front in red", 15, kInk);
+  Heading(scene, data.title, lines);
   const Range y = ObjectiveRange(data);
   Range x{std::numeric_limits<double>::infinity(), 0.0};
   for (const SweepFigurePoint& p : data.points) {
