@@ -104,8 +104,8 @@ OptionSpec Size() {
 
 const OptionSpec kQuiet = Flag("--quiet", "no progress on stderr and no summary on stdout");
 const OptionSpec kJson = Flag("--json",
-                              "print summary.json on stdout even on a terminal (the default when "
-                              "stdout is not one)");
+                              "print the JSON summary on stdout even on a terminal (the default "
+                              "when stdout is not one; --quiet silences only the default)");
 const OptionSpec kLenient =
     Flag("--lenient", "skip and count malformed lines of phone logs instead of failing");
 const OptionSpec kOverwrite = Flag(
@@ -215,7 +215,7 @@ const std::vector<CommandSpec>& Commands() {
        "[evaluation] split and map_fraction then divide it.",
        {kConfig, Text("--map", "M", "data set to map", true),
         Text("--query", "Q", "data set to localise", true),
-        Text("--out", "O", "output folder", true), kOverwrite, kLenient, kQuiet,
+        Text("--out", "O", "output folder", true), kOverwrite, kLenient, kQuiet, kJson,
         Formats("formats of the figures: png, pdf, svg, comma-separated (default png)"),
         WidthMm("page width of PDF and SVG figures (default 180: two panels)")},
        {}},
@@ -235,7 +235,7 @@ const std::vector<CommandSpec>& Commands() {
        "candidates.csv and summary.json.",
        {Text("--wifi-map", "W", "Wi-Fi map file", true),
         Text("--data", "PHONE_LOG", "the phone's log", true),
-        Text("--out", "O", "output folder", true), kOverwrite, kConfig, kLenient, kQuiet,
+        Text("--out", "O", "output folder", true), kOverwrite, kConfig, kLenient, kQuiet, kJson,
         Formats("formats of the figures: png, pdf, svg, comma-separated (default png)"),
         WidthMm("page width of PDF and SVG figures (default 180: two panels)")},
        {}},
@@ -247,7 +247,7 @@ const std::vector<CommandSpec>& Commands() {
         Text("--wifi-map", "W", "Wi-Fi map file", true),
         Text("--data", "PHONE_LOG", "the phone's log", true),
         Number("--at", "T", "the time of the call, seconds of the phone's log", true),
-        Text("--out", "O", "output folder", true), kOverwrite, kConfig, kLenient, kQuiet,
+        Text("--out", "O", "output folder", true), kOverwrite, kConfig, kLenient, kQuiet, kJson,
         Formats("formats of call's figure: png, pdf, svg, comma-separated (default png)"),
         WidthMm("page width of PDF and SVG figures (default 180: a two-column map)")},
        {}},

@@ -1,6 +1,8 @@
 // `ratslam evaluate`: the fusion paper's localisation benchmark (sections 5.2-5.3) with FABMAP.
 #include <cstdio>
+#include <fstream>
 #include <iostream>
+#include <sstream>
 #include <string>
 
 #include "apps/cli.h"
@@ -36,7 +38,7 @@ int EvaluateCommand(const Arguments& parsed) {
   if (Status s = session.Load(); !s.ok()) return fail(s);
   const fabmap::FabmapMode mode = session.mode();
   if (!args->quiet) {
-    std::fprintf(stderr, "evaluate: mode %s, %zu map nodes, %zu queries\n",
+    std::fprintf(stderr, "%smode %s, %zu map nodes, %zu queries\n", MessagePrefix().c_str(),
                  fabmap::ToString(mode).c_str(), session.result().map.size(),
                  session.result().queries.size());
   }
@@ -87,17 +89,37 @@ int EvaluateCommand(const Arguments& parsed) {
     }
   }
 
-  std::printf("%-12s %6s %6s %6s %6s | %6s %6s %6s %6s | %6s %6s\n", "mode", "c2", "c5", "c10",
-              "c20", "m2", "m5", "m10", "m20", "reject", "floor");
-  const auto row = [](const std::string& name, const fabmap::EvaluationMetrics& x) {
-    std::printf("%-12s", name.c_str());
-    for (double v : x.correct_within) std::printf(" %6.1f", 100 * v);
-    std::printf(" |");
-    for (double v : x.misplaced_beyond) std::printf(" %6.1f", 100 * v);
-    std::printf(" | %6.1f %6.1f\n", 100 * x.rejection_rate, 100 * x.floor_mistake_rate);
+  // The table on a terminal; evaluation.json into a pipe or with --json.
+  std::string table;
+  char cell[128];
+  std::snprintf(cell, sizeof cell, "%-12s %6s %6s %6s %6s | %6s %6s %6s %6s | %6s %6s\n", "mode",
+                "c2", "c5", "c10", "c20", "m2", "m5", "m10", "m20", "reject", "floor");
+  table += cell;
+  const auto row = [&](const std::string& name, const fabmap::EvaluationMetrics& x) {
+    std::snprintf(cell, sizeof cell, "%-12s", name.c_str());
+    table += cell;
+    for (double v : x.correct_within) {
+      std::snprintf(cell, sizeof cell, " %6.1f", 100 * v);
+      table += cell;
+    }
+    table += " |";
+    for (double v : x.misplaced_beyond) {
+      std::snprintf(cell, sizeof cell, " %6.1f", 100 * v);
+      table += cell;
+    }
+    std::snprintf(cell, sizeof cell, " | %6.1f %6.1f\n", 100 * x.rejection_rate,
+                  100 * x.floor_mistake_rate);
+    table += cell;
   };
   row(fabmap::ToString(mode), m);
   for (const auto& [name, b] : r.baselines) row(name, b);
+  table += "(% of queries: cD the match within D m, mD beyond D m or on another floor)\n";
+  table +=
+      MessagePrefix() + "outputs in " + out_path + " (evaluation.json; --json prints it here)\n";
+  std::ifstream json((*out)->Path("evaluation.json"), std::ios::binary);
+  std::stringstream json_text;
+  json_text << json.rdbuf();
+  PrintOutcome(args->values.count("--json") > 0, args->quiet, json_text.str(), table);
   return kExitOk;
 }
 

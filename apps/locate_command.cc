@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "apps/cli.h"
+#include "apps/progress.h"
 #include "common/number_text.h"
 #include "common/output_folder.h"
 #include "fusion/io/config.h"
@@ -80,6 +81,13 @@ std::vector<std::pair<std::string, double>> Readings(const WifiScan& scan) {
 }
 
 // Percentiles of the errors on the right floor; a wrong floor (infinite error) is counted apart.
+// "2.3 m": a JSON number in metres to a tenth, for the terminal.
+std::string Metres(const nlohmann::ordered_json& value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f m", value.is_number() ? value.get<double>() : NAN);
+  return text;
+}
+
 nlohmann::ordered_json ErrorSummary(std::vector<double> all) {
   nlohmann::ordered_json j;
   std::vector<double> errors;
@@ -457,7 +465,24 @@ int LocateCommand(const Arguments& parsed) {
         [&](int w) { return LocalisationCurvesScene(curves, title, 30.0, w); }, kTwoColumnMm);
     if (!drawn.ok()) return fail(drawn);
   }
-  if (!args->quiet) std::cout << summary;
+  std::string human = MessagePrefix() + std::to_string(d.wifi.size()) + " scans";
+  if (!filter_errors.empty()) {
+    const nlohmann::ordered_json f = ErrorSummary(filter_errors);
+    const nlohmann::ordered_json k = ErrorSummary(knn_errors);
+    human += ", " + std::to_string(filter_errors.size()) + " with ground truth";
+    if (f.contains("median_error_m")) {
+      human += ": median error " + Metres(f["median_error_m"]) + ", 90 % within " +
+               Metres(f["p90_error_m"]);
+    }
+    if (k.contains("median_error_m")) {
+      human += " (3-NN fingerprints: median " + Metres(k["median_error_m"]) + ", 90 % within " +
+               Metres(k["p90_error_m"]) + ")";
+    }
+    human += "; " + f["wrong_floor"].dump() + " on the wrong floor";
+  }
+  human += "\n" + MessagePrefix() + "outputs in " + args->values.at("--out") +
+           " (summary.json; --json prints it here)\n";
+  PrintOutcome(args->values.count("--json") > 0, args->quiet, summary, human);
   return kExitOk;
 }
 
@@ -675,7 +700,17 @@ int CallCommand(const Arguments& parsed) {
   if (!written.ok()) return fail(written);
   Status drawn = WriteCommandFigure(*args, folder.value()->Path("call.png"), build, kTwoColumnMm);
   if (!drawn.ok()) return fail(drawn);
-  if (!args->quiet) std::cout << summary;
+  std::string human = MessagePrefix() + "robot at experience " + j["robot_experience"].dump() +
+                      ": route " + Metres(j["route_length_m"]) + " through " +
+                      std::to_string(plan->stops.size()) + " stops for " +
+                      std::to_string(candidates.size()) + " candidates";
+  if (j.contains("estimate_error_m")) {
+    human += "; estimate " + Metres(j["estimate_error_m"]) + " from the truth, nearest candidate " +
+             Metres(j["nearest_candidate_error_m"]);
+  }
+  human += "\n" + MessagePrefix() + "outputs in " + args->values.at("--out") +
+           " (call.json; --json prints it here)\n";
+  PrintOutcome(args->values.count("--json") > 0, args->quiet, summary, human);
   return kExitOk;
 }
 

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iostream>
 
 namespace ratslam {
 
@@ -32,7 +33,9 @@ void ProgressPrinter::Update(const ProgressUpdate& p) {
   const std::string phase = p.phase.substr(0, comma);
   const std::string detail = comma == std::string::npos ? "" : p.phase.substr(comma + 1);
   const double now = clock_->Seconds();
-  bool print = terminal_;
+  // A terminal line is redrawn at most ten times a second (a fast phase would otherwise
+  // write thousands), and always at a new phase or detail and at the end.
+  bool print = terminal_ && now - last_draw_s_ >= 0.1;
   if (phase != phase_ || last_tenth_ < 0) {
     if (drew_) Finish();
     phase_ = phase;
@@ -44,13 +47,15 @@ void ProgressPrinter::Update(const ProgressUpdate& p) {
   if (detail != detail_) print = true;
   detail_ = detail;
   const int tenth = p.total > 0 ? static_cast<int>(p.done * 10 / p.total) : -1;
-  if (tenth > last_tenth_) print = true;
+  if (tenth > last_tenth_ && !terminal_) print = true;  // plain lines: every tenth
+  if (terminal_ && p.total > 0 && p.done >= p.total) print = true;
   last_tenth_ = std::max(last_tenth_, tenth);
   last_ = p;
   if (print) Print(p, now, !terminal_);
 }
 
 void ProgressPrinter::Print(const ProgressUpdate& p, double now, bool end_line) {
+  last_draw_s_ = now;
   const double elapsed = now - phase_start_s_;
   std::string line = phase_ + ":";
   char buffer[160];
@@ -97,6 +102,14 @@ void ProgressPrinter::Finish() {
   }
   last_tenth_ = -1;
   phase_.clear();
+}
+
+void PrintOutcome(bool json_flag, bool quiet, const std::string& json, const std::string& human) {
+  if (json_flag || (!quiet && !::isatty(STDOUT_FILENO))) {
+    std::cout << json;
+  } else if (!quiet) {
+    std::cout << human;
+  }
 }
 
 }  // namespace ratslam

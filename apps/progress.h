@@ -41,8 +41,14 @@ class ProgressPrinter : public ProgressSink {
   uint64_t first_done_ = 0;  // done when the phase was first seen (resumed work has no rate)
   int last_tenth_ = -1;
   bool drew_ = false;  // a terminal line is open
+  double last_draw_s_ = -1e300;
   ProgressUpdate last_;
 };
+
+// What a command prints at its end on stdout: `json` with --json, or when stdout is not a
+// terminal (scripts), `human` (a few lines for people) on a terminal, nothing with --quiet
+// (unless --json).
+void PrintOutcome(bool json_flag, bool quiet, const std::string& json, const std::string& human);
 
 }  // namespace ratslam
 

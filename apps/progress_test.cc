@@ -82,12 +82,34 @@ TEST(ProgressPrinterTest, ATerminalLineIsRedrawnAndEndedOnce) {
   std::FILE* f = std::tmpfile();
   FakeClock clock;
   ProgressPrinter p(f, false, /*terminal=*/1, &clock);
-  for (uint64_t done = 1; done <= 5; ++done) p.Update({"replay", done, 5, 1.5 * done});
+  for (uint64_t done = 1; done <= 5; ++done) {
+    p.Update({"replay", done, 5, 1.5 * done});
+    clock.now += 0.2;
+  }
   p.Finish();
   const std::string text = Contents(f);
   EXPECT_EQ(std::count(text.begin(), text.end(), '\r'), 5);
   EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1);
   EXPECT_NE(text.find("data time 7.5 s"), std::string::npos) << text;
+  std::fclose(f);
+}
+
+// A fast phase (640 queries in 0.14 s was seen) is not redrawn per step: at most ten times a
+// second, and at its end.
+TEST(ProgressPrinterTest, ATerminalLineIsRedrawnAtMostTenTimesASecond) {
+  std::FILE* f = std::tmpfile();
+  FakeClock clock;
+  ProgressPrinter p(f, false, /*terminal=*/1, &clock);
+  for (uint64_t done = 1; done <= 1000; ++done) {
+    p.Update({"queries", done, 1000});
+    clock.now += 0.001;  // one second in all
+  }
+  p.Finish();
+  const std::string text = Contents(f);
+  const auto draws = std::count(text.begin(), text.end(), '\r');
+  EXPECT_GE(draws, 10);
+  EXPECT_LE(draws, 12);  // every 0.1 s, plus the first and the last
+  EXPECT_NE(text.find("1000/1000"), std::string::npos);
   std::fclose(f);
 }
 

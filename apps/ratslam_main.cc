@@ -170,12 +170,8 @@ int RunReplay(const ReplayRequest& request) {
 
   int exit_code = kExitOk;
   if (result.summary) {
-    // --json always prints; --quiet silences the default (JSON into a pipe, text on a terminal).
-    if (request.json || (!request.quiet && !::isatty(STDOUT_FILENO))) {
-      std::cout << result.summary->json;
-    } else if (!request.quiet) {
-      std::cout << HumanSummary(*result.summary, request.out);
-    }
+    PrintOutcome(request.json, request.quiet, result.summary->json,
+                 HumanSummary(*result.summary, request.out));
   }
   if (!result.outputs.ok()) exit_code = fail(result.outputs);
   if (!result.save.ok()) exit_code = fail(result.save);

@@ -213,6 +213,16 @@ TEST(IpinLocateTest, ARunsMapLocatesThePhoneAndTheRobotIsCalled) {
     return nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
   };
   const nlohmann::json c = call(run, "c");
+  {
+    // --json prints call.json on stdout despite --quiet; without either, a pipe gets it too.
+    const std::string args =
+        "call --map " + run + " --wifi-map " + wifi + " --data " + log("03") + " --at 100 --out ";
+    const Result json = RunRatslam(args + (root / "c_json").string() + " --quiet --json", root);
+    EXPECT_EQ(json.exit_code, 0) << json.err;
+    EXPECT_EQ(json.out, e2e::Slurp(root / "c_json" / "call.json"));
+    const Result quiet = RunRatslam(args + (root / "c_quiet").string() + " --quiet", root);
+    EXPECT_EQ(quiet.out, "");
+  }
   EXPECT_TRUE(e2e::UndocumentedKeys(c).empty())
       << "not in configs/README.md: " << e2e::Join(e2e::UndocumentedKeys(c));
 
