@@ -160,7 +160,11 @@ TEST(FigureOutputTest, NoTextRunsOffAFigureLaidOutForAPage) {
   closure.loop_closure = true;
   map.links.push_back(closure);
   map.ground_truth = {{0, 0}, {19, 0}};  // its legend item too
-  std::vector<int> floors(20, 0);        // the second half of the map on floor 1
+  PoseCellOptions cells;
+  cells.dim_xy_cells = 21;
+  PoseCellNetwork network(cells);
+  network.Reset({10.67, 10.77, 20.78});
+  std::vector<int> floors(20, 0);  // the second half of the map on floor 1
   std::fill(floors.begin() + 10, floors.end(), 1);
   for (double width_mm : {88.0, 180.0}) {
     const int w = VectorLayoutWidthPx(width_mm);
@@ -179,9 +183,14 @@ TEST(FigureOutputTest, NoTextRunsOffAFigureLaidOutForAPage) {
     graph_options.width_px = w;
     graph_options.height_px = w;
     graph_options.title = map_options.title;
+    PoseCellImageOptions cell_options;
+    const auto [cw, ch] = VectorLayoutSize(cell_options.width_px, cell_options.height_px, width_mm);
+    cell_options.width_px = cw;
+    cell_options.height_px = ch;
     for (const Scene& scene :
-         {SweepParameterScene(sweep, w), SweepHeatmapScene(sweep, 0, 1, w),
-          SweepParetoScene(sweep, w), SequencePairsScene(pairs, "Wi-Fi sequence pairs", w),
+         {PoseCellScene(network, cell_options), SweepParameterScene(sweep, w),
+          SweepHeatmapScene(sweep, 0, 1, w), SweepParetoScene(sweep, w),
+          SequencePairsScene(pairs, "Wi-Fi sequence pairs", w),
           SimilarityMatrixScene(matrix, times, similarity), ExperienceMapScene(map, map_options),
           TemplateGraphScene({{0.0, 1, 1, DecisionSource::kNew}}, graph_options),
           ExperienceMapFloorsScene(map, floors, {}, map_options)}) {

@@ -543,6 +543,10 @@ Scene PoseCellScene(const PoseCellNetwork& network, const PoseCellImageOptions& 
   char label[128];
   std::snprintf(label, sizeof label, "best pose: x %.2f, y %.2f, theta %.2f cells (%.0f deg)",
                 best.x, best.y, best.theta, best.theta * 360.0 / nt);
+  if (left + TextWidthPx(label, 15) > options.width_px - 10.0f) {  // a narrow page: shorter
+    std::snprintf(label, sizeof label, "best: x %.2f, y %.2f cells, heading %.0f deg", best.x,
+                  best.y, best.theta * 360.0 / nt);
+  }
   scene.Text({left, static_cast<float>(options.height_px - 16)}, label, 15, kInk);
   // Colour bar under the ring: both panels run from zero to their own largest sum.
   {
