@@ -251,6 +251,20 @@ const std::vector<CommandSpec>& Commands() {
         Formats("formats of call's figure: png, pdf, svg, comma-separated (default png)"),
         WidthMm("page width of PDF and SVG figures (default 180: a two-column map)")},
        {}},
+      {"route",
+       "the shortest path between two experiences of a map",
+       "Prints the shortest path over the experience graph of RUN from experience --from (default: "
+       "the map's current one) to --to, or to the reachable experience nearest the point --to-xy, "
+       "with its length in metres; with --out also route.json, route.csv and route.png.",
+       {Text("--map", "RUN", "run folder or saved map", true),
+        Whole("--from", "E", "start experience (default: the map's current experience)", 0,
+              int64_t{1} << 32),
+        Whole("--to", "E", "end experience", 0, int64_t{1} << 32),
+        Text("--to-xy", "X,Y", "end at the reachable experience nearest this point (metres)"),
+        Text("--out", "O", "output folder"), kOverwrite, kQuiet, kJson,
+        Formats("formats of route's figure: png, pdf, svg, comma-separated (default png)"),
+        WidthMm()},
+       {}},
       {"simulate",
        "simulate a world into a replay data set",
        "Simulates a world (built in: office, circular, day_night, aliased_floors, apartment; or "

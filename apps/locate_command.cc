@@ -486,17 +486,6 @@ int LocateCommand(const Arguments& parsed) {
   return kExitOk;
 }
 
-namespace {
-
-// The robot's map for `call`: a replay's run folder (experiences.csv, links.csv; the robot is at
-// summary.json's current_experience, or else at the experience of frames.csv's last frame that
-// had one) or a saved map file (its current experience).
-struct RobotMap {
-  std::vector<Experience> experiences;
-  std::vector<Link> links;
-  std::optional<uint32_t> current;
-};
-
 StatusOr<RobotMap> LoadRobotMap(const std::string& path) {
   RobotMap m;
   if (fs::is_directory(path)) {
@@ -522,8 +511,6 @@ StatusOr<RobotMap> LoadRobotMap(const std::string& path) {
   if (!m.current) m.current = static_cast<uint32_t>(m.experiences.size() - 1);
   return m;
 }
-
-}  // namespace
 
 int CallCommand(const Arguments& parsed) {
   const Arguments* args = &parsed;

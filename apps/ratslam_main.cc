@@ -427,6 +427,7 @@ int Dispatch(int argc, char** argv) {
       {"wifi-map", WifiMapCommand},
       {"locate", LocateCommand},
       {"call", CallCommand},
+      {"route", RouteCommand},
       {"simulate", SimulateCommand},
       {"import", ImportCommand},
   };

@@ -1,10 +1,13 @@
 // Runs the `ratslam` program as a user would and checks its outputs.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -14,6 +17,7 @@
 #include "common/scratch_dir.h"
 #include "render/image.h"
 #include "render/renderer.h"
+#include "sensors/dataset/csv.h"
 #include "sensors/dataset/synthetic_dataset.h"
 #include "tests/documented_keys.h"
 #include "tests/run_ratslam.h"
@@ -616,6 +620,90 @@ TEST_F(ReplayEndToEndTest, PrintConfigFailsWithLineNumber) {
   EXPECT_NE(r.err.find("bad2.toml:3: pose_cells.dim_theta_cells: expected an integer"),
             std::string::npos)
       << r.err;
+}
+
+// `ratslam route` on a replay's map: the path it prints is linked step by step, as long as the
+// shortest distance an independent all-pairs computation (Floyd-Warshall over experiences.csv
+// and links.csv) finds, and --to-xy ends at the experience nearest the point.
+TEST_F(ReplayEndToEndTest, RouteIsTheShortestPathOverTheExperienceGraph) {
+  const fs::path run = root_ / "route_run";
+  ASSERT_EQ(RunRatslam(ReplayArgs(run), root_).exit_code, 0);
+  StatusOr<CsvTable> ex = CsvTable::Read(
+      (run / "experiences.csv").string(), {"id", "x_m", "y_m"},
+      {"theta_rad", "template_id", "time_s", "pose_cell_x", "pose_cell_y", "pose_cell_theta"});
+  StatusOr<CsvTable> li = CsvTable::Read(
+      (run / "links.csv").string(), {"from_id", "to_id"},
+      {"id", "distance_m", "heading_rad", "facing_rad", "duration_s", "loop_closure", "kind"});
+  ASSERT_TRUE(ex.ok() && li.ok());
+  const size_t n = ex->rows();
+  ASSERT_GT(n, 10u);
+  ASSERT_LT(n, 1500u);  // Floyd-Warshall below stays cheap
+  std::vector<double> x(n), y(n);
+  for (size_t i = 0; i < n; ++i) x[i] = *ex->Number(i, "x_m"), y[i] = *ex->Number(i, "y_m");
+  const double inf = std::numeric_limits<double>::infinity();
+  std::vector<double> d(n * n, inf);
+  std::set<std::pair<size_t, size_t>> linked;
+  for (size_t i = 0; i < n; ++i) d[i * n + i] = 0;
+  for (size_t r = 0; r < li->rows(); ++r) {
+    const auto a = static_cast<size_t>(*li->Number(r, "from_id"));
+    const auto b = static_cast<size_t>(*li->Number(r, "to_id"));
+    const double w = std::hypot(x[a] - x[b], y[a] - y[b]);
+    d[a * n + b] = d[b * n + a] = std::min(d[a * n + b], w);
+    linked.insert({a, b});
+    linked.insert({b, a});
+  }
+  for (size_t k = 0; k < n; ++k)
+    for (size_t i = 0; i < n; ++i)
+      for (size_t j = 0; j < n; ++j)
+        d[i * n + j] = std::min(d[i * n + j], d[i * n + k] + d[k * n + j]);
+
+  // The farthest pair from experience 0, and the route between them.
+  size_t far = 0;
+  for (size_t j = 0; j < n; ++j) {
+    if (std::isfinite(d[j]) && d[j] > d[far]) far = j;
+  }
+  const Result r = RunRatslam("route --json --map " + run.string() + " --from 0 --to " +
+                                  std::to_string(far) + " --out " + (root_ / "route").string(),
+                              root_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_TRUE(e2e::UndocumentedKeys(j).empty())
+      << "not in configs/README.md: " << e2e::Join(e2e::UndocumentedKeys(j));
+  EXPECT_EQ(r.out, Slurp(root_ / "route" / "route.json"));
+  EXPECT_NEAR(j["length_m"].get<double>(), d[far], 1e-9 * (1 + d[far]));
+  const std::vector<size_t> path = j["experiences"].get<std::vector<size_t>>();
+  ASSERT_GE(path.size(), 2u);
+  EXPECT_EQ(path.front(), 0u);
+  EXPECT_EQ(path.back(), far);
+  double along = 0;
+  for (size_t k = 1; k < path.size(); ++k) {
+    EXPECT_TRUE(linked.count({path[k - 1], path[k]})) << path[k - 1] << "-" << path[k];
+    along += std::hypot(x[path[k]] - x[path[k - 1]], y[path[k]] - y[path[k - 1]]);
+  }
+  EXPECT_NEAR(along, d[far], 1e-9 * (1 + d[far]));
+  StatusOr<CsvTable> csv =
+      CsvTable::Read((root_ / "route" / "route.csv").string(),
+                     {"step", "experience_id", "x_m", "y_m", "distance_m"}, {});
+  ASSERT_TRUE(csv.ok()) << csv.status().message();
+  EXPECT_EQ(csv->rows(), path.size());
+  EXPECT_TRUE(fs::exists(root_ / "route" / "route.png"));
+
+  // A point next to experience `far` ends there.
+  char xy[96];
+  std::snprintf(xy, sizeof xy, "%.17g,%.17g", x[far] + 0.01, y[far]);
+  const Result near = RunRatslam(
+      "route --json --map " + run.string() + " --from 0 --to-xy " + std::string(xy), root_);
+  ASSERT_EQ(near.exit_code, 0) << near.err;
+  EXPECT_EQ(nlohmann::json::parse(near.out)["to"].get<size_t>(), far);
+
+  // Errors: an unknown experience names the range; --to with --to-xy is a usage error.
+  const Result unknown =
+      RunRatslam("route --map " + run.string() + " --to " + std::to_string(n), root_);
+  EXPECT_EQ(unknown.exit_code, 1);
+  EXPECT_NE(unknown.err.find("no experience " + std::to_string(n)), std::string::npos)
+      << unknown.err;
+  const Result both = RunRatslam("route --map " + run.string() + " --to 1 --to-xy 0,0", root_);
+  EXPECT_EQ(both.exit_code, 2);
 }
 
 }  // namespace

@@ -1,0 +1,198 @@
+// `ratslam route`: the shortest path on a map's experience graph between two experiences (or
+// from one to the experience nearest a point), printed and, with --out, written and drawn.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "apps/cli.h"
+#include "apps/progress.h"
+#include "common/number_text.h"
+#include "common/output_folder.h"
+#include "fusion/phone_localisation/robot_call.h"
+#include "viewer/figures.h"
+
+namespace ratslam {
+namespace {
+
+// "X,Y" in metres; nothing (after a message) when it is not two finite numbers.
+std::optional<Point2> ParsePoint(const std::string& flag, const std::string& text) {
+  const size_t comma = text.find(',');
+  if (comma != std::string::npos) {
+    const std::optional<double> x = ParseNumber(flag, text.substr(0, comma));
+    if (!x) return std::nullopt;
+    const std::optional<double> y = ParseNumber(flag, text.substr(comma + 1));
+    if (!y) return std::nullopt;
+    return Point2{*x, *y};
+  }
+  std::cerr << MessagePrefix() << flag << ": expected X,Y in metres, got '" << text << "'\n";
+  return std::nullopt;
+}
+
+}  // namespace
+
+int RouteCommand(const Arguments& args) {
+  auto fail = [](const Status& s) {
+    std::cerr << MessagePrefix() << s.message() << "\n";
+    return kExitError;
+  };
+  const bool to_id = args.values.count("--to") > 0, to_xy = args.values.count("--to-xy") > 0;
+  if (to_id == to_xy) {
+    std::cerr << MessagePrefix() << "give exactly one of --to E and --to-xy X,Y\n"
+              << "Run 'ratslam route --help' for the options.\n";
+    return kExitUsage;
+  }
+  const std::string map_path = args.values.at("--map");
+  StatusOr<RobotMap> map = LoadRobotMap(map_path);
+  if (!map.ok()) return fail(map.status());
+  const int64_t n = static_cast<int64_t>(map->experiences.size());
+  auto experience = [&](const char* flag) -> std::optional<uint32_t> {
+    const std::optional<int64_t> id =
+        ParseInteger(flag, args.values.at(flag), 0, std::numeric_limits<uint32_t>::max());
+    if (!id) return std::nullopt;
+    if (*id >= n) {
+      std::cerr << MessagePrefix() << flag << ": no experience " << *id << " in " << map_path
+                << " (it has 0.." << n - 1 << ")\n";
+      return std::nullopt;
+    }
+    return static_cast<uint32_t>(*id);
+  };
+  uint32_t from = *map->current;
+  if (args.values.count("--from")) {
+    const std::optional<uint32_t> id = experience("--from");
+    if (!id) return kExitError;
+    from = *id;
+  }
+  RouteGraph graph;
+  for (const Experience& e : map->experiences) graph.nodes.push_back({e.x_m, e.y_m});
+  for (const Link& l : map->links) graph.edges.push_back({l.from, l.to});
+  std::vector<double> distance;
+  std::vector<uint32_t> previous;
+  ShortestPaths(graph, from, &distance, &previous);
+
+  uint32_t to = 0;
+  std::optional<Point2> point;
+  if (to_id) {
+    const std::optional<uint32_t> id = experience("--to");
+    if (!id) return kExitError;
+    to = *id;
+    if (!std::isfinite(distance[to])) {
+      return fail(Status::Error("experience " + std::to_string(to) + " cannot be reached from " +
+                                std::to_string(from) + " over the links of " + map_path));
+    }
+  } else {
+    point = ParsePoint("--to-xy", args.values.at("--to-xy"));
+    if (!point) return kExitUsage;
+    // The nearest experience the robot can reach (ties: the lower id).
+    double best = std::numeric_limits<double>::infinity();
+    for (uint32_t k = 0; k < graph.nodes.size(); ++k) {
+      if (!std::isfinite(distance[k])) continue;
+      const double d = std::hypot(graph.nodes[k].x - point->x, graph.nodes[k].y - point->y);
+      if (d < best) best = d, to = k;
+    }
+  }
+  std::vector<uint32_t> path = {to};
+  while (path.back() != from) path.push_back(previous[path.back()]);
+  std::reverse(path.begin(), path.end());
+
+  nlohmann::ordered_json j;
+  j["map"] = map_path;
+  j["from"] = from;
+  j["to"] = to;
+  if (point) {
+    j["to_point"] = {{"x_m", point->x}, {"y_m", point->y}};
+    j["to_point_distance_m"] =
+        std::hypot(graph.nodes[to].x - point->x, graph.nodes[to].y - point->y);
+  }
+  j["length_m"] = distance[to];
+  j["straight_line_m"] =
+      std::hypot(graph.nodes[to].x - graph.nodes[from].x, graph.nodes[to].y - graph.nodes[from].y);
+  j["experiences"] = path;
+  const std::string json = j.dump(2) + "\n";
+
+  char line[256];
+  std::snprintf(line, sizeof line, "%.1f m from experience %u to %u through %zu experiences",
+                distance[to], from, to, path.size());
+  std::string human = MessagePrefix() + line + "\n";
+  if (point) {
+    std::snprintf(line, sizeof line, "experience %u is %.1f m from (%s, %s)\n", to,
+                  j["to_point_distance_m"].get<double>(), ShortestNumber(point->x).c_str(),
+                  ShortestNumber(point->y).c_str());
+    human += MessagePrefix() + line;
+  }
+  std::string ids;
+  for (size_t k = 0; k < path.size(); ++k) ids += (k ? " " : "") + std::to_string(path[k]);
+  human += MessagePrefix() + "experiences: " + ids + "\n";
+
+  if (args.values.count("--out")) {
+    std::ostringstream csv;
+    csv << "step,experience_id,x_m,y_m,distance_m\n";
+    for (size_t k = 0; k < path.size(); ++k) {
+      const Point2& p = graph.nodes[path[k]];
+      csv << k << ',' << path[k] << ',' << ShortestNumber(p.x) << ',' << ShortestNumber(p.y) << ','
+          << ShortestNumber(distance[path[k]]) << '\n';
+    }
+    StatusOr<std::unique_ptr<DiskFolder>> folder = DiskFolder::Open(args.values.at("--out"));
+    if (!folder.ok()) return fail(folder.status());
+    if (Status s = folder.value()->Write({{"route.csv", csv.str()}, {"route.json", json}});
+        !s.ok()) {
+      return fail(s);
+    }
+    ExperienceMapImageData image;
+    image.experiences = map->experiences;
+    image.links = map->links;
+    ExperienceMapImageOptions options;
+    char title[160];
+    std::snprintf(title, sizeof title, "route from experience %u to %u: %.1f m", from, to,
+                  distance[to]);
+    options.title = title;
+    if (point) {  // the point in view, with the map
+      WorldBounds b{point->x - 2, point->y - 2, point->x + 2, point->y + 2};
+      for (const Point2& p : graph.nodes) {
+        b.min_x_m = std::min(b.min_x_m, p.x);
+        b.min_y_m = std::min(b.min_y_m, p.y);
+        b.max_x_m = std::max(b.max_x_m, p.x);
+        b.max_y_m = std::max(b.max_y_m, p.y);
+      }
+      options.bounds = b;
+    }
+    auto build = [&](int width_px) {
+      ExperienceMapImageOptions o = options;
+      if (width_px > 0) {
+        o.width_px = width_px;
+        o.height_px = width_px * 3 / 4;
+      }
+      WorldToImage to_image;
+      Scene scene = ExperienceMapScene(image, o, &to_image);
+      std::vector<ScenePoint> line_px;
+      for (uint32_t e : path) line_px.push_back(to_image(graph.nodes[e].x, graph.nodes[e].y));
+      scene.Polyline(line_px, 6.0f, {148, 103, 189, 230});  // purple: red marks loop closures
+      scene.Disc(line_px.front(), 9.0f, {44, 160, 44, 255}, 20);
+      scene.Ring(line_px.back(), 8.0f, 12.0f, 0.0f, 6.2832f, {148, 103, 189, 255}, 24);
+      if (point) {
+        const ScenePoint p = to_image(point->x, point->y);
+        scene.Line({p.x - 9, p.y - 9}, {p.x + 9, p.y + 9}, 3.0f, kInk);
+        scene.Line({p.x - 9, p.y + 9}, {p.x + 9, p.y - 9}, 3.0f, kInk);
+      }
+      scene.Text({30, 75},
+                 point ? "purple: route   green: start   ring: end   x: the point asked for"
+                       : "purple: route   green: start   ring: end",
+                 15.0f, kInk);
+      return scene;
+    };
+    if (Status s = WriteCommandFigure(args, folder.value()->Path("route.png"), build); !s.ok()) {
+      return fail(s);
+    }
+    human += MessagePrefix() + "outputs in " + args.values.at("--out") +
+             " (route.json, route.csv, route.png)\n";
+  }
+  PrintOutcome(args.values.count("--json") > 0, args.quiet, json, human);
+  return kExitOk;
+}
+
+}  // namespace ratslam
