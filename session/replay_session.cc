@@ -65,6 +65,11 @@ Status ReplaySession::Load() {
         ReplaceOdometryWithVisual(&dataset.value(), env_.images, options_.pipeline.visual_odometry)
             .WithContext("visual odometry"));
   }
+  if (dataset->odometry.empty()) {
+    return Status::Error("data set '" + dataset->name +
+                         "' has no odometry stream: set [visual_odometry] enabled = true to "
+                         "take odometry from its images");
+  }
   RATSLAM_RETURN_IF_ERROR(CheckFrontEndInputs(options_.pipeline.sensors, *dataset));
   dataset_ = std::move(dataset).value();
   return env_.out->Write("config.toml",

@@ -254,6 +254,44 @@ TEST_F(ReplayEndToEndTest, VisualOdometryWithClassicCameraClosesLoops) {
   EXPECT_LT(s["map_ate_m"].get<double>(), 0.2 * s["odometry_ate_m"].get<double>());
 }
 
+// A data set without odometry (St Lucia 2007 ships none) replays when visual odometry is on,
+// to exactly the map of the same images with an odometry stream (which visual odometry
+// replaces); with it off the run refuses to start and says what to turn on.
+TEST_F(ReplayEndToEndTest, DataWithoutOdometryReplaysOnVisualOdometry) {
+  const fs::path data = root_ / "no_odometry";
+  fs::remove_all(data);
+  fs::copy(root_ / "data", data, fs::copy_options::recursive);
+  std::string manifest = Slurp(data / "manifest.toml");
+  const size_t line = manifest.find("odometry = ");
+  ASSERT_NE(line, std::string::npos);
+  manifest.erase(line, manifest.find('\n', line) + 1 - line);
+  std::ofstream(data / "manifest.toml") << manifest;
+  fs::remove(data / "odometry.csv");
+  const std::string vo =
+      "[camera]\ncrop_top_px = 8\ncrop_bottom_px = 32\nmatch_threshold = 0.03\n"
+      "[pose_cells]\ndim_xy_cells = 30\ncell_size_m = 1.5\n"
+      "[visual_odometry]\nenabled = true\nspeed_m_per_s = 1.0\n"
+      "field_of_view_rad = 1.8\ncrop_top_px = 8\ncrop_bottom_px = 32\n";
+  std::ofstream(root_ / "vo.toml") << vo;
+  auto replay = [&](const fs::path& in, const std::string& config, const std::string& out) {
+    return RunRatslam("replay --quiet --config " + config + " --data " + in.string() + " --out " +
+                          (root_ / out).string(),
+                      root_);
+  };
+  const Result with = replay(root_ / "data", (root_ / "vo.toml").string(), "vo_with");
+  ASSERT_EQ(with.exit_code, 0) << with.err;
+  const Result without = replay(data, (root_ / "vo.toml").string(), "vo_without");
+  ASSERT_EQ(without.exit_code, 0) << without.err;
+  for (const char* name : {"experiences.csv", "links.csv", "trajectory_tum.txt", "frames.csv"}) {
+    EXPECT_EQ(Slurp(root_ / "vo_with" / name), Slurp(root_ / "vo_without" / name)) << name;
+  }
+  const Result off = replay(data, config_, "vo_off");
+  EXPECT_EQ(off.exit_code, 1);
+  EXPECT_NE(off.err.find("has no odometry stream: set [visual_odometry] enabled = true"),
+            std::string::npos)
+      << off.err;
+}
+
 TEST_F(ReplayEndToEndTest, SameInputSameOutputBitForBit) {
   const fs::path a = root_ / "det_a", b = root_ / "det_b";
   ASSERT_EQ(RunRatslam(ReplayArgs(a), root_).exit_code, 0);

@@ -201,9 +201,11 @@ StatusOr<Dataset> ReadDataset(const std::string& folder) {
   schema::TableBinder stream_binder(*streams_table, "[streams]", "streams.", manifest_path);
   streams.VisitFields(stream_binder);
   RATSLAM_RETURN_IF_ERROR(stream_binder.Finish());
-  if (streams.odometry.empty()) {
+  // Odometry may come from the images instead ([visual_odometry]; St Lucia 2007 has none).
+  if (streams.odometry.empty() && streams.images.empty()) {
     return Status::Error(schema::TomlWhere(manifest_path, streams_table) +
-                         ": streams.odometry is required");
+                         ": streams.odometry is required (or streams.images, for visual "
+                         "odometry)");
   }
   Dataset d;
   d.folder = folder;
@@ -219,7 +221,7 @@ StatusOr<Dataset> ReadDataset(const std::string& folder) {
     return (fs::path(folder) / files.at(stream)).string();
   };
   auto named = [&](const std::string& stream) { return !files.at(stream).empty(); };
-  RATSLAM_RETURN_IF_ERROR(ReadOdometry(path_of("odometry"), &d));
+  if (named("odometry")) RATSLAM_RETURN_IF_ERROR(ReadOdometry(path_of("odometry"), &d));
   if (named("images")) RATSLAM_RETURN_IF_ERROR(ReadImages(path_of("images"), &d));
   if (named("ground_truth")) RATSLAM_RETURN_IF_ERROR(ReadGroundTruth(path_of("ground_truth"), &d));
   if (named("wifi")) RATSLAM_RETURN_IF_ERROR(ReadWifi(path_of("wifi"), &d));
