@@ -376,45 +376,88 @@ StatusOr<ImportedConfig> ImportOpenRatslamIni(const std::string& path) {
       return Status::Ok();
     };
   };
-  // OpenRatSLAM key -> our field (key names from the OpenRatSLAM configuration files).
-  std::map<std::string, Setter> setters = {
-      {"pc_dim_xy", whole(o.ratslam.pose_cells.dim_xy_cells)},
-      {"pc_dim_th", whole(o.ratslam.pose_cells.dim_theta_cells)},
-      {"pc_cell_x_size", real(o.ratslam.pose_cells.cell_size_m)},
-      {"pc_w_e_dim", whole(o.ratslam.pose_cells.excitation_size_cells)},
-      {"pc_w_i_dim", whole(o.ratslam.pose_cells.inhibition_size_cells)},
-      {"pc_w_e_var", real(o.ratslam.pose_cells.excitation_variance_cells2)},
-      {"pc_w_i_var", real(o.ratslam.pose_cells.inhibition_variance_cells2)},
-      {"pc_global_inhib", real(o.ratslam.pose_cells.global_inhibition)},
-      {"pc_vt_inject_energy", real(o.ratslam.local_view.injection_gain)},
-      {"pc_vt_restore", real(o.ratslam.local_view.decay_restore_per_frame)},
+  // OpenRatSLAM uses pc_w_e_var and pc_w_i_var as the Gaussian's sigma (exp(-r^2 / (2 v^2))):
+  // ours is the variance.
+  auto sigma = [](double& variance) {
+    return [&variance](double v) {
+      variance = v * v;
+      return Status::Ok();
+    };
+  };
+  // OpenRatSLAM key -> our field, the field's name in our validation messages, and
+  // OpenRatSLAM's own default, which an INI that leaves the key out gets (ratslam_ros branch;
+  // ../shared/reference/openratslam-facts.md, section 2). vt_shift_match 25 in steps of 5 is
+  // what New College, which sets neither, searches.
+  struct Key {
+    const char* name;
+    Setter set;
+    const char* field;  // as PipelineOptions::IsValid names it
+    double openratslam_default;
+  };
+  const std::vector<Key> keys = {
+      {"pc_dim_xy", whole(o.ratslam.pose_cells.dim_xy_cells), "pose_cells.dim_xy_cells", 21},
+      {"pc_dim_th", whole(o.ratslam.pose_cells.dim_theta_cells), "pose_cells.dim_theta_cells", 36},
+      {"pc_cell_x_size", real(o.ratslam.pose_cells.cell_size_m), "pose_cells.cell_size_m", 1.0},
+      {"pc_w_e_dim", whole(o.ratslam.pose_cells.excitation_size_cells),
+       "pose_cells.excitation_size_cells", 7},
+      {"pc_w_i_dim", whole(o.ratslam.pose_cells.inhibition_size_cells),
+       "pose_cells.inhibition_size_cells", 5},
+      {"pc_w_e_var", sigma(o.ratslam.pose_cells.excitation_variance_cells2),
+       "pose_cells.excitation_variance_cells2", 1},
+      {"pc_w_i_var", sigma(o.ratslam.pose_cells.inhibition_variance_cells2),
+       "pose_cells.inhibition_variance_cells2", 2},
+      {"pc_global_inhib", real(o.ratslam.pose_cells.global_inhibition),
+       "pose_cells.global_inhibition", 0.00002},
+      {"pc_vt_inject_energy", real(o.ratslam.local_view.injection_gain),
+       "local_view.injection_gain", 0.15},
+      {"pc_vt_restore", real(o.ratslam.local_view.decay_restore_per_frame),
+       "local_view.decay_restore_per_frame", 0.05},
       {"vt_active_decay",
        [&o](double v) {
          o.ratslam.local_view.decay_per_match = v;
          o.ratslam.local_view.decay_floor = v;
          return Status::Ok();
-       }},
-      {"exp_delta_pc_threshold", real(o.ratslam.action.match_distance_cells)},
-      {"exp_loops", whole(o.ratslam.experience_map.relaxation_sweeps)},
-      {"exp_correction", real(o.ratslam.experience_map.relaxation_correction)},
-      {"vt_match_threshold", real(o.sensors.classic_camera.match_threshold)},
-      {"vt_shift_match", whole(o.sensors.classic_camera.shift_px)},
-      {"vt_step_match", whole(o.sensors.classic_camera.shift_step_px)},
-      {"vt_normalisation", real(o.sensors.classic_camera.global_normalisation_mean)},
-      {"vt_patch_normalisation", whole(o.sensors.classic_camera.patch_normalisation_radius_px)},
-      {"vt_patch_normalise", whole(o.sensors.classic_camera.patch_normalisation_radius_px)},
-      {"template_x_size", whole(o.sensors.classic_camera.template_width_px)},
-      {"template_y_size", whole(o.sensors.classic_camera.template_height_px)},
-      {"image_crop_x_min", whole(o.sensors.classic_camera.crop_left_px)},
-      {"image_crop_x_max", whole(o.sensors.classic_camera.crop_right_px)},
-      {"image_crop_y_min", whole(o.sensors.classic_camera.crop_top_px)},
-      {"image_crop_y_max", whole(o.sensors.classic_camera.crop_bottom_px)},
+       },
+       "local_view.decay_", 1.0},
+      {"exp_delta_pc_threshold", real(o.ratslam.action.match_distance_cells),
+       "action.match_distance_cells", 2.0},
+      {"exp_loops", whole(o.ratslam.experience_map.relaxation_sweeps),
+       "experience_map.relaxation_sweeps", 10},
+      {"exp_correction", real(o.ratslam.experience_map.relaxation_correction),
+       "experience_map.relaxation_correction", 0.5},
+      {"vt_match_threshold", real(o.sensors.classic_camera.match_threshold),
+       "camera.match_threshold", 0.03},
+      {"vt_shift_match", whole(o.sensors.classic_camera.shift_px), "camera.shift_px", 25},
+      {"vt_step_match", whole(o.sensors.classic_camera.shift_step_px), "camera.shift_step_px", 5},
+      {"vt_normalisation", real(o.sensors.classic_camera.global_normalisation_mean),
+       "camera.global_normalisation_mean", 0},
+      {"vt_patch_normalise", whole(o.sensors.classic_camera.patch_normalisation_radius_px),
+       "camera.patch_normalisation_radius_px", 0},
+      {"template_x_size", whole(o.sensors.classic_camera.template_width_px),
+       "camera.template_width_px", 1},
+      {"template_y_size", whole(o.sensors.classic_camera.template_height_px),
+       "camera.template_height_px", 1},
+      {"image_crop_x_min", whole(o.sensors.classic_camera.crop_left_px), "camera.crop_left_px", 0},
+      {"image_crop_x_max", whole(o.sensors.classic_camera.crop_right_px), "camera.crop_right_px",
+       -1},
+      {"image_crop_y_min", whole(o.sensors.classic_camera.crop_top_px), "camera.crop_top_px", 0},
+      {"image_crop_y_max", whole(o.sensors.classic_camera.crop_bottom_px), "camera.crop_bottom_px",
+       -1},
       {"vt_panoramic",
        [&o](double v) {
          o.sensors.classic_camera.panoramic = v != 0.0;
          return Status::Ok();
-       }},
+       },
+       "camera.panoramic", 0},
   };
+  std::map<std::string, Setter> setters;
+  for (const Key& k : keys) {
+    setters[k.name] = k.set;
+    (void)k.set(k.openratslam_default);  // every default is valid for its setter
+  }
+  // An older spelling of vt_patch_normalise.
+  setters["vt_patch_normalisation"] = setters.at("vt_patch_normalise");
+  std::map<std::string, std::string> set_at;  // INI key -> "path:line: key = value"
   std::string line, section;
   int number = 0;
   while (std::getline(in, line)) {
@@ -453,9 +496,29 @@ StatusOr<ImportedConfig> ImportOpenRatslamIni(const std::string& path) {
     }
     Status s = it->second(number_value);
     if (!s.ok()) return Status::Error(where + ": " + key + ": " + s.message());
+    set_at[key] = where + ": " + key + " = " + value;
   }
   std::string error;
-  if (!o.IsValid(&error)) return Status::Error(path + ": imported values are invalid: " + error);
+  if (!o.IsValid(&error)) {
+    // Name the INI lines that set the values the message is about, or say that OpenRatSLAM's
+    // default was used for them.
+    std::string about;
+    for (const Key& k : keys) {
+      const std::string field = k.field;
+      const std::string short_field = field.substr(field.find('.') + 1);
+      const bool named =
+          error.rfind(field, 0) == 0 || error.find(" " + short_field) != std::string::npos;
+      if (!named) continue;
+      about += about.empty() ? "; " : ", ";
+      if (auto at = set_at.find(k.name); at != set_at.end()) {
+        about += at->second;
+      } else {
+        about += std::string(k.name) + " not set (OpenRatSLAM's default " +
+                 ShortestNumber(k.openratslam_default) + ")";
+      }
+    }
+    return Status::Error(path + ": imported values are invalid: " + error + about);
+  }
   return imported;
 }
 

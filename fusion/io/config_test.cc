@@ -201,7 +201,7 @@ TEST(ConfigTest, ImportsOpenRatslamIniAndReportsUnusedKeys) {
   std::ofstream(path) << "[general]\ntopic_root=irat_red\n\n[ratslam]\n"
                          "vt_match_threshold=0.085\npc_dim_xy=30\npc_cell_x_size=0.015\n"
                          "exp_loops=20\nvt_active_decay = 1.5 ; comment\nvt_panoramic=1\n"
-                         "[draw]\nenable=1\n";
+                         "template_x_size=60\n[draw]\nenable=1\n";
   StatusOr<ImportedConfig> imported = ImportOpenRatslamIni(path.string());
   ASSERT_TRUE(imported.ok()) << imported.status().message();
   const PipelineOptions& o = imported->options;
@@ -218,6 +218,95 @@ TEST(ConfigTest, ImportsOpenRatslamIniAndReportsUnusedKeys) {
   ASSERT_FALSE(bad.ok());
   EXPECT_NE(bad.status().message().find(":2: pc_dim_xy: not a number"), std::string::npos);
   std::filesystem::remove(path);
+}
+
+// OpenRatSLAM's three shipped configurations, rebuilt from the values the facts file lists for
+// them (../shared/reference/openratslam-facts.md, "Values set by the shipped configs"; keys not
+// listed there are left out, as the files leave them out): every key they leave out takes
+// OpenRatSLAM's default, checked by hand against the facts file's key table.
+TEST(ConfigTest, ShippedOpenRatslamConfigsImportWithOpenRatslamsDefaults) {
+  const auto dir = TestScratch().path();
+  struct Shipped {
+    const char* name;
+    const char* ratslam;  // the [ratslam] section
+  };
+  const Shipped shipped[] = {
+      {"stlucia",
+       "image_crop_x_min=40\nimage_crop_x_max=600\nimage_crop_y_min=150\nimage_crop_y_max=300\n"
+       "template_x_size=60\ntemplate_y_size=10\nvt_match_threshold=0.085\nvt_shift_match=5\n"
+       "vt_step_match=1\nvt_panoramic=0\nvt_normalisation=0.4\nvt_patch_normalise=0\n"
+       "pc_vt_restore=0.04\npc_dim_xy=30\npc_cell_x_size=2\npc_vt_inject_energy=0.15\n"
+       "vt_active_decay=1.0\nexp_delta_pc_threshold=1.0\nexp_loops=20\n"},
+      {"irataus",
+       "image_crop_y_min=0\nimage_crop_y_max=150\ntemplate_x_size=60\ntemplate_y_size=20\n"
+       "vt_match_threshold=0.03\nvt_shift_match=4\nvt_step_match=1\nvt_panoramic=0\n"
+       "vt_normalisation=0\nvt_patch_normalise=0\npc_dim_xy=11\npc_cell_x_size=0.015\n"
+       "pc_vt_inject_energy=0.1\nvt_active_decay=1.0\nexp_delta_pc_threshold=2\n"
+       "exp_loops=20\nexp_initial_em_deg=140\n"},
+      {"newcollege",
+       "template_x_size=60\ntemplate_y_size=10\nvt_match_threshold=0.054\nvt_panoramic=1\n"
+       "vt_normalisation=0\nvt_patch_normalise=2\npc_dim_xy=30\npc_cell_x_size=1.0\n"
+       "pc_vt_inject_energy=0.2\nvt_active_decay=1.0\nexp_delta_pc_threshold=2.0\n"
+       "exp_loops=100\n"},
+  };
+  std::map<std::string, PipelineOptions> got;
+  for (const Shipped& c : shipped) {
+    const auto path = dir / (std::string("config_") + c.name + ".txt");
+    std::ofstream(path) << "[general]\ntopic_root=" << c.name << "\n[ratslam]\n"
+                        << c.ratslam << "[draw]\nenable=1\n";
+    StatusOr<ImportedConfig> imported = ImportOpenRatslamIni(path.string());
+    ASSERT_TRUE(imported.ok()) << c.name << ": " << imported.status().message();
+    // Reloads: the converted file parses back to the same options.
+    StatusOr<PipelineOptions> back = ParseConfig(PrintConfig(imported->options), c.name);
+    ASSERT_TRUE(back.ok()) << back.status().message();
+    EXPECT_EQ(PrintConfig(*back), PrintConfig(imported->options));
+    got[c.name] = imported->options;
+  }
+  const PipelineOptions& nc = got["newcollege"];
+  EXPECT_EQ(nc.sensors.classic_camera.shift_step_px, 5);  // left out: 12 rotations, 30 deg apart
+  EXPECT_EQ(nc.sensors.classic_camera.shift_px, 25);
+  EXPECT_EQ(nc.ratslam.local_view.decay_restore_per_frame, 0.05);
+  EXPECT_EQ(nc.sensors.classic_camera.crop_left_px, 0);
+  EXPECT_EQ(nc.sensors.classic_camera.crop_right_px, -1);  // the image width
+  EXPECT_EQ(nc.sensors.classic_camera.patch_normalisation_radius_px, 2);
+  EXPECT_TRUE(nc.sensors.classic_camera.panoramic);
+  for (const auto& [name, o] : got) {
+    SCOPED_TRACE(name);
+    EXPECT_EQ(o.ratslam.pose_cells.dim_theta_cells, 36);
+    EXPECT_EQ(o.ratslam.pose_cells.excitation_size_cells, 7);
+    EXPECT_EQ(o.ratslam.pose_cells.inhibition_size_cells, 5);
+    EXPECT_EQ(o.ratslam.pose_cells.excitation_variance_cells2, 1.0);  // sigma 1
+    EXPECT_EQ(o.ratslam.pose_cells.inhibition_variance_cells2, 4.0);  // sigma 2
+    EXPECT_EQ(o.ratslam.pose_cells.global_inhibition, 0.00002);
+    EXPECT_EQ(o.ratslam.experience_map.relaxation_correction, 0.5);
+    EXPECT_EQ(o.ratslam.experience_map.relaxation_scheme, RelaxationScheme::kFull);
+  }
+  const PipelineOptions& sl = got["stlucia"];
+  EXPECT_EQ(sl.sensors.classic_camera.shift_px, 5);
+  EXPECT_EQ(sl.sensors.classic_camera.shift_step_px, 1);
+  EXPECT_EQ(sl.sensors.classic_camera.crop_left_px, 40);
+  EXPECT_EQ(sl.sensors.classic_camera.crop_bottom_px, 300);
+  EXPECT_EQ(sl.sensors.classic_camera.global_normalisation_mean, 0.4);
+  EXPECT_EQ(sl.ratslam.local_view.decay_restore_per_frame, 0.04);
+  EXPECT_EQ(sl.ratslam.pose_cells.cell_size_m, 2.0);
+  EXPECT_EQ(sl.ratslam.action.match_distance_cells, 1.0);
+  EXPECT_EQ(sl.ratslam.experience_map.relaxation_sweeps, 20);
+  const PipelineOptions& ir = got["irataus"];
+  EXPECT_EQ(ir.sensors.classic_camera.template_height_px, 20);
+  EXPECT_EQ(ir.sensors.classic_camera.shift_px, 4);
+  EXPECT_EQ(ir.ratslam.local_view.injection_gain, 0.1);
+  EXPECT_EQ(ir.ratslam.pose_cells.dim_xy_cells, 11);
+
+  // A value our checks refuse names the INI line; a default they refuse says it was one.
+  const auto bad = dir / "bad.ini";
+  std::ofstream(bad) << "[ratslam]\ntemplate_x_size=60\npc_w_e_dim=4\n";
+  Status s = ImportOpenRatslamIni(bad.string()).status();
+  EXPECT_NE(s.message().find("bad.ini:3: pc_w_e_dim = 4"), std::string::npos) << s.message();
+  std::ofstream(bad) << "[ratslam]\nvt_match_threshold=0.1\n";
+  s = ImportOpenRatslamIni(bad.string()).status();
+  EXPECT_NE(s.message().find("template_x_size not set (OpenRatSLAM's default 1)"),
+            std::string::npos)
+      << s.message();
 }
 
 TEST(ConfigTest, AnOpenRatslamIniPassedAsConfigSaysHowToConvertIt) {
