@@ -296,8 +296,17 @@ ClassicCameraMatcher::ClassicCameraMatcher(const ClassicCameraOptions& options)
   if (!options.IsValid(&error)) throw std::invalid_argument("ClassicCameraOptions: " + error);
   row_stride_ = (options.template_width_px + 31) / 32 * 32;  // whole 32-byte SIMD words
   bytes_per_template_ = static_cast<size_t>(row_stride_) * options.template_height_px;
-  for (int s = -options.shift_px; s <= options.shift_px; s += options.shift_step_px) {
-    shifts_.push_back(s);
+  if (options.panoramic) {
+    // The whole ring, as OpenRatSLAM searches a panorama (offsets 0, step, 2 step, ... of the
+    // template's columns; a smaller offset wins a tie): a place seen the other way round
+    // matches. Template column u meets query column u - offset.
+    for (int offset = 0; offset < options.template_width_px; offset += options.shift_step_px) {
+      shifts_.push_back(-offset);
+    }
+  } else {
+    for (int s = -options.shift_px; s <= options.shift_px; s += options.shift_step_px) {
+      shifts_.push_back(s);
+    }
   }
 }
 

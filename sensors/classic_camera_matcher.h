@@ -1,8 +1,9 @@
 // The classic RatSLAM camera front end (Milford and Wyeth 2008; the variant of OpenRatSLAM,
 // Ball et al. 2013): crop, block-mean down-sampling to a small template, optional global and
 // patch normalisation, then comparison with every stored template by mean absolute intensity
-// difference over a range of column shifts. In panoramic mode the shifts wrap around and the
-// best shift gives the heading change since the template was stored.
+// difference over a range of column shifts. In panoramic mode every shift of the ring is tried
+// (in steps of shift_step_px; shift_px is not used), shifts wrap around, and the best shift gives
+// the heading change since the template was stored.
 //
 // Templates are stored as 8-bit intensities (0..255 for 0..1) so that the comparison runs on
 // SIMD sum-of-absolute-differences instructions; the quantisation error (at most 1/510 per
@@ -56,7 +57,8 @@ struct ClassicCameraOptions {
       schema::Unit("px").Within(1, 4096));
     v("template_height_px", template_height_px, "template rows",
       schema::Unit("px").Within(1, 4096));
-    v("shift_px", shift_px, "templates are compared at column offsets -shift_px..+shift_px",
+    v("shift_px", shift_px,
+      "templates are compared at column offsets -shift_px..+shift_px (a panorama: every offset)",
       schema::Unit("px").NonNegative());
     v("shift_step_px", shift_step_px, "step between compared column offsets",
       schema::Unit("px").AtLeast(1));

@@ -116,6 +116,30 @@ TEST(ClassicCameraMatcherTest, PanoramicMatchGivesHeadingChange) {
   EXPECT_NEAR(turned->heading_change_rad, -std::numbers::pi / 2, 1e-12);
 }
 
+// A panorama searches the whole ring (as OpenRatSLAM does), not only +-shift_px: a place seen
+// facing the other way matches with a heading change of half a turn.
+TEST(ClassicCameraMatcherTest, PanoramicMatchSearchesTheWholeRing) {
+  ClassicCameraOptions options;
+  options.template_width_px = 36;
+  options.template_height_px = 4;
+  options.shift_px = 3;  // not used by a panorama
+  options.shift_step_px = 2;
+  options.panoramic = true;
+  ClassicCameraMatcher matcher(options);
+  const Image a = RandomImage(36, 4, 8);
+  ASSERT_TRUE(matcher.Observe(a.view(), 0.0)->is_new);
+  auto behind = matcher.Observe(RollColumns(a, 18).view(), 1.0);
+  ASSERT_TRUE(behind.ok());
+  EXPECT_FALSE(behind->is_new);
+  EXPECT_NEAR(std::abs(behind->heading_change_rad), std::numbers::pi, 1e-12);
+  // An odd roll between the steps' offsets is not an exact match any more.
+  const TemplateComparison odd =
+      matcher.Compare(matcher.MakeTemplate(RollColumns(a, 5).view()).value());
+  EXPECT_GT(odd.mean_difference, 0.0);
+  EXPECT_EQ(matcher.Compare(matcher.MakeTemplate(RollColumns(a, 6).view()).value()).mean_difference,
+            0.0);
+}
+
 TEST(ClassicCameraMatcherTest, BlockMeanAndCrop) {
   ClassicCameraOptions options;
   options.crop_left_px = 2;
