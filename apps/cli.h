@@ -110,20 +110,34 @@ inline StatusOr<FigureOptions> FigureOptionsOf(const Arguments& args) {
   return o;
 }
 
-// Writes a command's figure (natural size, see WriteNaturalFigure) as `png_path` and, with
-// --format, as the same stem in each format asked for; --width-mm sets the vector page.
-// `default_width_mm` is the page width without --width-mm (two-panel figures need two columns).
+// Where a command's figure goes: `path` and, with --format, the same stem in each format asked
+// for; the vector page width (--width-mm, else `default_width_mm`: two-panel figures need two
+// columns); a PNG renderer when a target is a PNG.
+struct CommandFigure {
+  std::vector<FigureTarget> targets;
+  double width_mm = kOneColumnMm;
+  std::unique_ptr<SceneRenderer> renderer;
+};
+inline StatusOr<CommandFigure> CommandFigureOf(const Arguments& args, const std::string& path,
+                                               double default_width_mm) {
+  StatusOr<FigureOptions> figure = FigureOptionsOf(args);
+  if (!figure.ok()) return figure.status();
+  CommandFigure c;
+  c.width_mm = args.values.count("--width-mm") ? figure->width_mm : default_width_mm;
+  c.targets = FigureTargets(path, figure->formats ? &*figure->formats : nullptr);
+  StatusOr<std::unique_ptr<SceneRenderer>> renderer = RendererFor(c.targets);
+  if (!renderer.ok()) return renderer.status();
+  c.renderer = std::move(renderer.value());
+  return c;
+}
+
+// Writes a command's figure (natural size, see WriteNaturalFigure) to CommandFigureOf's targets.
 inline Status WriteCommandFigure(const Arguments& args, const std::string& png_path,
                                  const std::function<Scene(int width_px)>& build,
                                  double default_width_mm = kOneColumnMm) {
-  StatusOr<FigureOptions> figure = FigureOptionsOf(args);
+  StatusOr<CommandFigure> figure = CommandFigureOf(args, png_path, default_width_mm);
   if (!figure.ok()) return figure.status();
-  if (!args.values.count("--width-mm")) figure->width_mm = default_width_mm;
-  const std::vector<FigureTarget> targets =
-      FigureTargets(png_path, figure->formats ? &*figure->formats : nullptr);
-  StatusOr<std::unique_ptr<SceneRenderer>> renderer = RendererFor(targets);
-  if (!renderer.ok()) return renderer.status();
-  return WriteNaturalFigure(renderer->get(), build, targets, figure->width_mm);
+  return WriteNaturalFigure(figure->renderer.get(), build, figure->targets, figure->width_mm);
 }
 
 // `ratslam render ...` (render_command.cc).

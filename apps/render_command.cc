@@ -80,16 +80,13 @@ std::optional<std::vector<TimeSpan>> ParseSpans(const std::string& text) {
 // `default_width_mm`: the page width without --width-mm (two-panel figures need two columns).
 Status Write(const Arguments& args, const std::string& out, const SceneBuilder& build, int width_px,
              int height_px, double default_width_mm = kOneColumnMm) {
-  StatusOr<FigureOptions> figure = FigureOptionsOf(args);
+  StatusOr<CommandFigure> figure = CommandFigureOf(args, out, default_width_mm);
   if (!figure.ok()) return figure.status();
-  if (!args.values.count("--width-mm")) figure->width_mm = default_width_mm;
-  const std::vector<FigureTarget> targets =
-      FigureTargets(out, figure->formats ? &*figure->formats : nullptr);
-  StatusOr<std::unique_ptr<SceneRenderer>> renderer = RendererFor(targets);
-  if (!renderer.ok()) return renderer.status();
-  RATSLAM_RETURN_IF_ERROR(
-      WriteFigure(renderer->get(), build, width_px, height_px, targets, figure->width_mm));
-  for (const FigureTarget& t : targets) std::cerr << MessagePrefix() << "wrote " << t.path << "\n";
+  RATSLAM_RETURN_IF_ERROR(WriteFigure(figure->renderer.get(), build, width_px, height_px,
+                                      figure->targets, figure->width_mm));
+  for (const FigureTarget& t : figure->targets) {
+    std::cerr << MessagePrefix() << "wrote " << t.path << "\n";
+  }
   return Status::Ok();
 }
 
