@@ -15,6 +15,7 @@
 #include "common/number_text.h"
 #include "common/output_folder.h"
 #include "fusion/phone_localisation/robot_call.h"
+#include "render/image.h"
 #include "viewer/figures.h"
 
 namespace ratslam {
@@ -179,10 +180,13 @@ int RouteCommand(const Arguments& args) {
         scene.Line({p.x - 9, p.y - 9}, {p.x + 9, p.y + 9}, 3.0f, kInk);
         scene.Line({p.x - 9, p.y + 9}, {p.x + 9, p.y - 9}, 3.0f, kInk);
       }
-      scene.Text({30, 75},
-                 point ? "purple: route   green: start   ring: end   x: the point asked for"
-                       : "purple: route   green: start   ring: end",
-                 15.0f, kInk);
+      std::string legend = "purple: route   green: start   ring: end";
+      if (point) {
+        const std::string full = legend + "   x: the point asked for";
+        // A one-column page has no room for the long form.
+        legend = TextWidthPx(full, 15.0f) <= o.width_px - 60.0f ? full : legend + "   x: --to-xy";
+      }
+      scene.Text({30, 75}, legend, 15.0f, kInk);
       return scene;
     };
     if (Status s = WriteCommandFigure(args, folder.value()->Path("route.png"), build); !s.ok()) {
