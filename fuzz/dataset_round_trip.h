@@ -4,6 +4,7 @@
 #define RATSLAM_FUZZ_DATASET_ROUND_TRIP_H_
 
 #include <cmath>
+#include <filesystem>
 #include <string>
 
 #include "fuzz/fuzz_support.h"
@@ -20,6 +21,7 @@ inline size_t Readings(const Dataset& d) {
 
 inline void CheckWritesAndReadsBack(const Dataset& d) {
   const std::string folder = (Scratch() / "round_trip").string();
+  std::filesystem::remove_all(folder);  // nothing left from the previous input
   const Status written = WriteDataset(d, folder);
   if (!written.ok()) {
     // Refusing to write a value the reader cannot give back is allowed, and must say so.

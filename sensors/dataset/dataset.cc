@@ -310,6 +310,14 @@ Status WriteDataset(const Dataset& d, const std::string& folder) {
     return Status::Error(folder + ": image folder '" + d.image_folder +
                          "' must be a relative path inside the data set");
   }
+  // The image folder sits beside the files written here; one named like them could not be both.
+  for (const char* name : {"manifest.toml", "odometry.csv", "images.csv", "ground_truth.csv",
+                           "wifi.csv", "compass.csv"}) {
+    if (*image_folder.begin() == name) {
+      return Status::Error(folder + ": image folder '" + d.image_folder +
+                           "' cannot be stored: it has the name of the data set's file " + name);
+    }
+  }
   manifest += "\n[streams]\nodometry = \"odometry.csv\"\n";
   if (!d.images.empty()) {
     manifest += "images = \"images.csv\"\nimage_folder = " + TomlQuoted(d.image_folder) + "\n";

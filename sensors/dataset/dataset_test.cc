@@ -199,6 +199,16 @@ TEST_F(DatasetTest, HostileNamesRoundTripOrAreRefusedBeforeWriting) {
   infinite.ground_truth[1].x_m = std::numeric_limits<double>::infinity();
   EXPECT_NE(WriteDataset(infinite, refused.string()).message().find("ground-truth x inf"),
             std::string::npos);
+  // An image folder named like one of the written files (found by dataset_fuzzer) could not be
+  // both a folder and the file.
+  for (const char* folder : {"wifi.csv", "manifest.toml", "odometry.csv/frames"}) {
+    Dataset clash = d;
+    clash.image_folder = folder;
+    const Status status = WriteDataset(clash, refused.string());
+    EXPECT_NE(status.message().find("image folder '" + std::string(folder) + "' cannot be stored"),
+              std::string::npos)
+        << status.message();
+  }
   EXPECT_FALSE(fs::exists(refused / "manifest.toml"));
   EXPECT_FALSE(fs::exists(refused / "odometry.csv"));
 }
