@@ -124,6 +124,12 @@ const std::vector<CommandSpec>& Commands() {
         Text("--out", "O", "output folder", true), kOverwrite, kConfig,
         Text("--save-map", "F", "save the whole state to F at the end"),
         Text("--load-map", "F", "resume from the state saved in F"),
+        Flag("--localise",
+             "localise on the map of --load-map without changing it (any data set; writes "
+             "localisation.csv)"),
+        Number("--lost-after", "M",
+               "with --localise: lost when dead reckoning is M metres from the last recognised "
+               "place (default 5)"),
         Number("--until", "T", "stop after data time T seconds"),
         Flag("--render", "also write the run's images (experience map, template graph, ...)"),
         Whole("--animate", "N", "write an experience-map frame every N events to O/animation/", 1,
@@ -162,7 +168,12 @@ const std::vector<CommandSpec>& Commands() {
        "configs/synthetic.toml).",
        {Text("--out", "D", "output folder", true), kOverwrite,
         Whole("--seed", "S", "random seed", 0, kSeedMax),
-        Whole("--laps", "N", "laps of the loop", 1, 1000)},
+        Whole("--laps", "N", "laps of the loop", 1, 1000),
+        Whole("--noise-seed", "S",
+              "seed of the sensor noise alone (default: from --seed): another session of the "
+              "same world",
+              1, kSeedMax),
+        Number("--start-m", "M", "start M metres along the loop (default 0)")},
        {}},
       {"render", "images from a run folder, a saved map, a data set or a Wi-Fi map", "", {}, {}},
       {"render experience-map",

@@ -199,7 +199,8 @@ TEST(CommandLineTest, BashCompletionCompletes) {
   };
   EXPECT_EQ(complete("ratslam rep"), "replay");
   EXPECT_EQ(complete("ratslam render pose"), "pose-cells");
-  EXPECT_EQ(complete("ratslam replay --data x --lo"), "--load-map");
+  EXPECT_EQ(complete("ratslam replay --data x --loa"), "--load-map");
+  EXPECT_EQ(complete("ratslam replay --data x --lo"), "--load-map --localise --lost-after");
   EXPECT_EQ(complete("ratslam sweep submit DIR --sl"), "--slurm");
   EXPECT_EQ(complete("ratslam print-config --"), "--help --config");
   std::filesystem::remove(script);

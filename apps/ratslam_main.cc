@@ -98,6 +98,17 @@ std::string HumanSummary(const RunSummary& s, const std::string& out) {
                   MessagePrefix().c_str(), *s.map_ate_m, *s.odometry_ate_m, s.ate_points);
     text += line;
   }
+  if (s.lost_fraction) {
+    std::snprintf(line, sizeof line, "%slocalised in %.1f %% of the frames",
+                  MessagePrefix().c_str(), 100.0 * (1.0 - *s.lost_fraction));
+    text += line;
+    if (s.localisation_median_error_m) {
+      std::snprintf(line, sizeof line, ", median error %.2f m (rigid fit)",
+                    *s.localisation_median_error_m);
+      text += line;
+    }
+    text += "\n";
+  }
   text += MessagePrefix() + "outputs in " + out + " (summary.json; --json prints it here)\n";
   return text;
 }
@@ -228,6 +239,16 @@ int Replay(const Arguments& parsed) {
   request.out = args->values.at("--out");
   request.session.save_map = args->Value("--save-map");
   request.session.load_map = args->Value("--load-map");
+  request.session.localise = args->values.count("--localise") > 0;
+  if (args->values.count("--lost-after") && !request.session.localise) {
+    std::cerr << MessagePrefix() << "--lost-after applies only with --localise\n";
+    return kExitUsage;
+  }
+  if (args->values.count("--lost-after")) {
+    auto lost = ParseNumber("--lost-after", args->values.at("--lost-after"));
+    if (!lost) return kExitUsage;
+    request.session.lost_after_m = *lost;
+  }
   if (args->values.count("--until")) {
     auto until = ParseNumber("--until", args->values.at("--until"));
     if (!until) return kExitUsage;
@@ -370,6 +391,16 @@ int SynthesizeCommand(const Arguments& parsed) {
     auto laps = ParseInteger("--laps", args->values.at("--laps"), 1, 1000);
     if (!laps) return kExitUsage;
     options.laps = static_cast<int>(*laps);
+  }
+  if (args->values.count("--noise-seed")) {
+    auto seed = ParseInteger("--noise-seed", args->values.at("--noise-seed"), 1, int64_t{1} << 53);
+    if (!seed) return kExitUsage;
+    options.noise_seed = static_cast<uint64_t>(*seed);
+  }
+  if (args->values.count("--start-m")) {
+    auto start = ParseNumber("--start-m", args->values.at("--start-m"));
+    if (!start) return kExitUsage;
+    options.start_m = *start;
   }
   return Synthesize(options, args->values.at("--out"));
 }

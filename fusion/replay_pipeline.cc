@@ -118,7 +118,8 @@ Status ReplayPipeline::Run(const ReplayControl& control) {
       control.progress(progress);
     }
   }
-  if (finished() && options_.wifi_sequence.enabled && !state_.wifi_sequence_flushed) {
+  if (finished() && options_.wifi_sequence.enabled && !localising() &&
+      !state_.wifi_sequence_flushed) {
     // The sequence still open when the data ends (a walk that ends where it began) is matched
     // too, and the map relaxed until the new links settle, as no odometry step follows.
     state_.wifi_sequence_flushed = true;
@@ -180,7 +181,7 @@ Status ReplayPipeline::HandleWifi(const Event& event) {
   StatusOr<std::optional<FrameDecision>> decision = front_end_->OnWifi(scan);
   if (!decision.ok()) return decision.status();
   if (decision.value()) RATSLAM_RETURN_IF_ERROR(Apply(*decision.value()));
-  return options_.wifi_sequence.enabled ? AddSequencePose(scan) : Status::Ok();
+  return options_.wifi_sequence.enabled && !localising() ? AddSequencePose(scan) : Status::Ok();
 }
 
 Pose2 ReplayPipeline::MapPose(const SequencePose& pose) const {
@@ -269,6 +270,15 @@ Status ReplayPipeline::Apply(const FrameDecision& decision) {
   const auto current = slam_->experience_map().current();
   frame.experience_id = current ? static_cast<int64_t>(*current) : -1;
   state_.frames.push_back(frame);
+  if (localising()) {
+    const ExperienceMap& map = slam_->experience_map();
+    LocalisationRecord r;
+    r.time_s = frame.time_s;
+    r.experience_id = frame.experience_id;
+    map.CurrentPose(&r.x_m, &r.y_m, &r.theta_rad);
+    r.lost = !current || std::hypot(map.offset().forward_m, map.offset().left_m) > lost_after_m_;
+    localisation_.push_back(r);
+  }
   return Status::Ok();
 }
 
@@ -311,6 +321,23 @@ Status ReplayPipeline::Restore(const State& state) {
   state_.ratslam = {};
   state_.front_end.clear();
   state_.wifi_sequence = {};
+  return Status::Ok();
+}
+
+Status ReplayPipeline::AdoptMap(const State& map, double lost_after_m) {
+  if (!(lost_after_m > 0.0) || !std::isfinite(lost_after_m)) {
+    return Status::Error("localisation: lost_after_m must be positive and finite");
+  }
+  // The map, with everything that belongs to the run that made it set back to a start.
+  State start;
+  start.ratslam = map.ratslam;
+  start.ratslam.counters = {};
+  start.front_end = map.front_end;
+  start.events_total = events_.size();
+  RATSLAM_RETURN_IF_ERROR(Restore(start));
+  slam_->FreezeMap(events_.empty() ? 0.0 : events_.front().time_s);
+  localisation_.clear();
+  lost_after_m_ = lost_after_m;
   return Status::Ok();
 }
 

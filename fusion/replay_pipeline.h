@@ -121,12 +121,22 @@ class ReplayPipeline {
   const State& state() const { return state_; }
   // The run so far as plain records (what outputs and figures read).
   RunView View() const {
-    return {slam_->experience_map(), slam_->pose_cells(), state_.frames, state_.trajectory};
+    return {slam_->experience_map(), slam_->pose_cells(), state_.frames, state_.trajectory,
+            localising() ? &localisation_ : nullptr};
   }
   // A snapshot of the complete state (spine included).
   State Snapshot() const;
   // Restores a snapshot; fails if it does not belong to this data set and these options.
   Status Restore(const State& state);
+  // Localisation only: takes the map of `map` (a snapshot of a run under these options, on any
+  // data set) and replays this data set from its start on it, frozen (Ratslam::FreezeMap): no
+  // templates, experiences or links join the map, Wi-Fi sequence loop closure is off, and every
+  // view frame adds a LocalisationRecord, lost when no place has been recognised yet or when dead
+  // reckoning has gone further than `lost_after_m` (straight line) from the last one. The pose
+  // cells keep the map's final activity; views of known places pull them to the right place.
+  Status AdoptMap(const State& map, double lost_after_m);
+  bool localising() const { return slam_->frozen(); }
+  const std::vector<LocalisationRecord>& localisation() const { return localisation_; }
   const std::vector<Event>& events() const { return events_; }
   // Wi-Fi sequence loop closure (its poses, loops and similarity), whether enabled or not.
   const WifiSequenceLoopCloser& wifi_sequence() const { return *wifi_sequence_; }
@@ -154,7 +164,9 @@ class ReplayPipeline {
   std::shared_ptr<const FabmapResources> fabmap_;
   std::unique_ptr<FrontEnd> front_end_;
   std::unique_ptr<WifiSequenceLoopCloser> wifi_sequence_;
-  State state_;  // the parts not held by slam_ and camera_
+  State state_;                                   // the parts not held by slam_ and camera_
+  std::vector<LocalisationRecord> localisation_;  // localisation runs only (not saved)
+  double lost_after_m_ = 0.0;
 };
 
 }  // namespace ratslam

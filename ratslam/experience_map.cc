@@ -170,6 +170,11 @@ StatusOr<bool> ExperienceMap::LinkTo(uint32_t id, double time_s,
       added = true;
     }
   }
+  MoveTo(id, time_s, compass_heading_rad);
+  return added;
+}
+
+void ExperienceMap::MoveTo(uint32_t id, double time_s, std::optional<double> compass_heading_rad) {
   state_.current = id;
   state_.offset = LocalOffset();
   const std::optional<double>& target = state_.experiences[id].compass_heading_rad;
@@ -177,7 +182,6 @@ StatusOr<bool> ExperienceMap::LinkTo(uint32_t id, double time_s,
     state_.offset.facing_rad = WrapAngle(*compass_heading_rad - *target);
   }
   state_.offset_start_time_s = time_s;
-  return added;
 }
 
 void ExperienceMap::Relax() {

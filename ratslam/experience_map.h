@@ -150,6 +150,14 @@ class ExperienceMap {
   // opposite direction. Returns true when a link was added.
   StatusOr<bool> LinkTo(uint32_t id, double time_s,
                         std::optional<double> compass_heading_rad = std::nullopt);
+  // Makes `id` (which must exist) current with no link, dead reckoning restarting from it (facing
+  // as in LinkTo): localisation on a frozen map recognising a place.
+  void MoveTo(uint32_t id, double time_s, std::optional<double> compass_heading_rad = std::nullopt);
+  // No current experience and no offset: a localisation run before it recognises a place.
+  void Forget() {
+    state_.current.reset();
+    state_.offset = LocalOffset();
+  }
 
   // Links existing experiences `from` and `to` with `to`'s pose in `from`'s frame measured by
   // something other than odometry (Wi-Fi sequence loop closure); the current experience does not

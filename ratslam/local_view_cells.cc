@@ -43,6 +43,15 @@ double LocalViewCells::DecayAtTime(const ViewTemplate& t, double time_s) const {
   return std::max(options_.decay_floor, t.decay - options_.decay_restore_per_s * elapsed);
 }
 
+void LocalViewCells::SettleForLocalisation(double start_time_s) {
+  for (ViewTemplate& t : state_.templates) {
+    t.decay = options_.decay_floor;
+    t.decay_frame = state_.frame;
+    t.decay_time_s = start_time_s;
+  }
+  settled_templates_ = state_.templates.size();
+}
+
 StatusOr<std::optional<Injection>> LocalViewCells::Observe(const ViewDecision& decision,
                                                            const PoseCellPosition& current_pose) {
   const uint64_t frame = ++state_.frame;
@@ -82,6 +91,7 @@ StatusOr<std::optional<Injection>> LocalViewCells::Observe(const ViewDecision& d
     recent = decision.template_id + static_cast<uint64_t>(options_.skip_recent_templates) >= count;
   }
   t.decay_frame = frame;
+  if (decision.template_id < settled_templates_) recent = false;
   if (recent || !decision.allow_injection) return std::optional<Injection>();
   const double energy = options_.injection_gain *
                         (options_.energy_limit - std::exp(options_.energy_decay_rate * decay)) /

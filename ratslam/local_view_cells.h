@@ -130,6 +130,10 @@ class LocalViewCells {
   // Restores a state; fails, changing nothing, on ids out of order, a decay or time that is not
   // finite, or a theta outside the ring (x and y are checked by Ratslam, which knows the grid).
   Status SetState(State state);
+  // Localisation on a frozen map, from data time `start_time_s` on (another data set's clock):
+  // every template now stored is rested (decay at the floor, as if last matched long ago) and
+  // never counts as recent, whatever its creation time or how many templates come after it.
+  void SettleForLocalisation(double start_time_s);
 
  private:
   double DecayAtStartOfFrame(const ViewTemplate& t, uint64_t frame) const;
@@ -138,6 +142,7 @@ class LocalViewCells {
   LocalViewOptions options_;
   int dim_theta_cells_;
   State state_;
+  size_t settled_templates_ = 0;  // SettleForLocalisation: ids below this are never recent
 };
 
 }  // namespace ratslam

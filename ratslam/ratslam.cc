@@ -40,6 +40,11 @@ Status Ratslam::OnView(const ViewDecision& decision) {
   if (!injection.ok()) return injection.status();
   ++counters_.view_frames;
   current_template_ = decision.template_id;
+  if (frozen_templates_ && decision.template_id >= *frozen_templates_) {
+    current_template_.reset();
+    ++localisation_counters_.unmapped_views;
+    return Status::Ok();
+  }
   if (injection.value()) {
     pose_cells_.Inject(injection.value()->position, injection.value()->energy);
     ++counters_.injections;
@@ -55,6 +60,13 @@ StatusOr<ActionKind> Ratslam::OnOdometry(const OdometryStep& step) {
   pose_cells_.Step(step.forward_m, step.rotation_rad);
   experience_map_.Integrate(step.forward_m, step.rotation_rad);
   return Act(step.time_s);
+}
+
+void Ratslam::FreezeMap(double start_time_s) {
+  frozen_templates_ = local_view_.size();
+  local_view_.SettleForLocalisation(start_time_s);
+  current_template_.reset();
+  experience_map_.Forget();
 }
 
 StatusOr<ActionKind> Ratslam::Act(double time_s) {
@@ -78,6 +90,15 @@ StatusOr<ActionKind> Ratslam::Act(double time_s) {
     }
   }
 
+  if (frozen_templates_) {
+    if (!nearest || nearest_distance >= options_.action.match_distance_cells ||
+        experience_map_.current() == nearest) {
+      return ActionKind::kNone;
+    }
+    experience_map_.MoveTo(*nearest, time_s, compass_heading_rad_);
+    ++localisation_counters_.recognitions;
+    return ActionKind::kRecognised;
+  }
   ActionKind action = ActionKind::kNone;
   if (!nearest || nearest_distance >= options_.action.match_distance_cells) {
     const uint32_t id =

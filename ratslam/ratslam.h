@@ -53,7 +53,13 @@ struct OdometryStep {
   double rotation_rad = 0.0;  // heading change during the step (counter-clockwise positive)
 };
 
-enum class ActionKind { kNone, kCreatedExperience, kLinkedExisting, kRefusedAmbiguous };
+enum class ActionKind {
+  kNone,
+  kCreatedExperience,
+  kLinkedExisting,
+  kRefusedAmbiguous,
+  kRecognised  // frozen map: moved to an existing experience, no link made
+};
 
 class Ratslam {
  public:
@@ -63,6 +69,11 @@ class Ratslam {
     uint64_t injections = 0;
     uint64_t loop_closures = 0;  // links made to an experience that existed already
     uint64_t refused_ambiguous = 0;
+  };
+  // Of a frozen map (FreezeMap), not saved.
+  struct LocalisationCounters {
+    uint64_t recognitions = 0;    // moves to an experience the pose cells agree with
+    uint64_t unmapped_views = 0;  // view frames of templates made after the freeze
   };
 
   // `options` must be valid (IsValid); throws std::invalid_argument otherwise.
@@ -84,11 +95,24 @@ class Ratslam {
   // experiences (see ExperienceMap).
   void SetCompassHeading(std::optional<double> heading_rad) { compass_heading_rad_ = heading_rad; }
 
+  // Localisation on a frozen map (`replay --localise`): from now on the templates, experiences and
+  // links stay as they are. A view of a template made after the freeze (a place the map does not
+  // know; the front end still keeps it, so that its ids stay those of the local view cells)
+  // injects no energy and leaves no current template. The action logic makes no experience and no
+  // link: it moves the current experience to the current template's experience nearest the pose
+  // cells, when within match_distance_cells (ActionKind::kRecognised), and otherwise dead reckons
+  // on. The current experience is forgotten: the robot is lost until it recognises a place. The
+  // templates are rested for data starting at `start_time_s`
+  // (LocalViewCells::SettleForLocalisation). Not part of State: a frozen spine is never saved.
+  void FreezeMap(double start_time_s);
+  bool frozen() const { return frozen_templates_.has_value(); }
+
   const PoseCellNetwork& pose_cells() const { return pose_cells_; }
   const LocalViewCells& local_view() const { return local_view_; }
   const ExperienceMap& experience_map() const { return experience_map_; }
   std::optional<uint32_t> current_template() const { return current_template_; }
   const Counters& counters() const { return counters_; }
+  const LocalisationCounters& localisation_counters() const { return localisation_counters_; }
   const RatslamOptions& options() const { return options_; }
 
   struct State {
@@ -114,6 +138,8 @@ class Ratslam {
   std::optional<uint32_t> current_template_;
   Counters counters_;
   std::optional<double> compass_heading_rad_;
+  std::optional<size_t> frozen_templates_;  // templates of the frozen map
+  LocalisationCounters localisation_counters_;
 };
 
 }  // namespace ratslam

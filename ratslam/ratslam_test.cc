@@ -42,16 +42,25 @@ TEST(RatslamTest, RejectsOdometryThatIsNotFinite) {
   EXPECT_FALSE(slam.OnOdometry({0.0, std::numeric_limits<double>::quiet_NaN(), 0.0}).ok());
 }
 
-TEST(RatslamTest, RevisitedPlaceClosesTheLoop) {
-  // Out and back along a line of 30 places 1 m apart, then the same places again in order.
+RatslamOptions LineOptions() {
   RatslamOptions options;
   options.local_view.skip_recent_templates = 5;
-  Ratslam slam(options);
-  double t = 0.0;
-  for (uint32_t i = 0; i < 30; ++i, t += 1.0) {
-    ASSERT_TRUE(slam.OnView({t, i, true, 0.0}).ok());
-    ASSERT_TRUE(slam.OnOdometry({t, 1.0, 0.0}).ok());
+  return options;
+}
+
+// A line of 30 new places 1 m apart, one per second from *t.
+void MapLine(Ratslam* slam, double* t) {
+  for (uint32_t i = 0; i < 30; ++i, *t += 1.0) {
+    ASSERT_TRUE(slam->OnView({*t, i, true, 0.0}).ok());
+    ASSERT_TRUE(slam->OnOdometry({*t, 1.0, 0.0}).ok());
   }
+}
+
+TEST(RatslamTest, RevisitedPlaceClosesTheLoop) {
+  // Out and back along a line of 30 places 1 m apart, then the same places again in order.
+  Ratslam slam(LineOptions());
+  double t = 0.0;
+  MapLine(&slam, &t);
   // Drive home with a drifting odometry (teleport back to the start: heading unchanged), then
   // see the first places again; the injections pull the packet back and links close the loop.
   for (int lap = 0; lap < 3; ++lap) {
@@ -62,6 +71,45 @@ TEST(RatslamTest, RevisitedPlaceClosesTheLoop) {
   }
   EXPECT_GT(slam.counters().loop_closures, 0u);
   EXPECT_GT(slam.counters().injections, 0u);
+}
+
+// A frozen map (localisation only): places seen again move the current experience to theirs and
+// dead reckoning restarts there; nothing joins the map; a view the map does not hold injects
+// nothing and is counted.
+TEST(RatslamTest, FrozenMapRecognisesPlacesAndNeverGrows) {
+  Ratslam slam(LineOptions());
+  double t = 0.0;
+  MapLine(&slam, &t);
+  const size_t experiences = slam.experience_map().num_experiences();
+  const size_t links = slam.experience_map().num_links();
+  slam.FreezeMap(t);
+  EXPECT_TRUE(slam.frozen());
+  EXPECT_FALSE(slam.experience_map().current().has_value());  // lost until a place is seen
+  ASSERT_TRUE(slam.OnView({t, 30, true, 0.0}).ok());          // a place the map does not know
+  auto action = slam.OnOdometry({t, 1.0, 0.0});
+  ASSERT_TRUE(action.ok());
+  EXPECT_EQ(action.value(), ActionKind::kNone);
+  EXPECT_EQ(slam.counters().injections, 0u);
+  EXPECT_EQ(slam.localisation_counters().unmapped_views, 1u);
+  EXPECT_FALSE(slam.current_template().has_value());
+  t += 1.0;
+  for (int lap = 0; lap < 3; ++lap) {
+    for (uint32_t i = 0; i < 30; ++i, t += 1.0) {
+      ASSERT_TRUE(slam.OnView({t, i, false, 0.0}).ok());
+      action = slam.OnOdometry({t, 1.0, 0.0});
+      ASSERT_TRUE(action.ok());
+      EXPECT_NE(action.value(), ActionKind::kCreatedExperience);
+      EXPECT_NE(action.value(), ActionKind::kLinkedExisting);
+    }
+  }
+  EXPECT_EQ(slam.experience_map().num_experiences(), experiences);
+  EXPECT_EQ(slam.experience_map().num_links(), links);
+  EXPECT_GT(slam.localisation_counters().recognitions, 10u);
+  EXPECT_GT(slam.counters().injections, 0u);
+  // At the end of the line, where place 29 was stored (after its odometry step, as then).
+  ASSERT_TRUE(slam.experience_map().current().has_value());
+  EXPECT_EQ(slam.experience_map().experience(*slam.experience_map().current()).template_id, 29u);
+  EXPECT_NEAR(slam.experience_map().offset().forward_m, 0.0, 1e-9);
 }
 
 TEST(RatslamTest, StateRoundTripContinuesIdentically) {

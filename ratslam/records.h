@@ -35,12 +35,24 @@ struct FrameRecord {
   bool recent = false;  // re-used a recent template (no injection; not counted as a match)
 };
 
+// One view frame of a localisation run on a frozen map (ReplayPipeline::AdoptMap): where the map
+// puts the robot.
+struct LocalisationRecord {
+  double time_s = 0.0;
+  int64_t experience_id = -1;  // the experience recognised last; -1 before the first
+  double x_m = 0.0, y_m = 0.0, theta_rad = 0.0;  // that experience composed with dead reckoning
+  bool lost = true;  // no experience yet, or dead reckoned further than lost_after_m from it
+};
+
 // A read-only view of a run: the map, the pose cells and the records, wherever they live.
 struct RunView {
   const ExperienceMap& map;
   const PoseCellNetwork& pose_cells;
   const std::vector<FrameRecord>& frames;
   const std::vector<TrajectoryRecord>& trajectory;
+  // Localisation runs only: the map is another run's, frozen (its experiences were made on
+  // another data set's clock).
+  const std::vector<LocalisationRecord>* localisation = nullptr;
 };
 
 }  // namespace ratslam

@@ -1,5 +1,6 @@
 #include "session/replay_session.h"
 
+#include <cmath>
 #include <stdexcept>
 #include <utility>
 
@@ -55,6 +56,15 @@ ReplaySession::~ReplaySession() = default;
 Status ReplaySession::Load() {
   std::string error;
   if (!options_.pipeline.IsValid(&error)) return Status::Error("configuration: " + error);
+  if (options_.localise) {
+    if (options_.load_map.empty()) return Status::Error("localisation needs a map (--load-map)");
+    if (!options_.save_map.empty()) {
+      return Status::Error("localisation does not change the map: there is nothing to save");
+    }
+    if (!(options_.lost_after_m > 0.0) || !std::isfinite(options_.lost_after_m)) {
+      return Status::Error("localisation: the lost distance must be positive and finite");
+    }
+  }
   PhoneLogOptions phone;
   phone.lenient = options_.lenient;
   phone.pdr = options_.pipeline.pdr;
@@ -92,6 +102,12 @@ Status ReplaySession::Prepare() {
     StatusOr<MapFile> map = LoadMapFile(path);
     if (!map.ok()) return map.status();
     RATSLAM_RETURN_IF_ERROR(CheckSameConfiguration(*map, options_.pipeline).WithContext(path));
+    if (options_.localise) {
+      RATSLAM_RETURN_IF_ERROR(
+          pipeline->AdoptMap(map->state, options_.lost_after_m).WithContext(path));
+      pipeline_ = std::move(pipeline);
+      return Status::Ok();
+    }
     if (map->dataset_name != dataset_->name) {
       return Status::Error(path + ": the map was made from data set '" + map->dataset_name +
                            "', not '" + dataset_->name + "'");
@@ -131,7 +147,8 @@ Status ReplaySession::WriteOutputs() {
   info.interrupted = result_.interrupted;
   info.config_path = options_.config_path;
   info.config_fingerprint = fingerprint_;
-  info.resumed_from = options_.load_map;
+  (options_.localise ? info.localised_on : info.resumed_from) = options_.load_map;
+  info.lost_after_m = options_.lost_after_m;
   info.provenance = options_.provenance;
   info.inputs = options_.data;
   StatusOr<RunSummary> summary = WriteRunOutputs(*env_.out, *pipeline_, *dataset_, info);
@@ -146,6 +163,7 @@ Status ReplaySession::WriteOutputs() {
 
 Status ReplaySession::SaveMap() {
   if (!pipeline_) return Status::Error("replay session: SaveMap before Prepare");
+  if (options_.localise) return Status::Ok();  // the map is as it was loaded
   std::string path = options_.save_map;
   if (path.empty() && (result_.interrupted || !result_.replay.ok() || !result_.outputs.ok())) {
     path = env_.out->Path("interrupted.map");

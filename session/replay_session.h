@@ -35,8 +35,12 @@ struct ReplaySessionOptions {
   std::string config_path;        // as given by the user, for the summary; empty: defaults
   std::vector<std::string> data;  // one data set, or several sessions of one run
   bool lenient = false;           // skip (and count) malformed lines of phone logs
-  std::string load_map;           // resume from this map file
-  std::string save_map;           // save the final state here
+  std::string load_map;           // resume from this map file (or localise on it)
+  // Localisation only (ReplayPipeline::AdoptMap): replay `data` from its start on the frozen map
+  // of load_map, which any data set may have made; nothing is saved.
+  bool localise = false;
+  double lost_after_m = 5.0;  // a localisation frame this far from its last place is lost
+  std::string save_map;       // save the final state here
   double until_s = std::numeric_limits<double>::infinity();  // stop after this data time
   RunProvenance provenance;  // command line and start time, for summary.json's `run`
 };

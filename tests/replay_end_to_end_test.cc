@@ -1,6 +1,7 @@
 // Runs the `ratslam` program as a user would and checks its outputs.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -14,6 +15,7 @@
 #include <vector>
 
 #include "apps/demo_config.h"
+#include "common/geometry.h"
 #include "common/scratch_dir.h"
 #include "render/image.h"
 #include "render/renderer.h"
@@ -33,6 +35,11 @@ const char* const kOutputs[] = {"experiences.csv",  "links.csv",          "traje
 using e2e::Result;
 using e2e::RunRatslam;
 using e2e::Slurp;
+
+double Median(std::vector<double> v) {
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
 
 nlohmann::json Summary(const fs::path& out) {
   return nlohmann::json::parse(Slurp(out / "summary.json"));
@@ -742,6 +749,116 @@ TEST_F(ReplayEndToEndTest, RouteIsTheShortestPathOverTheExperienceGraph) {
       << unknown.err;
   const Result both = RunRatslam("route --map " + run.string() + " --to 1 --to-xy 0,0", root_);
   EXPECT_EQ(both.exit_code, 2);
+}
+
+// Localisation only: a map made on two laps, then another session of the same world (other
+// sensor noise) that starts 60 m along the loop, far from where the map's pose cells were left.
+// The map must not change, nearly every frame must be localised, and the positions must agree
+// with ground truth through the map run's own alignment (an oracle independent of the
+// localisation run) far better than chance. A session in another world recognises nothing.
+TEST_F(ReplayEndToEndTest, LocalisationOnASavedMapFollowsTheNextSession) {
+  SyntheticOptions map_options = DemoSyntheticOptions();
+  map_options.laps = 2;
+  SyntheticOptions next = DemoSyntheticOptions();
+  next.laps = 1;
+  next.noise_seed = 7;
+  next.start_m = 60.0;
+  SyntheticOptions elsewhere = next;
+  elsewhere.seed = map_options.seed + 1;
+  StatusOr<Dataset> map_data = WriteSyntheticDataset(map_options, (root_ / "loc_map").string());
+  StatusOr<Dataset> next_data = WriteSyntheticDataset(next, (root_ / "loc_next").string());
+  StatusOr<Dataset> other_data = WriteSyntheticDataset(elsewhere, (root_ / "loc_other").string());
+  ASSERT_TRUE(map_data.ok() && next_data.ok() && other_data.ok());
+  const fs::path map_run = root_ / "loc_map_run", map_file = root_ / "loc.map";
+  const std::string base = "replay --quiet --config " + config_ + " --data ";
+  ASSERT_EQ(RunRatslam(base + (root_ / "loc_map").string() + " --out " + map_run.string() +
+                           " --save-map " + map_file.string(),
+                       root_)
+                .exit_code,
+            0);
+  const fs::path run = root_ / "loc_run";
+  const Result r = RunRatslam(base + (root_ / "loc_next").string() + " --out " + run.string() +
+                                  " --load-map " + map_file.string() + " --localise",
+                              root_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json s = Summary(run);
+  EXPECT_TRUE(e2e::UndocumentedKeys(s).empty())
+      << "not in configs/README.md: " << e2e::Join(e2e::UndocumentedKeys(s));
+  EXPECT_EQ(Slurp(run / "experiences.csv"), Slurp(map_run / "experiences.csv"));
+  EXPECT_EQ(Slurp(run / "links.csv"), Slurp(map_run / "links.csv"));
+  EXPECT_FALSE(s.contains("match_rate_within_m"));
+  const nlohmann::json& l = s["localisation"];
+  ASSERT_TRUE(l.is_object()) << s.dump(2);
+  EXPECT_EQ(l["frames"].get<size_t>(), next_data->images.size());
+
+  // The map run's frame against the world's, from its experiences and its ground truth.
+  StatusOr<CsvTable> ex =
+      CsvTable::Read((map_run / "experiences.csv").string(), {"id", "x_m", "y_m", "time_s"},
+                     {"theta_rad", "template_id", "pose_cell_x", "pose_cell_y", "pose_cell_theta"});
+  ASSERT_TRUE(ex.ok()) << ex.status().message();
+  std::vector<Point2> map_xy, world_xy;
+  for (size_t i = 0; i < ex->rows(); ++i) {
+    const auto gt = InterpolateGroundTruth(map_data->ground_truth, *ex->Number(i, "time_s"));
+    ASSERT_TRUE(gt.has_value());
+    map_xy.push_back({*ex->Number(i, "x_m"), *ex->Number(i, "y_m")});
+    world_xy.push_back({gt->x_m, gt->y_m});
+  }
+  const std::optional<RigidAlignment2D> to_world = AlignRigid2D(map_xy, world_xy);
+  ASSERT_TRUE(to_world.has_value());
+
+  StatusOr<CsvTable> rows =
+      CsvTable::Read((run / "localisation.csv").string(),
+                     {"time_s", "experience_id", "lost", "x_m", "y_m", "theta_rad"},
+                     {"true_x_m", "true_y_m", "error_m"});
+  ASSERT_TRUE(rows.ok()) << rows.status().message();
+  ASSERT_EQ(rows->rows(), next_data->images.size());
+  std::vector<double> errors, chance;
+  size_t lost = 0;
+  for (size_t i = 0; i < rows->rows(); ++i) {
+    const auto truth = InterpolateGroundTruth(next_data->ground_truth, *rows->Number(i, "time_s"));
+    ASSERT_TRUE(truth.has_value());
+    if (*rows->Number(i, "lost") != 0) {
+      ++lost;
+      continue;
+    }
+    const Point2 p = Apply(*to_world, {*rows->Number(i, "x_m"), *rows->Number(i, "y_m")});
+    errors.push_back(std::hypot(p.x - truth->x_m, p.y - truth->y_m));
+    // Chance: the median distance from the truth to a map experience picked at random.
+    std::vector<double> to_experiences;
+    for (const Point2& w : world_xy) {
+      to_experiences.push_back(std::hypot(w.x - truth->x_m, w.y - truth->y_m));
+    }
+    chance.push_back(Median(to_experiences));
+  }
+  const double lost_fraction = static_cast<double>(lost) / static_cast<double>(rows->rows());
+  EXPECT_NEAR(l["lost_fraction"].get<double>(), lost_fraction, 1e-12);
+  EXPECT_LT(lost_fraction, 0.1);
+  ASSERT_FALSE(errors.empty());
+  EXPECT_LT(Median(errors), Median(chance) / 10) << "chance " << Median(chance);
+  EXPECT_LT(Median(errors), 2.0);
+  EXPECT_GT(l["recognitions"].get<int>(), 0);
+
+  const fs::path other = root_ / "loc_other_run";
+  const Result o = RunRatslam(base + (root_ / "loc_other").string() + " --out " + other.string() +
+                                  " --load-map " + map_file.string() + " --localise",
+                              root_);
+  ASSERT_EQ(o.exit_code, 0) << o.err;
+  const nlohmann::json lo = Summary(other).value("localisation", nlohmann::json::object());
+  EXPECT_GT(lo.value("lost_fraction", 0.0), 0.9) << lo.dump(2);
+
+  // Misuse is refused before anything runs.
+  const std::string localise = base + (root_ / "loc_next").string() + " --out " +
+                               (root_ / "loc_refused").string() + " --localise";
+  EXPECT_NE(RunRatslam(localise, root_).err.find("localisation needs a map (--load-map)"),
+            std::string::npos);
+  EXPECT_NE(RunRatslam(localise + " --load-map " + map_file.string() + " --save-map x.map", root_)
+                .err.find("nothing to save"),
+            std::string::npos);
+  EXPECT_NE(RunRatslam(base + (root_ / "loc_next").string() + " --out " +
+                           (root_ / "loc_refused").string() + " --lost-after 3",
+                       root_)
+                .err.find("--lost-after applies only with --localise"),
+            std::string::npos);
 }
 
 }  // namespace

@@ -178,7 +178,24 @@ Status WriteRunImages(SceneRenderer* renderer, const RunView& run, const Dataset
     map_data.ground_truth =
         GroundTruthInMapFrame(map_data.experiences, dataset,
                               trajectory.empty() ? -1.0 : trajectory.back().time_s, &truth_floors);
-    const std::vector<int> floors = ExperienceFloors(map_data.experiences, dataset);
+    std::vector<int> floors = ExperienceFloors(map_data.experiences, dataset);
+    if (run.localisation) {
+      // The map is another run's: this data set's path, placed by the frames localised (the
+      // experiences' times belong to the other data set), on one panel.
+      map_options.title = "localisation on a saved map (" + dataset.name + ")";
+      std::vector<Point2> localised, truth, path;
+      for (const LocalisationRecord& r : *run.localisation) {
+        const auto gt = InterpolateGroundTruth(dataset.ground_truth, r.time_s);
+        if (!gt) continue;
+        path.push_back({gt->x_m, gt->y_m});
+        if (r.lost) continue;
+        localised.push_back({r.x_m, r.y_m});
+        truth.push_back({gt->x_m, gt->y_m});
+      }
+      map_data.ground_truth = AlignGroundTruthToMap(localised, truth, path);
+      truth_floors.clear();
+      std::fill(floors.begin(), floors.end(), 0);
+    }
     for (const FigureTarget& target : targets("experience_map.png")) {
       if (target.format == FigureFormat::kPng) {
         if (renderer == nullptr) return Status::Error(target.path + ": no PNG renderer");

@@ -34,6 +34,11 @@ inline const RunCsvColumns kLinkColumns = {{"id", "from_id", "to_id", "distance_
 inline const char* LinkKindName(bool loop_closure, bool wifi_sequence) {
   return wifi_sequence ? "wifi_sequence" : loop_closure ? "loop_closure" : "odometry";
 }
+// localisation.csv (replay --localise): one row per view frame; the errors are empty when the
+// frame is lost or the data set has no ground truth.
+inline const RunCsvColumns kLocalisationColumns = {
+    {"time_s", "experience_id", "lost", "x_m", "y_m", "theta_rad"},
+    {"true_x_m", "true_y_m", "error_m"}};
 inline const RunCsvColumns kFrameColumns = {
     {"time_s", "template_id", "new_template", "experience_id"}, {"source", "recent"}};
 

@@ -1,5 +1,6 @@
 #include "fusion/io/run_outputs.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -158,6 +159,32 @@ nlohmann::ordered_json SequenceSummary(const WifiSequenceLoopCloser& closer,
 
 }  // namespace
 
+std::vector<double> LocalisationErrors(const std::vector<LocalisationRecord>& records,
+                                       const std::vector<GroundTruthRow>& ground_truth,
+                                       std::vector<Point2>* truth) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::vector<double> errors(records.size(), nan);
+  std::vector<Point2> true_at(records.size(), {nan, nan});
+  std::vector<Point2> estimate, paired_truth;
+  for (size_t i = 0; i < records.size(); ++i) {
+    const auto gt = InterpolateGroundTruth(ground_truth, records[i].time_s);
+    if (!gt) continue;
+    true_at[i] = {gt->x_m, gt->y_m};
+    if (records[i].lost) continue;
+    estimate.push_back({records[i].x_m, records[i].y_m});
+    paired_truth.push_back(true_at[i]);
+  }
+  if (const auto a = AlignRigid2D(estimate, paired_truth)) {
+    for (size_t i = 0; i < records.size(); ++i) {
+      if (records[i].lost || std::isnan(true_at[i].x)) continue;
+      const Point2 p = Apply(*a, {records[i].x_m, records[i].y_m});
+      errors[i] = std::hypot(p.x - true_at[i].x, p.y - true_at[i].y);
+    }
+  }
+  if (truth) *truth = std::move(true_at);
+  return errors;
+}
+
 RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, const RunInfo& info) {
   const ReplayPipeline::State& state = pipeline.state();
   const Ratslam& slam = pipeline.slam();
@@ -172,7 +199,9 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
   if (!dataset.ground_truth.empty()) {
     // The experience map: every experience against the true position at its creation.
     std::vector<Point2> estimate, truth;
+    // (A localisation run's experiences were made on another data set's clock.)
     for (const Experience& e : map.experiences()) {
+      if (pipeline.localising()) break;
       if (auto gt = InterpolateGroundTruth(dataset.ground_truth, e.time_s)) {
         estimate.push_back({e.x_m, e.y_m});
         truth.push_back({gt->x_m, gt->y_m});
@@ -210,6 +239,7 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
       return k;
     };
     for (const FrameRecord& f : state.frames) {
+      if (pipeline.localising()) break;    // templates stored on another data set's clock
       if (f.is_new || f.recent) continue;  // only matches that can close a loop
       const auto now = InterpolateGroundTruth(dataset.ground_truth, f.time_s);
       const auto then = InterpolateGroundTruth(dataset.ground_truth,
@@ -277,13 +307,49 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
   j["config"] = info.config_path.empty() ? "(defaults)" : info.config_path;
   j["config_fingerprint"] = FingerprintHex(info.config_fingerprint);
   if (!info.resumed_from.empty()) j["resumed_from"] = info.resumed_from;
+  if (pipeline.localising()) {
+    const std::vector<LocalisationRecord>& records = pipeline.localisation();
+    size_t lost = 0;
+    std::vector<uint32_t> visited;
+    for (const LocalisationRecord& r : records) {
+      lost += r.lost;
+      if (r.experience_id >= 0) visited.push_back(static_cast<uint32_t>(r.experience_id));
+    }
+    std::sort(visited.begin(), visited.end());
+    visited.erase(std::unique(visited.begin(), visited.end()), visited.end());
+    s.lost_fraction =
+        records.empty() ? 1.0 : static_cast<double>(lost) / static_cast<double>(records.size());
+    nlohmann::ordered_json l;
+    l["map"] = info.localised_on;
+    l["frames"] = records.size();
+    l["lost_fraction"] = *s.lost_fraction;
+    l["lost_after_m"] = info.lost_after_m;
+    l["recognitions"] = slam.localisation_counters().recognitions;
+    l["experiences_recognised"] = visited.size();
+    l["unmapped_views"] = slam.localisation_counters().unmapped_views;
+    if (!dataset.ground_truth.empty()) {
+      s.localisation_errors_m = LocalisationErrors(records, dataset.ground_truth);
+      std::vector<double> known;
+      for (double e : s.localisation_errors_m) {
+        if (!std::isnan(e)) known.push_back(e);
+      }
+      l["error_points"] = known.size();
+      if (!known.empty()) {
+        std::nth_element(known.begin(), known.begin() + known.size() / 2, known.end());
+        s.localisation_median_error_m = known[known.size() / 2];
+        l["median_error_m"] = *s.localisation_median_error_m;
+        l["error_alignment"] = "rigid least-squares fit of the frames not lost to ground truth";
+      }
+    }
+    j["localisation"] = l;
+  }
   // A replay draws no random number outside its configuration's own seeds.
   j["run"] = RunObject(info.provenance, info.inputs, std::nullopt, info.config_fingerprint);
   if (s.map_ate_m) j["map_ate_m"] = *s.map_ate_m;
   if (s.trajectory_ate_m) j["trajectory_ate_m"] = *s.trajectory_ate_m;
   if (s.odometry_ate_m) j["odometry_ate_m"] = *s.odometry_ate_m;
   if (s.ate_points) j["ate_points"] = s.ate_points;
-  if (!dataset.ground_truth.empty()) {
+  if (!dataset.ground_truth.empty() && !pipeline.localising()) {
     j["matches"] = s.evaluated_matches;
     j["match_rate_within_m"] = RatesWithin(s.match_distances_m);
     j["floor_mistakes"] = s.floor_mistakes;
@@ -399,6 +465,26 @@ StatusOr<RunSummary> WriteRunOutputs(OutputFolder& folder, const ReplayPipeline&
   }
 
   RunSummary summary = Summarise(pipeline, dataset, info);
+  if (pipeline.localising()) {
+    std::vector<Point2> truth;
+    const std::vector<LocalisationRecord>& records = pipeline.localisation();
+    const std::vector<double> errors = LocalisationErrors(records, dataset.ground_truth, &truth);
+    std::ostringstream localisation;
+    localisation << kLocalisationColumns.Header();
+    for (size_t i = 0; i < records.size(); ++i) {
+      const LocalisationRecord& r = records[i];
+      localisation << Num(r.time_s) << ',' << r.experience_id << ',' << (r.lost ? 1 : 0) << ','
+                   << Num(r.x_m) << ',' << Num(r.y_m) << ',' << Num(r.theta_rad) << ',';
+      if (!std::isnan(truth[i].x))
+        localisation << Num(truth[i].x) << ',' << Num(truth[i].y);
+      else
+        localisation << ',';
+      localisation << ',';
+      if (!std::isnan(errors[i])) localisation << Num(errors[i]);
+      localisation << '\n';
+    }
+    files.emplace_back("localisation.csv", localisation.str());
+  }
   files.emplace_back("summary.json", summary.json);
   // All or nothing: a full disk leaves the previous run's complete set, not a mix.
   RATSLAM_RETURN_IF_ERROR(folder.Write(files));

@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 
+#include "common/geometry.h"
 #include "common/output_folder.h"
 #include "common/provenance.h"
 #include "common/status.h"
@@ -21,6 +22,8 @@ struct RunInfo {
   std::string config_path;       // as given, or empty for built-in defaults
   uint64_t config_fingerprint = 0;
   std::string resumed_from;         // map file, or empty
+  std::string localised_on;         // map file of a localisation run (replay --localise)
+  double lost_after_m = 0.0;        // its lost distance
   RunProvenance provenance;         // command line and start time, for summary.json's `run`
   std::vector<std::string> inputs;  // the data paths, as given
 };
@@ -36,12 +39,26 @@ struct RunSummary {
   // Of them, matches to a template stored in another session (multi-session runs): with a
   // session per phone, the cross-device matches.
   std::vector<double> cross_session_distances_m;
-  std::string json;  // the whole summary.json text
+  // Localisation runs: per view frame of localisation(), the error of the aligned position
+  // (NaN when lost or without ground truth); see LocalisationErrors.
+  std::vector<double> localisation_errors_m;
+  std::optional<double> localisation_median_error_m;
+  std::optional<double> lost_fraction;  // present for localisation runs only
+  std::string json;                     // the whole summary.json text
 };
 
 // The corrected pose of a trajectory record in the final map.
 void RecordPose(const ExperienceMap& map, const TrajectoryRecord& record, double* x_m, double* y_m,
                 double* theta_rad);
+
+// A localisation run's error per record: the positions of the frames not lost are rigidly aligned
+// to the ground truth at their times (least squares, as for the ATE: the frozen map's frame is
+// not the ground truth's), and each error is the aligned position's distance from the truth. NaN
+// for a lost frame, a frame outside the ground truth, or when fewer than 2 frames can be aligned.
+// `truth` (optional) gets the true position, NaN where none.
+std::vector<double> LocalisationErrors(const std::vector<LocalisationRecord>& records,
+                                       const std::vector<GroundTruthRow>& ground_truth,
+                                       std::vector<Point2>* truth = nullptr);
 
 RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, const RunInfo& info);
 

@@ -170,6 +170,7 @@ bool SyntheticOptions::IsValid(std::string* error) const {
     return fail("field_of_view_rad: must be in (0, pi)");
   }
   if (pillars < 0) return fail("pillars: must not be negative");
+  if (!(start_m >= 0.0) || start_m > 1e6) return fail("start_m: must be in [0, 1e6]");
   return true;
 }
 
@@ -177,12 +178,14 @@ StatusOr<Dataset> WriteSyntheticDataset(const SyntheticOptions& o, const std::st
   std::string error;
   if (!o.IsValid(&error)) return Status::Error("synthetic data set: " + error);
   Random world_rng(o.seed);
-  Random noise_rng(o.seed ^ 0x5DEECE66DULL);
+  Random noise_rng(o.noise_seed != 0 ? o.noise_seed : o.seed ^ 0x5DEECE66DULL);
   const LoopPath path(o.loop_length_m, o.loop_width_m, o.corner_radius_m);
   const std::vector<Pillar> pillars = MakePillars(o, path, world_rng);
 
   Dataset d;
   d.name = "synthetic-loop-seed" + std::to_string(o.seed);
+  if (o.noise_seed != 0) d.name += "-noise" + std::to_string(o.noise_seed);
+  if (o.start_m != 0.0) d.name += "-from" + std::to_string(static_cast<long long>(o.start_m)) + "m";
   const double duration_s = o.laps * path.Perimeter() / o.speed_m_per_s;
   const int frames = static_cast<int>(std::floor(duration_s * o.rate_hz)) + 1;
   std::error_code ec;
@@ -192,7 +195,7 @@ StatusOr<Dataset> WriteSyntheticDataset(const SyntheticOptions& o, const std::st
   Pose previous{};
   for (int i = 0; i < frames; ++i) {
     const double t = i / o.rate_hz;
-    const double s = t * o.speed_m_per_s;
+    const double s = o.start_m + t * o.speed_m_per_s;
     const int lap = static_cast<int>(s / path.Perimeter());
     // Blend the lateral offset smoothly between laps over the first 10 m of each lap.
     const double lap_start = lap * path.Perimeter();

@@ -16,7 +16,10 @@
 namespace ratslam {
 
 struct SyntheticOptions {
-  uint64_t seed = 1;                // everything random derives from this
+  uint64_t seed = 1;                // the world (pillars), and the noise unless noise_seed is set
+  uint64_t noise_seed = 0;          // sensor noise; 0: derived from seed. Another noise seed is
+                                    // another session in the same world and frame
+  double start_m = 0.0;             // distance along the loop where the robot starts
   int laps = 3;                     // times round the loop
   double loop_length_m = 40.0;      // outer size of the rounded rectangle along x
   double loop_width_m = 24.0;       // outer size along y
