@@ -54,7 +54,8 @@ void RecordPose(const ExperienceMap& map, const TrajectoryRecord& record, double
 // A localisation run's error per record: the positions of the frames not lost are rigidly aligned
 // to the ground truth at their times (least squares, as for the ATE: the frozen map's frame is
 // not the ground truth's), and each error is the aligned position's distance from the truth. NaN
-// for a lost frame, a frame outside the ground truth, or when fewer than 2 frames can be aligned.
+// for a lost frame, a frame outside the ground truth, or when fewer than 10 frames can be aligned
+// (a fit to fewer would fit them almost exactly, whatever they are).
 // `truth` (optional) gets the true position, NaN where none.
 std::vector<double> LocalisationErrors(const std::vector<LocalisationRecord>& records,
                                        const std::vector<GroundTruthRow>& ground_truth,

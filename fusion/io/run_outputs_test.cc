@@ -1,0 +1,52 @@
+#include "fusion/io/run_outputs.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+namespace ratslam {
+namespace {
+
+// Truth along a line at 1 m/s; the localised frames are the truth turned by 90 degrees and
+// shifted (another frame), one of them 3 m off, one lost.
+TEST(LocalisationErrorsTest, RigidFitThenDistanceAndNoFitToAHandful) {
+  std::vector<GroundTruthRow> truth;
+  for (int i = 0; i <= 20; ++i) truth.push_back({1.0 * i, 1.0 * i, 0.0, 0.0, 0});
+  std::vector<LocalisationRecord> records;
+  for (int i = 0; i < 20; ++i) {
+    LocalisationRecord r;
+    r.time_s = i + 0.5;
+    r.x_m = 5.0;  // (x, y) -> (-y, x) + (5, 7)
+    r.y_m = 7.0 + (i + 0.5);
+    r.lost = false;
+    records.push_back(r);
+  }
+  records[4].lost = true;
+  records[12].x_m += 3.0;
+  std::vector<Point2> true_at;
+  const std::vector<double> errors = LocalisationErrors(records, truth, &true_at);
+  ASSERT_EQ(errors.size(), records.size());
+  EXPECT_TRUE(std::isnan(errors[4]));
+  EXPECT_NEAR(true_at[4].x, 4.5, 1e-12);
+  // The outlier pulls the least-squares fit a little: 3 m over 19 frames moves the centroid
+  // 0.16 m and turns the line slightly, up to about 0.25 m at its ends.
+  EXPECT_NEAR(errors[12], 3.0, 0.2);
+  for (size_t i = 0; i < errors.size(); ++i) {
+    if (i != 4 && i != 12) {
+      EXPECT_LT(errors[i], 0.3) << i;
+    }
+  }
+  // Nine localised frames: a fit would match them almost exactly, so no errors at all.
+  records.resize(9);
+  records[4].lost = false;
+  for (double e : LocalisationErrors(records, truth)) EXPECT_TRUE(std::isnan(e));
+  // Outside the ground truth: no truth, no error.
+  records.resize(20, records[0]);
+  for (LocalisationRecord& r : records) r.time_s += 100.0;
+  for (double e : LocalisationErrors(records, truth, &true_at)) EXPECT_TRUE(std::isnan(e));
+  EXPECT_TRUE(std::isnan(true_at[0].x));
+}
+
+}  // namespace
+}  // namespace ratslam
