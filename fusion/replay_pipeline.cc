@@ -98,13 +98,9 @@ Status ReplayPipeline::Run(const ReplayControl& control) {
       case EventType::kWifi:
         status = HandleWifi(event);
         break;
-      case EventType::kCompass: {
-        const CompassRow& row = dataset_.compass[event.index];
-        ++state_.compass_readings_seen;
-        front_end_->OnCompass(row.time_s, row.heading_rad);
-        slam_->SetCompassHeading(front_end_->CompassHeading());
+      case EventType::kCompass:
+        FeedCompass(dataset_.compass[event.index]);
         break;
-      }
     }
     if (!status.ok()) return status;
     ++state_.next_event;
@@ -130,7 +126,10 @@ Status ReplayPipeline::Run(const ReplayControl& control) {
 }
 
 Status ReplayPipeline::HandleOdometry(const Event& event) {
-  const OdometryRow& row = dataset_.odometry[event.index];
+  return FeedOdometry(dataset_.odometry[event.index]);
+}
+
+Status ReplayPipeline::FeedOdometry(const OdometryRow& row) {
   const double dt = state_.have_odometry ? row.time_s - state_.last_odometry_time_s : 0.0;
   state_.have_odometry = true;
   state_.last_odometry_time_s = row.time_s;
@@ -170,14 +169,31 @@ Status ReplayPipeline::HandleImage(const Event& event) {
   const std::string where = "images.csv:" + std::to_string(row.line);
   StatusOr<GrayImage> image = images_->Load(dataset_.ImagePath(row));
   if (!image.ok()) return image.status().WithContext(where);
-  StatusOr<std::optional<FrameDecision>> decision = front_end_->OnImage(row.time_s, image.value());
-  if (!decision.ok()) return decision.status().WithContext(where + ": " + row.file);
+  return FeedImage(row.time_s, image.value()).WithContext(where + ": " + row.file);
+}
+
+Status ReplayPipeline::FeedImage(double time_s, const GrayImage& image) {
+  if (!front_end_->WantsImages()) {
+    ++state_.images_skipped;
+    return Status::Ok();
+  }
+  StatusOr<std::optional<FrameDecision>> decision = front_end_->OnImage(time_s, image);
+  if (!decision.ok()) return decision.status();
   return decision.value() ? Apply(*decision.value()) : Status::Ok();
 }
 
+void ReplayPipeline::FeedCompass(const CompassRow& row) {
+  ++state_.compass_readings_seen;
+  front_end_->OnCompass(row.time_s, row.heading_rad);
+  slam_->SetCompassHeading(front_end_->CompassHeading());
+}
+
 Status ReplayPipeline::HandleWifi(const Event& event) {
+  return FeedWifi(dataset_.wifi[event.index]);
+}
+
+Status ReplayPipeline::FeedWifi(const WifiScan& scan) {
   ++state_.wifi_scans_seen;
-  const WifiScan& scan = dataset_.wifi[event.index];
   StatusOr<std::optional<FrameDecision>> decision = front_end_->OnWifi(scan);
   if (!decision.ok()) return decision.status();
   if (decision.value()) RATSLAM_RETURN_IF_ERROR(Apply(*decision.value()));

@@ -116,6 +116,14 @@ class ReplayPipeline {
   // a stop is requested. On an error the state stays valid up to the last complete event.
   Status Run(const ReplayControl& control);
 
+  // One input fed directly, outside the data set's events (a live source, or Python's
+  // frame-by-frame session), through the same code the replay uses. Inputs must come in time
+  // order; the data set's own events are not consumed.
+  Status FeedOdometry(const OdometryRow& row);
+  Status FeedImage(double time_s, const GrayImage& image);
+  Status FeedWifi(const WifiScan& scan);
+  void FeedCompass(const CompassRow& row);
+
   bool finished() const { return state_.next_event >= events_.size(); }
   const Ratslam& slam() const { return *slam_; }
   const State& state() const { return state_; }

@@ -10,6 +10,7 @@ packages=(
   libopencv-dev libosmesa6-dev libtomlplusplus-dev nlohmann-json3-dev libcli11-dev
   libcairo2-dev fonts-dejavu-core
   libgtest-dev libgmock-dev googletest libbenchmark-dev
+  pybind11-dev python3-pybind11 python3-numpy python3-dev
   "$@"
 )
 

@@ -11,10 +11,6 @@
 #include "sensors/dataset/visual_odometry_source.h"
 
 namespace ratslam {
-namespace {
-
-// A map resumes only under the configuration that made it. Maps of format 3 carry it, so the
-// error names every key that differs; format 2 maps hold a fingerprint, compared as it was then.
 Status CheckSameConfiguration(const MapFile& map, const PipelineOptions& now) {
   if (!map.config.empty()) {
     StatusOr<PipelineOptions> before = ParseMapConfig(map.config, map.format_version);
@@ -36,8 +32,6 @@ Status CheckSameConfiguration(const MapFile& map, const PipelineOptions& now) {
   }
   return Status::Ok();
 }
-
-}  // namespace
 
 ReplaySession::ReplaySession(ReplaySessionOptions options, SessionEnvironment environment)
     : options_(std::move(options)), env_(environment) {

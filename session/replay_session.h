@@ -23,6 +23,7 @@
 #include "common/progress.h"
 #include "common/provenance.h"
 #include "common/status.h"
+#include "fusion/io/map_file.h"
 #include "fusion/io/run_outputs.h"
 #include "fusion/replay_pipeline.h"
 #include "sensors/dataset/dataset.h"
@@ -74,6 +75,11 @@ struct ReplayResult {
   double wall_seconds = 0.0;  // of the replay stage
   bool ok() const { return replay.ok() && outputs.ok() && save.ok(); }
 };
+
+// A map resumes (or is localised on) only under the configuration that made it. Maps of
+// format 3 and later carry it, so the error names every key that differs; format 2 maps hold a
+// fingerprint, compared as it was then.
+Status CheckSameConfiguration(const MapFile& map, const PipelineOptions& now);
 
 class ReplaySession {
  public:

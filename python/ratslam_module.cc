@@ -1,0 +1,414 @@
+// The `ratslam` Python module: configurations, replays and localisation runs on data sets, and
+// sessions stepped frame by frame with the caller's own inputs, over the same library sessions
+// and pipeline the command line uses. Results come back as a dict (the summary) and columns of
+// NumPy arrays (experiences, links, trajectory, frames, localisation). Errors raise
+// ratslam.Error with the library's message (file, line and key where it has them).
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "apps/output_guard.h"
+#include "common/geometry.h"
+#include "common/output_folder.h"
+#include "common/provenance.h"
+#include "fusion/io/config.h"
+#include "fusion/io/map_file.h"
+#include "fusion/io/run_outputs.h"
+#include "fusion/replay_pipeline.h"
+#include "session/replay_session.h"
+
+namespace py = pybind11;
+
+namespace ratslam::python {
+namespace {
+
+struct Error : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+void Check(const Status& status) {
+  if (!status.ok()) throw Error(status.message());
+}
+template <typename T>
+T Take(StatusOr<T> value) {
+  Check(value.status());
+  return std::move(value).value();
+}
+
+// A value written as TOML, for Config.set.
+std::string TomlValue(const py::handle& value) {
+  if (py::isinstance<py::bool_>(value)) return value.cast<bool>() ? "true" : "false";
+  if (py::isinstance<py::int_>(value)) return py::str(value).cast<std::string>();
+  if (py::isinstance<py::float_>(value)) {
+    const double v = value.cast<double>();
+    if (!std::isfinite(v)) throw Error("Config.set: a value must be finite");
+    return py::repr(value).cast<std::string>();
+  }
+  if (py::isinstance<py::str>(value)) return nlohmann::json(value.cast<std::string>()).dump();
+  if (py::isinstance<py::list>(value) || py::isinstance<py::tuple>(value)) {
+    std::string text = "[";
+    for (const py::handle item : value) text += (text.size() > 1 ? ", " : "") + TomlValue(item);
+    return text + "]";
+  }
+  throw Error("Config.set: values are bool, int, float, str or lists of them, not " +
+              py::str(value.get_type()).cast<std::string>());
+}
+
+class Config {
+ public:
+  Config() = default;
+  explicit Config(PipelineOptions options) : options_(std::move(options)) {}
+  static Config Load(const std::string& path) { return Config(Take(LoadConfigFile(path))); }
+  static Config FromToml(const std::string& text) {
+    return Config(Take(ParseConfig(text, "<Config.from_toml>")));
+  }
+  std::string Toml() const { return PrintConfig(options_); }
+  // `key` is "section.name" as in the TOML file; the value is checked as a file's would be.
+  void Set(const std::string& key, const py::handle& value) {
+    const size_t dot = key.find('.');
+    if (dot == std::string::npos || dot == 0 || dot + 1 == key.size()) {
+      throw Error("Config.set: key '" + key + "' must be section.name");
+    }
+    const std::string text =
+        "[" + key.substr(0, dot) + "]\n" + key.substr(dot + 1) + " = " + TomlValue(value) + "\n";
+    PipelineOptions changed = Take(ParseConfigOnto(text, "Config.set", options_));
+    std::string error;
+    if (!changed.IsValid(&error)) throw Error("Config.set: " + error);
+    options_ = std::move(changed);
+  }
+  py::object ToDict() const {
+    return py::module_::import("tomllib").attr("loads")(PrintConfig(options_, false));
+  }
+  const PipelineOptions& options() const { return options_; }
+
+ private:
+  PipelineOptions options_;
+};
+
+// One NumPy column from a field of each record.
+template <typename T, typename Record, typename Get>
+void Column(py::dict* columns, const char* name, const std::vector<Record>& rows, Get get) {
+  py::array_t<T> a(static_cast<py::ssize_t>(rows.size()));
+  T* out = a.mutable_data();
+  for (size_t i = 0; i < rows.size(); ++i) out[i] = static_cast<T>(get(rows[i]));
+  (*columns)[name] = std::move(a);
+}
+
+py::dict ExperienceColumns(const ExperienceMap& map) {
+  using E = Experience;
+  const std::vector<E>& rows = map.experiences();
+  py::dict c;
+  Column<int64_t>(&c, "id", rows, [](const E& e) { return e.id; });
+  Column<double>(&c, "x_m", rows, [](const E& e) { return e.x_m; });
+  Column<double>(&c, "y_m", rows, [](const E& e) { return e.y_m; });
+  Column<double>(&c, "theta_rad", rows, [](const E& e) { return e.theta_rad; });
+  Column<int64_t>(&c, "template_id", rows, [](const E& e) { return e.template_id; });
+  Column<double>(&c, "time_s", rows, [](const E& e) { return e.time_s; });
+  return c;
+}
+
+py::dict LinkColumns(const ExperienceMap& map) {
+  const std::vector<Link>& rows = map.links();
+  py::dict c;
+  Column<int64_t>(&c, "id", rows, [](const Link& l) { return l.id; });
+  Column<int64_t>(&c, "from_id", rows, [](const Link& l) { return l.from; });
+  Column<int64_t>(&c, "to_id", rows, [](const Link& l) { return l.to; });
+  Column<double>(&c, "distance_m", rows, [](const Link& l) { return l.distance_m; });
+  Column<double>(&c, "heading_rad", rows, [](const Link& l) { return l.heading_rad; });
+  Column<double>(&c, "facing_rad", rows, [](const Link& l) { return l.facing_rad; });
+  Column<double>(&c, "duration_s", rows, [](const Link& l) { return l.duration_s; });
+  Column<int64_t>(&c, "loop_closure", rows, [](const Link& l) { return l.loop_closure ? 1 : 0; });
+  return c;
+}
+
+// Each odometry step's pose on the final map, and raw dead reckoning.
+py::dict TrajectoryColumns(const ReplayPipeline& pipeline) {
+  using T = TrajectoryRecord;
+  const ExperienceMap& map = pipeline.slam().experience_map();
+  const std::vector<T>& rows = pipeline.state().trajectory;
+  std::vector<Pose2> poses;
+  for (const T& r : rows) {
+    Pose2 p;
+    RecordPose(map, r, &p.x_m, &p.y_m, &p.theta_rad);
+    poses.push_back(p);
+  }
+  py::dict c;
+  Column<double>(&c, "time_s", rows, [](const T& r) { return r.time_s; });
+  Column<int64_t>(&c, "experience_id", rows, [](const T& r) { return r.experience_id; });
+  Column<double>(&c, "x_m", poses, [](const Pose2& p) { return p.x_m; });
+  Column<double>(&c, "y_m", poses, [](const Pose2& p) { return p.y_m; });
+  Column<double>(&c, "theta_rad", poses, [](const Pose2& p) { return p.theta_rad; });
+  Column<double>(&c, "odometry_x_m", rows, [](const T& r) { return r.odometry_x_m; });
+  Column<double>(&c, "odometry_y_m", rows, [](const T& r) { return r.odometry_y_m; });
+  Column<double>(&c, "odometry_theta_rad", rows, [](const T& r) { return r.odometry_theta_rad; });
+  return c;
+}
+
+py::dict FrameColumns(const ReplayPipeline& pipeline) {
+  using F = FrameRecord;
+  const std::vector<F>& rows = pipeline.state().frames;
+  py::dict c;
+  Column<double>(&c, "time_s", rows, [](const F& f) { return f.time_s; });
+  Column<int64_t>(&c, "template_id", rows, [](const F& f) { return f.template_id; });
+  Column<int64_t>(&c, "new_template", rows, [](const F& f) { return f.is_new ? 1 : 0; });
+  Column<int64_t>(&c, "experience_id", rows, [](const F& f) { return f.experience_id; });
+  Column<int64_t>(&c, "recent", rows, [](const F& f) { return f.recent ? 1 : 0; });
+  return c;
+}
+
+py::dict LocalisationColumns(const ReplayPipeline& pipeline) {
+  using L = LocalisationRecord;
+  const std::vector<L>& rows = pipeline.localisation();
+  py::dict c;
+  Column<double>(&c, "time_s", rows, [](const L& r) { return r.time_s; });
+  Column<int64_t>(&c, "experience_id", rows, [](const L& r) { return r.experience_id; });
+  Column<int64_t>(&c, "lost", rows, [](const L& r) { return r.lost ? 1 : 0; });
+  Column<double>(&c, "x_m", rows, [](const L& r) { return r.x_m; });
+  Column<double>(&c, "y_m", rows, [](const L& r) { return r.y_m; });
+  Column<double>(&c, "theta_rad", rows, [](const L& r) { return r.theta_rad; });
+  return c;
+}
+
+// Everything a finished pipeline holds, as columns.
+py::dict RunColumns(const ReplayPipeline& pipeline) {
+  py::dict run;
+  run["experiences"] = ExperienceColumns(pipeline.slam().experience_map());
+  run["links"] = LinkColumns(pipeline.slam().experience_map());
+  run["trajectory"] = TrajectoryColumns(pipeline);
+  run["frames"] = FrameColumns(pipeline);
+  if (pipeline.localising()) run["localisation"] = LocalisationColumns(pipeline);
+  return run;
+}
+
+// ratslam.replay: what `ratslam replay` does, into the folder `out`, returning the summary and
+// the run as columns.
+py::dict Replay(const std::vector<std::string>& data, const std::string& out,
+                const std::optional<Config>& config, const std::string& load_map,
+                const std::string& save_map, bool localise, double lost_after_m,
+                std::optional<double> until_s, bool overwrite) {
+  if (data.empty()) throw Error("replay: give at least one data set");
+  ReplaySessionOptions options;
+  options.pipeline = config ? config->options() : PipelineOptions();
+  options.config_path = config ? "(from Python)" : "";
+  options.data = data;
+  options.load_map = load_map;
+  options.save_map = save_map;
+  options.localise = localise;
+  options.lost_after_m = lost_after_m;
+  if (until_s) options.until_s = *until_s;
+  options.provenance = {"python: ratslam.replay", UtcNowIso8601()};
+  std::vector<std::string> inputs = data;
+  if (!load_map.empty()) inputs.push_back(load_map);
+  OutputGuard guard = Take(OutputGuard::Begin(out, overwrite, inputs));
+  std::unique_ptr<DiskFolder> folder = Take(DiskFolder::Open(out));
+  SessionEnvironment environment;
+  environment.out = folder.get();
+  ReplaySession session(std::move(options), environment);
+  StatusOr<ReplayResult> result = [&] {
+    py::gil_scoped_release release;
+    return session.Run();
+  }();
+  Check(result.status());
+  (void)guard.Finish(result->ok());
+  if (!result->replay.ok()) {
+    throw Error(result->replay.message() + " (the outputs so far are in " + out + ")");
+  }
+  Check(result->outputs);
+  Check(result->save);
+  py::dict run = RunColumns(session.pipeline());
+  run["summary"] = py::module_::import("json").attr("loads")(result->summary->json);
+  return run;
+}
+
+// A session stepped with the caller's inputs: an empty data set whose pipeline is fed directly.
+class Session {
+ public:
+  explicit Session(const Config& config) : options_(config.options()) {
+    if (options_.sensors.front_end.kind == FrontEndKind::kFabmap) {
+      throw Error(
+          "Session: the FABMAP front end learns its models from a whole data set; use "
+          "ratslam.replay");
+    }
+    if (options_.visual_odometry.enabled) {
+      throw Error("Session: feed odometry yourself ([visual_odometry] enabled must be false)");
+    }
+    dataset_.name = "python-session";
+    pipeline_ = std::make_unique<ReplayPipeline>(options_, dataset_, &images_);
+  }
+
+  static std::unique_ptr<Session> Load(const std::string& path, const Config& config, bool localise,
+                                       double lost_after_m) {
+    auto session = std::make_unique<Session>(config);
+    MapFile map = Take(LoadMapFile(path));
+    Check(CheckSameConfiguration(map, session->options_).WithContext(path));
+    if (localise) {
+      Check(session->pipeline_->AdoptMap(map.state, lost_after_m).WithContext(path));
+    } else {
+      // Mapping goes on from the map, whatever data set made it.
+      ReplayPipeline::State state = map.state;
+      state.events_total = 0;
+      state.next_event = 0;
+      Check(session->pipeline_->Restore(state).WithContext(path));
+      if (!state.trajectory.empty()) session->last_time_s_ = state.trajectory.back().time_s;
+    }
+    return session;
+  }
+
+  void Odometry(double time_s, double forward_speed, double turn_rate) {
+    Advance(time_s);
+    if (!std::isfinite(forward_speed) || !std::isfinite(turn_rate)) {
+      throw Error("odometry at t=" + std::to_string(time_s) + ": speeds must be finite");
+    }
+    Check(pipeline_->FeedOdometry({time_s, forward_speed, turn_rate}));
+  }
+  void Image(double time_s, const py::array_t<uint8_t, py::array::c_style>& pixels) {
+    if (pixels.ndim() != 2 || pixels.shape(0) < 1 || pixels.shape(1) < 1) {
+      throw Error("image: expected a 2-D uint8 array (height, width) of grey levels");
+    }
+    Advance(time_s);
+    GrayImage image;
+    image.height = static_cast<int>(pixels.shape(0));
+    image.width = static_cast<int>(pixels.shape(1));
+    image.pixels.assign(pixels.data(), pixels.data() + pixels.size());
+    Check(pipeline_->FeedImage(time_s, image).WithContext("image at t=" + std::to_string(time_s)));
+  }
+  void Wifi(double time_s, const std::map<std::string, double>& readings) {
+    Advance(time_s);
+    WifiScan scan;
+    scan.time_s = time_s;
+    for (const auto& [bssid, rssi] : readings) {
+      if (bssid.empty() || !std::isfinite(rssi)) {
+        throw Error("wifi at t=" + std::to_string(time_s) +
+                    ": BSSIDs must be non-empty and RSSI finite");
+      }
+      scan.readings.push_back({bssid, rssi});
+    }
+    Check(pipeline_->FeedWifi(scan).WithContext("wifi at t=" + std::to_string(time_s)));
+  }
+  void Compass(double time_s, double heading_rad) {
+    Advance(time_s);
+    if (!std::isfinite(heading_rad)) throw Error("compass: the heading must be finite");
+    pipeline_->FeedCompass({time_s, heading_rad});
+  }
+
+  void SaveMap(const std::string& path) const {
+    MapFile map;
+    map.config_fingerprint = ConfigFingerprint(options_);
+    map.dataset_name = dataset_.name;
+    map.config = PrintConfig(options_, false);
+    map.state = pipeline_->Snapshot();
+    Check(SaveMapFile(map, path));
+  }
+
+  py::dict Summary() const {
+    const Ratslam& slam = pipeline_->slam();
+    py::dict d;
+    d["frames"] = pipeline_->state().frames.size();
+    d["templates"] = slam.local_view().size();
+    d["experiences"] = slam.experience_map().num_experiences();
+    d["links"] = slam.experience_map().num_links();
+    d["loop_closures"] = slam.counters().loop_closures;
+    d["view_injections"] = slam.counters().injections;
+    d["odometry_steps"] = pipeline_->state().trajectory.size();
+    const auto current = slam.experience_map().current();
+    d["current_experience"] = current ? py::object(py::int_(*current)) : py::object(py::none());
+    if (pipeline_->localising()) {
+      d["recognitions"] = slam.localisation_counters().recognitions;
+      d["unmapped_views"] = slam.localisation_counters().unmapped_views;
+    }
+    return d;
+  }
+  py::object CurrentExperience() const {
+    const auto current = pipeline_->slam().experience_map().current();
+    return current ? py::object(py::int_(*current)) : py::object(py::none());
+  }
+  py::tuple Pose() const {
+    double x, y, theta;
+    pipeline_->slam().experience_map().CurrentPose(&x, &y, &theta);
+    return py::make_tuple(x, y, theta);
+  }
+  const ReplayPipeline& pipeline() const { return *pipeline_; }
+
+ private:
+  void Advance(double time_s) {
+    if (!std::isfinite(time_s)) throw Error("times must be finite");
+    if (last_time_s_ && time_s < *last_time_s_) {
+      throw Error("time goes backwards: " + std::to_string(time_s) + " s after " +
+                  std::to_string(*last_time_s_) + " s");
+    }
+    last_time_s_ = time_s;
+  }
+
+  PipelineOptions options_;
+  Dataset dataset_;
+  FileImageLoader images_;
+  std::unique_ptr<ReplayPipeline> pipeline_;
+  std::optional<double> last_time_s_;
+};
+
+}  // namespace
+}  // namespace ratslam::python
+
+PYBIND11_MODULE(ratslam, m) {
+  using namespace ratslam::python;
+  m.doc() =
+      "RatSLAM: replays, localisation on saved maps and frame-by-frame sessions (see the README's "
+      "Python section).";
+  py::register_exception<Error>(m, "Error", PyExc_RuntimeError);
+
+  py::class_<Config>(m, "Config", "A pipeline configuration (the TOML of `ratslam print-config`).")
+      .def(py::init<>(), "The built-in defaults.")
+      .def_static("load", &Config::Load, py::arg("path"), "Reads a TOML configuration file.")
+      .def_static("from_toml", &Config::FromToml, py::arg("text"))
+      .def("toml", &Config::Toml, "The resolved configuration as TOML, with comments.")
+      .def("set", &Config::Set, py::arg("key"), py::arg("value"),
+           "Sets 'section.name' to a value, checked as a configuration file's would be.")
+      .def("to_dict", &Config::ToDict, "The configuration as nested dicts.");
+
+  m.def("replay", &Replay, py::arg("data"), py::arg("out"), py::arg("config") = std::nullopt,
+        py::arg("load_map") = "", py::arg("save_map") = "", py::arg("localise") = false,
+        py::arg("lost_after_m") = 5.0, py::arg("until_s") = std::nullopt,
+        py::arg("overwrite") = false,
+        "Replays data sets (a list of paths: one multi-session run) into folder `out`, as "
+        "`ratslam replay` does. Returns {'summary': dict (summary.json), 'experiences', 'links', "
+        "'trajectory', 'frames' and, when localising, 'localisation': dicts of NumPy arrays}.");
+
+  py::class_<Session>(m, "Session",
+                      "A RatSLAM session fed frame by frame: odometry, grey images, Wi-Fi scans "
+                      "and compass headings, in time order.")
+      .def(py::init<const Config&>(), py::arg("config") = Config())
+      .def_static("load", &Session::Load, py::arg("path"), py::arg("config") = Config(),
+                  py::arg("localise") = false, py::arg("lost_after_m") = 5.0,
+                  "Continues from a saved map (any run's, made under the same configuration); "
+                  "with localise=True the map is frozen and only localised on.")
+      .def("odometry", &Session::Odometry, py::arg("time_s"), py::arg("forward_speed_m_per_s"),
+           py::arg("turn_rate_rad_per_s"),
+           "Speeds held since the previous odometry input (as a data set's odometry.csv).")
+      .def("image", &Session::Image, py::arg("time_s"), py::arg("pixels"),
+           "A grey image, uint8 array (height, width).")
+      .def("wifi", &Session::Wifi, py::arg("time_s"), py::arg("readings"),
+           "A Wi-Fi scan: {bssid: rssi_dbm}.")
+      .def("compass", &Session::Compass, py::arg("time_s"), py::arg("heading_rad"))
+      .def("save_map", &Session::SaveMap, py::arg("path"))
+      .def("summary", &Session::Summary)
+      .def_property_readonly("current_experience", &Session::CurrentExperience)
+      .def_property_readonly("pose", &Session::Pose,
+                             "(x_m, y_m, theta_rad): the current experience plus dead reckoning.")
+      .def("experiences",
+           [](const Session& s) { return ExperienceColumns(s.pipeline().slam().experience_map()); })
+      .def("links",
+           [](const Session& s) { return LinkColumns(s.pipeline().slam().experience_map()); })
+      .def("trajectory", [](const Session& s) { return TrajectoryColumns(s.pipeline()); })
+      .def("frames", [](const Session& s) { return FrameColumns(s.pipeline()); })
+      .def("localisation", [](const Session& s) { return LocalisationColumns(s.pipeline()); });
+}

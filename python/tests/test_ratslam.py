@@ -1,0 +1,192 @@
+"""Tests of the ratslam Python module, run by ctest with Debian's /usr/bin/python3.
+
+The oracle for replays and sessions is the `ratslam` program itself: a replay from Python and a
+session fed the same data set frame by frame must give exactly the command line's experiences.
+"""
+import csv
+import json
+import os
+import shutil
+import struct
+import subprocess
+import tempfile
+import unittest
+import zlib
+
+import numpy as np
+
+import ratslam
+
+SOURCE = os.environ["RATSLAM_SOURCE_DIR"]
+BINARY = os.environ["RATSLAM_BINARY"]
+SYNTHETIC_CONFIG = os.path.join(SOURCE, "configs", "synthetic.toml")
+
+
+def read_grey_png(path):
+    """A minimal decoder for the 8-bit grey, non-interlaced PNGs the synthesizer writes
+    (no OpenCV for Python in the dependencies)."""
+    with open(path, "rb") as f:
+        data = f.read()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n", path
+    pos, idat = 8, b""
+    while pos < len(data):
+        length, kind = struct.unpack(">I4s", data[pos:pos + 8])
+        body = data[pos + 8:pos + 8 + length]
+        if kind == b"IHDR":
+            width, height, depth, colour, _, _, interlace = struct.unpack(">IIBBBBB", body)
+            assert (depth, colour, interlace) == (8, 0, 0), path
+        elif kind == b"IDAT":
+            idat += body
+        pos += 12 + length
+    raw = zlib.decompress(idat)
+    rows = np.zeros((height, width), dtype=np.uint8)
+    previous = np.zeros(width, dtype=np.int32)
+    stride = width + 1
+    for y in range(height):
+        kind = raw[y * stride]
+        line = np.frombuffer(raw, dtype=np.uint8, count=width, offset=y * stride + 1).astype(np.int32)
+        if kind == 0:
+            out = line
+        elif kind == 1:  # Sub: what OpenCV writes for these images
+            out = np.cumsum(line) & 0xFF
+        elif kind == 2:  # Up
+            out = (line + previous) & 0xFF
+        else:
+            raise ValueError(f"{path}: PNG filter {kind} not supported by this test decoder")
+        rows[y] = out
+        previous = out
+    return rows
+
+
+def read_csv(path):
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+class RatslamModuleTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.root = tempfile.mkdtemp(prefix="ratslam_python_")
+        cls.data = os.path.join(cls.root, "data")
+        subprocess.run([BINARY, "synthesize", "--out", cls.data, "--laps", "2"], check=True,
+                       capture_output=True)
+        cls.cli_run = os.path.join(cls.root, "cli_run")
+        subprocess.run([BINARY, "replay", "--quiet", "--data", cls.data, "--out", cls.cli_run,
+                        "--config", SYNTHETIC_CONFIG], check=True)
+
+    @classmethod
+    def tearDownClass(cls):
+        shutil.rmtree(cls.root)
+
+    def assertColumnsMatchCsv(self, columns, rows, names):
+        self.assertEqual(len(columns[names[0]]), len(rows))
+        for name in names:
+            expected = np.array([float(r[name]) for r in rows])
+            np.testing.assert_array_equal(columns[name].astype(float), expected, err_msg=name)
+
+    def test_config_defaults_set_and_errors(self):
+        config = ratslam.Config()
+        self.assertIn("[pose_cells]", config.toml())
+        config.set("local_view.decay_per_match", 0.25)
+        self.assertEqual(config.to_dict()["local_view"]["decay_per_match"], 0.25)
+        config.set("front_end.kind", "fused")
+        self.assertEqual(config.to_dict()["front_end"]["kind"], "fused")
+        with self.assertRaisesRegex(ratslam.Error, "decay_per_macth"):
+            config.set("local_view.decay_per_macth", 1.0)
+        with self.assertRaisesRegex(ratslam.Error, "dim_xy_cells"):
+            config.set("pose_cells.dim_xy_cells", -3)
+        with self.assertRaisesRegex(ratslam.Error, "section.name"):
+            config.set("dim_xy_cells", 3)
+        # A rejected value leaves the configuration as it was.
+        self.assertEqual(config.to_dict()["local_view"]["decay_per_match"], 0.25)
+        loaded = ratslam.Config.load(SYNTHETIC_CONFIG)
+        self.assertEqual(ratslam.Config.from_toml(loaded.toml()).toml(), loaded.toml())
+        with self.assertRaisesRegex(ratslam.Error, "no-such.toml"):
+            ratslam.Config.load(os.path.join(self.root, "no-such.toml"))
+
+    def test_replay_equals_the_command_line(self):
+        out = os.path.join(self.root, "py_run")
+        run = ratslam.replay([self.data], out, config=ratslam.Config.load(SYNTHETIC_CONFIG))
+        with open(os.path.join(out, "summary.json")) as f:
+            on_disk = json.load(f)
+        self.assertEqual(run["summary"]["experiences"], on_disk["experiences"])
+        self.assertGreater(run["summary"]["loop_closures"], 0)
+        with open(os.path.join(self.cli_run, "experiences.csv")) as a, \
+                open(os.path.join(out, "experiences.csv")) as b:
+            self.assertEqual(a.read(), b.read())
+        self.assertColumnsMatchCsv(run["experiences"],
+                                   read_csv(os.path.join(self.cli_run, "experiences.csv")),
+                                   ["id", "x_m", "y_m", "theta_rad", "template_id", "time_s"])
+        self.assertColumnsMatchCsv(run["links"], read_csv(os.path.join(self.cli_run, "links.csv")),
+                                   ["id", "from_id", "to_id", "distance_m", "loop_closure"])
+        self.assertEqual(len(run["trajectory"]["time_s"]), on_disk["odometry_steps"])
+        # An earlier run's folder is refused without overwrite, as on the command line.
+        with self.assertRaisesRegex(ratslam.Error, "overwrite"):
+            ratslam.replay([self.data], out, config=ratslam.Config.load(SYNTHETIC_CONFIG))
+        with self.assertRaisesRegex(ratslam.Error, "no-such-data"):
+            ratslam.replay([os.path.join(self.root, "no-such-data")], os.path.join(self.root, "x"))
+
+    def test_session_fed_frame_by_frame_equals_the_replay(self):
+        config = ratslam.Config.load(SYNTHETIC_CONFIG)
+        session = ratslam.Session(config)
+        odometry = read_csv(os.path.join(self.data, "odometry.csv"))
+        images = read_csv(os.path.join(self.data, "images.csv"))
+        # The replay's order: at equal times the image comes before the odometry.
+        events = [(float(r["time_s"]), 0, r) for r in images] + \
+                 [(float(r["time_s"]), 1, r) for r in odometry]
+        events.sort(key=lambda e: (e[0], e[1]))
+        half = len(events) // 2
+        for i, (t, kind, row) in enumerate(events):
+            if i == half:
+                # Save half way and go on in a new session loaded from the map.
+                path = os.path.join(self.root, "half.map")
+                session.save_map(path)
+                session = ratslam.Session.load(path, config)
+            if kind == 0:
+                session.image(t, read_grey_png(os.path.join(self.data, "images", row["file"])))
+            else:
+                session.odometry(t, float(row["forward_speed_m_per_s"]),
+                                 float(row["turn_rate_rad_per_s"]))
+        self.assertColumnsMatchCsv(session.experiences(),
+                                   read_csv(os.path.join(self.cli_run, "experiences.csv")),
+                                   ["id", "x_m", "y_m", "theta_rad", "template_id", "time_s"])
+        summary = session.summary()
+        self.assertGreater(summary["loop_closures"], 0)
+        self.assertEqual(session.current_experience, summary["current_experience"])
+
+        # Localisation on the finished map: the map does not grow and places are recognised.
+        final = os.path.join(self.root, "final.map")
+        session.save_map(final)
+        localising = ratslam.Session.load(final, config, localise=True)
+        experiences = summary["experiences"]
+        for t, kind, row in events[:400]:
+            if kind == 0:
+                localising.image(t, read_grey_png(os.path.join(self.data, "images", row["file"])))
+            else:
+                localising.odometry(t, float(row["forward_speed_m_per_s"]),
+                                    float(row["turn_rate_rad_per_s"]))
+        self.assertEqual(localising.summary()["experiences"], experiences)
+        self.assertGreater(localising.summary()["recognitions"], 0)
+        lost = localising.localisation()["lost"]
+        self.assertEqual(len(lost), 200)
+        self.assertLess(lost.mean(), 0.5)
+
+    def test_session_refuses_bad_input(self):
+        session = ratslam.Session(ratslam.Config.load(SYNTHETIC_CONFIG))
+        session.odometry(1.0, 0.5, 0.0)
+        with self.assertRaisesRegex(ratslam.Error, "time goes backwards"):
+            session.odometry(0.5, 0.5, 0.0)
+        with self.assertRaisesRegex(ratslam.Error, "2-D uint8"):
+            session.image(2.0, np.zeros((4, 4, 3), dtype=np.uint8))
+        with self.assertRaisesRegex(ratslam.Error, "finite"):
+            session.odometry(3.0, float("nan"), 0.0)
+        with self.assertRaisesRegex(ratslam.Error, "finite"):
+            session.wifi(4.0, {"aa:bb": float("inf")})
+        fabmap = ratslam.Config()
+        fabmap.set("front_end.kind", "fabmap")
+        with self.assertRaisesRegex(ratslam.Error, "FABMAP"):
+            ratslam.Session(fabmap)
+
+
+if __name__ == "__main__":
+    unittest.main()
