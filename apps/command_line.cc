@@ -138,11 +138,13 @@ const std::vector<CommandSpec>& Commands() {
         WidthMm(), kLenient, kQuiet, kJson},
        {}},
       {"import",
-       "convert data sets (phone logs, ...) to the replay format",
+       "convert data sets (ROS bags, phone logs, ...) to the replay format",
        "Converts data sets to the replay format in folder F (one multi-session data set when "
-       "--data is repeated).",
+       "--data is repeated), images included: a bag's images are stored as it holds them "
+       "(JPEG stays JPEG; raw images become grey PNG). A bag's topics come from [bag] in the "
+       "configuration.",
        {Text("--data", "D", "data set to convert; repeat to join sessions", true, true),
-        Text("--out", "F", "output folder", true), kOverwrite, kConfig, kLenient},
+        Text("--out", "F", "output folder", true), kOverwrite, kConfig, kLenient, kQuiet},
        {}},
       {"demo",
        "simulate the built-in day_night world and replay it",
@@ -173,7 +175,10 @@ const std::vector<CommandSpec>& Commands() {
               "seed of the sensor noise alone (default: from --seed): another session of the "
               "same world",
               1, kSeedMax),
-        Number("--start-m", "M", "start M metres along the loop (default 0)")},
+        Number("--start-m", "M", "start M metres along the loop (default 0)"),
+        Text("--bag", "F",
+             "also write the loop as a ROS 1 bag F (/synthetic/camera/image/compressed, "
+             "/synthetic/odom, /synthetic/ground_truth)")},
        {}},
       {"render", "images from a run folder, a saved map, a data set or a Wi-Fi map", "", {}, {}},
       {"render experience-map",

@@ -115,7 +115,7 @@ TEST(CommandLineTest, UsageErrorsSayWhatIsWrong) {
       {"render experience-map --run r --size 32x32", "--size: expected WIDTHxHEIGHT"},
       {"render experience-map --run r --color sesion", "(did you mean 'session'?)"},
       {"print-config --render", "ratslam print-config: unknown option '--render'"},
-      {"import --data d --out o --quiet", "unknown option '--quiet'"},
+      {"print-config --quiet", "unknown option '--quiet'"},
       {"replay --dta x --out y", "unknown option '--dta' (did you mean '--data'?)"},
       {"replay --data x --out y --outt z", "(did you mean '--out'?)"},
       {"replya --data x", "unknown command 'replya' (did you mean 'replay'?)"},

@@ -37,6 +37,7 @@
 #include "sensors/dataset/dataset.h"
 #include "sensors/dataset/dataset_loader.h"
 #include "sensors/dataset/image_loader.h"
+#include "sensors/dataset/rosbag.h"
 #include "sensors/dataset/synthetic_dataset.h"
 #include "sensors/dataset/visual_odometry_source.h"
 #include "session/replay_session.h"
@@ -272,7 +273,8 @@ int Replay(const Arguments& parsed) {
   return RunReplay(request);
 }
 
-int Synthesize(const SyntheticOptions& options, const std::string& folder) {
+int Synthesize(const SyntheticOptions& options, const std::string& folder,
+               const std::string& bag_path) {
   StatusOr<Dataset> d = WriteSyntheticDataset(options, folder);
   if (!d.ok()) {
     std::cerr << MessagePrefix() << d.status().message() << "\n";
@@ -280,6 +282,21 @@ int Synthesize(const SyntheticOptions& options, const std::string& folder) {
   }
   std::cerr << MessagePrefix() << "wrote " << d->images.size() << " frames of '" << d->name
             << "' to " << folder << "\n";
+  if (!bag_path.empty()) {
+    // OpenRatSLAM's topic names under the root "synthetic" (what topic_root=synthetic implies).
+    const BagTopics topics{"/synthetic/camera/image/compressed", "/synthetic/odom",
+                           "/synthetic/ground_truth"};
+    StatusOr<Dataset> written = ReadDataset(folder);
+    FileImageLoader images;
+    Status s = written.ok() ? WriteRosbag(*written, &images, topics, bag_path) : written.status();
+    if (!s.ok()) {
+      std::cerr << MessagePrefix() << s.message() << "\n";
+      return kExitError;
+    }
+    std::cerr << MessagePrefix() << "wrote the same frames as a ROS bag to " << bag_path << " ("
+              << topics.image_topic << ", " << topics.odometry_topic << ", "
+              << topics.ground_truth_topic << ")\n";
+  }
   return kExitOk;
 }
 
@@ -358,24 +375,30 @@ int ImportCommand(const Arguments& parsed) {
   PhoneLogOptions phone;
   phone.lenient = args->lenient;
   phone.pdr = options->pdr;
-  StatusOr<Dataset> d = LoadSessions(args->all.at("--data"), phone);
+  StatusOr<Dataset> d = LoadSessions(args->all.at("--data"), phone, 1.0, options->bag);
   if (!d.ok()) {
     std::cerr << MessagePrefix() << d.status().message() << "\n";
     return kExitError;
   }
-  if (!d->images.empty()) {
-    std::cerr << MessagePrefix() << "import copies no images; convert image data sets by hand\n";
+  const std::string out = args->values.at("--out");
+  Status copied = CopyImagesInto(&d.value(), out, [&](size_t done, size_t total) {
+    if (!args->quiet) {
+      std::cerr << MessagePrefix() << "images " << done << " / " << total << "\n";
+    }
+  });
+  if (!copied.ok()) {
+    std::cerr << MessagePrefix() << copied.message() << "\n";
     return kExitError;
   }
-  Status written = WriteDataset(d.value(), args->values.at("--out"));
+  Status written = WriteDataset(d.value(), out);
   if (!written.ok()) {
     std::cerr << MessagePrefix() << written.message() << "\n";
     return kExitError;
   }
   std::cerr << MessagePrefix() << "wrote '" << d->name << "' (" << d->odometry.size()
-            << " odometry rows, " << d->wifi.size() << " Wi-Fi scans, " << d->compass.size()
-            << " compass rows, " << d->ground_truth.size() << " ground-truth rows) to "
-            << args->values.at("--out") << "\n";
+            << " odometry rows, " << d->images.size() << " images, " << d->wifi.size()
+            << " Wi-Fi scans, " << d->compass.size() << " compass rows, " << d->ground_truth.size()
+            << " ground-truth rows) to " << args->values.at("--out") << "\n";
   return kExitOk;
 }
 
@@ -402,7 +425,7 @@ int SynthesizeCommand(const Arguments& parsed) {
     if (!start) return kExitUsage;
     options.start_m = *start;
   }
-  return Synthesize(options, args->values.at("--out"));
+  return Synthesize(options, args->values.at("--out"), args->Value("--bag"));
 }
 
 }  // namespace

@@ -209,7 +209,7 @@ int RenderSimilarity(const Arguments& args) {
   }
   PhoneLogOptions phone;
   phone.pdr = options->pdr;
-  StatusOr<Dataset> dataset = LoadSessions(args.all.at("--data"), phone);
+  StatusOr<Dataset> dataset = LoadSessions(args.all.at("--data"), phone, 1.0, options->bag);
   if (!dataset.ok()) return Fail(dataset.status().message());
   const std::string sensor = args.values.count("--sensor") ? args.values.at("--sensor") : "camera";
   SimilarityImageOptions image_options;

@@ -22,6 +22,7 @@
 #include "ratslam/records.h"
 #include "sensors/dataset/dataset.h"
 #include "sensors/dataset/image_loader.h"
+#include "sensors/dataset/rosbag.h"
 #include "sensors/pedestrian_dead_reckoning.h"
 #include "sensors/visual_odometry.h"
 
@@ -35,6 +36,7 @@ struct PipelineOptions {
   RatslamOptions ratslam;
   WifiSequenceOptions wifi_sequence;     // Wi-Fi sequence loop closure beside the front end
   fabmap::EvaluationOptions evaluation;  // `ratslam evaluate` only: how map and queries split
+  BagTopics bag;  // which topics of a ROS bag make the data set (not part of a map's identity)
 
   bool IsValid(std::string* error) const;
 
@@ -64,6 +66,7 @@ struct PipelineOptions {
     v("wifi_words", sensors.fabmap.localiser.wifi_words);
     v("virtual_wifi", sensors.fabmap.localiser.virtual_wifi);
     v("evaluation", evaluation);
+    v("bag", bag);
   }
 };
 

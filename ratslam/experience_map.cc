@@ -50,7 +50,7 @@ void ExperienceMap::Integrate(double forward_m, double rotation_rad) {
 }
 
 void ExperienceMap::CurrentPose(double* x_m, double* y_m, double* theta_rad) const {
-  Pose2 base;
+  Pose2 base{0.0, 0.0, options_.initial_heading_rad};
   if (state_.current) {
     const Experience& e = state_.experiences[*state_.current];
     base = {e.x_m, e.y_m, e.theta_rad};

@@ -52,6 +52,9 @@ struct ExperienceMapOptions {
   double link_sigma_m = 0.05;
   double link_sigma_m_per_m = 0.05;
   double link_sigma_rad = 0.05;
+  // Heading of the map's frame at the start: the first experience faces this way (OpenRatSLAM's
+  // exp_initial_em_deg, 90 degrees by its default). It rotates the whole map and nothing else.
+  double initial_heading_rad = 0.0;
 
   bool IsValid(std::string* error) const;
 
@@ -82,6 +85,9 @@ struct ExperienceMapOptions {
     v("link_sigma_m_per_m", link_sigma_m_per_m,
       "translation noise of a link per metre of its length", schema::Unit("m/m").NonNegative());
     v("link_sigma_rad", link_sigma_rad, "rotation noise of a link", schema::Unit("rad").Positive());
+    v("initial_heading_rad", initial_heading_rad,
+      "heading of the start, so of the first experience (OpenRatSLAM's exp_initial_em_deg)",
+      schema::Unit("rad").Within(-2 * M_PI, 2 * M_PI));
   }
   // The link noise model these options describe.
   LinkNoise Noise() const { return {link_sigma_m, link_sigma_m_per_m, link_sigma_rad}; }

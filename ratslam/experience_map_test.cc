@@ -36,6 +36,37 @@ TEST(ExperienceMapTest, LinksCarryOdometryInTheSourceFrame) {
   EXPECT_NEAR(map.experience(1).y_m, 2.0, 1e-12);
 }
 
+// OpenRatSLAM's exp_initial_em_deg: the start faces the initial heading, so 2 m of travel before
+// the first experience puts it 2 m along that heading, and the rest of the map turns with it.
+TEST(ExperienceMapTest, InitialHeadingRotatesTheWholeMapAndNothingElse) {
+  auto drive = [](double initial) {
+    ExperienceMapOptions o;
+    o.initial_heading_rad = initial;
+    ExperienceMap map(o);
+    map.Integrate(2.0, 0.0);
+    map.CreateExperience(0, {}, 0.0);
+    map.Integrate(0.0, kPi / 2);
+    map.Integrate(3.0, 0.0);
+    map.CreateExperience(1, {}, 1.0);
+    return map;
+  };
+  const ExperienceMap east = drive(0.0), north = drive(kPi / 2);
+  EXPECT_NEAR(north.experience(0).x_m, 0.0, 1e-12);
+  EXPECT_NEAR(north.experience(0).y_m, 2.0, 1e-12);
+  EXPECT_NEAR(north.experience(0).theta_rad, kPi / 2, 1e-12);
+  EXPECT_NEAR(north.experience(1).x_m, -3.0, 1e-12);  // a left turn from north faces west
+  EXPECT_NEAR(north.experience(1).y_m, 2.0, 1e-12);
+  for (uint32_t i = 0; i < 2; ++i) {  // each position is the unrotated one turned by 90 degrees
+    EXPECT_NEAR(north.experience(i).x_m, -east.experience(i).y_m, 1e-12);
+    EXPECT_NEAR(north.experience(i).y_m, east.experience(i).x_m, 1e-12);
+  }
+  const Link& a = east.links()[0];
+  const Link& b = north.links()[0];  // links are relative: unchanged
+  EXPECT_NEAR(a.distance_m, b.distance_m, 1e-12);
+  EXPECT_NEAR(a.heading_rad, b.heading_rad, 1e-12);
+  EXPECT_NEAR(a.facing_rad, b.facing_rad, 1e-12);
+}
+
 // Drives a square of side 10 m with a heading bias, then closes the loop back to experience 0.
 ExperienceMap DriveBiasedSquare(const ExperienceMapOptions& options) {
   ExperienceMap map(options);

@@ -11,6 +11,7 @@ packages=(
   libcairo2-dev fonts-dejavu-core
   libgtest-dev libgmock-dev googletest libbenchmark-dev
   pybind11-dev python3-pybind11 python3-numpy python3-dev
+  librosbag-storage-dev libsensor-msgs-dev libnav-msgs-dev
   "$@"
 )
 

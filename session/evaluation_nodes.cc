@@ -149,7 +149,8 @@ bool HasManifest(const std::string& path) {
 StatusOr<std::vector<EvaluationNode>> LoadEvaluationNodes(const std::string& path, bool as_map,
                                                           bool want_images,
                                                           const EvaluationOptions& options,
-                                                          const PhoneLogOptions& phone) {
+                                                          const PhoneLogOptions& phone,
+                                                          const BagTopics& bag) {
   std::string error;
   if (!options.IsValid(&error)) return Status::Error("[evaluation] " + error);
   std::error_code ec;
@@ -173,7 +174,7 @@ StatusOr<std::vector<EvaluationNode>> LoadEvaluationNodes(const std::string& pat
     if (!d.ok()) return d.status();
     return DatasetNodes(*d, as_map, want_images, options);
   }
-  auto d = LoadDataset(path, phone);
+  auto d = LoadDataset(path, phone, bag);
   if (!d.ok()) return d.status();
   return DatasetNodes(*d, as_map, want_images, options);
 }

@@ -10,6 +10,7 @@
 #include "common/status.h"
 #include "fusion/fabmap/evaluation.h"
 #include "sensors/dataset/ipin_log.h"
+#include "sensors/dataset/rosbag.h"
 
 namespace ratslam {
 
@@ -19,7 +20,8 @@ namespace ratslam {
 // are read with `phone` (dead reckoning, leniency); UJIIndoorLoc with its leniency.
 StatusOr<std::vector<fabmap::EvaluationNode>> LoadEvaluationNodes(
     const std::string& path, bool as_map, bool want_images,
-    const fabmap::EvaluationOptions& options, const PhoneLogOptions& phone);
+    const fabmap::EvaluationOptions& options, const PhoneLogOptions& phone,
+    const BagTopics& bag = {});
 
 }  // namespace ratslam
 

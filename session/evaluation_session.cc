@@ -77,7 +77,8 @@ Status EvaluationSession::Load() {
   phone.lenient = options_.lenient;
   phone.pdr = options_.pipeline.pdr;
   const fabmap::EvaluationOptions& evaluation = options_.pipeline.evaluation;
-  auto map_nodes = LoadEvaluationNodes(options_.map_path, true, vision, evaluation, phone);
+  auto map_nodes = LoadEvaluationNodes(options_.map_path, true, vision, evaluation, phone,
+                                       options_.pipeline.bag);
   if (!map_nodes.ok()) return map_nodes.status();
   std::error_code ec;
   if (std::filesystem::equivalent(options_.map_path, options_.query_path, ec)) {
@@ -87,7 +88,8 @@ Status EvaluationSession::Load() {
     result_.queries = std::move(split.queries);
   } else {
     result_.map = *std::move(map_nodes);
-    auto q = LoadEvaluationNodes(options_.query_path, false, vision, evaluation, phone);
+    auto q = LoadEvaluationNodes(options_.query_path, false, vision, evaluation, phone,
+                                 options_.pipeline.bag);
     if (!q.ok()) return q.status();
     result_.queries = *std::move(q);
   }

@@ -20,6 +20,7 @@
 #include "render/image.h"
 #include "render/renderer.h"
 #include "sensors/dataset/csv.h"
+#include "sensors/dataset/rosbag.h"
 #include "sensors/dataset/synthetic_dataset.h"
 #include "tests/documented_keys.h"
 #include "tests/run_ratslam.h"
@@ -297,6 +298,60 @@ TEST_F(ReplayEndToEndTest, DataWithoutOdometryReplaysOnVisualOdometry) {
   EXPECT_NE(off.err.find("has no odometry stream: set [visual_odometry] enabled = true"),
             std::string::npos)
       << off.err;
+}
+
+// The synthetic loop as a ROS bag (OpenRatSLAM's topic names) replays to the same map as the
+// folder it was written from, with ground truth from the bag; `import` turns the bag back into a
+// folder that replays to the same map again.
+TEST_F(ReplayEndToEndTest, BagReplayGivesTheFolderReplaysMap) {
+  if (!RosbagSupported()) GTEST_SKIP() << "built without librosbag-storage-dev";
+  const fs::path dir = root_ / "bag";
+  const Result made = RunRatslam(
+      "synthesize --out " + (dir / "data").string() + " --bag " + (dir / "loop.bag").string(),
+      root_);
+  ASSERT_EQ(made.exit_code, 0) << made.err;
+  std::ofstream(dir / "bag.toml") << Slurp(config_)
+                                  << "\n[bag]\nimage_topic = \"synthetic/camera/image\"\n"
+                                     "ground_truth_topic = \"/synthetic/ground_truth\"\n";
+  auto replay = [&](const fs::path& data, const std::string& out) {
+    return RunRatslam("replay --quiet --config " + (dir / "bag.toml").string() + " --data " +
+                          data.string() + " --out " + (dir / out).string(),
+                      root_);
+  };
+  const Result folder = replay(dir / "data", "from_folder");
+  ASSERT_EQ(folder.exit_code, 0) << folder.err;
+  const Result bag = replay(dir / "loop.bag", "from_bag");
+  ASSERT_EQ(bag.exit_code, 0) << bag.err;
+  for (const char* name : {"experiences.csv", "links.csv", "frames.csv", "trajectory_tum.txt"}) {
+    EXPECT_EQ(Slurp(dir / "from_folder" / name), Slurp(dir / "from_bag" / name)) << name;
+  }
+  const nlohmann::json a = Summary(dir / "from_folder"), b = Summary(dir / "from_bag");
+  ASSERT_TRUE(b.contains("map_ate_m")) << "the bag's ground truth was not read";
+  EXPECT_NEAR(b["map_ate_m"].get<double>(), a["map_ate_m"].get<double>(), 1e-9);
+  EXPECT_GT(b["loop_closures"].get<int>(), 0);
+  const Result imported =
+      RunRatslam("import --quiet --config " + (dir / "bag.toml").string() + " --data " +
+                     (dir / "loop.bag").string() + " --out " + (dir / "imported").string(),
+                 root_);
+  ASSERT_EQ(imported.exit_code, 0) << imported.err;
+  EXPECT_TRUE(fs::exists(dir / "imported" / "images" / "000000.png"));
+  const Result again = replay(dir / "imported", "from_import");
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  EXPECT_EQ(Slurp(dir / "from_folder" / "experiences.csv"),
+            Slurp(dir / "from_import" / "experiences.csv"));
+  // A map made from the folder localises the bag: the topics are not part of the map.
+  const Result saved = RunRatslam(
+      "replay --quiet --config " + config_ + " --data " + (dir / "data").string() + " --out " +
+          (dir / "map_run").string() + " --save-map " + (dir / "loop.map").string(),
+      root_);
+  ASSERT_EQ(saved.exit_code, 0) << saved.err;
+  const Result localised =
+      RunRatslam("replay --quiet --config " + (dir / "bag.toml").string() + " --data " +
+                     (dir / "loop.bag").string() + " --out " + (dir / "localised").string() +
+                     " --load-map " + (dir / "loop.map").string() + " --localise",
+                 root_);
+  ASSERT_EQ(localised.exit_code, 0) << localised.err;
+  EXPECT_LT(Summary(dir / "localised")["localisation"]["lost_fraction"].get<double>(), 0.1);
 }
 
 TEST_F(ReplayEndToEndTest, SameInputSameOutputBitForBit) {

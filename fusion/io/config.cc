@@ -260,6 +260,7 @@ constexpr AddedKey kKeysAddedAfter[] = {
     {6, "experience_map.link_sigma_m"},
     {6, "experience_map.link_sigma_m_per_m"},
     {6, "experience_map.link_sigma_rad"},
+    {7, "experience_map.initial_heading_rad"},
 };
 
 // Whole sections added after a map format version: older maps resume only with every key at its
@@ -270,6 +271,7 @@ struct AddedSection {
 };
 constexpr AddedSection kSectionsAddedAfter[] = {
     {5, "wifi_sequence"},
+    {7, "bag"},
 };
 
 }  // namespace
@@ -334,6 +336,8 @@ StatusOr<uint64_t> FingerprintAsOfMapVersion(const PipelineOptions& options, uin
     if (eq != std::string::npos && dropped.count(section + "." + line.substr(0, eq))) continue;
     kept += line + "\n";
   }
+  // A dropped last section leaves the blank line that separated it from the one before.
+  while (kept.size() >= 2 && kept.compare(kept.size() - 2, 2, "\n\n") == 0) kept.pop_back();
   return Fnv1a(kept);
 }
 
@@ -425,6 +429,12 @@ StatusOr<ImportedConfig> ImportOpenRatslamIni(const std::string& path) {
        "experience_map.relaxation_sweeps", 10},
       {"exp_correction", real(o.ratslam.experience_map.relaxation_correction),
        "experience_map.relaxation_correction", 0.5},
+      {"exp_initial_em_deg",
+       [&o](double v) {
+         o.ratslam.experience_map.initial_heading_rad = v * M_PI / 180.0;
+         return Status::Ok();
+       },
+       "experience_map.initial_heading_rad", 90.0},
       {"vt_match_threshold", real(o.sensors.classic_camera.match_threshold),
        "camera.match_threshold", 0.03},
       {"vt_shift_match", whole(o.sensors.classic_camera.shift_px), "camera.shift_px", 25},
@@ -459,6 +469,10 @@ StatusOr<ImportedConfig> ImportOpenRatslamIni(const std::string& path) {
   setters["vt_patch_normalisation"] = setters.at("vt_patch_normalise");
   std::map<std::string, std::string> set_at;  // INI key -> "path:line: key = value"
   std::string line, section;
+  std::optional<std::string> topic_root;
+  std::string topic_root_at;
+  size_t topic_root_note = 0;
+  bool visual_odometry_section = false;
   int number = 0;
   while (std::getline(in, line)) {
     ++number;
@@ -471,6 +485,7 @@ StatusOr<ImportedConfig> ImportOpenRatslamIni(const std::string& path) {
     if (line.front() == '[') {
       if (line.back() != ']') return Status::Error(where + ": malformed section header");
       section = line.substr(1, line.size() - 2);
+      if (section == "visual_odometry") visual_odometry_section = true;
       continue;
     }
     const auto eq = line.find('=');
@@ -482,6 +497,12 @@ StatusOr<ImportedConfig> ImportOpenRatslamIni(const std::string& path) {
     };
     const std::string key = trim(line.substr(0, eq));
     const std::string value = trim(line.substr(eq + 1));
+    if (key == "topic_root") {
+      topic_root = value;
+      topic_root_at = where + ": [" + section + "] " + key + " = " + value;
+      topic_root_note = imported.notes.size();  // in line order among the notes
+      continue;
+    }
     auto it = setters.find(key);
     if (it == setters.end()) {
       imported.notes.push_back(where + ": [" + section + "] " + key + " = " + value +
@@ -497,6 +518,26 @@ StatusOr<ImportedConfig> ImportOpenRatslamIni(const std::string& path) {
     Status s = it->second(number_value);
     if (!s.ok()) return Status::Error(where + ": " + key + ": " + s.message());
     set_at[key] = where + ": " + key + " = " + value;
+  }
+  if (topic_root) {
+    // Topics are topic_root plus fixed suffixes; odometry comes from the bag unless the file
+    // configures OpenRatSLAM's visual odometry node (facts file, section 5). ROS resolves a
+    // relative name under "/" and collapses "//".
+    auto topic = [](const std::string& name) {
+      std::string out = "/";
+      for (char c : name) {
+        if (c != '/' || out.back() != '/') out += c;
+      }
+      if (out.size() > 1 && out.back() == '/') out.pop_back();
+      return out;
+    };
+    o.bag.image_topic = topic(*topic_root + "/camera/image");
+    o.bag.odometry_topic = visual_odometry_section ? "" : topic(*topic_root + "/odom");
+    imported.notes.insert(
+        imported.notes.begin() + static_cast<std::ptrdiff_t>(topic_root_note),
+        topic_root_at + " (-> [bag] image_topic = \"" + o.bag.image_topic + "\"" +
+            (visual_odometry_section ? ", no odometry topic: the file runs visual odometry)"
+                                     : ", odometry_topic = \"" + o.bag.odometry_topic + "\")"));
   }
   std::string error;
   if (!o.IsValid(&error)) {
@@ -517,6 +558,7 @@ StatusOr<ImportedConfig> ImportOpenRatslamIni(const std::string& path) {
                  ShortestNumber(k.openratslam_default) + ")";
       }
     }
+    if (error.rfind("bag.", 0) == 0) about += "; " + topic_root_at;
     return Status::Error(path + ": imported values are invalid: " + error + about);
   }
   return imported;

@@ -213,6 +213,24 @@ TEST(ConfigTest, ImportsOpenRatslamIniAndReportsUnusedKeys) {
   EXPECT_TRUE(o.sensors.classic_camera.panoramic);
   ASSERT_EQ(imported->notes.size(), 2u);
   EXPECT_NE(imported->notes[0].find(":2: [general] topic_root"), std::string::npos);
+  EXPECT_NE(imported->notes[0].find("(-> [bag] image_topic = \"/irat_red/camera/image\", "
+                                    "odometry_topic = \"/irat_red/odom\")"),
+            std::string::npos)
+      << imported->notes[0];
+  EXPECT_EQ(o.bag.image_topic, "/irat_red/camera/image");
+  // With OpenRatSLAM's visual odometry node configured, odometry is not read from the bag.
+  std::ofstream(path) << "[general]\ntopic_root=/newcollege/\n[visual_odometry]\n"
+                         "vtrans_image_x_min=195\n[ratslam]\ntemplate_x_size=60\n";
+  StatusOr<ImportedConfig> vo = ImportOpenRatslamIni(path.string());
+  ASSERT_TRUE(vo.ok()) << vo.status().message();
+  EXPECT_EQ(vo->options.bag.image_topic, "/newcollege/camera/image");
+  EXPECT_EQ(vo->options.bag.odometry_topic, "");
+  std::ofstream(path) << "[general]\ntopic_root=my robot\n[ratslam]\ntemplate_x_size=60\n";
+  StatusOr<ImportedConfig> spaced = ImportOpenRatslamIni(path.string());
+  ASSERT_FALSE(spaced.ok());
+  EXPECT_NE(spaced.status().message().find(":2: [general] topic_root = my robot"),
+            std::string::npos)
+      << spaced.status().message();
   std::ofstream(path) << "[ratslam]\npc_dim_xy=thirty\n";
   StatusOr<ImportedConfig> bad = ImportOpenRatslamIni(path.string());
   ASSERT_FALSE(bad.ok());
@@ -296,6 +314,12 @@ TEST(ConfigTest, ShippedOpenRatslamConfigsImportWithOpenRatslamsDefaults) {
   EXPECT_EQ(ir.sensors.classic_camera.shift_px, 4);
   EXPECT_EQ(ir.ratslam.local_view.injection_gain, 0.1);
   EXPECT_EQ(ir.ratslam.pose_cells.dim_xy_cells, 11);
+  // exp_initial_em_deg: 140 in the iRat file, OpenRatSLAM's default 90 in the others.
+  EXPECT_DOUBLE_EQ(ir.ratslam.experience_map.initial_heading_rad, 140 * M_PI / 180);
+  EXPECT_DOUBLE_EQ(sl.ratslam.experience_map.initial_heading_rad, M_PI / 2);
+  EXPECT_DOUBLE_EQ(nc.ratslam.experience_map.initial_heading_rad, M_PI / 2);
+  EXPECT_EQ(nc.bag.image_topic, "/newcollege/camera/image");
+  EXPECT_EQ(nc.bag.odometry_topic, "/newcollege/odom");
 
   // A value our checks refuse names the INI line; a default they refuse says it was one.
   const auto bad = dir / "bad.ini";

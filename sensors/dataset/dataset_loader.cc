@@ -2,10 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 
+#include "common/file_util.h"
+#include "common/text_file.h"
 #include "sensors/dataset/msft_log.h"
 
 namespace ratslam {
@@ -18,6 +21,7 @@ StatusOr<DatasetFormat> DetectDatasetFormat(const std::string& path) {
   }
   std::ifstream in(path);
   if (!in) return Status::Error(path + ": no such file or folder");
+  if (LooksLikeRosbag(path)) return DatasetFormat::kRosBag;
   std::string line;
   for (int i = 0; i < 200 && std::getline(in, line); ++i) {
     if (line.empty() || line[0] == '%') continue;
@@ -35,28 +39,42 @@ StatusOr<DatasetFormat> DetectDatasetFormat(const std::string& path) {
   }
   return Status::Error(
       path +
-      ": unknown data-set format (expected a replay folder, an IPIN log or a Microsoft walk)");
+      ": unknown data-set format (expected a replay folder, a ROS 1 bag, an IPIN log or a "
+      "Microsoft walk)");
 }
 
-StatusOr<Dataset> LoadDataset(const std::string& path, const PhoneLogOptions& phone_options) {
-  StatusOr<DatasetFormat> format = DetectDatasetFormat(path);
-  if (!format.ok()) return format.status();
-  switch (format.value()) {
+namespace {
+StatusOr<Dataset> Read(const std::string& path, DatasetFormat format,
+                       const PhoneLogOptions& phone_options, const BagTopics& bag,
+                       PhoneLogReport* report) {
+  switch (format) {
     case DatasetFormat::kReplayFolder:
       return ReadDataset(path);
     case DatasetFormat::kIpinLog:
-      return ReadIpinLog(path, phone_options);
+      return ReadIpinLog(path, phone_options, report);
     case DatasetFormat::kMicrosoftLog:
-      return ReadMicrosoftLog(path, phone_options);
+      return ReadMicrosoftLog(path, phone_options, report);
+    case DatasetFormat::kRosBag:
+      return ReadRosbag(path, bag);
   }
   return Status::Error(path + ": unsupported format");
 }
+}  // namespace
+
+StatusOr<Dataset> LoadDataset(const std::string& path, const PhoneLogOptions& phone_options,
+                              const BagTopics& bag) {
+  StatusOr<DatasetFormat> format = DetectDatasetFormat(path);
+  if (!format.ok()) return format.status();
+  PhoneLogReport report;
+  return Read(path, *format, phone_options, bag, &report);
+}
 
 StatusOr<Dataset> LoadSessions(const std::vector<std::string>& paths,
-                               const PhoneLogOptions& phone_options, double gap_s) {
+                               const PhoneLogOptions& phone_options, double gap_s,
+                               const BagTopics& bag) {
   if (paths.empty()) return Status::Error("no data set given");
   if (paths.size() == 1) {
-    StatusOr<Dataset> d = LoadDataset(paths[0], phone_options);
+    StatusOr<Dataset> d = LoadDataset(paths[0], phone_options, bag);
     if (d.ok()) d->session_start_times_s = {d->odometry.empty() ? 0.0 : d->odometry.front().time_s};
     return d;
   }
@@ -67,10 +85,7 @@ StatusOr<Dataset> LoadSessions(const std::vector<std::string>& paths,
     PhoneLogReport report;
     StatusOr<DatasetFormat> format = DetectDatasetFormat(path);
     if (!format.ok()) return format.status();
-    StatusOr<Dataset> d =
-        format.value() == DatasetFormat::kIpinLog        ? ReadIpinLog(path, options, &report)
-        : format.value() == DatasetFormat::kMicrosoftLog ? ReadMicrosoftLog(path, options, &report)
-                                                         : ReadDataset(path);
+    StatusOr<Dataset> d = Read(path, *format, options, bag, &report);
     if (!d.ok()) return d.status();
     if (format.value() == DatasetFormat::kIpinLog && !options.reference) {
       options.reference = report.reference;  // later logs share the first log's frame
@@ -119,6 +134,45 @@ StatusOr<Dataset> LoadSessions(const std::vector<std::string>& paths,
   joined.name +=
       " +" + std::to_string(paths.size() - 1) + (paths.size() == 2 ? " session" : " sessions");
   return joined;
+}
+
+Status CopyImagesInto(Dataset* dataset, const std::string& folder,
+                      const std::function<void(size_t, size_t)>& progress) {
+  if (dataset->images.empty()) return Status::Ok();
+  const fs::path images = fs::path(folder) / "images";
+  std::error_code ec;
+  fs::create_directories(images, ec);
+  if (ec) return Status::Error(images.string() + ": cannot create: " + ec.message());
+  BagImageReader bags;
+  std::vector<std::string> names(dataset->images.size());
+  for (size_t i = 0; i < dataset->images.size(); ++i) {
+    const std::string source = dataset->ImagePath(dataset->images[i]);
+    std::string bytes, extension;
+    std::string bag;
+    uint64_t message = 0;
+    if (!fs::exists(source) && ParseBagImageReference(source, &bag, &message)) {
+      StatusOr<EncodedImage> encoded = bags.Encoded(source);
+      if (!encoded.ok()) return encoded.status();
+      bytes.assign(encoded->bytes.begin(), encoded->bytes.end());
+      extension = encoded->extension;
+    } else {
+      StatusOr<std::string> read = ReadRegularFile(source, "image", uint64_t{1} << 30);
+      if (!read.ok()) return read.status();
+      bytes = std::move(read).value();
+      extension = fs::path(source).extension().string();
+      if (!extension.empty()) extension.erase(0, 1);
+    }
+    char name[32];
+    std::snprintf(name, sizeof name, "%06zu", i);
+    names[i] = std::string(name) + (extension.empty() ? "" : "." + extension);
+    RATSLAM_RETURN_IF_ERROR(WriteFileAtomically((images / names[i]).string(), bytes, false));
+    if (progress && (i + 1) % 500 == 0) progress(i + 1, dataset->images.size());
+  }
+  for (size_t i = 0; i < names.size(); ++i) dataset->images[i].file = names[i];
+  dataset->folder = folder;
+  dataset->image_folder = "images";
+  if (progress) progress(names.size(), names.size());
+  return Status::Ok();
 }
 
 }  // namespace ratslam

@@ -3,9 +3,19 @@
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 
+#include "sensors/dataset/rosbag.h"
+
 namespace ratslam {
 
+FileImageLoader::FileImageLoader() : bags_(std::make_unique<BagImageReader>()) {}
+FileImageLoader::~FileImageLoader() = default;
+
 StatusOr<GrayImage> FileImageLoader::Load(const std::string& path) {
+  std::string bag;
+  uint64_t message = 0;
+  if (!std::filesystem::exists(path) && ParseBagImageReference(path, &bag, &message)) {
+    return bags_->Load(path);
+  }
   if (!std::filesystem::exists(path)) return Status::Error(path + ": image file missing");
   cv::Mat mat;
   try {

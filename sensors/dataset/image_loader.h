@@ -4,6 +4,7 @@
 #define RATSLAM_SENSORS_DATASET_IMAGE_LOADER_H_
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -23,10 +24,18 @@ class ImageLoader {
   virtual StatusOr<GrayImage> Load(const std::string& path) = 0;
 };
 
-// Reads any format OpenCV's imgcodecs reads (PNG, JPEG, PGM, ...) and converts it to grey.
+class BagImageReader;
+
+// Reads any format OpenCV's imgcodecs reads (PNG, JPEG, PGM, ...) and converts it to grey; a path
+// `<file>.bag#<n>` is message n of a ROS bag (sensors/dataset/rosbag.h).
 class FileImageLoader : public ImageLoader {
  public:
+  FileImageLoader();
+  ~FileImageLoader() override;
   StatusOr<GrayImage> Load(const std::string& path) override;
+
+ private:
+  std::unique_ptr<BagImageReader> bags_;
 };
 
 }  // namespace ratslam
