@@ -178,7 +178,10 @@ const std::vector<CommandSpec>& Commands() {
         Number("--start-m", "M", "start M metres along the loop (default 0)"),
         Text("--bag", "F",
              "also write the loop as a ROS 1 bag F (/synthetic/camera/image/compressed, "
-             "/synthetic/odom, /synthetic/ground_truth)")},
+             "/synthetic/odom, /synthetic/ground_truth)"),
+        Text("--video", "F",
+             "also write the loop as a Motion-JPEG video F (.avi) with OpenRatSLAM's odometry "
+             "log beside it (F's name with .txt)")},
        {}},
       {"render", "images from a run folder, a saved map, a data set or a Wi-Fi map", "", {}, {}},
       {"render experience-map",

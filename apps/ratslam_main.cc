@@ -39,6 +39,7 @@
 #include "sensors/dataset/image_loader.h"
 #include "sensors/dataset/rosbag.h"
 #include "sensors/dataset/synthetic_dataset.h"
+#include "sensors/dataset/video.h"
 #include "sensors/dataset/visual_odometry_source.h"
 #include "session/replay_session.h"
 #include "sim/world.h"
@@ -274,7 +275,7 @@ int Replay(const Arguments& parsed) {
 }
 
 int Synthesize(const SyntheticOptions& options, const std::string& folder,
-               const std::string& bag_path) {
+               const std::string& bag_path, const std::string& video_path) {
   StatusOr<Dataset> d = WriteSyntheticDataset(options, folder);
   if (!d.ok()) {
     std::cerr << MessagePrefix() << d.status().message() << "\n";
@@ -296,6 +297,18 @@ int Synthesize(const SyntheticOptions& options, const std::string& folder,
     std::cerr << MessagePrefix() << "wrote the same frames as a ROS bag to " << bag_path << " ("
               << topics.image_topic << ", " << topics.odometry_topic << ", "
               << topics.ground_truth_topic << ")\n";
+  }
+  if (!video_path.empty()) {
+    StatusOr<Dataset> written = ReadDataset(folder);
+    FileImageLoader images;
+    Status s = written.ok() ? WriteVideo(*written, &images, video_path, options.rate_hz)
+                            : written.status();
+    if (!s.ok()) {
+      std::cerr << MessagePrefix() << s.message() << "\n";
+      return kExitError;
+    }
+    std::cerr << MessagePrefix() << "wrote the same frames as a video to " << video_path
+              << " with OpenRatSLAM's odometry log beside it\n";
   }
   return kExitOk;
 }
@@ -375,7 +388,8 @@ int ImportCommand(const Arguments& parsed) {
   PhoneLogOptions phone;
   phone.lenient = args->lenient;
   phone.pdr = options->pdr;
-  StatusOr<Dataset> d = LoadSessions(args->all.at("--data"), phone, 1.0, options->bag);
+  StatusOr<Dataset> d =
+      LoadSessions(args->all.at("--data"), phone, 1.0, options->bag, options->video);
   if (!d.ok()) {
     std::cerr << MessagePrefix() << d.status().message() << "\n";
     return kExitError;
@@ -425,7 +439,8 @@ int SynthesizeCommand(const Arguments& parsed) {
     if (!start) return kExitUsage;
     options.start_m = *start;
   }
-  return Synthesize(options, args->values.at("--out"), args->Value("--bag"));
+  return Synthesize(options, args->values.at("--out"), args->Value("--bag"),
+                    args->Value("--video"));
 }
 
 }  // namespace

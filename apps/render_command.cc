@@ -209,7 +209,8 @@ int RenderSimilarity(const Arguments& args) {
   }
   PhoneLogOptions phone;
   phone.pdr = options->pdr;
-  StatusOr<Dataset> dataset = LoadSessions(args.all.at("--data"), phone, 1.0, options->bag);
+  StatusOr<Dataset> dataset =
+      LoadSessions(args.all.at("--data"), phone, 1.0, options->bag, options->video);
   if (!dataset.ok()) return Fail(dataset.status().message());
   const std::string sensor = args.values.count("--sensor") ? args.values.at("--sensor") : "camera";
   SimilarityImageOptions image_options;

@@ -23,6 +23,7 @@
 #include "sensors/dataset/dataset.h"
 #include "sensors/dataset/image_loader.h"
 #include "sensors/dataset/rosbag.h"
+#include "sensors/dataset/video.h"
 #include "sensors/pedestrian_dead_reckoning.h"
 #include "sensors/visual_odometry.h"
 
@@ -36,7 +37,8 @@ struct PipelineOptions {
   RatslamOptions ratslam;
   WifiSequenceOptions wifi_sequence;     // Wi-Fi sequence loop closure beside the front end
   fabmap::EvaluationOptions evaluation;  // `ratslam evaluate` only: how map and queries split
-  BagTopics bag;  // which topics of a ROS bag make the data set (not part of a map's identity)
+  BagTopics bag;       // which topics of a ROS bag make the data set (not part of a map's identity)
+  VideoOptions video;  // how a video's frames get times and odometry (ditto)
 
   bool IsValid(std::string* error) const;
 
@@ -67,6 +69,7 @@ struct PipelineOptions {
     v("virtual_wifi", sensors.fabmap.localiser.virtual_wifi);
     v("evaluation", evaluation);
     v("bag", bag);
+    v("video", video);
   }
 };
 

@@ -7,6 +7,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -190,6 +191,25 @@ py::dict RunColumns(const ReplayPipeline& pipeline) {
   return run;
 }
 
+// Polls Python's signal handlers from the replay's progress reports (every 500 events), taking
+// the GIL only for that: Ctrl-C stops the replay between events, as on the command line.
+class InterruptiblePython : public ProgressSink {
+ public:
+  void Update(const ProgressUpdate&) override {
+    if (stop_.load()) return;
+    py::gil_scoped_acquire acquire;
+    if (PyErr_CheckSignals() != 0) {
+      PyErr_Clear();  // raised again as KeyboardInterrupt once the outputs are written
+      stop_.store(true);
+    }
+  }
+  const std::atomic<bool>* flag() const { return &stop_; }
+  bool stopped() const { return stop_.load(); }
+
+ private:
+  std::atomic<bool> stop_{false};
+};
+
 // ratslam.replay: what `ratslam replay` does, into the folder `out`, returning the summary and
 // the run as columns.
 py::dict Replay(const std::vector<std::string>& data, const std::string& out,
@@ -213,6 +233,9 @@ py::dict Replay(const std::vector<std::string>& data, const std::string& out,
   std::unique_ptr<DiskFolder> folder = Take(DiskFolder::Open(out));
   SessionEnvironment environment;
   environment.out = folder.get();
+  InterruptiblePython interrupt;
+  environment.progress = &interrupt;
+  environment.stop_requested = interrupt.flag();
   ReplaySession session(std::move(options), environment);
   StatusOr<ReplayResult> result = [&] {
     py::gil_scoped_release release;
@@ -220,6 +243,11 @@ py::dict Replay(const std::vector<std::string>& data, const std::string& out,
   }();
   Check(result.status());
   (void)guard.Finish(result->ok());
+  if (interrupt.stopped()) {
+    PyErr_SetString(PyExc_KeyboardInterrupt,
+                    ("ratslam.replay stopped; the outputs so far are in " + out).c_str());
+    throw py::error_already_set();
+  }
   if (!result->replay.ok()) {
     throw Error(result->replay.message() + " (the outputs so far are in " + out + ")");
   }

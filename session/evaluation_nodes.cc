@@ -146,11 +146,9 @@ bool HasManifest(const std::string& path) {
 
 }  // namespace
 
-StatusOr<std::vector<EvaluationNode>> LoadEvaluationNodes(const std::string& path, bool as_map,
-                                                          bool want_images,
-                                                          const EvaluationOptions& options,
-                                                          const PhoneLogOptions& phone,
-                                                          const BagTopics& bag) {
+StatusOr<std::vector<EvaluationNode>> LoadEvaluationNodes(
+    const std::string& path, bool as_map, bool want_images, const EvaluationOptions& options,
+    const PhoneLogOptions& phone, const BagTopics& bag, const VideoOptions& video) {
   std::string error;
   if (!options.IsValid(&error)) return Status::Error("[evaluation] " + error);
   std::error_code ec;
@@ -174,7 +172,7 @@ StatusOr<std::vector<EvaluationNode>> LoadEvaluationNodes(const std::string& pat
     if (!d.ok()) return d.status();
     return DatasetNodes(*d, as_map, want_images, options);
   }
-  auto d = LoadDataset(path, phone, bag);
+  auto d = LoadDataset(path, phone, bag, video);
   if (!d.ok()) return d.status();
   return DatasetNodes(*d, as_map, want_images, options);
 }

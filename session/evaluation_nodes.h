@@ -11,6 +11,7 @@
 #include "fusion/fabmap/evaluation.h"
 #include "sensors/dataset/ipin_log.h"
 #include "sensors/dataset/rosbag.h"
+#include "sensors/dataset/video.h"
 
 namespace ratslam {
 
@@ -21,7 +22,7 @@ namespace ratslam {
 StatusOr<std::vector<fabmap::EvaluationNode>> LoadEvaluationNodes(
     const std::string& path, bool as_map, bool want_images,
     const fabmap::EvaluationOptions& options, const PhoneLogOptions& phone,
-    const BagTopics& bag = {});
+    const BagTopics& bag = {}, const VideoOptions& video = {});
 
 }  // namespace ratslam
 

@@ -78,7 +78,7 @@ Status EvaluationSession::Load() {
   phone.pdr = options_.pipeline.pdr;
   const fabmap::EvaluationOptions& evaluation = options_.pipeline.evaluation;
   auto map_nodes = LoadEvaluationNodes(options_.map_path, true, vision, evaluation, phone,
-                                       options_.pipeline.bag);
+                                       options_.pipeline.bag, options_.pipeline.video);
   if (!map_nodes.ok()) return map_nodes.status();
   std::error_code ec;
   if (std::filesystem::equivalent(options_.map_path, options_.query_path, ec)) {
@@ -89,7 +89,7 @@ Status EvaluationSession::Load() {
   } else {
     result_.map = *std::move(map_nodes);
     auto q = LoadEvaluationNodes(options_.query_path, false, vision, evaluation, phone,
-                                 options_.pipeline.bag);
+                                 options_.pipeline.bag, options_.pipeline.video);
     if (!q.ok()) return q.status();
     result_.queries = *std::move(q);
   }

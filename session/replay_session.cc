@@ -16,8 +16,10 @@ Status CheckSameConfiguration(const MapFile& map, const PipelineOptions& now) {
     StatusOr<PipelineOptions> before = ParseMapConfig(map.config, map.format_version);
     if (!before.ok()) return before.status();
     std::vector<std::string> differences = ConfigDifferences(*before, now);
-    // Which topics of a bag were read says nothing about the map.
-    std::erase_if(differences, [](const std::string& d) { return d.rfind("bag.", 0) == 0; });
+    // How a bag or a video was read says nothing about the map.
+    std::erase_if(differences, [](const std::string& d) {
+      return d.rfind("bag.", 0) == 0 || d.rfind("video.", 0) == 0;
+    });
     if (differences.empty()) return Status::Ok();
     std::string keys;
     for (const std::string& d : differences) keys += "\n  " + d;
@@ -64,7 +66,8 @@ Status ReplaySession::Load() {
   PhoneLogOptions phone;
   phone.lenient = options_.lenient;
   phone.pdr = options_.pipeline.pdr;
-  StatusOr<Dataset> dataset = LoadSessions(options_.data, phone, 1.0, options_.pipeline.bag);
+  StatusOr<Dataset> dataset =
+      LoadSessions(options_.data, phone, 1.0, options_.pipeline.bag, options_.pipeline.video);
   if (!dataset.ok()) return dataset.status();
   if (options_.pipeline.visual_odometry.enabled) {
     RATSLAM_RETURN_IF_ERROR(

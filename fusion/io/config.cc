@@ -261,6 +261,18 @@ constexpr AddedKey kKeysAddedAfter[] = {
     {6, "experience_map.link_sigma_m_per_m"},
     {6, "experience_map.link_sigma_rad"},
     {7, "experience_map.initial_heading_rad"},
+    {7, "visual_odometry.model"},
+    {7, "visual_odometry.translation_left_px"},
+    {7, "visual_odometry.translation_right_px"},
+    {7, "visual_odometry.translation_top_px"},
+    {7, "visual_odometry.translation_bottom_px"},
+    {7, "visual_odometry.rotation_left_px"},
+    {7, "visual_odometry.rotation_right_px"},
+    {7, "visual_odometry.rotation_top_px"},
+    {7, "visual_odometry.rotation_bottom_px"},
+    {7, "visual_odometry.camera_hz"},
+    {7, "visual_odometry.translation_scaling"},
+    {7, "visual_odometry.max_speed_m_per_s"},
 };
 
 // Whole sections added after a map format version: older maps resume only with every key at its
@@ -272,6 +284,7 @@ struct AddedSection {
 constexpr AddedSection kSectionsAddedAfter[] = {
     {5, "wifi_sequence"},
     {7, "bag"},
+    {7, "video"},
 };
 
 }  // namespace
@@ -453,6 +466,34 @@ StatusOr<ImportedConfig> ImportOpenRatslamIni(const std::string& path) {
       {"image_crop_y_min", whole(o.sensors.classic_camera.crop_top_px), "camera.crop_top_px", 0},
       {"image_crop_y_max", whole(o.sensors.classic_camera.crop_bottom_px), "camera.crop_bottom_px",
        -1},
+      // [visual_odometry] (facts file, sections 2 and 4.2); the section turns the model on.
+      {"vtrans_image_x_min", whole(o.visual_odometry.translation_left_px),
+       "visual_odometry.translation_left_px", 0},
+      {"vtrans_image_x_max", whole(o.visual_odometry.translation_right_px),
+       "visual_odometry.translation_right_px", -1},
+      {"vtrans_image_y_min", whole(o.visual_odometry.translation_top_px),
+       "visual_odometry.translation_top_px", 0},
+      {"vtrans_image_y_max", whole(o.visual_odometry.translation_bottom_px),
+       "visual_odometry.translation_bottom_px", -1},
+      {"vrot_image_x_min", whole(o.visual_odometry.rotation_left_px),
+       "visual_odometry.rotation_left_px", 0},
+      {"vrot_image_x_max", whole(o.visual_odometry.rotation_right_px),
+       "visual_odometry.rotation_right_px", -1},
+      {"vrot_image_y_min", whole(o.visual_odometry.rotation_top_px),
+       "visual_odometry.rotation_top_px", 0},
+      {"vrot_image_y_max", whole(o.visual_odometry.rotation_bottom_px),
+       "visual_odometry.rotation_bottom_px", -1},
+      {"camera_fov_deg",
+       [&o](double v) {
+         o.visual_odometry.field_of_view_rad = v * M_PI / 180.0;
+         return Status::Ok();
+       },
+       "visual_odometry.field_of_view_rad", 50.0},
+      {"camera_hz", real(o.visual_odometry.camera_hz), "visual_odometry.camera_hz", 10.0},
+      {"vtrans_scaling", real(o.visual_odometry.translation_scaling),
+       "visual_odometry.translation_scaling", 100.0},
+      {"vtrans_max", real(o.visual_odometry.max_speed_m_per_s), "visual_odometry.max_speed_m_per_s",
+       20.0},
       {"vt_panoramic",
        [&o](double v) {
          o.sensors.classic_camera.panoramic = v != 0.0;
@@ -518,6 +559,12 @@ StatusOr<ImportedConfig> ImportOpenRatslamIni(const std::string& path) {
     Status s = it->second(number_value);
     if (!s.ok()) return Status::Error(where + ": " + key + ": " + s.message());
     set_at[key] = where + ": " + key + " = " + value;
+  }
+  if (visual_odometry_section) {
+    // OpenRatSLAM's visual odometry node: its model, and its fixed search of 0..39 px.
+    o.visual_odometry.enabled = true;
+    o.visual_odometry.model = "openratslam";
+    o.visual_odometry.max_shift_px = 39;
   }
   if (topic_root) {
     // Topics are topic_root plus fixed suffixes; odometry comes from the bag unless the file

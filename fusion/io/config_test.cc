@@ -320,6 +320,36 @@ TEST(ConfigTest, ShippedOpenRatslamConfigsImportWithOpenRatslamsDefaults) {
   EXPECT_DOUBLE_EQ(nc.ratslam.experience_map.initial_heading_rad, M_PI / 2);
   EXPECT_EQ(nc.bag.image_topic, "/newcollege/camera/image");
   EXPECT_EQ(nc.bag.odometry_topic, "/newcollege/odom");
+  for (const auto& [name, o] : got) EXPECT_FALSE(o.visual_odometry.enabled) << name;
+  // St Lucia's [visual_odometry] section (facts file, "Values set by the shipped configs") turns
+  // on OpenRatSLAM's visual odometry with its values, and leaves odometry out of the bag topics.
+  const auto stlucia = dir / "config_stlucia_vo.txt";
+  std::ofstream(stlucia) << "[general]\ntopic_root=stlucia\n[ratslam]\ntemplate_x_size=60\n"
+                            "[visual_odometry]\nvtrans_image_x_min=195\nvtrans_image_x_max=475\n"
+                            "vtrans_image_y_min=270\nvtrans_image_y_max=430\n"
+                            "vrot_image_x_min=195\nvrot_image_x_max=475\nvrot_image_y_min=75\n"
+                            "vrot_image_y_max=240\ncamera_fov_deg=53\ncamera_hz=10\n"
+                            "vtrans_scaling=1000\nvtrans_max=20\n";
+  StatusOr<ImportedConfig> slvo = ImportOpenRatslamIni(stlucia.string());
+  ASSERT_TRUE(slvo.ok()) << slvo.status().message();
+  const VisualOdometryOptions& vo = slvo->options.visual_odometry;
+  EXPECT_TRUE(vo.enabled);
+  EXPECT_EQ(vo.model, "openratslam");
+  EXPECT_EQ(vo.max_shift_px, 39);
+  EXPECT_EQ(vo.translation_left_px, 195);
+  EXPECT_EQ(vo.translation_right_px, 475);
+  EXPECT_EQ(vo.translation_top_px, 270);
+  EXPECT_EQ(vo.translation_bottom_px, 430);
+  EXPECT_EQ(vo.rotation_left_px, 195);
+  EXPECT_EQ(vo.rotation_right_px, 475);
+  EXPECT_EQ(vo.rotation_top_px, 75);
+  EXPECT_EQ(vo.rotation_bottom_px, 240);
+  EXPECT_DOUBLE_EQ(vo.field_of_view_rad, 53 * M_PI / 180);
+  EXPECT_EQ(vo.camera_hz, 10.0);
+  EXPECT_EQ(vo.translation_scaling, 1000.0);
+  EXPECT_EQ(vo.max_speed_m_per_s, 20.0);
+  EXPECT_EQ(slvo->options.bag.image_topic, "/stlucia/camera/image");
+  EXPECT_EQ(slvo->options.bag.odometry_topic, "");
 
   // A value our checks refuse names the INI line; a default they refuse says it was one.
   const auto bad = dir / "bad.ini";

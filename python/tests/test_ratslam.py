@@ -7,9 +7,11 @@ import csv
 import json
 import os
 import shutil
+import signal
 import struct
 import subprocess
 import tempfile
+import threading
 import unittest
 import zlib
 
@@ -125,6 +127,20 @@ class RatslamModuleTest(unittest.TestCase):
             ratslam.replay([self.data], out, config=ratslam.Config.load(SYNTHETIC_CONFIG))
         with self.assertRaisesRegex(ratslam.Error, "no-such-data"):
             ratslam.replay([os.path.join(self.root, "no-such-data")], os.path.join(self.root, "x"))
+
+    def test_ctrl_c_stops_a_replay_and_keeps_its_outputs(self):
+        out = os.path.join(self.root, "interrupted")
+        timer = threading.Timer(0.02, lambda: os.kill(os.getpid(), signal.SIGINT))
+        timer.start()
+        with self.assertRaises(KeyboardInterrupt) as caught:
+            ratslam.replay([self.data], out, config=ratslam.Config.load(SYNTHETIC_CONFIG))
+        timer.join()
+        self.assertIn("the outputs so far are in", str(caught.exception))
+        with open(os.path.join(out, "summary.json")) as f:
+            stopped = json.load(f)
+        with open(os.path.join(self.cli_run, "summary.json")) as f:
+            whole = json.load(f)
+        self.assertLess(stopped["frames"], whole["frames"])
 
     def test_session_fed_frame_by_frame_equals_the_replay(self):
         config = ratslam.Config.load(SYNTHETIC_CONFIG)

@@ -6,10 +6,13 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include "common/file_util.h"
 #include "common/text_file.h"
 #include "sensors/dataset/msft_log.h"
+#include "sensors/dataset/video.h"
 
 namespace ratslam {
 namespace fs = std::filesystem;
@@ -22,6 +25,7 @@ StatusOr<DatasetFormat> DetectDatasetFormat(const std::string& path) {
   std::ifstream in(path);
   if (!in) return Status::Error(path + ": no such file or folder");
   if (LooksLikeRosbag(path)) return DatasetFormat::kRosBag;
+  if (LooksLikeVideo(path)) return DatasetFormat::kVideo;
   std::string line;
   for (int i = 0; i < 200 && std::getline(in, line); ++i) {
     if (line.empty() || line[0] == '%') continue;
@@ -46,7 +50,7 @@ StatusOr<DatasetFormat> DetectDatasetFormat(const std::string& path) {
 namespace {
 StatusOr<Dataset> Read(const std::string& path, DatasetFormat format,
                        const PhoneLogOptions& phone_options, const BagTopics& bag,
-                       PhoneLogReport* report) {
+                       const VideoOptions& video, PhoneLogReport* report) {
   switch (format) {
     case DatasetFormat::kReplayFolder:
       return ReadDataset(path);
@@ -56,25 +60,27 @@ StatusOr<Dataset> Read(const std::string& path, DatasetFormat format,
       return ReadMicrosoftLog(path, phone_options, report);
     case DatasetFormat::kRosBag:
       return ReadRosbag(path, bag);
+    case DatasetFormat::kVideo:
+      return ReadVideo(path, video);
   }
   return Status::Error(path + ": unsupported format");
 }
 }  // namespace
 
 StatusOr<Dataset> LoadDataset(const std::string& path, const PhoneLogOptions& phone_options,
-                              const BagTopics& bag) {
+                              const BagTopics& bag, const VideoOptions& video) {
   StatusOr<DatasetFormat> format = DetectDatasetFormat(path);
   if (!format.ok()) return format.status();
   PhoneLogReport report;
-  return Read(path, *format, phone_options, bag, &report);
+  return Read(path, *format, phone_options, bag, video, &report);
 }
 
 StatusOr<Dataset> LoadSessions(const std::vector<std::string>& paths,
                                const PhoneLogOptions& phone_options, double gap_s,
-                               const BagTopics& bag) {
+                               const BagTopics& bag, const VideoOptions& video) {
   if (paths.empty()) return Status::Error("no data set given");
   if (paths.size() == 1) {
-    StatusOr<Dataset> d = LoadDataset(paths[0], phone_options, bag);
+    StatusOr<Dataset> d = LoadDataset(paths[0], phone_options, bag, video);
     if (d.ok()) d->session_start_times_s = {d->odometry.empty() ? 0.0 : d->odometry.front().time_s};
     return d;
   }
@@ -85,7 +91,7 @@ StatusOr<Dataset> LoadSessions(const std::vector<std::string>& paths,
     PhoneLogReport report;
     StatusOr<DatasetFormat> format = DetectDatasetFormat(path);
     if (!format.ok()) return format.status();
-    StatusOr<Dataset> d = Read(path, *format, options, bag, &report);
+    StatusOr<Dataset> d = Read(path, *format, options, bag, video, &report);
     if (!d.ok()) return d.status();
     if (format.value() == DatasetFormat::kIpinLog && !options.reference) {
       options.reference = report.reference;  // later logs share the first log's frame
@@ -144,6 +150,7 @@ Status CopyImagesInto(Dataset* dataset, const std::string& folder,
   fs::create_directories(images, ec);
   if (ec) return Status::Error(images.string() + ": cannot create: " + ec.message());
   BagImageReader bags;
+  VideoFrameReader videos;
   std::vector<std::string> names(dataset->images.size());
   for (size_t i = 0; i < dataset->images.size(); ++i) {
     const std::string source = dataset->ImagePath(dataset->images[i]);
@@ -155,6 +162,15 @@ Status CopyImagesInto(Dataset* dataset, const std::string& folder,
       if (!encoded.ok()) return encoded.status();
       bytes.assign(encoded->bytes.begin(), encoded->bytes.end());
       extension = encoded->extension;
+    } else if (!fs::exists(source) && ParseVideoFrameReference(source, &bag, &message)) {
+      // A video frame, decoded (to grey, as replays see it) and stored losslessly.
+      StatusOr<GrayImage> frame = videos.Load(source);
+      if (!frame.ok()) return frame.status();
+      const cv::Mat grey(frame->height, frame->width, CV_8U, frame->pixels.data());
+      std::vector<uint8_t> png;
+      if (!cv::imencode(".png", grey, png)) return Status::Error(source + ": cannot encode PNG");
+      bytes.assign(png.begin(), png.end());
+      extension = "png";
     } else {
       StatusOr<std::string> read = ReadRegularFile(source, "image", uint64_t{1} << 30);
       if (!read.ok()) return read.status();

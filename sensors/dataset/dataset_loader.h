@@ -10,18 +10,20 @@
 #include "sensors/dataset/dataset.h"
 #include "sensors/dataset/ipin_log.h"
 #include "sensors/dataset/rosbag.h"
+#include "sensors/dataset/video.h"
 
 namespace ratslam {
 
-enum class DatasetFormat { kReplayFolder, kIpinLog, kMicrosoftLog, kRosBag };
+enum class DatasetFormat { kReplayFolder, kIpinLog, kMicrosoftLog, kRosBag, kVideo };
 
 // A folder with manifest.toml: the replay format; a file starting "#ROSBAG V2.0": a ROS 1 bag
-// (topics from `bag`); a file whose lines look like
+// (topics from `bag`); a file named like a video (.avi, .mp4, ...): a video with its odometry log
+// (sensors/dataset/video.h); a file whose lines look like
 // `WIFI;...`/`ACCE;...` (after `%` comments): an IPIN log; tab-separated `unix_ms TYPE_...`
 // lines: a Microsoft Indoor Location Competition walk. Anything else is an error naming the path.
 StatusOr<DatasetFormat> DetectDatasetFormat(const std::string& path);
 StatusOr<Dataset> LoadDataset(const std::string& path, const PhoneLogOptions& phone_options,
-                              const BagTopics& bag = {});
+                              const BagTopics& bag = {}, const VideoOptions& video = {});
 
 // One data set from several sessions in order: each is shifted in time to start `gap_s` after
 // the previous one ends, odometry gets a zero row at each start (no motion across the gap), and
@@ -29,7 +31,7 @@ StatusOr<Dataset> LoadDataset(const std::string& path, const PhoneLogOptions& ph
 // the first log's geographic reference, so their ground truths share one frame.
 StatusOr<Dataset> LoadSessions(const std::vector<std::string>& paths,
                                const PhoneLogOptions& phone_options, double gap_s = 1.0,
-                               const BagTopics& bag = {});
+                               const BagTopics& bag = {}, const VideoOptions& video = {});
 
 // Copies every image of `dataset` (files, or messages of a ROS bag, stored as the bag holds them:
 // JPEG stays JPEG) into `folder`/images as 000000.<ext>, 000001.<ext>, ... and points the rows

@@ -9,6 +9,7 @@
 
 #include "sensors/dataset/image_loader.h"
 #include "sensors/dataset/synthetic_dataset.h"
+#include "sensors/dataset/visual_odometry_source.h"
 
 namespace ratslam {
 namespace {
@@ -281,6 +282,63 @@ TEST(ImageLoaderTest, MissingAndCorruptFilesAreErrors) {
   std::ofstream(bad) << "not a png";
   EXPECT_FALSE(loader.Load(bad.string()).ok());
   fs::remove(bad);
+}
+
+}  // namespace
+}  // namespace ratslam
+
+namespace ratslam {
+namespace {
+
+// OpenRatSLAM's visual odometry on the synthetic loop, whose camera has a known field of view and
+// rate: the integrated turn rate follows the true heading (one turn per lap) and agrees with our
+// constant-speed model's rotation (separate code, tested on exact shifts), which an error in the
+// sign, the scale or camera_hz would break. Both overestimate the turn by about 17 %: the
+// synthetic camera's pixels do not all span field_of_view_rad / width, which both models assume.
+TEST(OpenRatslamVisualOdometrySource, TurnsAsTheGroundTruthOnTheSyntheticLoop) {
+  SyntheticOptions synthetic;
+  synthetic.laps = 1;
+  const fs::path folder =
+      fs::temp_directory_path() / ("ratslam_vo_loop_" + std::to_string(::getpid()));
+  StatusOr<Dataset> d = WriteSyntheticDataset(synthetic, folder.string());
+  ASSERT_TRUE(d.ok()) << d.status().message();
+  VisualOdometryOptions vo;
+  vo.enabled = true;
+  vo.model = "openratslam";
+  vo.max_shift_px = 39;
+  vo.field_of_view_rad = synthetic.field_of_view_rad;
+  vo.camera_hz = synthetic.rate_hz;
+  vo.rotation_top_px = 8;
+  vo.rotation_bottom_px = 32;
+  FileImageLoader images;
+  auto turn = [&](const VisualOdometryOptions& options) {
+    Dataset data = d.value();
+    EXPECT_TRUE(ReplaceOdometryWithVisual(&data, &images, options).ok());
+    EXPECT_EQ(data.odometry.size(), data.images.size());
+    double turned = 0.0;
+    for (size_t i = 1; i < data.odometry.size(); ++i) {
+      turned += data.odometry[i].turn_rate_rad_per_s *
+                (data.odometry[i].time_s - data.odometry[i - 1].time_s);
+      EXPECT_GE(data.odometry[i].forward_speed_m_per_s, 0.0);
+      EXPECT_LE(data.odometry[i].forward_speed_m_per_s, 20.0);
+    }
+    return turned;
+  };
+  const double turned = turn(vo);
+  VisualOdometryOptions constant = vo;
+  constant.model = "constant_speed";
+  constant.crop_top_px = 8;
+  constant.crop_bottom_px = 32;
+  const double reference = turn(constant);
+  double truth = 0.0;
+  for (size_t i = 1; i < d->ground_truth.size(); ++i) {
+    truth +=
+        std::remainder(d->ground_truth[i].theta_rad - d->ground_truth[i - 1].theta_rad, 2 * M_PI);
+  }
+  EXPECT_NEAR(truth, 2 * M_PI, 0.1);
+  EXPECT_NEAR(turned, reference, 0.02 * reference);
+  EXPECT_NEAR(turned, truth, 0.25 * truth) << "visual odometry turned " << turned;
+  fs::remove_all(folder);
 }
 
 }  // namespace

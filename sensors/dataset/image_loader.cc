@@ -4,10 +4,12 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "sensors/dataset/rosbag.h"
+#include "sensors/dataset/video.h"
 
 namespace ratslam {
 
-FileImageLoader::FileImageLoader() : bags_(std::make_unique<BagImageReader>()) {}
+FileImageLoader::FileImageLoader()
+    : bags_(std::make_unique<BagImageReader>()), videos_(std::make_unique<VideoFrameReader>()) {}
 FileImageLoader::~FileImageLoader() = default;
 
 StatusOr<GrayImage> FileImageLoader::Load(const std::string& path) {
@@ -15,6 +17,9 @@ StatusOr<GrayImage> FileImageLoader::Load(const std::string& path) {
   uint64_t message = 0;
   if (!std::filesystem::exists(path) && ParseBagImageReference(path, &bag, &message)) {
     return bags_->Load(path);
+  }
+  if (!std::filesystem::exists(path) && ParseVideoFrameReference(path, &bag, &message)) {
+    return videos_->Load(path);
   }
   if (!std::filesystem::exists(path)) return Status::Error(path + ": image file missing");
   cv::Mat mat;

@@ -25,9 +25,11 @@ class ImageLoader {
 };
 
 class BagImageReader;
+class VideoFrameReader;
 
 // Reads any format OpenCV's imgcodecs reads (PNG, JPEG, PGM, ...) and converts it to grey; a path
-// `<file>.bag#<n>` is message n of a ROS bag (sensors/dataset/rosbag.h).
+// `<file>.bag#<n>` is message n of a ROS bag (sensors/dataset/rosbag.h), `<video>#<n>` frame n of
+// a video (sensors/dataset/video.h).
 class FileImageLoader : public ImageLoader {
  public:
   FileImageLoader();
@@ -36,6 +38,7 @@ class FileImageLoader : public ImageLoader {
 
  private:
   std::unique_ptr<BagImageReader> bags_;
+  std::unique_ptr<VideoFrameReader> videos_;
 };
 
 }  // namespace ratslam

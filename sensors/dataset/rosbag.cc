@@ -23,6 +23,9 @@
 #include <opencv2/imgproc.hpp>
 #include <set>
 
+#include "sensors/dataset/opencv_gray.h"
+#include "sensors/dataset/rosbag_check.h"
+
 namespace ratslam {
 namespace fs = std::filesystem;
 
@@ -93,29 +96,6 @@ StatusOr<std::string> ResolveTopic(const std::string& bag, const std::string& wh
   return name;
 }
 
-StatusOr<GrayImage> ToGray(const cv::Mat& mat, const std::string& where) {
-  if (mat.empty()) return Status::Error(where + ": cannot decode image");
-  cv::Mat grey;
-  if (mat.channels() == 1) {
-    grey = mat;
-  } else if (mat.channels() == 3) {
-    cv::cvtColor(mat, grey, cv::COLOR_BGR2GRAY);
-  } else if (mat.channels() == 4) {
-    cv::cvtColor(mat, grey, cv::COLOR_BGRA2GRAY);
-  } else {
-    return Status::Error(where + ": " + std::to_string(mat.channels()) + " channels");
-  }
-  GrayImage image;
-  image.width = grey.cols;
-  image.height = grey.rows;
-  image.pixels.resize(static_cast<size_t>(grey.cols) * static_cast<size_t>(grey.rows));
-  for (int r = 0; r < grey.rows; ++r) {
-    std::copy(grey.ptr<uint8_t>(r), grey.ptr<uint8_t>(r) + grey.cols,
-              image.pixels.begin() + static_cast<ptrdiff_t>(r) * grey.cols);
-  }
-  return image;
-}
-
 StatusOr<GrayImage> DecodeCompressed(const sensor_msgs::CompressedImage& msg,
                                      const std::string& where) {
   if (msg.data.empty()) return Status::Error(where + ": empty compressed image");
@@ -131,7 +111,7 @@ StatusOr<GrayImage> DecodeCompressed(const sensor_msgs::CompressedImage& msg,
   if (mat.empty()) {
     return Status::Error(where + ": cannot decode image (format '" + msg.format + "')");
   }
-  return ToGray(mat, where);
+  return GrayFromMat(mat, where);
 }
 
 // A raw image as an OpenCV matrix in BGR(A) or grey, after checking its size fields.
@@ -222,6 +202,7 @@ StatusOr<Dataset> ReadRosbag(const std::string& path, const BagTopics& topics) {
   d.name = fs::path(path).stem().string();
   d.folder = path;  // where it was read from; the images' references are absolute
   d.image_folder = "";
+  RATSLAM_RETURN_IF_ERROR(CheckRosbagStructure(path));
   SilenceRosLogging();
   const std::string reference = fs::absolute(path).string() + "#";
   std::vector<int64_t> image_ns, odometry_ns, truth_ns;  // stamps, exact
@@ -371,6 +352,7 @@ class BagImageReader::Impl {
       messages_.clear();
       path_.clear();
       if (!LooksLikeRosbag(path)) return Status::Error(path + ": not a ROS 1 bag");
+      RATSLAM_RETURN_IF_ERROR(CheckRosbagStructure(path));
       SilenceRosLogging();
       try {
         auto bag = std::make_unique<rosbag::Bag>();
@@ -419,7 +401,7 @@ StatusOr<GrayImage> BagImageReader::Load(const std::string& reference) {
       if (msg) {
         StatusOr<cv::Mat> mat = RawToMat(*msg, reference);
         if (!mat.ok()) return mat.status();
-        return ToGray(*mat, reference);
+        return GrayFromMat(*mat, reference);
       }
     }
   } catch (const std::exception& e) {
@@ -451,7 +433,7 @@ StatusOr<EncodedImage> BagImageReader::Encoded(const std::string& reference) {
       if (msg) {
         StatusOr<cv::Mat> mat = RawToMat(*msg, reference);
         if (!mat.ok()) return mat.status();
-        StatusOr<GrayImage> grey = ToGray(*mat, reference);
+        StatusOr<GrayImage> grey = GrayFromMat(*mat, reference);
         if (!grey.ok()) return grey.status();
         const cv::Mat g(grey->height, grey->width, CV_8U, grey->pixels.data());
         EncodedImage out;

@@ -7,8 +7,27 @@ Status ReplaceOdometryWithVisual(Dataset* dataset, ImageLoader* images,
   if (dataset->images.empty()) {
     return Status::Error(dataset->name + ": visual odometry needs images; the data set has none");
   }
-  VisualOdometry vo(options);
   std::vector<OdometryRow> rows;
+  if (options.model == "openratslam") {
+    // OpenRatSLAM publishes velocities per frame, stamped with the frame; they hold from the
+    // previous frame, as an odometry row's do.
+    OpenRatslamVisualOdometry vo(options);
+    for (const ImageRow& row : dataset->images) {
+      StatusOr<GrayImage> image = images->Load(dataset->ImagePath(row));
+      if (!image.ok()) return image.status().WithContext("image " + std::to_string(row.line));
+      StatusOr<std::optional<VisualVelocities>> v =
+          vo.Step({image->width, image->height, image->width, image->pixels.data()});
+      if (!v.ok()) return v.status().WithContext(dataset->ImagePath(row));
+      if (rows.empty()) {
+        rows.push_back({row.time_s, 0.0, 0.0});
+      } else if (v.value() && row.time_s > rows.back().time_s) {
+        rows.push_back({row.time_s, v.value()->forward_m_per_s, v.value()->turn_rate_rad_per_s});
+      }
+    }
+    dataset->odometry = std::move(rows);
+    return Status::Ok();
+  }
+  VisualOdometry vo(options);
   for (const ImageRow& row : dataset->images) {
     StatusOr<GrayImage> image = images->Load(dataset->ImagePath(row));
     if (!image.ok()) return image.status().WithContext("images.csv:" + std::to_string(row.line));
