@@ -92,6 +92,13 @@ StatusOr<std::vector<LogRow>> ReadOdometryLog(const std::string& path) {
   return rows;
 }
 
+// A file through FFmpeg, or OpenCV's own Motion-JPEG reader. Never CAP_ANY: that also probes
+// camera back ends (GStreamer, USB device lists), which leak and print.
+bool OpenFile(cv::VideoCapture& capture, const std::string& path) {
+  if (capture.open(path, cv::CAP_FFMPEG)) return true;
+  return capture.open(path, cv::CAP_OPENCV_MJPEG);
+}
+
 }  // namespace
 
 bool VideoOptions::IsValid(std::string* error) const { return schema::CheckFields(*this, error); }
@@ -128,7 +135,7 @@ StatusOr<Dataset> ReadVideo(const std::string& path, const VideoOptions& options
   cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
   cv::VideoCapture capture;
   try {
-    capture.open(path);
+    OpenFile(capture, path);
   } catch (const cv::Exception& e) {
     return Status::Error(path + ": OpenCV's video reader failed: " + e.what());
   }
@@ -207,14 +214,14 @@ StatusOr<GrayImage> VideoFrameReader::Load(const std::string& reference) {
   try {
     if (path != impl_->path || !impl_->capture.isOpened()) {
       impl_->path.clear();
-      if (!impl_->capture.open(path)) return Status::Error(path + ": cannot open the video");
+      if (!OpenFile(impl_->capture, path)) return Status::Error(path + ": cannot open the video");
       impl_->path = path;
       impl_->next = 0;
     }
     if (frame != impl_->next) {  // reading on is exact; seeking is the codec's business
       if (frame < impl_->next) {
         impl_->capture.release();
-        if (!impl_->capture.open(path)) return Status::Error(path + ": cannot open the video");
+        if (!OpenFile(impl_->capture, path)) return Status::Error(path + ": cannot open the video");
         impl_->next = 0;
       }
       while (impl_->next < frame && impl_->capture.grab()) ++impl_->next;
