@@ -570,16 +570,8 @@ StatusOr<ImportedConfig> ImportOpenRatslamIni(const std::string& path) {
     // Topics are topic_root plus fixed suffixes; odometry comes from the bag unless the file
     // configures OpenRatSLAM's visual odometry node (facts file, section 5). ROS resolves a
     // relative name under "/" and collapses "//".
-    auto topic = [](const std::string& name) {
-      std::string out = "/";
-      for (char c : name) {
-        if (c != '/' || out.back() != '/') out += c;
-      }
-      if (out.size() > 1 && out.back() == '/') out.pop_back();
-      return out;
-    };
-    o.bag.image_topic = topic(*topic_root + "/camera/image");
-    o.bag.odometry_topic = visual_odometry_section ? "" : topic(*topic_root + "/odom");
+    o.bag.image_topic = NormaliseRosTopic(*topic_root + "/camera/image");
+    o.bag.odometry_topic = visual_odometry_section ? "" : NormaliseRosTopic(*topic_root + "/odom");
     imported.notes.insert(
         imported.notes.begin() + static_cast<std::ptrdiff_t>(topic_root_note),
         topic_root_at + " (-> [bag] image_topic = \"" + o.bag.image_topic + "\"" +

@@ -15,13 +15,11 @@ FileImageLoader::~FileImageLoader() = default;
 StatusOr<GrayImage> FileImageLoader::Load(const std::string& path) {
   std::string bag;
   uint64_t message = 0;
-  if (!std::filesystem::exists(path) && ParseBagImageReference(path, &bag, &message)) {
-    return bags_->Load(path);
+  if (!std::filesystem::exists(path)) {  // then maybe a bag's message or a video's frame
+    if (ParseBagImageReference(path, &bag, &message)) return bags_->Load(path);
+    if (ParseVideoFrameReference(path, &bag, &message)) return videos_->Load(path);
+    return Status::Error(path + ": image file missing");
   }
-  if (!std::filesystem::exists(path) && ParseVideoFrameReference(path, &bag, &message)) {
-    return videos_->Load(path);
-  }
-  if (!std::filesystem::exists(path)) return Status::Error(path + ": image file missing");
   cv::Mat mat;
   try {
     mat = cv::imread(path, cv::IMREAD_GRAYSCALE);

@@ -36,17 +36,6 @@ constexpr const char* kRawImage = "sensor_msgs/Image";
 constexpr const char* kOdometry = "nav_msgs/Odometry";
 constexpr const char* kPoseStamped = "geometry_msgs/PoseStamped";
 
-// ROS resolves a relative name under "/" and collapses doubled slashes ("/newcollege//odom").
-std::string NormaliseTopic(const std::string& name) {
-  std::string out = "/";
-  for (char c : name) {
-    if (c == '/' && out.back() == '/') continue;
-    out += c;
-  }
-  if (out.size() > 1 && out.back() == '/') out.pop_back();
-  return out;
-}
-
 std::string Quoted(const std::set<std::string>& names) {
   if (names.empty()) return "none";
   std::string s;
@@ -79,7 +68,7 @@ StatusOr<std::string> ResolveTopic(const std::string& bag, const std::string& wh
     }
     return candidates.empty() ? std::string() : *candidates.begin();
   }
-  std::string name = NormaliseTopic(wanted);
+  std::string name = NormaliseRosTopic(wanted);
   if (!topic_types.count(name) && try_compressed && topic_types.count(name + "/compressed")) {
     name += "/compressed";
   }
@@ -509,7 +498,7 @@ Status WriteRosbag(const Dataset& dataset, ImageLoader* images, const BagTopics&
         msg.format = "mono8; png compressed ";
         const cv::Mat g(image->height, image->width, CV_8U, image->pixels.data());
         if (!cv::imencode(".png", g, msg.data)) return Status::Error(path + ": PNG encoding");
-        bag.write(NormaliseTopic(topics.image_topic), msg.header.stamp, msg);
+        bag.write(NormaliseRosTopic(topics.image_topic), msg.header.stamp, msg);
       } else if (e.type == EventType::kOdometry) {
         const OdometryRow& row = dataset.odometry[e.index];
         const double dt = have_last ? row.time_s - last_t : 0.0;
@@ -529,7 +518,7 @@ Status WriteRosbag(const Dataset& dataset, ImageLoader* images, const BagTopics&
         msg.pose.pose.orientation.w = std::cos(theta / 2);
         msg.twist.twist.linear.x = row.forward_speed_m_per_s;
         msg.twist.twist.angular.z = row.turn_rate_rad_per_s;
-        bag.write(NormaliseTopic(topics.odometry_topic), msg.header.stamp, msg);
+        bag.write(NormaliseRosTopic(topics.odometry_topic), msg.header.stamp, msg);
       }
     }
     if (!topics.ground_truth_topic.empty()) {
@@ -543,7 +532,7 @@ Status WriteRosbag(const Dataset& dataset, ImageLoader* images, const BagTopics&
         msg.pose.position.y = row.y_m;
         msg.pose.orientation.z = std::sin(row.theta_rad / 2);
         msg.pose.orientation.w = std::cos(row.theta_rad / 2);
-        bag.write(NormaliseTopic(topics.ground_truth_topic), msg.header.stamp, msg);
+        bag.write(NormaliseRosTopic(topics.ground_truth_topic), msg.header.stamp, msg);
       }
     }
     bag.close();

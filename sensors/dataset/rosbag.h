@@ -49,6 +49,10 @@ struct BagTopics {
 // Whether this build reads bags (librosbag-storage-dev was found at configure time).
 bool RosbagSupported();
 
+// A topic name as ROS resolves it: relative names under "/", doubled slashes collapsed
+// ("/newcollege//odom" is "/newcollege/odom"), no trailing slash.
+std::string NormaliseRosTopic(const std::string& name);
+
 // Whether the file starts like a ROS 1 bag ("#ROSBAG V2.0").
 bool LooksLikeRosbag(const std::string& path);
 

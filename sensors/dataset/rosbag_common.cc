@@ -25,6 +25,16 @@ bool BagTopics::IsValid(std::string* error) const {
   return true;
 }
 
+std::string NormaliseRosTopic(const std::string& name) {
+  std::string out = "/";
+  for (char c : name) {
+    if (c == '/' && out.back() == '/') continue;
+    out += c;
+  }
+  if (out.size() > 1 && out.back() == '/') out.pop_back();
+  return out;
+}
+
 bool LooksLikeRosbag(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   char head[13] = {};
