@@ -23,11 +23,6 @@ class ClassicCameraFrontEnd : public FrontEnd {
     d.source = d.view.is_new ? DecisionSource::kNew : DecisionSource::kCamera;
     return std::optional<FrameDecision>(d);
   }
-  StatusOr<std::optional<FrameDecision>> OnWifi(const WifiScan&) override {
-    return std::optional<FrameDecision>();
-  }
-  void OnCompass(double, double) override {}
-  std::optional<double> CompassHeading() const override { return std::nullopt; }
   bool WantsImages() const override { return true; }
   uint32_t size() const override { return matcher_.size(); }
 

@@ -51,6 +51,7 @@ class FabmapFrontEnd : public FrontEnd {
   std::optional<double> CompassHeading() const override { return std::nullopt; }
   bool WantsImages() const override { return fabmap::UsesVision(mode()); }
   uint32_t size() const override { return static_cast<uint32_t>(places_.size()); }
+  void SettleForLocalisation() override { settled_ = size(); }
   std::optional<FabmapLearningReport> fabmap_learning() const override {
     return FabmapLearningReport{
         settings_.front_end.wifi_learning,
@@ -213,7 +214,7 @@ class FabmapFrontEnd : public FrontEnd {
     if (r.best_place >= 0 && r.best_probability >= settings_.front_end.match_probability) {
       const bool old_enough =
           OldEnough(n, r.best_place, time_s, created_time_s_[r.best_place],
-                    settings_.front_end.recency_templates, settings_.front_end.recency_s);
+                    settings_.front_end.recency_templates, settings_.front_end.recency_s, settled_);
       d.view.template_id = static_cast<uint32_t>(r.best_place);
       d.view.is_new = false;
       d.recent = !old_enough;
@@ -234,6 +235,7 @@ class FabmapFrontEnd : public FrontEnd {
   std::unique_ptr<fabmap::Localiser> localiser_;
   std::vector<fabmap::Query> places_;
   std::vector<double> created_time_s_;
+  int64_t settled_ = 0;  // templates from a saved map (SettleForLocalisation)
   std::vector<WifiReading> newest_scan_;
   std::optional<double> newest_scan_time_s_;
   uint64_t scans_seen_ = 0;    // Wi-Fi scans received

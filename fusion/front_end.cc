@@ -19,6 +19,10 @@ std::string ToString(FrontEndKind kind) {
       return "fabmap";
     case FrontEndKind::kNone:
       return "none";
+    case FrontEndKind::kDescriptors:
+      return "descriptors";
+    case FrontEndKind::kCustom:
+      return "custom";
   }
   return "unknown";
 }
@@ -39,7 +43,8 @@ std::string ConfigThatFits(const Dataset& d) {
 
 Status CheckFrontEndInputs(const FrontEndSettings& settings, const Dataset& dataset) {
   const FrontEndKind kind = settings.front_end.kind;
-  bool camera = kind == FrontEndKind::kClassicCamera, wifi = false, compass = false;
+  bool camera = kind == FrontEndKind::kClassicCamera || kind == FrontEndKind::kDescriptors,
+       wifi = false, compass = false;
   if (kind == FrontEndKind::kFused) {
     camera = settings.fused.use_camera;
     wifi = settings.fused.use_wifi;
@@ -70,8 +75,10 @@ StatusOr<FrontEndKind> FrontEndKindFromString(const std::string& name) {
   if (name == "fused") return FrontEndKind::kFused;
   if (name == "fabmap") return FrontEndKind::kFabmap;
   if (name == "none") return FrontEndKind::kNone;
+  if (name == "descriptors") return FrontEndKind::kDescriptors;
+  if (name == "custom") return FrontEndKind::kCustom;
   return Status::Error("unknown front end '" + name +
-                       "' (valid: classic_camera, fused, fabmap, none)");
+                       "' (valid: classic_camera, fused, fabmap, none, descriptors, custom)");
 }
 
 bool FabmapSettings::IsValid(std::string* error) const {
@@ -116,16 +123,26 @@ bool FusedOptions::IsValid(std::string* error) const {
 }
 
 std::unique_ptr<FrontEnd> CreateFrontEnd(const FrontEndSettings& s,
-                                         std::shared_ptr<const FabmapResources> fabmap) {
+                                         const FrontEndResources& resources) {
   switch (s.front_end.kind) {
     case FrontEndKind::kClassicCamera:
       return front_end_internal::MakeClassicCameraFrontEnd(s.classic_camera);
     case FrontEndKind::kFused:
       return front_end_internal::MakeFusedFrontEnd(s.fused, s.camera_12x9, s.wifi);
     case FrontEndKind::kFabmap:
-      return front_end_internal::MakeFabmapFrontEnd(s.fabmap, std::move(fabmap));
+      return front_end_internal::MakeFabmapFrontEnd(s.fabmap, resources.fabmap);
     case FrontEndKind::kNone:
       return front_end_internal::MakeNoViewFrontEnd();
+    case FrontEndKind::kDescriptors:
+      return front_end_internal::MakeDescriptorFrontEnd(s.descriptors, resources.descriptors);
+    case FrontEndKind::kCustom: {
+      if (!resources.custom) {
+        throw std::invalid_argument("front end kind 'custom' needs a front-end factory");
+      }
+      std::unique_ptr<FrontEnd> front_end = resources.custom();
+      if (!front_end) throw std::invalid_argument("the custom front-end factory made nothing");
+      return front_end;
+    }
   }
   return nullptr;
 }

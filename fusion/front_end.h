@@ -21,15 +21,20 @@
 // templates); only both sensors below threshold make a new template.
 // Wi-Fi is evaluated at the camera rate with the newest scan; scans older than max_wifi_age_s
 // count as absent. Any sensor can be switched off (Wi-Fi only, camera only, fused).
+// kDescriptors: per-image descriptors computed elsewhere (fusion/descriptor_table.h) matched by
+// cosine similarity with min_similarity and the same recency rule; pixels are never loaded.
+// kCustom: a front end of your own (see "Writing a front end" below FrontEnd).
 #ifndef RATSLAM_FUSION_FRONT_END_H_
 #define RATSLAM_FUSION_FRONT_END_H_
 
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
 
 #include "common/schema.h"
 #include "common/status.h"
+#include "fusion/descriptor_table.h"
 #include "fusion/fabmap/localiser.h"
 #include "fusion/fabmap/visual_model.h"
 #include "fusion/fabmap/vocabulary.h"
@@ -44,7 +49,7 @@
 namespace ratslam {
 
 // kNone matches nothing: every Wi-Fi scan is a new template (Wi-Fi sequence loop closure alone).
-enum class FrontEndKind { kClassicCamera, kFused, kFabmap, kNone };
+enum class FrontEndKind { kClassicCamera, kFused, kFabmap, kNone, kDescriptors, kCustom };
 std::string ToString(FrontEndKind kind);
 // Fails with the list of valid names.
 StatusOr<FrontEndKind> FrontEndKindFromString(const std::string& name);
@@ -56,8 +61,9 @@ struct FrontEndOptions {
   template <typename Visitor>
   void VisitFields(Visitor&& v) {
     v("kind", kind,
-      "front end that decides the active local view: classic_camera, fused, fabmap or none "
-      "(every Wi-Fi scan a new template)",
+      "front end that decides the active local view: classic_camera, fused, fabmap, none "
+      "(every Wi-Fi scan a new template), descriptors (per-image vectors from a file) or custom "
+      "(a C++ front end handed to the session)",
       schema::Any());
   }
 };
@@ -169,20 +175,46 @@ struct FrameDecision {
   bool recent = false;  // a familiar but recent template: re-used, no injection, not a match
 };
 
+// Writing a front end (the extension point for C++ users; fusion/front_end_test.cc has a
+// complete example). The pipeline hands a front end every event of the data set in time order
+// and applies the decisions it returns:
+//  - Frames: return a FrameDecision from OnImage (images are your frames: WantsImages() true)
+//    or from OnWifi (scans are your frames), and nothing from the other.
+//  - A decision names a template: a new one must take the next id (size() before the call) and
+//    set view.is_new; a known one is a re-visit, whose energy is injected into the pose cells
+//    unless view.allow_injection is false (set it, and `recent`, for a familiar view that is no
+//    loop-closure evidence, such as the template just stored). view.heading_change_rad is the
+//    heading now minus the heading the template was stored with, when you know it.
+//  - EncodeState/DecodeState make maps saveable and runs resumable: encode every template and
+//    everything a later decision depends on; decoding must reject bytes it did not write
+//    (sizes, NaN) with an error, never crash. Same inputs must give the same decisions, bit for
+//    bit (randomness takes a seed from your options).
+//  - Return errors as Status; never print or exit.
+// Set [front_end] kind = "custom" and give the session (SessionEnvironment::custom_front_end) or
+// the pipeline (FrontEndResources::custom) a factory that makes a fresh front end.
 class FrontEnd {
  public:
   virtual ~FrontEnd() = default;
   // A camera image; a decision when images are frames for this front end.
   virtual StatusOr<std::optional<FrameDecision>> OnImage(double time_s, const GrayImage& image) = 0;
-  // A Wi-Fi scan; a decision when scans are frames (no camera).
-  virtual StatusOr<std::optional<FrameDecision>> OnWifi(const WifiScan& scan) = 0;
-  virtual void OnCompass(double time_s, double heading_rad) = 0;
-  // The absolute heading the spine should use, if this front end uses a compass.
-  virtual std::optional<double> CompassHeading() const = 0;
+  // A Wi-Fi scan; a decision when scans are frames (no camera). By default scans are ignored.
+  virtual StatusOr<std::optional<FrameDecision>> OnWifi(const WifiScan&) {
+    return std::optional<FrameDecision>();
+  }
+  virtual void OnCompass(double /*time_s*/, double /*heading_rad*/) {}
+  // The absolute heading the spine should use, if this front end uses a compass (default none).
+  virtual std::optional<double> CompassHeading() const { return std::nullopt; }
   virtual bool WantsImages() const = 0;
+  // False when the front end needs only an image's time (descriptors computed elsewhere): the
+  // replay then passes an empty image instead of loading the file.
+  virtual bool NeedsPixels() const { return WantsImages(); }
   virtual uint32_t size() const = 0;  // templates stored
   virtual std::string EncodeState() const = 0;
   virtual Status DecodeState(const std::string& bytes) = 0;
+  // Localisation on a saved map: the templates stored so far were made by another run on
+  // another clock, so a match to one of them is never recent. Front ends with a recency rule
+  // in seconds must honour this; the default does nothing.
+  virtual void SettleForLocalisation() {}
   // FABMAP front ends say how their Wi-Fi model was learnt; others return nothing.
   virtual std::optional<FabmapLearningReport> fabmap_learning() const { return std::nullopt; }
 };
@@ -194,6 +226,20 @@ struct FrontEndSettings {
   KernelCameraOptions camera_12x9;
   WifiMatcherOptions wifi;
   FabmapSettings fabmap;
+  DescriptorOptions descriptors;
+};
+
+// Makes a fresh front end (for kCustom); called again for every restore.
+using FrontEndFactory = std::function<std::unique_ptr<FrontEnd>()>;
+
+// What front ends are built from beyond their options, prepared once per run.
+struct FrontEndResources {
+  FrontEndResources() = default;
+  FrontEndResources(std::shared_ptr<const FabmapResources> fabmap_resources)  // NOLINT: implicit
+      : fabmap(std::move(fabmap_resources)) {}
+  std::shared_ptr<const FabmapResources> fabmap;       // kFabmap (PrepareFabmapResources)
+  std::shared_ptr<const DescriptorTable> descriptors;  // kDescriptors
+  FrontEndFactory custom;                              // kCustom
 };
 
 // The FABMAP front end's models for `dataset`: `visual` (required when the mode uses vision;
@@ -205,16 +251,17 @@ StatusOr<std::shared_ptr<const FabmapResources>> PrepareFabmapResources(
     std::optional<fabmap::TrainedVisualModel> visual);
 
 // Fails, before any work, when `dataset` lacks a stream the front end needs: images for a
-// camera (classic camera, fused use_camera, FABMAP modes with vision), Wi-Fi scans for Wi-Fi
-// (fused use_wifi, FABMAP modes with Wi-Fi), a heading stream for the compass (fused
-// use_compass). The message names the front end, the missing stream and a shipped config
+// camera (classic camera, fused use_camera, FABMAP modes with vision, descriptors), Wi-Fi
+// scans for Wi-Fi (fused use_wifi, FABMAP modes with Wi-Fi), a heading stream for the compass
+// (fused use_compass). The message names the front end, the missing stream and a shipped config
 // that fits the streams the data set has.
 Status CheckFrontEndInputs(const FrontEndSettings& settings, const Dataset& dataset);
 
-// `fabmap` is required by the kFabmap front end (it throws std::invalid_argument without it,
-// like the pipeline does for invalid options).
+// kFabmap needs resources.fabmap, kDescriptors resources.descriptors, kCustom resources.custom
+// (returning a front end); without them it throws std::invalid_argument, like the pipeline does
+// for invalid options.
 std::unique_ptr<FrontEnd> CreateFrontEnd(const FrontEndSettings& settings,
-                                         std::shared_ptr<const FabmapResources> fabmap = nullptr);
+                                         const FrontEndResources& resources = {});
 
 }  // namespace ratslam
 

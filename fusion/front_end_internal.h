@@ -26,9 +26,10 @@ inline GrayImageView ViewOf(const GrayImage& image) {
 // The recency rule of eqs. 10-11, shared by the fused and FABMAP front ends: a match to template
 // `best` of `count` counts only when it is at least `recency_templates` templates and
 // `recency_s` seconds old (made at `created_s`, now `now_s`).
+// Templates below `settled` come from a saved map (FrontEnd::SettleForLocalisation): always old.
 inline bool OldEnough(int64_t count, int64_t best, double now_s, double created_s,
-                      int recency_templates, double recency_s) {
-  return count - best >= recency_templates && now_s - created_s >= recency_s;
+                      int recency_templates, double recency_s, int64_t settled = 0) {
+  return best < settled || (count - best >= recency_templates && now_s - created_s >= recency_s);
 }
 
 std::unique_ptr<FrontEnd> MakeClassicCameraFrontEnd(const ClassicCameraOptions& options);
@@ -36,6 +37,8 @@ std::unique_ptr<FrontEnd> MakeFusedFrontEnd(const FusedOptions& options,
                                             const KernelCameraOptions& camera,
                                             const WifiMatcherOptions& wifi);
 std::unique_ptr<FrontEnd> MakeNoViewFrontEnd();
+std::unique_ptr<FrontEnd> MakeDescriptorFrontEnd(const DescriptorOptions& options,
+                                                 std::shared_ptr<const DescriptorTable> table);
 std::unique_ptr<FrontEnd> MakeFabmapFrontEnd(const FabmapSettings& settings,
                                              std::shared_ptr<const FabmapResources> resources);
 

@@ -162,7 +162,7 @@ TEST(FrontEndTest, MissingInputStreamsAreNamedWithAConfigThatFits) {
 
 TEST(FrontEndTest, KindNamesRoundTrip) {
   for (FrontEndKind k : {FrontEndKind::kClassicCamera, FrontEndKind::kFused, FrontEndKind::kFabmap,
-                         FrontEndKind::kNone}) {
+                         FrontEndKind::kNone, FrontEndKind::kDescriptors, FrontEndKind::kCustom}) {
     EXPECT_EQ(FrontEndKindFromString(ToString(k)).value(), k);
   }
   EXPECT_FALSE(FrontEndKindFromString("fab_map").ok());
@@ -233,7 +233,7 @@ TEST(FabmapFrontEndTest, SecondLapRecognisesTheFirstLapsPlaces) {
   std::string corrupt = a->EncodeState();
   corrupt.resize(corrupt.size() - 3);
   EXPECT_FALSE(b->DecodeState(corrupt).ok());
-  EXPECT_THROW(CreateFrontEnd(settings, nullptr), std::invalid_argument);
+  EXPECT_THROW(CreateFrontEnd(settings, FrontEndResources{}), std::invalid_argument);
 }
 
 TEST(FabmapFrontEndTest, VisionWithoutAModelIsAClearError) {

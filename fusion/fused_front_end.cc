@@ -47,6 +47,7 @@ class FusedFrontEnd : public FrontEnd {
   }
   bool WantsImages() const override { return options_.use_camera; }
   uint32_t size() const override { return static_cast<uint32_t>(created_time_s_.size()); }
+  void SettleForLocalisation() override { settled_ = size(); }
 
   std::string EncodeState() const override {
     ByteWriter w;
@@ -140,7 +141,7 @@ class FusedFrontEnd : public FrontEnd {
     if (best < 0 || score < threshold) return Verdict::kNovel;
     const int64_t n = static_cast<int64_t>(created_time_s_.size());
     const bool old_enough = OldEnough(n, best, time_s, created_time_s_[best],
-                                      options_.recency_templates, options_.recency_s);
+                                      options_.recency_templates, options_.recency_s, settled_);
     return old_enough ? Verdict::kMatch : Verdict::kFamiliarRecent;
   }
 
@@ -202,7 +203,8 @@ class FusedFrontEnd : public FrontEnd {
   FusedOptions options_;
   KernelCameraMatcher camera_;
   WifiFingerprintMatcher wifi_;
-  std::vector<double> created_time_s_;           // by template
+  std::vector<double> created_time_s_;  // by template
+  int64_t settled_ = 0;                 // templates from a saved map (SettleForLocalisation)
   std::vector<std::optional<double>> headings_;  // by template
   Fingerprint newest_scan_;
   std::optional<double> newest_scan_time_s_;

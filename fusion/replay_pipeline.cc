@@ -17,7 +17,9 @@ bool PipelineOptions::IsValid(std::string* error) const {
   return check(sensors.classic_camera.IsValid(&inner), "camera") &&
          check(sensors.fused.IsValid(&inner), "fused") &&
          check(sensors.camera_12x9.IsValid(&inner), "camera_12x9") &&
-         check(sensors.wifi.IsValid(&inner), "wifi") && check(pdr.IsValid(&inner), "pdr") &&
+         check(sensors.wifi.IsValid(&inner), "wifi") &&
+         check(sensors.descriptors.IsValid(&inner), "descriptors") &&
+         check(pdr.IsValid(&inner), "pdr") &&
          check(visual_odometry.IsValid(&inner), "visual_odometry") && ratslam.IsValid(error) &&
          check(wifi_sequence.IsValid(&inner), "wifi_sequence") && sensors.fabmap.IsValid(error) &&
          check(evaluation.IsValid(&inner), "evaluation") && check(bag.IsValid(&inner), "bag") &&
@@ -69,14 +71,14 @@ const PipelineOptions& Validated(const PipelineOptions& options) {
 }  // namespace
 
 ReplayPipeline::ReplayPipeline(const PipelineOptions& options, const Dataset& dataset,
-                               ImageLoader* images, std::shared_ptr<const FabmapResources> fabmap)
+                               ImageLoader* images, FrontEndResources resources)
     : options_(Validated(options)),
       dataset_(dataset),
       images_(images),
       events_(MergeEvents(dataset)),
       slam_(std::make_unique<Ratslam>(options.ratslam)),
-      fabmap_(std::move(fabmap)),
-      front_end_(CreateFrontEnd(options.sensors, fabmap_)),
+      resources_(std::move(resources)),
+      front_end_(CreateFrontEnd(options.sensors, resources_)),
       wifi_sequence_(std::make_unique<WifiSequenceLoopCloser>(options.wifi_sequence)) {
   state_.events_total = events_.size();
 }
@@ -168,6 +170,7 @@ Status ReplayPipeline::HandleImage(const Event& event) {
   }
   const ImageRow& row = dataset_.images[event.index];
   const std::string where = "images.csv:" + std::to_string(row.line);
+  if (!front_end_->NeedsPixels()) return FeedImage(row.time_s, GrayImage()).WithContext(where);
   StatusOr<GrayImage> image = images_->Load(dataset_.ImagePath(row));
   if (!image.ok()) return image.status().WithContext(where);
   return FeedImage(row.time_s, image.value()).WithContext(where + ": " + row.file);
@@ -317,7 +320,7 @@ Status ReplayPipeline::Restore(const State& state) {
   RATSLAM_RETURN_IF_ERROR(CheckRecords(state));
   auto slam = std::make_unique<Ratslam>(options_.ratslam);
   RATSLAM_RETURN_IF_ERROR(slam->SetState(state.ratslam));
-  std::unique_ptr<FrontEnd> front_end = CreateFrontEnd(options_.sensors, fabmap_);
+  std::unique_ptr<FrontEnd> front_end = CreateFrontEnd(options_.sensors, resources_);
   RATSLAM_RETURN_IF_ERROR(front_end->DecodeState(state.front_end));
   auto wifi_sequence = std::make_unique<WifiSequenceLoopCloser>(options_.wifi_sequence);
   RATSLAM_RETURN_IF_ERROR(wifi_sequence->SetState(state.wifi_sequence));
@@ -353,6 +356,7 @@ Status ReplayPipeline::AdoptMap(const State& map, double lost_after_m) {
   start.events_total = events_.size();
   RATSLAM_RETURN_IF_ERROR(Restore(start));
   slam_->FreezeMap(events_.empty() ? 0.0 : events_.front().time_s);
+  front_end_->SettleForLocalisation();
   localisation_.clear();
   lost_after_m_ = lost_after_m;
   return Status::Ok();

@@ -50,6 +50,7 @@ struct PipelineOptions {
     v("fused", sensors.fused);
     v("camera_12x9", sensors.camera_12x9);
     v("wifi", sensors.wifi);
+    v("descriptors", sensors.descriptors);
     v("pdr", pdr);
     v("visual_odometry", visual_odometry);
     v("pose_cells", ratslam.pose_cells);
@@ -114,9 +115,9 @@ class ReplayPipeline {
 
   // `options` must be valid; throws std::invalid_argument otherwise. `dataset` and `images`
   // must outlive the pipeline.
-  // The FABMAP front end also needs `fabmap` (see PrepareFabmapResources).
+  // The FABMAP, descriptor and custom front ends also need their `resources` (CreateFrontEnd).
   ReplayPipeline(const PipelineOptions& options, const Dataset& dataset, ImageLoader* images,
-                 std::shared_ptr<const FabmapResources> fabmap = nullptr);
+                 FrontEndResources resources = {});
 
   // Replays events from the current position until the data set ends, `until_time_s` passes, or
   // a stop is requested. On an error the state stays valid up to the last complete event.
@@ -175,7 +176,7 @@ class ReplayPipeline {
   ImageLoader* images_;
   std::vector<Event> events_;
   std::unique_ptr<Ratslam> slam_;
-  std::shared_ptr<const FabmapResources> fabmap_;
+  FrontEndResources resources_;
   std::unique_ptr<FrontEnd> front_end_;
   std::unique_ptr<WifiSequenceLoopCloser> wifi_sequence_;
   State state_;                                   // the parts not held by slam_ and camera_

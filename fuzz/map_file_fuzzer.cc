@@ -1,7 +1,8 @@
 // Map files: decoding never crashes; a map that decodes and is accepted by a pipeline (classic
-// camera, fused, FABMAP front end, or Wi-Fi sequence loop closure alone) runs on for a few hundred
-// events and summarises its outputs without touching an id that does not exist. The fuzzer found a
-// dangling trajectory id (Summarise) in 19 executions before restores were validated.
+// camera, fused, FABMAP front end, descriptors, or Wi-Fi sequence loop closure alone) runs on for a
+// few hundred events and summarises its outputs without touching an id that does not exist. The
+// fuzzer found a dangling trajectory id (Summarise) in 19 executions before restores were
+// validated.
 #include <cmath>
 #include <memory>
 #include <numbers>
@@ -81,7 +82,7 @@ struct Setup {
   Dataset dataset = MakeDataset();
   GeneratedImages images;
   std::vector<PipelineOptions> options;
-  std::vector<std::shared_ptr<const FabmapResources>> fabmap;
+  std::vector<FrontEndResources> resources;
 
   Setup() {
     PipelineOptions classic;
@@ -101,15 +102,28 @@ struct Setup {
     sequence.sensors.front_end.kind = FrontEndKind::kNone;
     sequence.wifi_sequence.enabled = true;
     sequence.wifi_sequence.min_loop_travel_m = 20.0;
-    options = {classic, fused, fabmap_wifi, sequence};
+    // Descriptors of the place each image shows (8 dimensions), re-matching on the second lap.
+    PipelineOptions descriptors;
+    descriptors.sensors.front_end.kind = FrontEndKind::kDescriptors;
+    descriptors.sensors.descriptors.min_similarity = 0.99;
+    options = {classic, fused, fabmap_wifi, sequence, descriptors};
+    DescriptorMatrix places{dataset.images.size(), 8, {}};
+    for (const ImageRow& image : dataset.images) {
+      const int place = std::atoi(image.file.c_str());
+      for (int k = 0; k < 8; ++k) places.values.push_back(std::cos(0.7 * place * (k + 1) + k));
+    }
     for (const PipelineOptions& o : options) {
-      fabmap.push_back(o.sensors.front_end.kind == FrontEndKind::kFabmap
-                           ? PrepareFabmapResources(o.sensors, dataset, std::nullopt).value()
-                           : nullptr);
+      FrontEndResources r;
+      if (o.sensors.front_end.kind == FrontEndKind::kFabmap) {
+        r.fabmap = PrepareFabmapResources(o.sensors, dataset, std::nullopt).value();
+      } else if (o.sensors.front_end.kind == FrontEndKind::kDescriptors) {
+        r.descriptors = DescriptorTable::Make(places, dataset, "places").value();
+      }
+      resources.push_back(r);
     }
   }
   std::unique_ptr<ReplayPipeline> Pipeline(size_t i) {
-    return std::make_unique<ReplayPipeline>(options[i], dataset, &images, fabmap[i]);
+    return std::make_unique<ReplayPipeline>(options[i], dataset, &images, resources[i]);
   }
 };
 

@@ -26,6 +26,7 @@
 #include "fusion/io/map_file.h"
 #include "fusion/io/run_outputs.h"
 #include "fusion/replay_pipeline.h"
+#include "session/evaluation_session.h"
 #include "session/replay_session.h"
 
 namespace py = pybind11;
@@ -267,6 +268,11 @@ class Session {
           "Session: the FABMAP front end learns its models from a whole data set; use "
           "ratslam.replay");
     }
+    if (options_.sensors.front_end.kind == FrontEndKind::kDescriptors ||
+        options_.sensors.front_end.kind == FrontEndKind::kCustom) {
+      throw Error("Session: the " + ToString(options_.sensors.front_end.kind) +
+                  " front end reads its inputs from a data set; use ratslam.replay");
+    }
     if (options_.visual_odometry.enabled) {
       throw Error("Session: feed odometry yourself ([visual_odometry] enabled must be false)");
     }
@@ -384,6 +390,61 @@ class Session {
   std::optional<double> last_time_s_;
 };
 
+py::dict NodeColumns(const std::vector<fabmap::EvaluationNode>& nodes) {
+  py::dict c;
+  using Node = fabmap::EvaluationNode;
+  Column<double>(&c, "time_s", nodes, [](const Node& n) { return n.time_s; });
+  Column<double>(&c, "x_m", nodes, [](const Node& n) { return n.x_m; });
+  Column<double>(&c, "y_m", nodes, [](const Node& n) { return n.y_m; });
+  Column<int32_t>(&c, "floor", nodes, [](const Node& n) { return n.floor; });
+  Column<int32_t>(&c, "session", nodes, [](const Node& n) { return n.session; });
+  return c;
+}
+
+// ratslam.evaluate: what `ratslam evaluate` does (the FABMAP localisation benchmark), into the
+// folder `out`, returning evaluation.json and the map and queries as columns.
+py::dict Evaluate(const std::string& map, const std::string& query, const std::string& out,
+                  const std::optional<Config>& config, bool lenient, bool overwrite) {
+  EvaluationSessionOptions options;
+  options.pipeline = config ? config->options() : PipelineOptions();
+  options.config_path = config ? "(from Python)" : "";
+  options.map_path = map;
+  options.query_path = query;
+  options.lenient = lenient;
+  options.provenance = {"python: ratslam.evaluate", UtcNowIso8601()};
+  OutputGuard guard = Take(OutputGuard::Begin(out, overwrite, {map, query}));
+  std::unique_ptr<DiskFolder> folder = Take(DiskFolder::Open(out));
+  EvaluationSession session(std::move(options), folder.get());
+  StatusOr<EvaluationResult> result = [&] {
+    py::gil_scoped_release release;
+    return session.Run();
+  }();
+  (void)guard.Finish(result.ok());
+  Check(result.status());
+  const EvaluationResult& r = *result;
+  py::dict run;
+  run["evaluation"] = py::module_::import("json").attr("loads")(r.json);
+  run["map"] = NodeColumns(r.map);
+  py::dict queries = NodeColumns(r.queries);
+  const auto index = [](const std::vector<int64_t>& v) {
+    py::array_t<int64_t> a(static_cast<py::ssize_t>(v.size()));
+    std::copy(v.begin(), v.end(), a.mutable_data());
+    return a;
+  };
+  const auto real = [](const std::vector<double>& v) {
+    py::array_t<double> a(static_cast<py::ssize_t>(v.size()));
+    std::copy(v.begin(), v.end(), a.mutable_data());
+    return a;
+  };
+  queries["match"] = index(r.matches);
+  queries["match_probability"] = real(r.match_probability);
+  queries["new_place_probability"] = real(r.new_place_probability);
+  queries["best_mapped_place"] = index(r.best_mapped_place);
+  queries["best_mapped_probability"] = real(r.best_mapped_probability);
+  run["queries"] = std::move(queries);
+  return run;
+}
+
 }  // namespace
 }  // namespace ratslam::python
 
@@ -410,6 +471,14 @@ PYBIND11_MODULE(ratslam, m) {
         "Replays data sets (a list of paths: one multi-session run) into folder `out`, as "
         "`ratslam replay` does. Returns {'summary': dict (summary.json), 'experiences', 'links', "
         "'trajectory', 'frames' and, when localising, 'localisation': dicts of NumPy arrays}.");
+
+  m.def("evaluate", &Evaluate, py::arg("map"), py::arg("query"), py::arg("out"),
+        py::arg("config") = std::nullopt, py::arg("lenient") = false, py::arg("overwrite") = false,
+        "The FABMAP localisation benchmark on data sets `map` and `query` (the same path: one "
+        "data set split by [evaluation]) into folder `out`, as `ratslam evaluate` does (without "
+        "its figures). Returns {'evaluation': dict (evaluation.json), 'map': columns of the "
+        "mapped places, 'queries': columns with 'match' (map index, -1: rejected as a new "
+        "place), the posteriors and the best mapped place}.");
 
   py::class_<Session>(m, "Session",
                       "A RatSLAM session fed frame by frame: odometry, grey images, Wi-Fi scans "

@@ -5,8 +5,8 @@
 #include <utility>
 
 #include "fusion/io/config.h"
+#include "fusion/io/front_end_resources.h"
 #include "fusion/io/map_file.h"
-#include "fusion/io/visual_model_file.h"
 #include "sensors/dataset/dataset_loader.h"
 #include "sensors/dataset/visual_odometry_source.h"
 
@@ -16,9 +16,11 @@ Status CheckSameConfiguration(const MapFile& map, const PipelineOptions& now) {
     StatusOr<PipelineOptions> before = ParseMapConfig(map.config, map.format_version);
     if (!before.ok()) return before.status();
     std::vector<std::string> differences = ConfigDifferences(*before, now);
-    // How a bag or a video was read says nothing about the map.
+    // How a bag or a video was read, and where a data set's descriptors are, say nothing
+    // about the map.
     std::erase_if(differences, [](const std::string& d) {
-      return d.rfind("bag.", 0) == 0 || d.rfind("video.", 0) == 0;
+      return d.rfind("bag.", 0) == 0 || d.rfind("video.", 0) == 0 ||
+             d.rfind("descriptors.file:", 0) == 0;
     });
     if (differences.empty()) return Status::Ok();
     std::string keys;
@@ -88,14 +90,19 @@ Status ReplaySession::Load() {
 
 Status ReplaySession::Prepare() {
   if (!dataset_) return Status::Error("replay session: Prepare before Load");
-  std::shared_ptr<const FabmapResources> fabmap;
-  if (options_.pipeline.sensors.front_end.kind == FrontEndKind::kFabmap) {
-    auto prepared = LoadFabmapResources(options_.pipeline.sensors, *dataset_, *env_.images);
-    if (!prepared.ok()) return prepared.status().WithContext("FABMAP front end");
-    fabmap = *prepared;
+  StatusOr<FrontEndResources> resources =
+      LoadFrontEndResources(options_.pipeline.sensors, options_.data, *dataset_, *env_.images);
+  if (!resources.ok()) return resources.status();
+  if (options_.pipeline.sensors.front_end.kind == FrontEndKind::kCustom) {
+    if (!env_.custom_front_end) {
+      return Status::Error(
+          "front_end.kind is custom, but no front end was given (a C++ program passes its "
+          "factory as SessionEnvironment::custom_front_end)");
+    }
+    resources->custom = env_.custom_front_end;
   }
   auto pipeline = std::make_unique<ReplayPipeline>(options_.pipeline, *dataset_, env_.images,
-                                                   std::move(fabmap));
+                                                   std::move(resources).value());
   if (!options_.load_map.empty()) {
     const std::string& path = options_.load_map;
     StatusOr<MapFile> map = LoadMapFile(path);

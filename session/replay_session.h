@@ -54,6 +54,9 @@ struct SessionEnvironment {
   ProgressSink* progress = nullptr;
   ImageLoader* images = nullptr;
   const std::atomic<bool>* stop_requested = nullptr;  // checked between events
+  // [front_end] kind = "custom": makes the run's front end (fusion/front_end.h, "Writing a
+  // front end"); called again for each restore.
+  FrontEndFactory custom_front_end;
 };
 
 // Called every `every` events with the pipeline (read only), e.g. to draw animation frames; an

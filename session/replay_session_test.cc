@@ -77,7 +77,7 @@ TEST_F(ReplaySessionTest, RunsEveryStageAndReportsThroughTheEnvironment) {
   MemoryFolder out("mem");
   FakeClock clock;
   RecordingProgress progress;
-  ReplaySession session(Options(), {&out, &clock, &progress, nullptr, nullptr});
+  ReplaySession session(Options(), {&out, &clock, &progress, nullptr, nullptr, {}});
   StatusOr<ReplayResult> result = session.Run();
   ASSERT_TRUE(result.ok()) << result.status().message();
   EXPECT_TRUE(result->ok());
@@ -108,7 +108,7 @@ TEST_F(ReplaySessionTest, OutputFailureStillSavesTheMap) {
   ReplaySessionOptions options = Options();
   options.until_s = 30.0;
   options.save_map = (dir_->path() / "elsewhere.map").string();
-  ReplaySession session(options, {&out, nullptr, nullptr, nullptr, nullptr});
+  ReplaySession session(options, {&out, nullptr, nullptr, nullptr, nullptr, {}});
   StatusOr<ReplayResult> result = session.Run();
   ASSERT_TRUE(result.ok());
   EXPECT_TRUE(result->replay.ok());
@@ -129,7 +129,7 @@ TEST_F(ReplaySessionTest, OutputFailureWithoutSaveMapSavesInterruptedMap) {
   out.refuse = {"summary.json"};
   ReplaySessionOptions options = Options();
   options.until_s = 20.0;
-  ReplaySession session(options, {&out, nullptr, nullptr, nullptr, nullptr});
+  ReplaySession session(options, {&out, nullptr, nullptr, nullptr, nullptr, {}});
   StatusOr<ReplayResult> result = session.Run();
   ASSERT_TRUE(result.ok());
   EXPECT_FALSE(result->outputs.ok());
@@ -141,7 +141,7 @@ TEST_F(ReplaySessionTest, StopRequestInterruptsAndSavesState) {
   MemoryFolder out((dir_->path() / "stopped").string());
   fs::create_directories(dir_->path() / "stopped");
   std::atomic<bool> stop{false};
-  ReplaySession session(Options(), {&out, nullptr, nullptr, nullptr, &stop});
+  ReplaySession session(Options(), {&out, nullptr, nullptr, nullptr, &stop, {}});
   ReplayCheckpoint checkpoint;
   checkpoint.every = 100;
   checkpoint.callback = [&stop](const ReplayPipeline&) {
@@ -163,13 +163,13 @@ TEST_F(ReplaySessionTest, LoadAndPrepareErrorsAreReturnedBeforeAnythingRuns) {
   MemoryFolder out("mem");
   ReplaySessionOptions missing = Options();
   missing.data = {(dir_->path() / "no-such-data").string()};
-  ReplaySession a(missing, {&out, nullptr, nullptr, nullptr, nullptr});
+  ReplaySession a(missing, {&out, nullptr, nullptr, nullptr, nullptr, {}});
   EXPECT_FALSE(a.Run().ok());
   EXPECT_TRUE(out.written.empty());
 
   ReplaySessionOptions wrong_map = Options();
   wrong_map.load_map = (dir_->path() / "no-such.map").string();
-  ReplaySession b(wrong_map, {&out, nullptr, nullptr, nullptr, nullptr});
+  ReplaySession b(wrong_map, {&out, nullptr, nullptr, nullptr, nullptr, {}});
   const StatusOr<ReplayResult> result = b.Run();
   ASSERT_FALSE(result.ok());
   EXPECT_NE(result.status().message().find("no-such.map"), std::string::npos);
@@ -182,12 +182,12 @@ TEST_F(ReplaySessionTest, ResumeChecksConfigurationAndDataSet) {
   ReplaySessionOptions first = Options();
   first.until_s = 10.0;
   first.save_map = (dir_->path() / "first.map").string();
-  ReplaySession a(first, {&out, nullptr, nullptr, nullptr, nullptr});
+  ReplaySession a(first, {&out, nullptr, nullptr, nullptr, nullptr, {}});
   ASSERT_TRUE(a.Run().ok());
   ReplaySessionOptions other = Options();
   other.pipeline.sensors.classic_camera.match_threshold = 0.07;
   other.load_map = first.save_map;
-  ReplaySession b(other, {&out, nullptr, nullptr, nullptr, nullptr});
+  ReplaySession b(other, {&out, nullptr, nullptr, nullptr, nullptr, {}});
   const StatusOr<ReplayResult> refused = b.Run();
   ASSERT_FALSE(refused.ok());
   // The map carries its configuration (format 3): the error names the key and both values.
@@ -195,6 +195,56 @@ TEST_F(ReplaySessionTest, ResumeChecksConfigurationAndDataSet) {
   EXPECT_NE(refused.status().message().find("camera.match_threshold: 0.06 -> 0.07"),
             std::string::npos)
       << refused.status().message();
+}
+
+// A front end of the caller's own: every image a new place (the smallest valid front end; a
+// useful one is in fusion/custom_front_end_test.cc).
+class EveryImageNew : public FrontEnd {
+ public:
+  StatusOr<std::optional<FrameDecision>> OnImage(double time_s, const GrayImage&) override {
+    FrameDecision d;
+    d.view.time_s = time_s;
+    d.view.template_id = count_++;
+    d.view.is_new = true;
+    return std::optional<FrameDecision>(d);
+  }
+  bool WantsImages() const override { return true; }
+  uint32_t size() const override { return count_; }
+  std::string EncodeState() const override { return std::to_string(count_); }
+  Status DecodeState(const std::string& bytes) override {
+    count_ = static_cast<uint32_t>(std::stoul(bytes));
+    return Status::Ok();
+  }
+
+ private:
+  uint32_t count_ = 0;
+};
+
+// kind = "custom" runs the session's factory; without one the session says how to give it.
+TEST_F(ReplaySessionTest, CustomFrontEndComesFromTheEnvironment) {
+  MemoryFolder out("mem");
+  ReplaySessionOptions options = Options();
+  options.pipeline.sensors.front_end.kind = FrontEndKind::kCustom;
+  options.until_s = 10.0;
+  ReplaySession without(options, {&out, nullptr, nullptr, nullptr, nullptr, {}});
+  const StatusOr<ReplayResult> refused = without.Run();
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.status().message().find("SessionEnvironment::custom_front_end"),
+            std::string::npos)
+      << refused.status().message();
+  int made = 0;
+  FrontEndFactory factory = [&made] {
+    ++made;
+    return std::make_unique<EveryImageNew>();
+  };
+  ReplaySession with(options, {&out, nullptr, nullptr, nullptr, nullptr, factory});
+  const StatusOr<ReplayResult> result = with.Run();
+  ASSERT_TRUE(result.ok()) << result.status().message();
+  EXPECT_EQ(made, 1);
+  const nlohmann::json s = nlohmann::json::parse(out.written.at("summary.json"));
+  EXPECT_GT(s["frames"].get<int>(), 50);
+  EXPECT_EQ(s["templates"].get<int>(), s["frames"].get<int>());
+  EXPECT_EQ(s["loop_closures"].get<int>(), 0);
 }
 
 }  // namespace

@@ -285,6 +285,7 @@ constexpr AddedSection kSectionsAddedAfter[] = {
     {5, "wifi_sequence"},
     {7, "bag"},
     {7, "video"},
+    {7, "descriptors"},
 };
 
 }  // namespace

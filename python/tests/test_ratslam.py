@@ -204,5 +204,72 @@ class RatslamModuleTest(unittest.TestCase):
             ratslam.Session(fabmap)
 
 
+    def test_descriptors_saved_by_numpy_drive_the_descriptor_front_end(self):
+        """Descriptors computed in NumPy (random Fourier features of the true position, whose
+        cosine similarity is about exp(-d^2 / 2) for places d metres apart) replace the images:
+        the folder keeps no image, numpy.save and numpy.savetxt files give the same map, and
+        every match is a true re-visit."""
+        data = os.path.join(self.root, "descriptor_data")
+        os.makedirs(data, exist_ok=True)
+        for name in os.listdir(self.data):
+            if name.endswith(".csv") or name.endswith(".toml"):
+                shutil.copy(os.path.join(self.data, name), data)
+        images = read_csv(os.path.join(data, "images.csv"))
+        truth = read_csv(os.path.join(data, "ground_truth.csv"))
+        t = np.array([float(r["time_s"]) for r in images])
+        gt_t = np.array([float(r["time_s"]) for r in truth])
+        x = np.interp(t, gt_t, [float(r["x_m"]) for r in truth])
+        y = np.interp(t, gt_t, [float(r["y_m"]) for r in truth])
+        rng = np.random.default_rng(5)
+        w = rng.normal(size=(2, 128))
+        phase = rng.uniform(0, 2 * np.pi, size=128)
+        descriptors = np.cos(np.outer(x, w[0]) + np.outer(y, w[1]) + phase)
+        descriptors += 0.05 * rng.normal(size=descriptors.shape)
+        np.save(os.path.join(data, "descriptors.npy"), np.asfortranarray(descriptors))
+        np.savetxt(os.path.join(data, "descriptors.csv"), descriptors, delimiter=",")
+        config = ratslam.Config.load(SYNTHETIC_CONFIG)
+        config.set("front_end.kind", "descriptors")
+        config.set("descriptors.min_similarity", 0.92)
+        run = ratslam.replay([data], os.path.join(self.root, "descriptors_npy"), config=config)
+        s = run["summary"]
+        self.assertEqual(s["frames"], len(images))
+        self.assertGreater(s["loop_closures"], 5)
+        self.assertGreater(s["matches"], 100)
+        self.assertGreaterEqual(s["match_rate_within_m"]["2"], 0.99)
+        self.assertLess(s["map_ate_m"], 0.3 * s["odometry_ate_m"])
+        config.set("descriptors.file", "descriptors.csv")
+        from_csv = ratslam.replay([data], os.path.join(self.root, "descriptors_csv"), config=config)
+        np.testing.assert_array_equal(from_csv["experiences"]["x_m"], run["experiences"]["x_m"])
+        # One row short: the error names the file and both counts.
+        np.save(os.path.join(data, "short.npy"), descriptors[:-1].astype(np.float32))
+        config.set("descriptors.file", "short.npy")
+        with self.assertRaisesRegex(ratslam.Error, f"short.npy: {len(images) - 1} descriptors"):
+            ratslam.replay([data], os.path.join(self.root, "descriptors_short"), config=config)
+
+    def test_evaluate_equals_the_command_line(self):
+        data = os.path.join(SOURCE, "..", "shared", "data", "msft-ilc20-site1")
+        if not os.path.isdir(data):
+            self.skipTest(f"missing {data}")
+        config = os.path.join(SOURCE, "configs", "msft-ilc20-wifi.toml")
+        cli = os.path.join(self.root, "evaluate_cli")
+        subprocess.run([BINARY, "evaluate", "--quiet", "--config", config, "--map", data,
+                        "--query", data, "--out", cli], check=True, capture_output=True)
+        out = os.path.join(self.root, "evaluate_py")
+        result = ratslam.evaluate(data, data, out, config=ratslam.Config.load(config))
+        with open(os.path.join(cli, "evaluation.json")) as f:
+            expected = json.load(f)
+        got = result["evaluation"]
+        for key in ("mode", "map_nodes", "queries", "correct_within_m", "misplaced_beyond_m",
+                    "rejection_rate", "floor_mistake_rate", "baselines", "wifi_words"):
+            self.assertEqual(got[key], expected[key], key)
+        rows = read_csv(os.path.join(cli, "queries.csv"))
+        np.testing.assert_array_equal(result["queries"]["match"],
+                                      [int(r["match"]) if r["match"] else -1 for r in rows])
+        np.testing.assert_array_equal(result["queries"]["x_m"], [float(r["x_m"]) for r in rows])
+        self.assertEqual(len(result["map"]["x_m"]), expected["map_nodes"])
+        with self.assertRaisesRegex(ratslam.Error, "overwrite"):
+            ratslam.evaluate(data, data, out, config=ratslam.Config.load(config))
+
+
 if __name__ == "__main__":
     unittest.main()

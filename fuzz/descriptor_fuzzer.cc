@@ -1,0 +1,80 @@
+// Descriptor files (.npy or CSV; the first byte chooses): any bytes parse to a matrix or an error
+// naming the file; an accepted matrix has rows * cols finite values, survives a write and read
+// back bit for bit, and drives the descriptor front end over a data set of as many images,
+// whose state then round-trips.
+#include <cmath>
+#include <cstring>
+#include <string>
+
+#include "fusion/front_end.h"
+#include "fuzz/fuzz_support.h"
+#include "sensors/dataset/descriptor_file.h"
+
+namespace ratslam::fuzz {
+
+std::vector<std::string> FuzzSeeds() {
+  DescriptorMatrix m{3, 4, {1, 2, 3, 4, 0.5f, -1, 2, 0, 1, 2, 3, 4.5f}};
+  const std::string path = (Scratch().path() / "seed.npy").string();
+  (void)WriteDescriptorNpy(m, path);
+  std::string npy = "n";
+  {
+    std::FILE* f = std::fopen(path.c_str(), "rb");
+    char buffer[4096];
+    size_t n = 0;
+    while (f && (n = std::fread(buffer, 1, sizeof buffer, f)) > 0) npy.append(buffer, n);
+    if (f) std::fclose(f);
+  }
+  return {npy, "c1,2,3\n4,5,6\n1,2,3.5\n", "cd0,d1\n0.25,-1e-3\n7,8\n"};
+}
+
+}  // namespace ratslam::fuzz
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  using namespace ratslam;
+  if (size == 0) return 0;
+  const bool npy = data[0] == 'n';
+  const std::string bytes(reinterpret_cast<const char*>(data) + 1, size - 1);
+  StatusOr<DescriptorMatrix> m = ParseDescriptors(bytes, "fuzz.desc", npy);
+  if (!m.ok()) {
+    if (m.status().message().find("fuzz.desc") == std::string::npos) {
+      fuzz::InvariantFailed("an error that does not name the file");
+    }
+    return 0;
+  }
+  if (m->rows == 0 || m->cols == 0 || m->values.size() != m->rows * m->cols) {
+    fuzz::InvariantFailed("matrix size");
+  }
+  for (float v : m->values) {
+    if (!std::isfinite(v)) fuzz::InvariantFailed("a non-finite value was accepted");
+  }
+  const std::string path = (fuzz::Scratch().path() / "round.npy").string();
+  if (!WriteDescriptorNpy(*m, path).ok()) fuzz::InvariantFailed("write failed");
+  StatusOr<DescriptorMatrix> back = ReadDescriptorFile(path);
+  if (!back.ok() || back->rows != m->rows || back->cols != m->cols ||
+      std::memcmp(back->values.data(), m->values.data(), 4 * m->values.size()) != 0) {
+    fuzz::InvariantFailed("npy round trip");
+  }
+  if (m->rows > 200 || m->cols > 64) return 0;  // the front end on small matrices only
+  Dataset dataset;
+  dataset.name = "fuzz";
+  for (size_t i = 0; i < m->rows; ++i) dataset.images.push_back({static_cast<double>(i), "x", 0});
+  auto table = DescriptorTable::Make(*m, dataset, "fuzz.desc");
+  if (!table.ok()) return 0;  // a zero row
+  FrontEndSettings settings;
+  settings.front_end.kind = FrontEndKind::kDescriptors;
+  settings.descriptors.recency_s = 1.5;
+  FrontEndResources resources;
+  resources.descriptors = *table;
+  auto front_end = CreateFrontEnd(settings, resources);
+  for (const ImageRow& image : dataset.images) {
+    auto d = front_end->OnImage(image.time_s, GrayImage());
+    if (!d.ok() || !d.value()) fuzz::InvariantFailed("a known image was refused");
+    if (d.value()->view.template_id > front_end->size()) fuzz::InvariantFailed("template id");
+  }
+  auto copy = CreateFrontEnd(settings, resources);
+  if (!copy->DecodeState(front_end->EncodeState()).ok() ||
+      copy->EncodeState() != front_end->EncodeState()) {
+    fuzz::InvariantFailed("state round trip");
+  }
+  return 0;
+}
