@@ -186,10 +186,44 @@ TEST(DescriptorFrontEndTest, OptionsAreValidatedAndKindsParse) {
   EXPECT_EQ(FrontEndKindFromString("descriptors").value(), FrontEndKind::kDescriptors);
   EXPECT_EQ(FrontEndKindFromString("custom").value(), FrontEndKind::kCustom);
   FrontEndSettings settings;
-  settings.front_end.kind = FrontEndKind::kDescriptors;
-  EXPECT_THROW(CreateFrontEnd(settings), std::invalid_argument);
   settings.front_end.kind = FrontEndKind::kCustom;
   EXPECT_THROW(CreateFrontEnd(settings), std::invalid_argument);
+}
+
+// Without a file the front end takes descriptors fed one by one (a live source, Python) and
+// decides exactly as from a file; images then say where their descriptors should come from.
+TEST(DescriptorFrontEndTest, FedDescriptorsDecideAsTheFileDoes) {
+  const std::vector<std::vector<float>> rows = {{1, 2, 3}, {3, 2, 1},    {1.1f, 2, 3},
+                                                {0, 0, 1}, {3, 2.2f, 1}, {-1, 0, 0}};
+  DescriptorOptions options;
+  options.recency_s = 1.5;
+  auto from_file = FrontEndFor(Make(rows), options);
+  FrontEndSettings settings;
+  settings.front_end.kind = FrontEndKind::kDescriptors;
+  settings.descriptors = options;
+  auto fed = CreateFrontEnd(settings);
+  const Status no_file = fed->OnImage(0, GrayImage()).status();
+  EXPECT_NE(no_file.message().find("no descriptor file"), std::string::npos) << no_file.message();
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const FrameDecision a = Frame(*from_file, static_cast<double>(i));
+    auto b = fed->OnDescriptor(static_cast<double>(i), rows[i]);
+    ASSERT_TRUE(b.ok()) << b.status().message();
+    EXPECT_EQ(a.view.template_id, b.value()->view.template_id) << i;
+    EXPECT_EQ(a.view.is_new, b.value()->view.is_new) << i;
+    EXPECT_EQ(a.recent, b.value()->recent) << i;
+  }
+  EXPECT_EQ(fed->EncodeState(), from_file->EncodeState());
+  EXPECT_FALSE(fed->OnDescriptor(9, {1, 2}).ok());  // another dimension
+  EXPECT_FALSE(fed->OnDescriptor(9, {0, 0, 0}).ok());
+  EXPECT_FALSE(fed->OnDescriptor(9, {1, NAN, 0}).ok());
+  // A map saved from a file-fed run continues in a fed one (which adopts its dimension).
+  auto continued = CreateFrontEnd(settings);
+  ASSERT_TRUE(continued->DecodeState(from_file->EncodeState()).ok());
+  EXPECT_FALSE(continued->OnDescriptor(10, {1, 0}).ok());
+  EXPECT_EQ(continued->OnDescriptor(10, {1, 2, 3}).value()->view.template_id, 0u);
+  // Other front ends take no descriptors.
+  FrontEndSettings classic;
+  EXPECT_FALSE(CreateFrontEnd(classic)->OnDescriptor(0, {1}).ok());
 }
 
 }  // namespace

@@ -48,6 +48,7 @@
 
 namespace ratslam {
 
+// kDescriptors without a table takes its descriptors from FrontEnd::OnDescriptor only.
 // kNone matches nothing: every Wi-Fi scan is a new template (Wi-Fi sequence loop closure alone).
 enum class FrontEndKind { kClassicCamera, kFused, kFabmap, kNone, kDescriptors, kCustom };
 std::string ToString(FrontEndKind kind);
@@ -202,6 +203,14 @@ class FrontEnd {
     return std::optional<FrameDecision>();
   }
   virtual void OnCompass(double /*time_s*/, double /*heading_rad*/) {}
+  // A place descriptor computed outside this program for the frame at `time_s` (a live
+  // source, or Python's frame-by-frame session); only the descriptor front end takes them.
+  virtual StatusOr<std::optional<FrameDecision>> OnDescriptor(
+      double /*time_s*/, const std::vector<float>& /*values*/) {
+    return Status::Error(
+        "this front end takes no descriptors (set [front_end] kind = "
+        "\"descriptors\")");
+  }
   // The absolute heading the spine should use, if this front end uses a compass (default none).
   virtual std::optional<double> CompassHeading() const { return std::nullopt; }
   virtual bool WantsImages() const = 0;
@@ -257,7 +266,7 @@ StatusOr<std::shared_ptr<const FabmapResources>> PrepareFabmapResources(
 // that fits the streams the data set has.
 Status CheckFrontEndInputs(const FrontEndSettings& settings, const Dataset& dataset);
 
-// kFabmap needs resources.fabmap, kDescriptors resources.descriptors, kCustom resources.custom
+// kFabmap needs resources.fabmap and kCustom resources.custom
 // (returning a front end); without them it throws std::invalid_argument, like the pipeline does
 // for invalid options.
 std::unique_ptr<FrontEnd> CreateFrontEnd(const FrontEndSettings& settings,

@@ -186,6 +186,12 @@ Status ReplayPipeline::FeedImage(double time_s, const GrayImage& image) {
   return decision.value() ? Apply(*decision.value()) : Status::Ok();
 }
 
+Status ReplayPipeline::FeedDescriptor(double time_s, const std::vector<float>& values) {
+  StatusOr<std::optional<FrameDecision>> decision = front_end_->OnDescriptor(time_s, values);
+  if (!decision.ok()) return decision.status();
+  return decision.value() ? Apply(*decision.value()) : Status::Ok();
+}
+
 void ReplayPipeline::FeedCompass(const CompassRow& row) {
   ++state_.compass_readings_seen;
   front_end_->OnCompass(row.time_s, row.heading_rad);

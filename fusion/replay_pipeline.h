@@ -129,6 +129,8 @@ class ReplayPipeline {
   Status FeedOdometry(const OdometryRow& row);
   Status FeedImage(double time_s, const GrayImage& image);
   Status FeedWifi(const WifiScan& scan);
+  // A place descriptor for the frame at `time_s` (the descriptor front end only).
+  Status FeedDescriptor(double time_s, const std::vector<float>& values);
   void FeedCompass(const CompassRow& row);
 
   bool finished() const { return state_.next_event >= events_.size(); }

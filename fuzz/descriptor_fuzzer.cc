@@ -1,7 +1,7 @@
 // Descriptor files (.npy or CSV; the first byte chooses): any bytes parse to a matrix or an error
 // naming the file; an accepted matrix has rows * cols finite values, survives a write and read
-// back bit for bit, and drives the descriptor front end over a data set of as many images,
-// whose state then round-trips.
+// back bit for bit, and drives the descriptor front end over a data set of as many images (the
+// same state as feeding the rows one by one), whose state then round-trips.
 #include <cmath>
 #include <cstring>
 #include <string>
@@ -71,6 +71,16 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (!d.ok() || !d.value()) fuzz::InvariantFailed("a known image was refused");
     if (d.value()->view.template_id > front_end->size()) fuzz::InvariantFailed("template id");
   }
+  // Fed one by one without the table, the same rows make the same state.
+  auto fed = CreateFrontEnd(settings);
+  for (size_t i = 0; i < m->rows; ++i) {
+    const std::vector<float> row(m->values.begin() + static_cast<ptrdiff_t>(i * m->cols),
+                                 m->values.begin() + static_cast<ptrdiff_t>((i + 1) * m->cols));
+    if (!fed->OnDescriptor(dataset.images[i].time_s, row).ok()) {
+      fuzz::InvariantFailed("a fed row was refused");
+    }
+  }
+  if (fed->EncodeState() != front_end->EncodeState()) fuzz::InvariantFailed("fed state differs");
   auto copy = CreateFrontEnd(settings, resources);
   if (!copy->DecodeState(front_end->EncodeState()).ok() ||
       copy->EncodeState() != front_end->EncodeState()) {

@@ -268,10 +268,8 @@ class Session {
           "Session: the FABMAP front end learns its models from a whole data set; use "
           "ratslam.replay");
     }
-    if (options_.sensors.front_end.kind == FrontEndKind::kDescriptors ||
-        options_.sensors.front_end.kind == FrontEndKind::kCustom) {
-      throw Error("Session: the " + ToString(options_.sensors.front_end.kind) +
-                  " front end reads its inputs from a data set; use ratslam.replay");
+    if (options_.sensors.front_end.kind == FrontEndKind::kCustom) {
+      throw Error("Session: a custom front end is a C++ factory; use ratslam.replay from C++");
     }
     if (options_.visual_odometry.enabled) {
       throw Error("Session: feed odometry yourself ([visual_odometry] enabled must be false)");
@@ -315,6 +313,16 @@ class Session {
     image.width = static_cast<int>(pixels.shape(1));
     image.pixels.assign(pixels.data(), pixels.data() + pixels.size());
     Check(pipeline_->FeedImage(time_s, image).WithContext("image at t=" + std::to_string(time_s)));
+  }
+  void Descriptor(double time_s,
+                  const py::array_t<float, py::array::c_style | py::array::forcecast>& values) {
+    if (values.ndim() != 1 || values.shape(0) < 1) {
+      throw Error("descriptor: expected a 1-D array of floats");
+    }
+    Advance(time_s);
+    const std::vector<float> v(values.data(), values.data() + values.size());
+    Check(pipeline_->FeedDescriptor(time_s, v).WithContext("descriptor at t=" +
+                                                           std::to_string(time_s)));
   }
   void Wifi(double time_s, const std::map<std::string, double>& readings) {
     Advance(time_s);
@@ -496,6 +504,9 @@ PYBIND11_MODULE(ratslam, m) {
       .def("wifi", &Session::Wifi, py::arg("time_s"), py::arg("readings"),
            "A Wi-Fi scan: {bssid: rssi_dbm}.")
       .def("compass", &Session::Compass, py::arg("time_s"), py::arg("heading_rad"))
+      .def("descriptor", &Session::Descriptor, py::arg("time_s"), py::arg("values"),
+           "A place descriptor for the frame at time_s (front_end.kind = \"descriptors\"): a "
+           "1-D float array, compared by cosine similarity.")
       .def("save_map", &Session::SaveMap, py::arg("path"))
       .def("summary", &Session::Summary)
       .def_property_readonly("current_experience", &Session::CurrentExperience)

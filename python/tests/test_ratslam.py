@@ -198,6 +198,8 @@ class RatslamModuleTest(unittest.TestCase):
             session.odometry(3.0, float("nan"), 0.0)
         with self.assertRaisesRegex(ratslam.Error, "finite"):
             session.wifi(4.0, {"aa:bb": float("inf")})
+        with self.assertRaisesRegex(ratslam.Error, "takes no descriptors"):
+            session.descriptor(5.0, np.ones(4))
         fabmap = ratslam.Config()
         fabmap.set("front_end.kind", "fabmap")
         with self.assertRaisesRegex(ratslam.Error, "FABMAP"):
@@ -240,6 +242,21 @@ class RatslamModuleTest(unittest.TestCase):
         config.set("descriptors.file", "descriptors.csv")
         from_csv = ratslam.replay([data], os.path.join(self.root, "descriptors_csv"), config=config)
         np.testing.assert_array_equal(from_csv["experiences"]["x_m"], run["experiences"]["x_m"])
+        # Fed frame by frame (at equal times the frame before the odometry, as the replay).
+        session = ratslam.Session(config)
+        odometry = read_csv(os.path.join(data, "odometry.csv"))
+        events = [(t[i], 0, i) for i in range(len(images))] + \
+                 [(float(r["time_s"]), 1, r) for r in odometry]
+        events.sort(key=lambda e: (e[0], e[1]))
+        for time_s, kind, item in events:
+            if kind == 0:
+                session.descriptor(time_s, descriptors[item])
+            else:
+                session.odometry(time_s, float(item["forward_speed_m_per_s"]),
+                                 float(item["turn_rate_rad_per_s"]))
+        np.testing.assert_array_equal(session.experiences()["x_m"], run["experiences"]["x_m"])
+        with self.assertRaisesRegex(ratslam.Error, "dimensions"):
+            session.descriptor(events[-1][0] + 1.0, np.ones(3))
         # One row short: the error names the file and both counts.
         np.save(os.path.join(data, "short.npy"), descriptors[:-1].astype(np.float32))
         config.set("descriptors.file", "short.npy")

@@ -94,7 +94,15 @@ StatusOr<std::vector<LogRow>> ReadOdometryLog(const std::string& path) {
 
 // A file through FFmpeg, or OpenCV's own Motion-JPEG reader. Never CAP_ANY: that also probes
 // camera back ends (GStreamer, USB device lists), which leak and print.
+// OpenCV's warnings about the back ends it tried go to stderr (the callers' errors say enough);
+// they are silenced only while opening, and the caller's log level is restored.
 bool OpenFile(cv::VideoCapture& capture, const std::string& path) {
+  const cv::utils::logging::LogLevel before =
+      cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
+  struct Restore {
+    cv::utils::logging::LogLevel level;
+    ~Restore() { cv::utils::logging::setLogLevel(level); }
+  } restore{before};
   if (capture.open(path, cv::CAP_FFMPEG)) return true;
   return capture.open(path, cv::CAP_OPENCV_MJPEG);
 }
@@ -131,8 +139,6 @@ StatusOr<Dataset> ReadVideo(const std::string& path, const VideoOptions& options
   std::string error;
   if (!options.IsValid(&error)) return Status::Error("video." + error);
   if (!fs::is_regular_file(path)) return Status::Error(path + ": not a file");
-  // OpenCV's warnings about backends it tried go to stderr; the error below says enough.
-  cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
   cv::VideoCapture capture;
   try {
     OpenFile(capture, path);

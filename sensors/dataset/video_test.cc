@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <opencv2/core.hpp>
+#include <opencv2/core/utils/logger.hpp>
 #include <opencv2/videoio.hpp>
 
 #include "sensors/dataset/dataset_loader.h"
@@ -87,6 +88,19 @@ TEST_F(VideoTest, WithoutALogFramesFollowTheFrameRate) {
   d = ReadVideo(Path("log_irat.avi"), options);
   ASSERT_TRUE(d.ok()) << d.status().message();
   EXPECT_NEAR(d->images[3].time_s, 3 / 20.0, 1e-12);
+}
+
+// Reading a video silences OpenCV only while it opens the file: the program's own OpenCV log
+// level is left as it was, after a good file and after one OpenCV cannot open.
+TEST_F(VideoTest, OpenCvLogLevelIsRestored) {
+  namespace logging = cv::utils::logging;
+  const logging::LogLevel before = logging::setLogLevel(logging::LOG_LEVEL_INFO);
+  ASSERT_TRUE(ReadVideo(Path("log_irat.avi"), {}).ok());
+  EXPECT_EQ(logging::getLogLevel(), logging::LOG_LEVEL_INFO);
+  std::ofstream(Path("not_a_video.avi")) << "not a video";
+  EXPECT_FALSE(ReadVideo(Path("not_a_video.avi"), {}).ok());
+  EXPECT_EQ(logging::getLogLevel(), logging::LOG_LEVEL_INFO);
+  logging::setLogLevel(before);
 }
 
 TEST_F(VideoTest, BadLogsAndFilesAreErrorsNamingFileLineAndColumn) {
