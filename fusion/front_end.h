@@ -76,6 +76,14 @@ struct FusedOptions {
   int recency_templates = 0;    // k: a match must be at least this many templates old
   double recency_s = 40.0;      // k: and at least this many seconds old (paper: 40 s)
   double max_wifi_age_s = 5.0;  // an older newest scan counts as absent
+  // Per-device RSSI offset, estimated online: each scan of a later session is compared with the
+  // earlier sessions' templates by the spread of its RSSI differences (a constant offset costs
+  // nothing there); the median difference to the best one is an estimate, and once there are
+  // rssi_offset_min_estimates of them their median is removed from the session's scans (in
+  // matching and in the templates it stores). No ground truth, no per-phone constant.
+  bool online_rssi_offset = false;
+  int rssi_offset_min_common_aps = 5;  // an estimate needs this many APs in common
+  int rssi_offset_min_estimates = 10;  // estimates before the offset is applied
 
   bool IsValid(std::string* error) const;
 
@@ -95,6 +103,16 @@ struct FusedOptions {
       schema::Unit("s").NonNegative());
     v("max_wifi_age_s", max_wifi_age_s, "a Wi-Fi scan older than this counts as absent at a frame",
       schema::Unit("s").NonNegative());
+    v("online_rssi_offset", online_rssi_offset,
+      "estimate each later session's RSSI offset to the earlier sessions' templates online and "
+      "remove it from its scans (phones that read several dB apart)",
+      schema::Any());
+    v("rssi_offset_min_common_aps", rssi_offset_min_common_aps,
+      "APs a scan must share with an earlier session's template to estimate the offset",
+      schema::Unit("APs").AtLeast(1));
+    v("rssi_offset_min_estimates", rssi_offset_min_estimates,
+      "offset estimates of a session before its median is applied",
+      schema::Unit("scans").AtLeast(1));
   }
 };
 
@@ -220,6 +238,12 @@ class FrontEnd {
   virtual uint32_t size() const = 0;  // templates stored
   virtual std::string EncodeState() const = 0;
   virtual Status DecodeState(const std::string& bytes) = 0;
+  // A new session (another walk, perhaps another phone) starts at `start_s`; called before each
+  // Wi-Fi scan with its session's start (repeats are no news). Default: nothing.
+  virtual void OnSessionStart(double /*start_s*/) {}
+  // The RSSI offset (dB) removed from each session's scans so far, by session (front ends that
+  // estimate one); the last entry is the current session's.
+  virtual std::vector<double> RssiOffsetsDb() const { return {}; }
   // Localisation on a saved map: the templates stored so far were made by another run on
   // another clock, so a match to one of them is never recent. Front ends with a recency rule
   // in seconds must honour this; the default does nothing.

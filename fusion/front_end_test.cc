@@ -245,5 +245,72 @@ TEST(FabmapFrontEndTest, VisionWithoutAModelIsAClearError) {
   EXPECT_NE(resources.status().message().find("visual_model"), std::string::npos);
 }
 
+// Two walks of the corridor, the second by a phone that reads 10 dB lower everywhere: a
+// difference the eq. 3 kernel (sigma^2 = 20 dB^2) cannot bridge, exp(-100 / 40) = 0.08 < 0.25.
+// With the online offset the second walk estimates -10 dB from its own scans and the first
+// walk's templates (no ground truth) and then re-visits the first walk's places.
+TEST(FusedFrontEndTest, OnlineRssiOffsetBridgesTwoPhones) {
+  auto walk = [](bool online, std::vector<double>* offsets, std::string* state) {
+    FrontEndSettings settings;
+    settings.front_end.kind = FrontEndKind::kFused;
+    settings.fused.recency_s = 0.0;
+    settings.fused.online_rssi_offset = online;
+    std::unique_ptr<FrontEnd> f = CreateFrontEnd(settings);
+    std::vector<double> x_of_template;
+    int matches = 0, close = 0;
+    size_t first_walk_templates = 0;
+    for (int session = 0; session < 2; ++session) {
+      const double start = 1000.0 * session;
+      if (session == 1) first_walk_templates = x_of_template.size();
+      for (int i = 0; i < 40; ++i) {
+        f->OnSessionStart(start);
+        WifiScan scan = CorridorScan(start + 2.0 * i, 2.0 * i, 0.0);
+        for (WifiReading& r : scan.readings) r.rssi_dbm -= 10.0 * session;
+        const auto d = f->OnWifi(scan);
+        EXPECT_TRUE(d.ok() && d->has_value());
+        const FrameDecision& decision = **d;
+        if (decision.view.is_new) {
+          x_of_template.push_back(2.0 * i);
+        } else if (session == 1 && decision.view.template_id < first_walk_templates) {
+          ++matches;
+          close += std::abs(x_of_template[decision.view.template_id] - 2.0 * i) <= 6.0;
+        }
+      }
+    }
+    *offsets = f->RssiOffsetsDb();
+    *state = f->EncodeState();
+    return std::make_pair(matches, close);
+  };
+  std::vector<double> offsets;
+  std::string state;
+  const auto [plain_matches, plain_close] = walk(false, &offsets, &state);
+  EXPECT_EQ(plain_matches, 0);
+  EXPECT_TRUE(offsets.empty());
+  const auto [matches, close] = walk(true, &offsets, &state);
+  ASSERT_EQ(offsets.size(), 2u);
+  EXPECT_EQ(offsets[0], 0.0);
+  EXPECT_NEAR(offsets[1], -10.0, 1e-4);  // float RSSI
+  // The scans after the first ten estimates re-visit the first walk, nearly all within 6 m of
+  // the place (a template covers a few metres of corridor; chance on the 78 m corridor: ~15 %).
+  EXPECT_GE(matches, 25);
+  EXPECT_GE(close, matches * 9 / 10);
+
+  // The estimates are part of the state: a restored front end goes on identically.
+  FrontEndSettings settings;
+  settings.front_end.kind = FrontEndKind::kFused;
+  settings.fused.recency_s = 0.0;
+  settings.fused.online_rssi_offset = true;
+  std::unique_ptr<FrontEnd> restored = CreateFrontEnd(settings);
+  ASSERT_TRUE(restored->DecodeState(state).ok());
+  EXPECT_EQ(restored->RssiOffsetsDb(), offsets);
+  EXPECT_EQ(restored->EncodeState(), state);
+  std::string truncated = state;
+  truncated.pop_back();
+  EXPECT_FALSE(restored->DecodeState(truncated).ok());
+  // Without the option the state has the format of earlier releases (shorter).
+  settings.fused.online_rssi_offset = false;
+  EXPECT_FALSE(CreateFrontEnd(settings)->DecodeState(state).ok());
+}
+
 }  // namespace
 }  // namespace ratslam

@@ -36,6 +36,7 @@ class FusedFrontEnd : public FrontEnd {
     readings.reserve(scan.readings.size());
     for (const WifiReading& r : scan.readings) readings.emplace_back(r.bssid, r.rssi_dbm);
     newest_scan_ = wifi_.MakeFingerprint(readings);
+    if (options_.online_rssi_offset) RemoveRssiOffset(&newest_scan_);
     newest_scan_time_s_ = scan.time_s;
     if (options_.use_camera) return std::optional<FrameDecision>();  // images are the frames
     return std::optional<FrameDecision>(Decide(scan.time_s, nullptr, &newest_scan_));
@@ -48,6 +49,20 @@ class FusedFrontEnd : public FrontEnd {
   bool WantsImages() const override { return options_.use_camera; }
   uint32_t size() const override { return static_cast<uint32_t>(created_time_s_.size()); }
   void SettleForLocalisation() override { settled_ = size(); }
+
+  void OnSessionStart(double start_s) override {
+    if (!options_.online_rssi_offset || (session_start_s_ && *session_start_s_ == start_s)) return;
+    if (session_start_s_) offsets_db_.push_back(CurrentOffset());
+    session_start_s_ = start_s;
+    templates_before_session_ = size();
+    offset_estimates_db_.clear();
+  }
+  std::vector<double> RssiOffsetsDb() const override {
+    if (!options_.online_rssi_offset) return {};
+    std::vector<double> all = offsets_db_;
+    all.push_back(CurrentOffset());
+    return all;
+  }
 
   std::string EncodeState() const override {
     ByteWriter w;
@@ -68,6 +83,13 @@ class FusedFrontEnd : public FrontEnd {
     w.PodVector(newest_scan_.rssi_dbm);
     w.Optional(newest_scan_time_s_);
     w.Optional(heading_rad_);
+    if (options_.online_rssi_offset) {  // without it, states keep the format of earlier releases
+      w.Optional(session_start_s_);
+      w.Pod(templates_before_session_);
+      w.PodVector(offset_estimates_db_);
+      w.PodVector(offsets_db_);
+      w.PodVector(calibrated_);
+    }
     return std::move(w.bytes());
   }
 
@@ -104,10 +126,26 @@ class FusedFrontEnd : public FrontEnd {
           r.Optional(&newest_time) && r.Optional(&heading))) {
       return Status::Error(r.error());
     }
+    std::optional<double> session_start;
+    uint32_t before_session = 0;
+    std::vector<double> estimates, offsets;
+    std::vector<uint8_t> calibrated;
+    if (options_.online_rssi_offset &&
+        !(r.Optional(&session_start) && r.Pod(&before_session) && r.PodVector(&estimates) &&
+          r.PodVector(&offsets) && r.PodVector(&calibrated))) {
+      return Status::Error(r.error());
+    }
     if (!r.AtEnd()) return Status::Error("fused front-end state: trailing bytes");
     if (camera.size() != created.size() || ws.fingerprints.size() != created.size() ||
         headings.size() != created.size()) {
       return Status::Error("fused front-end state: sensor template counts differ");
+    }
+    if (options_.online_rssi_offset && calibrated.size() != created.size()) {
+      return Status::Error("fused front-end state: RSSI calibration flags do not fit");
+    }
+    if (before_session > created.size() || !FiniteOrAbsent(session_start) ||
+        !AllFinite(estimates) || !AllFinite(offsets)) {
+      return Status::Error("fused front-end state: RSSI offset estimates do not fit");
     }
     if (!AllFinite(created) || !std::all_of(headings.begin(), headings.end(), FiniteOrAbsent) ||
         !FiniteOrAbsent(newest_time) || !FiniteOrAbsent(heading) || !AllFinite(newest.rssi_dbm) ||
@@ -130,11 +168,72 @@ class FusedFrontEnd : public FrontEnd {
     newest_scan_ = std::move(newest);
     newest_scan_time_s_ = newest_time;
     heading_rad_ = heading;
+    session_start_s_ = session_start;
+    templates_before_session_ = before_session;
+    offset_estimates_db_ = std::move(estimates);
+    offsets_db_ = std::move(offsets);
+    calibrated_ = std::move(calibrated);
     return Status::Ok();
   }
 
  private:
   enum class Verdict { kNovel, kFamiliarRecent, kMatch };
+
+  static double Median(std::vector<double> v) {
+    const size_t mid = v.size() / 2;
+    std::nth_element(v.begin(), v.begin() + static_cast<ptrdiff_t>(mid), v.end());
+    const double upper = v[mid];
+    if (v.size() % 2 == 1) return upper;
+    return 0.5 * (upper + *std::max_element(v.begin(), v.begin() + static_cast<ptrdiff_t>(mid)));
+  }
+  // Whether this session's scans are in the first session's units: the first session defines
+  // them; a later one once its offset is known. Only such templates give estimates.
+  bool InReferenceUnits() const {
+    return offsets_db_.empty() ||
+           offset_estimates_db_.size() >= static_cast<size_t>(options_.rssi_offset_min_estimates);
+  }
+  double CurrentOffset() const {
+    return offset_estimates_db_.size() >= static_cast<size_t>(options_.rssi_offset_min_estimates)
+               ? Median(offset_estimates_db_)
+               : 0.0;
+  }
+
+  // One estimate from this scan (against the earlier sessions' templates), then the session's
+  // offset, once known, removed from the scan.
+  void RemoveRssiOffset(Fingerprint* scan) {
+    const std::vector<Fingerprint>& stored = wifi_.state().fingerprints;
+    double best_spread = std::numeric_limits<double>::infinity(), best_median = 0.0;
+    std::vector<double> d;
+    for (uint32_t t = 0; t < templates_before_session_ && t < stored.size(); ++t) {
+      if (!calibrated_[t]) continue;
+      const Fingerprint& f = stored[t];
+      d.clear();
+      for (size_t a = 0, b = 0; a < scan->ap_ids.size() && b < f.ap_ids.size();) {
+        if (scan->ap_ids[a] < f.ap_ids[b]) {
+          ++a;
+        } else if (f.ap_ids[b] < scan->ap_ids[a]) {
+          ++b;
+        } else {
+          d.push_back(static_cast<double>(scan->rssi_dbm[a++]) - f.rssi_dbm[b++]);
+        }
+      }
+      if (d.size() < static_cast<size_t>(options_.rssi_offset_min_common_aps)) continue;
+      double mean = 0.0;
+      for (double x : d) mean += x;
+      mean /= static_cast<double>(d.size());
+      double spread = 0.0;
+      for (double x : d) spread += (x - mean) * (x - mean);
+      spread /= static_cast<double>(d.size());
+      if (spread < best_spread) {  // ties: the older template
+        best_spread = spread;
+        best_median = Median(d);
+      }
+    }
+    if (std::isfinite(best_spread)) offset_estimates_db_.push_back(best_median);
+    const double offset = CurrentOffset();
+    if (offset == 0.0) return;
+    for (float& rssi : scan->rssi_dbm) rssi = static_cast<float>(rssi - offset);
+  }
 
   // Eqs. 10-11: a sensor's best match counts when it reaches the threshold and is not recent.
   Verdict Judge(int32_t best, double score, double threshold, double time_s) const {
@@ -194,6 +293,7 @@ class FusedFrontEnd : public FrontEnd {
     wifi_.Add(scan ? *scan : Fingerprint());
     created_time_s_.push_back(time_s);
     headings_.push_back(options_.use_compass ? heading_rad_ : std::nullopt);
+    if (options_.online_rssi_offset) calibrated_.push_back(InReferenceUnits());
     d.view.template_id = n;
     d.view.is_new = true;
     d.source = DecisionSource::kNew;
@@ -209,6 +309,13 @@ class FusedFrontEnd : public FrontEnd {
   Fingerprint newest_scan_;
   std::optional<double> newest_scan_time_s_;
   std::optional<double> heading_rad_;
+  // Online RSSI offset: where the current session began, the templates stored before it, this
+  // session's estimates and the offsets of the sessions before it.
+  std::optional<double> session_start_s_;
+  uint32_t templates_before_session_ = 0;
+  std::vector<double> offset_estimates_db_;
+  std::vector<double> offsets_db_;
+  std::vector<uint8_t> calibrated_;  // by template: stored in the reference units (see above)
 };
 
 }  // namespace

@@ -199,7 +199,14 @@ void ReplayPipeline::FeedCompass(const CompassRow& row) {
 }
 
 Status ReplayPipeline::HandleWifi(const Event& event) {
-  return FeedWifi(dataset_.wifi[event.index]);
+  const WifiScan& scan = dataset_.wifi[event.index];
+  const std::vector<double>& starts = dataset_.session_start_times_s;
+  if (!starts.empty()) {
+    size_t session = 0;
+    while (session + 1 < starts.size() && scan.time_s >= starts[session + 1]) ++session;
+    front_end_->OnSessionStart(starts[session]);
+  }
+  return FeedWifi(scan);
 }
 
 Status ReplayPipeline::FeedWifi(const WifiScan& scan) {

@@ -164,6 +164,8 @@ class ReplayPipeline {
   std::optional<FabmapLearningReport> fabmap_learning() const {
     return front_end_->fabmap_learning();
   }
+  // The RSSI offsets removed per session ([fused] online_rssi_offset); empty otherwise.
+  std::vector<double> rssi_offsets_db() const { return front_end_->RssiOffsetsDb(); }
 
  private:
   Status HandleOdometry(const Event& event);

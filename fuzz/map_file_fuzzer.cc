@@ -93,6 +93,7 @@ struct Setup {
     fused.sensors.fused.use_camera = true;
     fused.sensors.fused.use_compass = true;
     fused.sensors.fused.recency_s = 20.0;
+    fused.sensors.fused.online_rssi_offset = true;  // its estimates are part of the state
     PipelineOptions fabmap_wifi;
     fabmap_wifi.sensors.front_end.kind = FrontEndKind::kFabmap;
     fabmap_wifi.sensors.fabmap.localiser.localiser.mode = fabmap::FabmapMode::kWifi;

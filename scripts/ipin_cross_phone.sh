@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Cross-phone matches on the IPIN 2023 training routes: repetitions 01-02 were recorded with one
 # phone (SM-A520F), 03-04 with another (SM-G930F). Runs the four repetitions of each route as one
-# multi-session run with a config and with the same config plus [wifi] offset_invariant = true,
-# and prints per route: template matches between the two phones' sessions, the share of them
+# multi-session run with a config, with the same config plus [wifi] offset_invariant = true, and
+# with [fused] online_rssi_offset = true (the second phone's offset estimated online), and prints
+# per route: template matches between the two phones' sessions, the share of them
 # within 5 m and 10 m of where the matched template was stored, and map ATE.
 # Usage: scripts/ipin_cross_phone.sh [config] [out dir]
 set -euo pipefail
@@ -14,8 +15,10 @@ bin=./build/apps/ratslam
 mkdir -p "$out"
 grep -q '^\[wifi\]' "$config" || { echo "$config has no [wifi] section" >&2; exit 1; }
 sed 's/^\[wifi\]$/[wifi]\noffset_invariant = true/' "$config" > "$out/invariant.toml"
-echo "| route | cross-phone matches | <=5 m | <=10 m | map ATE m | offset-invariant: matches | <=5 m | <=10 m | map ATE m |"
-echo "|---|---|---|---|---|---|---|---|---|"
+grep -q '^\[fused\]' "$config" || { echo "$config has no [fused] section" >&2; exit 1; }
+sed 's/^\[fused\]$/[fused]\nonline_rssi_offset = true/' "$config" > "$out/online.toml"
+echo "| route | cross-phone matches | <=5 m | <=10 m | map ATE m | offset-invariant: matches | <=5 m | <=10 m | map ATE m | online offset: matches | <=5 m | <=10 m | map ATE m | offsets dB |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 for route in 01 02 03 21 22 23; do
   args=()
   for rep in 01 02 03 04; do args+=(--data "$data/IPIN2023_T3_TrainingTrial${route}_repetition${rep}.txt"); done
@@ -23,7 +26,10 @@ for route in 01 02 03 21 22 23; do
   "$bin" replay --quiet --config "$config" --data "$out/data-$route" --out "$out/plain-$route" > /dev/null
   "$bin" replay --quiet --config "$out/invariant.toml" --data "$out/data-$route" \
     --out "$out/invariant-$route" > /dev/null
-  /usr/bin/python3 - "$out/data-$route" "$out/plain-$route" "$out/invariant-$route" "$route" <<'PY'
+  "$bin" replay --quiet --config "$out/online.toml" --data "$out/data-$route" \
+    --out "$out/online-$route" > /dev/null
+  /usr/bin/python3 - "$out/data-$route" "$out/plain-$route" "$out/invariant-$route" \
+    "$out/online-$route" "$route" <<'PY'
 import bisect, csv, json, math, re, sys
 data = sys.argv[1]
 starts = [float(x) for x in re.search(r"session_start_times_s = \[(.*)\]",
@@ -43,7 +49,7 @@ def truth(t):
     f = (t - a[0]) / (b[0] - a[0])
     return (a[1] + f * (b[1] - a[1]), a[2] + f * (b[2] - a[2]))
 cells = []
-for run in sys.argv[2:4]:
+for run in sys.argv[2:5]:
     created, distances = {}, []
     for r in csv.DictReader(open(run + "/frames.csv")):
         t, tid = float(r["time_s"]), int(r["template_id"])
@@ -58,8 +64,10 @@ for run in sys.argv[2:4]:
         distances.append(math.hypot(a[0] - b[0], a[1] - b[1]))
     n = len(distances)
     rate = lambda d: f"{sum(x <= d for x in distances) / n:.2f}" if n else "-"
-    ate = json.load(open(run + "/summary.json"))["map_ate_m"]
-    cells += [str(n), rate(5), rate(10), f"{ate:.2f}"]
-print(f"| {sys.argv[4]} | " + " | ".join(cells) + " |")
+    summary = json.load(open(run + "/summary.json"))
+    cells += [str(n), rate(5), rate(10), f"{summary['map_ate_m']:.2f}"]
+offsets = json.load(open(sys.argv[4] + "/summary.json")).get("wifi_rssi_offsets_db", [])
+cells.append(" / ".join(f"{x:.1f}" for x in offsets[1:]))
+print(f"| {sys.argv[5]} | " + " | ".join(cells) + " |")
 PY
 done

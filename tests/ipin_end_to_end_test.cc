@@ -10,6 +10,7 @@
 // chance. Dead reckoning drifts by tens of metres over two walks; the map must beat it clearly.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -170,6 +171,122 @@ TEST(IpinEndToEndTest, RunsThatCannotDoAnythingSaySo) {
   EXPECT_NE(message.find("processed no frame"), std::string::npos) << message;
   fs::remove_all(out);
   fs::remove(err);
+}
+
+// Median of `v` (the mean of the middle two for an even count).
+double Median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// The second phone of each route (repetitions 03-04) reads several dB below the first (01-02).
+// The oracle, from ground truth only: pair each scan of a session with the first session's scan
+// nearest in true position (same floor, within 2 m, at least 3 APs in common); the session's
+// offset is the median over pairs of the median RSSI difference. The online estimate, which sees
+// no ground truth, must land within 3 dB of it for every session, and the multi-session run must
+// then match across sessions more often than without it.
+TEST(IpinEndToEndTest, OnlineRssiOffsetFindsTheSecondPhonesOffset) {
+  const fs::path data = fs::path(RATSLAM_SHARED_DATA_DIR) / "ipin2023-t3";
+  for (const char* trial : {"02", "23"}) {
+    std::vector<std::string> paths;
+    for (const char* rep : {"01", "02", "03", "04"}) {
+      const fs::path p =
+          data / ("IPIN2023_T3_TrainingTrial" + std::string(trial) + "_repetition" + rep + ".txt");
+      if (!fs::exists(p)) GTEST_SKIP() << "missing " << p;
+      paths.push_back(p.string());
+    }
+    StatusOr<Dataset> d = LoadSessions(paths, {});
+    ASSERT_TRUE(d.ok()) << d.status().message();
+    const std::vector<double>& starts = d->session_start_times_s;
+    ASSERT_EQ(starts.size(), 4u);
+    auto session_of = [&](double t) {
+      size_t k = 0;
+      while (k + 1 < starts.size() && t >= starts[k + 1]) ++k;
+      return k;
+    };
+    struct Located {
+      size_t session;
+      GroundTruthRow truth;
+      const WifiScan* scan;
+    };
+    std::vector<Located> scans;
+    for (const WifiScan& scan : d->wifi) {
+      if (auto gt = InterpolateGroundTruth(d->ground_truth, scan.time_s)) {
+        scans.push_back({session_of(scan.time_s), *gt, &scan});
+      }
+    }
+    std::vector<double> oracle(4, 0.0);
+    for (size_t k = 1; k < 4; ++k) {
+      std::vector<double> pair_medians;
+      for (const Located& q : scans) {
+        if (q.session != k) continue;
+        const Located* nearest = nullptr;
+        double best = 2.0;
+        for (const Located& r : scans) {
+          if (r.session != 0 || r.truth.floor != q.truth.floor) continue;
+          const double dist = std::hypot(r.truth.x_m - q.truth.x_m, r.truth.y_m - q.truth.y_m);
+          if (dist <= best) {
+            best = dist;
+            nearest = &r;
+          }
+        }
+        if (nearest == nullptr) continue;
+        std::map<std::string, double> reference;
+        for (const WifiReading& w : nearest->scan->readings) reference[w.bssid] = w.rssi_dbm;
+        std::vector<double> differences;
+        for (const WifiReading& w : q.scan->readings) {
+          if (auto it = reference.find(w.bssid); it != reference.end()) {
+            differences.push_back(w.rssi_dbm - it->second);
+          }
+        }
+        if (differences.size() >= 3) pair_medians.push_back(Median(differences));
+      }
+      ASSERT_GE(pair_medians.size(), 20u) << "trial " << trial << " session " << k;
+      oracle[k] = Median(pair_medians);
+    }
+    EXPECT_LT(oracle[2], -3.0) << "trial " << trial << ": the second phone reads lower";
+
+    std::map<bool, nlohmann::json> summary;
+    for (bool online : {false, true}) {
+      const fs::path root =
+          fs::temp_directory_path() / ("ratslam_ipin_offset_" + std::to_string(::getpid()));
+      fs::create_directories(root);
+      const fs::path config = root / "config.toml";
+      std::ifstream shipped(std::string(RATSLAM_SOURCE_DIR) +
+                            "/configs/ipin2023-wifi-compass.toml");
+      std::stringstream text;
+      text << shipped.rdbuf();
+      std::string toml = text.str();
+      const std::string fused = "[fused]\n";
+      ASSERT_NE(toml.find(fused), std::string::npos);
+      toml.insert(toml.find(fused) + fused.size(),
+                  std::string("online_rssi_offset = ") + (online ? "true" : "false") + "\n");
+      std::ofstream(config) << toml;
+      const fs::path out = root / (std::string(trial) + (online ? "_on" : "_off"));
+      std::string command = std::string(RATSLAM_BINARY) + " replay --quiet --overwrite --config " +
+                            config.string() + " --out " + out.string();
+      for (const std::string& p : paths) command += " --data " + p;
+      ASSERT_EQ(std::system((command + " > /dev/null").c_str()), 0) << command;
+      std::ifstream in(out / "summary.json");
+      summary[online] = nlohmann::json::parse(in);
+      fs::remove_all(root);
+    }
+    const nlohmann::json& on = summary[true];
+    ASSERT_TRUE(on.contains("wifi_rssi_offsets_db")) << on.dump();
+    EXPECT_TRUE(e2e::UndocumentedKeys(on).empty())
+        << "not in configs/README.md: " << e2e::Join(e2e::UndocumentedKeys(on));
+    const std::vector<double> estimated = on["wifi_rssi_offsets_db"];
+    ASSERT_EQ(estimated.size(), 4u);
+    EXPECT_EQ(estimated[0], 0.0);
+    for (size_t k = 1; k < 4; ++k) {
+      EXPECT_NEAR(estimated[k], oracle[k], 3.0) << "trial " << trial << " session " << k;
+    }
+    EXPECT_FALSE(summary[false].contains("wifi_rssi_offsets_db"));
+    EXPECT_GT(on["cross_session_matches"].get<int>(),
+              summary[false]["cross_session_matches"].get<int>())
+        << "trial " << trial;
+  }
 }
 
 }  // namespace

@@ -273,6 +273,9 @@ constexpr AddedKey kKeysAddedAfter[] = {
     {7, "visual_odometry.camera_hz"},
     {7, "visual_odometry.translation_scaling"},
     {7, "visual_odometry.max_speed_m_per_s"},
+    {7, "fused.online_rssi_offset"},
+    {7, "fused.rssi_offset_min_common_aps"},
+    {7, "fused.rssi_offset_min_estimates"},
 };
 
 // Whole sections added after a map format version: older maps resume only with every key at its

@@ -295,6 +295,9 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
     j["fabmap_wifi_models_built"] = learning->wifi_relearnt;
     j["fabmap_wifi_tree_scans"] = learning->wifi_tree_scans;
   }
+  if (const std::vector<double> offsets = pipeline.rssi_offsets_db(); !offsets.empty()) {
+    j["wifi_rssi_offsets_db"] = offsets;  // removed from each session's scans
+  }
   if (dataset.session_start_times_s.size() > 1)
     j["sessions"] = dataset.session_start_times_s.size();
   if (pipeline.wifi_sequence().options().enabled) {

@@ -81,7 +81,10 @@ StatusOr<Dataset> LoadSessions(const std::vector<std::string>& paths,
   if (paths.empty()) return Status::Error("no data set given");
   if (paths.size() == 1) {
     StatusOr<Dataset> d = LoadDataset(paths[0], phone_options, bag, video);
-    if (d.ok()) d->session_start_times_s = {d->odometry.empty() ? 0.0 : d->odometry.front().time_s};
+    // A replay folder that joined several sessions (ratslam import of several logs) keeps them.
+    if (d.ok() && d->session_start_times_s.size() <= 1) {
+      d->session_start_times_s = {d->odometry.empty() ? 0.0 : d->odometry.front().time_s};
+    }
     return d;
   }
   Dataset joined;

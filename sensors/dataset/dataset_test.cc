@@ -7,6 +7,7 @@
 #include <fstream>
 #include <limits>
 
+#include "sensors/dataset/dataset_loader.h"
 #include "sensors/dataset/image_loader.h"
 #include "sensors/dataset/synthetic_dataset.h"
 #include "sensors/dataset/visual_odometry_source.h"
@@ -64,6 +65,25 @@ TEST_F(DatasetTest, WriteThenReadIsExact) {
   EXPECT_EQ(back.compass.size(), 1u);
   EXPECT_EQ(back.ground_truth[1].y_m, -4);
   EXPECT_EQ(back.wifi[0].readings[0].bssid, "aa:bb");
+}
+
+// A folder that joined several sessions (ratslam import of several logs) is still several
+// sessions when replayed alone: its session starts survive LoadSessions. A folder without them
+// is one session from its first odometry row.
+TEST_F(DatasetTest, LoadSessionsKeepsAJoinedFoldersSessions) {
+  Write("manifest.toml",
+        "format = \"ratslam-replay\"\nformat_version = 1\nname = \"t\"\n"
+        "session_start_times_s = [0.0, 0.4, 0.8]\n[streams]\nodometry = \"odometry.csv\"\n");
+  StatusOr<Dataset> joined = LoadSessions({folder_.string()}, {});
+  ASSERT_TRUE(joined.ok()) << joined.status().message();
+  EXPECT_EQ(joined->session_start_times_s, (std::vector<double>{0.0, 0.4, 0.8}));
+  Write("manifest.toml",
+        "format = \"ratslam-replay\"\nformat_version = 1\nname = \"t\"\n[streams]\n"
+        "odometry = \"odometry.csv\"\n");
+  Write("odometry.csv", "time_s,forward_speed_m_per_s,turn_rate_rad_per_s\n0.25,0,0\n0.5,1,0\n");
+  StatusOr<Dataset> single = LoadSessions({folder_.string()}, {});
+  ASSERT_TRUE(single.ok()) << single.status().message();
+  EXPECT_EQ(single->session_start_times_s, (std::vector<double>{0.25}));
 }
 
 TEST_F(DatasetTest, TruncatedRowNamesFileAndLine) {
