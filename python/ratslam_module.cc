@@ -422,12 +422,18 @@ py::dict Evaluate(const std::string& map, const std::string& query, const std::s
   options.provenance = {"python: ratslam.evaluate", UtcNowIso8601()};
   OutputGuard guard = Take(OutputGuard::Begin(out, overwrite, {map, query}));
   std::unique_ptr<DiskFolder> folder = Take(DiskFolder::Open(out));
-  EvaluationSession session(std::move(options), folder.get());
+  InterruptiblePython interrupt;
+  EvaluationSession session(std::move(options), folder.get(), nullptr, &interrupt);
+  session.set_stop_flag(interrupt.flag());
   StatusOr<EvaluationResult> result = [&] {
     py::gil_scoped_release release;
     return session.Run();
   }();
   (void)guard.Finish(result.ok());
+  if (interrupt.stopped()) {
+    PyErr_SetString(PyExc_KeyboardInterrupt, "ratslam.evaluate stopped before writing its outputs");
+    throw py::error_already_set();
+  }
   Check(result.status());
   const EvaluationResult& r = *result;
   py::dict run;

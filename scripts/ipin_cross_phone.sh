@@ -22,11 +22,11 @@ echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 for route in 01 02 03 21 22 23; do
   args=()
   for rep in 01 02 03 04; do args+=(--data "$data/IPIN2023_T3_TrainingTrial${route}_repetition${rep}.txt"); done
-  "$bin" import "${args[@]}" --out "$out/data-$route" > /dev/null 2>&1
-  "$bin" replay --quiet --config "$config" --data "$out/data-$route" --out "$out/plain-$route" > /dev/null
-  "$bin" replay --quiet --config "$out/invariant.toml" --data "$out/data-$route" \
+  "$bin" import --overwrite "${args[@]}" --out "$out/data-$route" > /dev/null 2>&1
+  "$bin" replay --quiet --overwrite --config "$config" --data "$out/data-$route" --out "$out/plain-$route" > /dev/null
+  "$bin" replay --quiet --overwrite --config "$out/invariant.toml" --data "$out/data-$route" \
     --out "$out/invariant-$route" > /dev/null
-  "$bin" replay --quiet --config "$out/online.toml" --data "$out/data-$route" \
+  "$bin" replay --quiet --overwrite --config "$out/online.toml" --data "$out/data-$route" \
     --out "$out/online-$route" > /dev/null
   /usr/bin/python3 - "$out/data-$route" "$out/plain-$route" "$out/invariant-$route" \
     "$out/online-$route" "$route" <<'PY'

@@ -105,6 +105,7 @@ Status EvaluationSession::Words(const std::vector<fabmap::EvaluationNode>& nodes
                                 const std::string& what, std::vector<fabmap::Observation>* words) {
   words->clear();
   for (size_t i = 0; i < nodes.size(); ++i) {
+    if (stopped()) return Status::Error("evaluation stopped by request");
     if (nodes[i].image.empty()) {
       return Status::Error(what + " node " + std::to_string(i) + " has no image");
     }
@@ -168,6 +169,7 @@ Status EvaluationSession::Localise() {
   result_.best_mapped_probability.clear();
   const double start = clock_->Seconds();
   for (size_t i = 0; i < result_.queries.size(); ++i) {
+    if (stopped()) return Status::Error("evaluation stopped by request");
     fabmap::Query q;
     if (vision) q.visual = query_words_[i];
     q.wifi = result_.queries[i].wifi;

@@ -6,6 +6,7 @@
 #ifndef RATSLAM_SESSION_EVALUATION_SESSION_H_
 #define RATSLAM_SESSION_EVALUATION_SESSION_H_
 
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -74,6 +75,10 @@ class EvaluationSession {
   StatusOr<EvaluationResult> Run();
 
   const EvaluationResult& result() const { return result_; }
+  // Checked between images and between queries: when set, the running stage stops with an
+  // error and stopped() is true (nothing is written after it).
+  void set_stop_flag(const std::atomic<bool>* stop_requested) { stop_requested_ = stop_requested; }
+  bool stopped() const { return stop_requested_ != nullptr && stop_requested_->load(); }
   fabmap::FabmapMode mode() const;
 
  private:
@@ -83,6 +88,7 @@ class EvaluationSession {
   EvaluationSessionOptions options_;
   OutputFolder* out_;
   const Clock* clock_;
+  const std::atomic<bool>* stop_requested_ = nullptr;
   ProgressSink* progress_;
   ImageLoader* images_;
   SteadyClock system_clock_;

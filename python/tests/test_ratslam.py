@@ -286,6 +286,14 @@ class RatslamModuleTest(unittest.TestCase):
         self.assertEqual(len(result["map"]["x_m"]), expected["map_nodes"])
         with self.assertRaisesRegex(ratslam.Error, "overwrite"):
             ratslam.evaluate(data, data, out, config=ratslam.Config.load(config))
+        # Ctrl-C stops it between queries, with nothing half written.
+        stopped = os.path.join(self.root, "evaluate_stopped")
+        timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
+        timer.start()
+        with self.assertRaisesRegex(KeyboardInterrupt, "stopped"):
+            ratslam.evaluate(data, data, stopped, config=ratslam.Config.load(config))
+        timer.join()
+        self.assertFalse(os.path.exists(os.path.join(stopped, "evaluation.json")))
 
 
 if __name__ == "__main__":
