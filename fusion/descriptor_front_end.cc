@@ -41,15 +41,10 @@ class DescriptorFrontEnd : public FrontEnd {
       return Status::Error("a descriptor of " + std::to_string(values.size()) +
                            " dimensions; this front end's have " + std::to_string(dimensions_));
     }
-    double norm2 = 0.0;
-    for (float v : values) norm2 += static_cast<double>(v) * v;
-    if (!(norm2 > 0.0) || !std::isfinite(norm2)) {
+    std::vector<float> unit;
+    if (!UnitDescriptor(values.data(), values.size(), &unit)) {
       return Status::Error("a descriptor must be finite and not all zeros");
     }
-    // Normalised as DescriptorTable::Make does, so a fed descriptor equals a file's.
-    const double inverse = 1.0 / std::sqrt(norm2);
-    std::vector<float> unit(values.size());
-    for (size_t k = 0; k < values.size(); ++k) unit[k] = static_cast<float>(values[k] * inverse);
     dimensions_ = values.size();
     return std::optional<FrameDecision>(Decide(time_s, unit.data()));
   }

@@ -16,6 +16,16 @@ bool DescriptorOptions::IsValid(std::string* error) const {
   return true;
 }
 
+bool UnitDescriptor(const float* values, size_t n, std::vector<float>* unit) {
+  double norm2 = 0.0;
+  for (size_t k = 0; k < n; ++k) norm2 += static_cast<double>(values[k]) * values[k];
+  if (!(norm2 > 0.0) || !std::isfinite(norm2)) return false;
+  const double inverse = 1.0 / std::sqrt(norm2);
+  unit->resize(n);
+  for (size_t k = 0; k < n; ++k) (*unit)[k] = static_cast<float>(values[k] * inverse);
+  return true;
+}
+
 StatusOr<std::shared_ptr<const DescriptorTable>> DescriptorTable::Make(
     const DescriptorMatrix& matrix, const Dataset& dataset, const std::string& name) {
   if (matrix.rows != dataset.images.size()) {
@@ -30,21 +40,16 @@ StatusOr<std::shared_ptr<const DescriptorTable>> DescriptorTable::Make(
   auto table = std::make_shared<DescriptorTable>();
   table->dimensions_ = matrix.cols;
   const size_t d = matrix.cols;
+  std::vector<float> unit;
   for (size_t i = 0; i < matrix.rows; ++i) {
-    const float* row = matrix.values.data() + i * d;
-    double norm2 = 0.0;
-    for (size_t k = 0; k < d; ++k) norm2 += static_cast<double>(row[k]) * row[k];
     const double time_s = dataset.images[i].time_s;
     const std::string which =
         "descriptor " + std::to_string(i) + " (image at " + ShortestNumber(time_s) + " s)";
-    if (!(norm2 > 0.0) || !std::isfinite(norm2)) {
+    if (!UnitDescriptor(matrix.values.data() + i * d, d, &unit)) {
       return Status::Error(name + ": " + which +
                            " has no length (all zeros, or too large to square): cosine "
                            "similarity needs a direction");
     }
-    const double inverse = 1.0 / std::sqrt(norm2);
-    std::vector<float> unit(d);
-    for (size_t k = 0; k < d; ++k) unit[k] = static_cast<float>(row[k] * inverse);
     if (!table->times_s_.empty() && time_s <= table->times_s_.back()) {
       if (time_s < table->times_s_.back()) {
         return Status::Error(name + ": the data set's image times go backwards at " + which);

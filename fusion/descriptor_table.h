@@ -43,6 +43,11 @@ struct DescriptorOptions {
   }
 };
 
+// `values` (n of them) scaled to unit length, computed in double: the one normalisation of file
+// rows and of descriptors fed directly. False (and `unit` untouched) when there is no direction:
+// all zeros, or a length that overflows.
+bool UnitDescriptor(const float* values, size_t n, std::vector<float>* unit);
+
 // Unit-length descriptors keyed by the data set's image times.
 class DescriptorTable {
  public:

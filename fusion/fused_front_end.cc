@@ -7,6 +7,7 @@
 
 #include "common/byte_buffer.h"
 #include "common/circular.h"
+#include "common/median.h"
 #include "fusion/front_end_internal.h"
 
 namespace ratslam {
@@ -179,13 +180,6 @@ class FusedFrontEnd : public FrontEnd {
  private:
   enum class Verdict { kNovel, kFamiliarRecent, kMatch };
 
-  static double Median(std::vector<double> v) {
-    const size_t mid = v.size() / 2;
-    std::nth_element(v.begin(), v.begin() + static_cast<ptrdiff_t>(mid), v.end());
-    const double upper = v[mid];
-    if (v.size() % 2 == 1) return upper;
-    return 0.5 * (upper + *std::max_element(v.begin(), v.begin() + static_cast<ptrdiff_t>(mid)));
-  }
   // Whether this session's scans are in the first session's units: the first session defines
   // them; a later one once its offset is known. Only such templates give estimates.
   bool InReferenceUnits() const {

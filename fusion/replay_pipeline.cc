@@ -198,13 +198,17 @@ void ReplayPipeline::FeedCompass(const CompassRow& row) {
   slam_->SetCompassHeading(front_end_->CompassHeading());
 }
 
+size_t ReplayPipeline::SessionAt(double time_s) const {
+  const std::vector<double>& starts = dataset_.session_start_times_s;
+  size_t session = 0;
+  while (session + 1 < starts.size() && time_s >= starts[session + 1]) ++session;
+  return session;
+}
+
 Status ReplayPipeline::HandleWifi(const Event& event) {
   const WifiScan& scan = dataset_.wifi[event.index];
-  const std::vector<double>& starts = dataset_.session_start_times_s;
-  if (!starts.empty()) {
-    size_t session = 0;
-    while (session + 1 < starts.size() && scan.time_s >= starts[session + 1]) ++session;
-    front_end_->OnSessionStart(starts[session]);
+  if (!dataset_.session_start_times_s.empty()) {
+    front_end_->OnSessionStart(dataset_.session_start_times_s[SessionAt(scan.time_s)]);
   }
   return FeedWifi(scan);
 }
@@ -246,10 +250,7 @@ Status ReplayPipeline::AddSequencePose(const WifiScan& scan) {
   const ExperienceMap& map = slam_->experience_map();
   SequencePose pose;
   pose.time_s = scan.time_s;
-  size_t session = 0;
-  const std::vector<double>& starts = dataset_.session_start_times_s;
-  while (session + 1 < starts.size() && scan.time_s >= starts[session + 1]) ++session;
-  pose.travel_m = state_.travel_m + kSessionGapM * static_cast<double>(session);
+  pose.travel_m = state_.travel_m + kSessionGapM * static_cast<double>(SessionAt(scan.time_s));
   pose.odometry = {state_.odometry_x_m, state_.odometry_y_m, state_.odometry_theta_rad};
   pose.compass_heading_rad = front_end_->CompassHeading();
   if (map.current()) {

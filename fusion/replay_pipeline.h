@@ -173,6 +173,8 @@ class ReplayPipeline {
   Status HandleWifi(const Event& event);
   Status Apply(const FrameDecision& decision);
   Status AddSequencePose(const WifiScan& scan);
+  // The data set's session (index into session_start_times_s; 0 without any) at `time_s`.
+  size_t SessionAt(double time_s) const;
   Status LinkLoop(const std::optional<SequenceLoop>& loop, double time_s);
 
   PipelineOptions options_;

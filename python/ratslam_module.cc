@@ -440,21 +440,12 @@ py::dict Evaluate(const std::string& map, const std::string& query, const std::s
   run["evaluation"] = py::module_::import("json").attr("loads")(r.json);
   run["map"] = NodeColumns(r.map);
   py::dict queries = NodeColumns(r.queries);
-  const auto index = [](const std::vector<int64_t>& v) {
-    py::array_t<int64_t> a(static_cast<py::ssize_t>(v.size()));
-    std::copy(v.begin(), v.end(), a.mutable_data());
-    return a;
-  };
-  const auto real = [](const std::vector<double>& v) {
-    py::array_t<double> a(static_cast<py::ssize_t>(v.size()));
-    std::copy(v.begin(), v.end(), a.mutable_data());
-    return a;
-  };
-  queries["match"] = index(r.matches);
-  queries["match_probability"] = real(r.match_probability);
-  queries["new_place_probability"] = real(r.new_place_probability);
-  queries["best_mapped_place"] = index(r.best_mapped_place);
-  queries["best_mapped_probability"] = real(r.best_mapped_probability);
+  const auto same = [](auto v) { return v; };
+  Column<int64_t>(&queries, "match", r.matches, same);
+  Column<double>(&queries, "match_probability", r.match_probability, same);
+  Column<double>(&queries, "new_place_probability", r.new_place_probability, same);
+  Column<int64_t>(&queries, "best_mapped_place", r.best_mapped_place, same);
+  Column<double>(&queries, "best_mapped_probability", r.best_mapped_probability, same);
   run["queries"] = std::move(queries);
   return run;
 }

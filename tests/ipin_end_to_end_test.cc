@@ -21,6 +21,7 @@
 #include <tuple>
 #include <utility>
 
+#include "common/median.h"
 #include "sensors/dataset/dataset_loader.h"
 #include "tests/documented_keys.h"
 
@@ -171,13 +172,6 @@ TEST(IpinEndToEndTest, RunsThatCannotDoAnythingSaySo) {
   EXPECT_NE(message.find("processed no frame"), std::string::npos) << message;
   fs::remove_all(out);
   fs::remove(err);
-}
-
-// Median of `v` (the mean of the middle two for an even count).
-double Median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 // The second phone of each route (repetitions 03-04) reads several dB below the first (01-02).

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "common/circular.h"
+#include "common/median.h"
 
 namespace ratslam {
 
@@ -220,15 +221,6 @@ double Residual(const RigidAlignment2D& t, const Point2& a, const Point2& b) {
   const double c = std::cos(t.rotation_rad), s = std::sin(t.rotation_rad);
   return std::hypot(c * a.x - s * a.y + t.translation_x_m - b.x,
                     s * a.x + c * a.y + t.translation_y_m - b.y);
-}
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  const size_t mid = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + mid, v.end());
-  if (v.size() % 2 == 1) return v[mid];
-  const double upper = v[mid];
-  return 0.5 * (upper + *std::max_element(v.begin(), v.begin() + mid));
 }
 
 }  // namespace
