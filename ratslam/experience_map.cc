@@ -269,8 +269,13 @@ void ExperienceMap::Touch(uint32_t id) {
 
 bool ExperienceMap::GrowRegion(uint32_t id, uint32_t above, bool this_pass) {
   bool grown = false;
+  const size_t cap = static_cast<size_t>(options_.relaxation_max_region_links);
   for (uint32_t k : state_.experiences[id].link_ids) {
     if (k < above || in_region_[k]) continue;
+    if (cap > 0 && state_.relaxation_pending_links.size() + grown_.size() >= cap) {
+      capped_this_pass_ = true;
+      break;
+    }
     in_region_[k] = 1;
     grown_.push_back(k);
     grown = true;
@@ -293,6 +298,7 @@ void ExperienceMap::RelaxIncremental() {
   std::vector<uint32_t>& region = state_.relaxation_pending_links;
   for (int sweep = 0; sweep < options_.relaxation_sweeps && !region.empty(); ++sweep) {
     ++pass_;
+    capped_this_pass_ = false;
     touched_.clear();
     grown_.clear();
     ahead_.clear();
@@ -339,6 +345,7 @@ void ExperienceMap::RelaxIncremental() {
         grown |= GrowRegion(id, 0, false);
       }
     }
+    if (capped_this_pass_) ++capped_passes_;
     if (settled && !grown) {
       for (uint32_t l : region) in_region_[l] = 0;
       region.clear();
@@ -350,7 +357,40 @@ void ExperienceMap::RelaxIncremental() {
       std::sort(region.begin() + old_size, region.end());
       std::inplace_merge(region.begin(), region.begin() + old_size, region.end());
     }
+    const size_t cap = static_cast<size_t>(options_.relaxation_max_region_links);
+    if (cap > 0 && region.size() > cap) TrimRegion(cap);
   }
+}
+
+void ExperienceMap::TrimRegion(size_t cap) {
+  // New links joined a region at its cap: the links whose ends this pass moved least on net
+  // (in units of the tolerances) leave it, ties by the lower id, so the region keeps its
+  // unsettled part.
+  if (!capped_this_pass_) ++capped_passes_;
+  capped_this_pass_ = true;
+  std::vector<uint32_t>& region = state_.relaxation_pending_links;
+  auto net = [&](uint32_t id) {
+    if (touched_pass_[id] != pass_) return 0.0;
+    const Experience& e = state_.experiences[id];
+    const Pose2& start = pass_start_[id];
+    return std::max(
+        (std::abs(e.x_m - start.x_m) + std::abs(e.y_m - start.y_m)) /
+            options_.relaxation_tolerance_m,
+        std::abs(WrapAngleNear(e.theta_rad - start.theta_rad)) / options_.relaxation_tolerance_rad);
+  };
+  std::vector<std::pair<double, uint32_t>> ranked;
+  ranked.reserve(region.size());
+  for (uint32_t l : region) {
+    const Link& link = state_.links[l];
+    ranked.emplace_back(std::max(net(link.from), net(link.to)), l);
+  }
+  // Largest movement first, then the higher id: the first `cap` stay.
+  std::nth_element(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(cap), ranked.end(),
+                   std::greater<>());
+  for (size_t i = cap; i < ranked.size(); ++i) in_region_[ranked[i].second] = 0;
+  region.clear();
+  for (size_t i = 0; i < cap; ++i) region.push_back(ranked[i].second);
+  std::sort(region.begin(), region.end());
 }
 
 std::vector<uint32_t> ExperienceMap::ShortestPath(uint32_t from, uint32_t to) const {

@@ -32,6 +32,12 @@ inline constexpr double kMaxCoordinate = 1e12;
 //    after a pass over a fixed set of links converge. A frame that only extends the map costs
 //    one link update; a loop closure costs passes over the loop and a fringe around it. The
 //    rotation of each experience is read once per pass (sin/cos per experience, not per link).
+//    The region stops growing at relaxation_max_region_links, and when new links take it past
+//    the cap, the links whose ends the last pass moved least leave it: on a map whose loops are
+//    larger, a closure's correction spreads over that many links around it and the rest of the
+//    map stays as it is (a window in the graph that follows the unsettled part), so an action
+//    costs at most relaxation_sweeps passes over the cap plus the links added since the last
+//    action, however large the map grows. relaxation_capped_passes() counts when that happened.
 //  - kLeastSquares: no relaxation passes; after an action that added a loop closure (the
 //    spine's or Wi-Fi sequence loop closure's), the whole graph is optimised by sparse least
 //    squares (ratslam/pose_graph.h) with the links' information from link_sigma_m,
@@ -48,6 +54,9 @@ struct ExperienceMapOptions {
   RelaxationScheme relaxation_scheme = RelaxationScheme::kIncremental;  // see RelaxationScheme
   double relaxation_tolerance_m = 1e-4;    // kIncremental: movement that grows the region
   double relaxation_tolerance_rad = 1e-5;  // kIncremental: rotation that grows the region
+  // kIncremental: the region stops growing at this many links (0: no limit), so a loop closure
+  // on a large map costs at most relaxation_sweeps passes over this many links per action.
+  int relaxation_max_region_links = 5000;
   // A link's noise: the information matrix of kLeastSquares and of the g2o output.
   double link_sigma_m = 0.05;
   double link_sigma_m_per_m = 0.05;
@@ -78,6 +87,10 @@ struct ExperienceMapOptions {
     v("relaxation_tolerance_rad", relaxation_tolerance_rad,
       "incremental: rotation of an experience that adds its links to the relaxed region",
       schema::Unit("rad").Positive());
+    v("relaxation_max_region_links", relaxation_max_region_links,
+      "incremental: the relaxed region stops growing at this many links (0: no limit); bounds an "
+      "action's cost on large maps, leaving the map beyond the region as it is",
+      schema::Unit("links").NonNegative());
     v("link_sigma_m", link_sigma_m,
       "translation noise of a link (plus link_sigma_m_per_m of its length): the information "
       "matrix of least_squares and of experience_map.g2o",
@@ -181,6 +194,9 @@ class ExperienceMap {
   // was and is retried at the next action.
   uint64_t least_squares_runs() const { return least_squares_runs_; }
   uint64_t least_squares_failures() const { return least_squares_failures_; }
+  // kIncremental: passes in which the region would have grown beyond relaxation_max_region_links
+  // (not saved). Zero means the cap changed nothing.
+  uint64_t relaxation_capped_passes() const { return capped_passes_; }
 
   // The pose of the current experience composed with the offset since it.
   void CurrentPose(double* x_m, double* y_m, double* theta_rad) const;
@@ -222,6 +238,8 @@ class ExperienceMap {
   // Adds `id`'s links with ids from `above` that are not in the region yet to it (and, with
   // `this_pass`, to the links still ahead in this pass). Returns true when the region grew.
   bool GrowRegion(uint32_t id, uint32_t above, bool this_pass);
+  // Shrinks the region to `cap` links after a pass, keeping those whose ends moved most.
+  void TrimRegion(size_t cap);
 
   ExperienceMapOptions options_;
   State state_;
@@ -238,6 +256,8 @@ class ExperienceMap {
   uint64_t link_updates_ = 0;
   uint64_t least_squares_runs_ = 0;
   uint64_t least_squares_failures_ = 0;
+  uint64_t capped_passes_ = 0;
+  bool capped_this_pass_ = false;
 };
 
 }  // namespace ratslam

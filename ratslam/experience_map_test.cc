@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <iostream>
 #include <numbers>
 
 #include "common/circular.h"
@@ -271,8 +272,8 @@ ExperienceMap DriveLongRoute(const ExperienceMapOptions& options, int n) {
 // spurious turn per metre: the first lap creates an experience per place, later laps link to
 // them, relaxing after every action. Returns the map error against the true places (RMSE after
 // rigid alignment) and counts link updates.
-double LapsMapError(RelaxationScheme scheme, int laps, uint64_t* link_updates) {
-  ExperienceMap map(Scheme(scheme));
+double LapsMapError(const ExperienceMapOptions& options, int laps, uint64_t* link_updates) {
+  ExperienceMap map(options);
   std::vector<Point2> truth;
   for (int s = 0; s < 60; ++s) {
     if (s < 20)
@@ -301,6 +302,9 @@ double LapsMapError(RelaxationScheme scheme, int laps, uint64_t* link_updates) {
   *link_updates = map.relaxation_link_updates();
   return AlignRigid2D(estimate, truth)->rmse_m;
 }
+double LapsMapError(RelaxationScheme scheme, int laps, uint64_t* link_updates) {
+  return LapsMapError(Scheme(scheme), laps, link_updates);
+}
 
 TEST(RelaxationSchemeTest, IncrementalIsAsAccurateAsFullForAFractionOfTheWork) {
   uint64_t full_updates = 0, incremental_updates = 0, none = 0;
@@ -311,6 +315,57 @@ TEST(RelaxationSchemeTest, IncrementalIsAsAccurateAsFullForAFractionOfTheWork) {
   EXPECT_LT(full, 0.5 * dead_reckoning) << full << " vs " << dead_reckoning;
   EXPECT_LE(incremental, 1.02 * full + 1e-3) << incremental << " vs " << full;
   EXPECT_LT(incremental_updates * 5, full_updates) << incremental_updates << " vs " << full_updates;
+}
+
+// A region cap smaller than the loop still takes most of the drift out, and bounds every
+// action's cost by the passes over the cap plus the links the action added.
+TEST(RelaxationSchemeTest, CappedRegionBoundsEachActionAndStillCorrects) {
+  uint64_t none = 0, uncapped_updates = 0, capped_updates = 0;
+  const double dead_reckoning = LapsMapError(RelaxationScheme::kFull, 1, &none);
+  ExperienceMapOptions uncapped = Scheme(RelaxationScheme::kIncremental);
+  uncapped.relaxation_max_region_links = 0;
+  ExperienceMapOptions capped = uncapped;
+  capped.relaxation_max_region_links = 40;  // a lap is 60 links
+  const double free_error = LapsMapError(uncapped, 6, &uncapped_updates);
+  const double capped_error = LapsMapError(capped, 6, &capped_updates);
+  EXPECT_LT(capped_error, 0.5 * dead_reckoning) << capped_error << " vs " << dead_reckoning;
+  // Not free: the window leaves part of each lap's correction undone.
+  EXPECT_GT(capped_error, free_error);
+  std::cout << "laps map error: dead reckoning " << dead_reckoning << " m, uncapped " << free_error
+            << " m (" << uncapped_updates << " link updates), capped at 40 links " << capped_error
+            << " m (" << capped_updates << ")\n";
+
+  ExperienceMap map(capped);
+  uint64_t worst = 0;
+  for (int i = 0; i < 1200; ++i) {
+    map.Integrate(1.0, 0.11);
+    map.CreateExperience(i, {}, i);
+    uint64_t before = map.relaxation_link_updates();
+    if (i >= 60 && i % 40 == 0) {
+      ASSERT_TRUE(map.LinkTo(static_cast<uint32_t>(i - 60), i).ok());
+    }
+    map.Relax();
+    worst = std::max(worst, map.relaxation_link_updates() - before);
+    ASSERT_LE(map.state().relaxation_pending_links.size(), 40u);
+  }
+  EXPECT_GT(map.relaxation_capped_passes(), 0u);
+  // Ten passes over at most the cap plus the action's two new links.
+  EXPECT_LE(worst, 10u * (40u + 2u));
+  EXPECT_GT(worst, 10u * 20u);  // the cap, not a settled map, is what bounds it
+}
+
+TEST(RelaxationSchemeTest, NoCapNeededNoCapUsed) {
+  // Below the cap, the cap changes nothing: the default map equals an uncapped one exactly.
+  ExperienceMapOptions uncapped = Scheme(RelaxationScheme::kIncremental);
+  uncapped.relaxation_max_region_links = 0;
+  ExperienceMap a = DriveLongRoute(Scheme(RelaxationScheme::kIncremental), 400);
+  ExperienceMap b = DriveLongRoute(uncapped, 400);
+  EXPECT_EQ(a.relaxation_capped_passes(), 0u);
+  ASSERT_EQ(a.num_experiences(), b.num_experiences());
+  for (size_t i = 0; i < a.num_experiences(); ++i) {
+    ASSERT_EQ(a.experience(i).x_m, b.experience(i).x_m) << i;
+    ASSERT_EQ(a.experience(i).theta_rad, b.experience(i).theta_rad) << i;
+  }
 }
 
 TEST(RelaxationSchemeTest, FullSchemeEqualsTheOriginalBitForBit) {

@@ -261,6 +261,7 @@ constexpr AddedKey kKeysAddedAfter[] = {
     {6, "experience_map.link_sigma_m_per_m"},
     {6, "experience_map.link_sigma_rad"},
     {7, "experience_map.initial_heading_rad"},
+    {7, "experience_map.relaxation_max_region_links"},
     {7, "visual_odometry.model"},
     {7, "visual_odometry.translation_left_px"},
     {7, "visual_odometry.translation_right_px"},

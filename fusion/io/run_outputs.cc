@@ -272,6 +272,9 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
   if (map.current()) j["current_experience"] = *map.current();
   j["links"] = s.links;
   j["loop_closures"] = s.loop_closures;
+  if (map.options().relaxation_scheme == RelaxationScheme::kIncremental) {
+    j["relaxation_capped_passes"] = map.relaxation_capped_passes();
+  }
   j["odometry_steps"] = state.trajectory.size();
   j["view_injections"] = slam.counters().injections;
   j["refused_ambiguous_links"] = slam.counters().refused_ambiguous;
