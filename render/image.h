@@ -22,6 +22,8 @@ struct RgbaImage {
   }
 };
 
+// An opaque image is written as RGB, others as RGBA; the bytes depend only on the image (not on
+// the number of cores that compress it). Written to a temporary file and renamed into place.
 Status WritePng(const RgbaImage& image, const std::string& path);
 StatusOr<RgbaImage> ReadPng(const std::string& path);
 

@@ -6,6 +6,11 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <random>
+#include <tuple>
+#include <vector>
 
 #include "common/scratch_dir.h"
 
@@ -123,6 +128,37 @@ TEST(PngTest, WriteReadRoundTrip) {
   EXPECT_EQ(back->pixels, image.pixels);
   std::filesystem::remove(path);
   EXPECT_FALSE(ReadPng(path.string()).ok());
+}
+
+// Our PNG writer against OpenCV's decoder (libpng): images of several bands of rows (the writer
+// compresses bands in parallel), odd widths, opaque (written as RGB) and translucent (RGBA)
+// pixels; the same image gives the same bytes twice.
+TEST(PngTest, LargeImagesRoundTripThroughAnIndependentDecoder) {
+  std::mt19937 rng(7);
+  for (const auto& [w, h, opaque] : {std::tuple{1, 1, true}, std::tuple{333, 517, true},
+                                     std::tuple{257, 300, false}, std::tuple{64, 128, true}}) {
+    RgbaImage image{w, h, std::vector<uint8_t>(static_cast<size_t>(w) * h * 4)};
+    for (size_t i = 0; i < image.pixels.size(); ++i) {
+      // Runs and noise, so both compress differently.
+      image.pixels[i] = (i / 4) % 97 < 40 ? 255 : static_cast<uint8_t>(rng());
+      if (i % 4 == 3 && opaque) image.pixels[i] = 255;
+    }
+    const auto path = TestScratch().path() / "ratslam_png_large.png";
+    ASSERT_TRUE(WritePng(image, path.string()).ok());
+    StatusOr<RgbaImage> back = ReadPng(path.string());
+    ASSERT_TRUE(back.ok()) << w << "x" << h;
+    EXPECT_EQ(back->width, w);
+    EXPECT_EQ(back->height, h);
+    EXPECT_TRUE(back->pixels == image.pixels) << w << "x" << h;
+    std::ifstream first_file(path, std::ios::binary);
+    const std::string first((std::istreambuf_iterator<char>(first_file)), {});
+    ASSERT_TRUE(WritePng(image, path.string()).ok());
+    std::ifstream second_file(path, std::ios::binary);
+    EXPECT_EQ(std::string((std::istreambuf_iterator<char>(second_file)), {}), first);
+  }
+  EXPECT_FALSE(WritePng(RgbaImage{2, 2, std::vector<uint8_t>(3)},
+                        (TestScratch().path() / "never_written.png").string())
+                   .ok());
 }
 
 }  // namespace
