@@ -1,9 +1,10 @@
 // IPIN competition phone logs: errors name the file; an accepted log becomes a data set that
-// `ratslam import` can write and read back.
+// `ratslam import` can write and read back, and its barometer readings give floors.
 #include <string>
 
 #include "fuzz/dataset_round_trip.h"
 #include "fuzz/fuzz_support.h"
+#include "sensors/barometer.h"
 #include "sensors/dataset/ipin_log.h"
 
 namespace ratslam::fuzz {
@@ -17,6 +18,10 @@ std::vector<std::string> FuzzSeeds() {
             std::to_string(9.8 + 3.0 * ((i / 12) % 2)) + ";3\n";
     walk += "AHRS;" + std::to_string(t) + ";" + std::to_string(100 + t) +
             ";1.0;2.0;90.0;0.1;0.2;0.3;3\n";
+    if (i % 10 == 0) {
+      walk += "PRES;" + std::to_string(t) + ";" + std::to_string(100 + t) + ";" +
+              std::to_string(976.87 - 0.05 * i) + ";3\n";
+    }
   }
   walk +=
       "WIFI;0.50;100.50;net;aa:bb;2437;-60\nWIFI;0.50;100.50;net;cc:dd;5200;-71;\n"
@@ -30,6 +35,9 @@ std::vector<std::string> FuzzSeeds() {
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   return ratslam::fuzz::FuzzPhoneLog(
       data, size, [](const std::string& path, const ratslam::PhoneLogOptions& options) {
+        // The barometer's floors from whatever PRES lines were accepted: never a crash.
+        ratslam::StatusOr<ratslam::PhoneLog> log = ratslam::ParseIpinLog(path, options);
+        if (log.ok()) (void)ratslam::EstimateFloors(log->streams.pressure);
         return ratslam::ReadIpinLog(path, options);
       });
 }

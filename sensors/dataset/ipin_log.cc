@@ -144,6 +144,10 @@ StatusOr<PhoneLog> ParseIpinLog(const std::string& path, const PhoneLogOptions& 
       if (status.ok()) {
         headings.push_back({v[1], WrapAngle(v[5] * std::numbers::pi / 180 + std::numbers::pi / 2)});
       }
+    } else if (type == "PRES") {
+      // PRES;AppTimestamp;SensorTimestamp;Pressure(mbar);Accuracy
+      status = numbers({{1, "AppTimestamp(s)", 0, kMaxTimeS}, {3, "Pressure(mbar)", 100, 1100}});
+      if (status.ok()) streams.pressure.push_back({v[1], v[3]});
     } else if (type == "POSI") {
       status = numbers({{1, "Timestamp(s)", 0, kMaxTimeS},
                         {3, "Latitude", -90, 90},
@@ -168,6 +172,9 @@ StatusOr<PhoneLog> ParseIpinLog(const std::string& path, const PhoneLogOptions& 
 
   std::stable_sort(posi.begin(), posi.end(),
                    [](const Posi& a, const Posi& b) { return a.time_s < b.time_s; });
+  std::stable_sort(
+      streams.pressure.begin(), streams.pressure.end(),
+      [](const PressureSample& a, const PressureSample& b) { return a.time_s < b.time_s; });
   if (!posi.empty()) {
     r.reference = options.reference ? *options.reference
                                     : GeoReference{posi.front().latitude, posi.front().longitude};

@@ -1,6 +1,7 @@
 // Reader for the IPIN competition smartphone logs (GetSensorData app; `;`-separated lines):
 // WIFI (Wi-Fi scans, with or without the Frequency column), ACCE (accelerometer), AHRS (phone
-// orientation: the compass), POSI (ground-truth points). Other line types are skipped.
+// orientation: the compass), PRES (barometer: kept in the parsed log's streams for floor
+// estimation, sensors/barometer.h), POSI (ground-truth points). Other line types are skipped.
 // Odometry comes from pedestrian dead reckoning over ACCE and AHRS, run after parsing
 // (phone_log.h). Ground truth: latitude and longitude to local metres (x east, y north) about a
 // reference point, the floor kept; the replay interpolates linearly between points (the walkers

@@ -92,6 +92,9 @@ TEST(IpinLogTest, OutOfRangeValuesNameTheFieldAndLine) {
       {"POSI;5.0;3;49.46;11.11;1.5;100\n", "floor is not a whole number"},
       {"WIFI;-5.0;105.0;net;aa:bb;2437;-60\n", "AppTimestamp(s) is out of range"},
       {"ACCE;5.1;105.1;0.1;0.2;1e9;3\n", "Acc_Z is out of range"},
+      {"PRES;5.2;105.2;9768.7;3\n", "Pressure(mbar) is out of range [100, 1100]"},
+      {"PRES;5.2;105.2;nan;3\n", "Pressure(mbar) is not a number"},
+      {"PRES;5.2;105.2\n", "missing field Pressure(mbar)"},
   };
   for (const auto& [line, expected] : cases) {
     const fs::path path = WriteFixture("ratslam_ipin_range.txt", std::string(kFixture) + line);
@@ -103,6 +106,18 @@ TEST(IpinLogTest, OutOfRangeValuesNameTheFieldAndLine) {
   }
   EXPECT_NE(ReadIpinLog("/dev/zero", {}).status().message().find("not a regular file"),
             std::string::npos);
+}
+
+TEST(IpinLogTest, BarometerReadingsAreKeptInTimeOrder) {
+  const fs::path path = WriteFixture("ratslam_ipin_pres.txt", std::string(kFixture) +
+                                                                  "PRES;2.0;102.0;976.8628;3\n"
+                                                                  "PRES;1.5;101.5;976.8699;3\n");
+  StatusOr<PhoneLog> log = ParseIpinLog(path.string(), {});
+  ASSERT_TRUE(log.ok()) << log.status().message();
+  ASSERT_EQ(log->streams.pressure.size(), 2u);
+  EXPECT_EQ(log->streams.pressure[0].time_s, 1.5);
+  EXPECT_EQ(log->streams.pressure[0].pressure_hpa, 976.8699);
+  EXPECT_EQ(log->streams.pressure[1].pressure_hpa, 976.8628);
 }
 
 TEST(IpinLogTest, StepsBecomeOdometryRows) {

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "common/status.h"
+#include "sensors/barometer.h"
 #include "sensors/dataset/dataset.h"
 #include "sensors/pedestrian_dead_reckoning.h"
 
@@ -45,6 +46,7 @@ struct PhoneLogStreams {
   std::vector<HeadingSample> headings;
   std::map<double, std::vector<WifiReading>> scans;  // readings by scan time
   std::vector<GroundTruthRow> ground_truth;          // headings not yet set
+  std::vector<PressureSample> pressure;              // barometer (IPIN's PRES), hPa
 };
 
 struct PhoneLog {
