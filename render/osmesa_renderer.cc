@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
-#include <cstring>
 #include <string>
 #include <vector>
 
@@ -269,8 +268,6 @@ class OsMesaRenderer : public SceneRenderer, public OsMesaContextHolder {
     if (w != framebuffer_width_ || h != framebuffer_height_) {
       RATSLAM_RETURN_IF_ERROR(AllocateFramebuffers(w, h));
     }
-    RgbaImage image;
-    Status status;
     gl_.BindFramebuffer(GL_FRAMEBUFFER, framebuffers_[0]);
     gl_.Viewport(0, 0, w, h);
     const Rgba bg = scene.background();
@@ -286,19 +283,18 @@ class OsMesaRenderer : public SceneRenderer, public OsMesaContextHolder {
     gl_.BlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
     gl_.BindFramebuffer(GL_FRAMEBUFFER, framebuffers_[1]);
     // The shaders put scene row 0 first in memory: the rows come out top first.
+    RgbaImage image;
     image.width = w;
     image.height = h;
     image.pixels.resize(static_cast<size_t>(w) * h * 4);
     gl_.PixelStorei(GL_PACK_ALIGNMENT, 1);
     gl_.ReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, image.pixels.data());
     gl_.Finish();
-    if (const GLenum error = gl_.GetError(); error != GL_NO_ERROR) {
-      status = Status::Error("OpenGL error " + std::to_string(error) + " while rendering");
-    }
+    const GLenum error = gl_.GetError();
     gl_.BindFramebuffer(GL_FRAMEBUFFER, 0);
-    if (!status.ok()) {
+    if (error != GL_NO_ERROR) {
       ReleaseFramebuffers();
-      return status;
+      return Status::Error("OpenGL error " + std::to_string(error) + " while rendering");
     }
     DrawTexts(scene, &image);
     return image;
@@ -323,22 +319,20 @@ class OsMesaRenderer : public SceneRenderer, public OsMesaContextHolder {
                                 renderbuffers_[1]);
     const bool complete = gl_.CheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
     gl_.BindFramebuffer(GL_FRAMEBUFFER, 0);
-    has_framebuffers_ = true;
+    framebuffer_width_ = w;
+    framebuffer_height_ = h;
     if (!complete || !ms_complete) {
       ReleaseFramebuffers();
       return Status::Error("OSMesa: framebuffer incomplete for " + std::to_string(w) + "x" +
                            std::to_string(h));
     }
-    framebuffer_width_ = w;
-    framebuffer_height_ = h;
     return Status::Ok();
   }
 
   void ReleaseFramebuffers() {
-    if (!has_framebuffers_) return;
+    if (framebuffer_width_ == 0) return;  // none allocated
     gl_.DeleteFramebuffers(2, framebuffers_);
     gl_.DeleteRenderbuffers(2, renderbuffers_);
-    has_framebuffers_ = false;
     framebuffer_width_ = framebuffer_height_ = 0;
   }
 
@@ -406,8 +400,7 @@ class OsMesaRenderer : public SceneRenderer, public OsMesaContextHolder {
 
   GLuint color_program_ = 0, texture_program_ = 0;
   GLuint framebuffers_[2] = {0, 0}, renderbuffers_[2] = {0, 0};
-  bool has_framebuffers_ = false;
-  int framebuffer_width_ = 0, framebuffer_height_ = 0;
+  int framebuffer_width_ = 0, framebuffer_height_ = 0;  // 0: no framebuffers allocated
 };
 
 const char kViewVertexShader[] = R"(#version 330 core

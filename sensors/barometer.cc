@@ -28,10 +28,12 @@ bool BarometerOptions::IsValid(std::string* error) const {
 }
 
 BarometricFloorTracker::BarometricFloorTracker(BarometerOptions options)
-    : options_(options), storey_m_(options.storey_m) {}
+    : options_(options), storey_m_(options.storey_m) {
+  options_.IsValid(&options_error_);
+}
 
 StatusOr<FloorEstimate> BarometricFloorTracker::Add(const PressureSample& sample) {
-  if (std::string error; !options_.IsValid(&error)) return Status::Error("barometer: " + error);
+  if (!options_error_.empty()) return Status::Error("barometer: " + options_error_);
   if (!std::isfinite(sample.time_s) || sample.time_s < last_time_s_) {
     return Status::Error("barometer: time " + std::to_string(sample.time_s) +
                          " s goes backwards or is not finite");

@@ -74,6 +74,7 @@ class BarometricFloorTracker {
   void Renumber();
 
   BarometerOptions options_;
+  std::string options_error_;          // empty when the options are valid (checked once)
   std::deque<PressureSample> window_;  // readings within smoothing_s
   double window_sum_ = 0.0;
   double reference_hpa_ = 0.0;  // first smoothed pressure
