@@ -50,11 +50,13 @@ std::vector<std::string> Split(const std::string& line) {
 }
 
 bool ParseDouble(const std::string& text, double* value) {
-  const auto begin = text.find_first_not_of(" \t");
+  // Blank (spaces, tabs, a carriage return) is no number; the end is found before any pointer
+  // is formed (text.data() + npos would overflow).
+  const auto begin = text.find_first_not_of(" \t\r");
   const auto end = text.find_last_not_of(" \t\r");
-  if (begin == std::string::npos) return false;
+  if (begin == std::string::npos || end == std::string::npos) return false;
   const char* first = text.data() + begin;
-  const char* last = text.data() + end + 1;
+  const char* last = text.data() + (end + 1);
   const auto result = std::from_chars(first, last, *value);
   return result.ec == std::errc() && result.ptr == last && std::isfinite(*value);
 }

@@ -95,6 +95,9 @@ TEST(IpinLogTest, OutOfRangeValuesNameTheFieldAndLine) {
       {"PRES;5.2;105.2;9768.7;3\n", "Pressure(mbar) is out of range [100, 1100]"},
       {"PRES;5.2;105.2;nan;3\n", "Pressure(mbar) is not a number"},
       {"PRES;5.2;105.2\n", "missing field Pressure(mbar)"},
+      // A field of a lone carriage return (the fuzzer: once a pointer past the string's end).
+      {"PRES;5.2;105.2;\r;3\n", "Pressure(mbar) is not a number"},
+      {"PRES;5.2;105.2; \t;3\n", "Pressure(mbar) is not a number"},
   };
   for (const auto& [line, expected] : cases) {
     const fs::path path = WriteFixture("ratslam_ipin_range.txt", std::string(kFixture) + line);
