@@ -128,7 +128,7 @@ std::unique_ptr<FrontEnd> CreateFrontEnd(const FrontEndSettings& s,
     case FrontEndKind::kClassicCamera:
       return front_end_internal::MakeClassicCameraFrontEnd(s.classic_camera);
     case FrontEndKind::kFused:
-      return front_end_internal::MakeFusedFrontEnd(s.fused, s.camera_12x9, s.wifi);
+      return front_end_internal::MakeFusedFrontEnd(s.fused, s.camera_12x9, s.wifi, s.barometer);
     case FrontEndKind::kFabmap:
       return front_end_internal::MakeFabmapFrontEnd(s.fabmap, resources.fabmap);
     case FrontEndKind::kNone:

@@ -21,6 +21,19 @@
 // templates); only both sensors below threshold make a new template.
 // Wi-Fi is evaluated at the camera rate with the newest scan; scans older than max_wifi_age_s
 // count as absent. Any sensor can be switched off (Wi-Fi only, camera only, fused).
+// Floors (use_barometer, with a pressure stream): each session's barometer gives levels
+// (sensors/barometer.h); a template stores its session and level, or "unknown" when made on
+// the stairs (in transit). A session is on its first level until the first dwell (walks start
+// standing). A match needs the barometer to agree: within a session the same level; across
+// sessions the same floor in the map's frame, where a later session starts with offset 0 to the
+// first (walks of one building usually start on one floor) and Wi-Fi revises it: each scan on a
+// level votes with its best confident match among earlier sessions' templates on a level,
+// whatever their floor, when that match beats the best on every other floor by 1.5 times (an
+// ambiguous scan abstains); a vote says the template's floor minus ours, and a value other than
+// 0 that leads every other (0 included) by floor_offset_min_votes moves the session's offset.
+// A query or template of unknown floor matches nothing that has a floor, so a scan taken on the
+// stairs becomes a new template.
+// Sessions without barometer readings are unconstrained, as before.
 // kDescriptors: per-image descriptors computed elsewhere (fusion/descriptor_table.h) matched by
 // cosine similarity with min_similarity and the same recency rule; pixels are never loaded.
 // kCustom: a front end of your own (see "Writing a front end" below FrontEnd).
@@ -40,6 +53,7 @@
 #include "fusion/fabmap/vocabulary.h"
 #include "ratslam/local_view_cells.h"
 #include "ratslam/records.h"
+#include "sensors/barometer.h"
 #include "sensors/classic_camera_matcher.h"
 #include "sensors/dataset/dataset.h"
 #include "sensors/dataset/image_loader.h"
@@ -84,6 +98,8 @@ struct FusedOptions {
   bool online_rssi_offset = false;
   int rssi_offset_min_common_aps = 5;  // an estimate needs this many APs in common
   int rssi_offset_min_estimates = 10;  // estimates before the offset is applied
+  bool use_barometer = false;          // floors from a pressure stream, when there is one
+  int floor_offset_min_votes = 3;      // lead of a floor offset over any other value
 
   bool IsValid(std::string* error) const;
 
@@ -113,7 +129,28 @@ struct FusedOptions {
     v("rssi_offset_min_estimates", rssi_offset_min_estimates,
       "offset estimates of a session before its median is applied",
       schema::Unit("scans").AtLeast(1));
+    v("use_barometer", use_barometer,
+      "with a pressure stream: give templates a floor (level) from the barometer ([barometer]) "
+      "and never match across floors or from the stairs; without one, no effect",
+      schema::Any());
+    v("floor_offset_min_votes", floor_offset_min_votes,
+      "a later session's floors start level with the first session's; its Wi-Fi matches to "
+      "earlier sessions vote, and a floor offset that leads every other by this many votes "
+      "replaces the current one",
+      schema::Unit("votes").AtLeast(1));
   }
+};
+
+// What the barometer said over a run (front ends with use_barometer and a pressure stream).
+struct FloorReport {
+  uint64_t pressure_readings = 0;
+  uint64_t floor_changes = 0;         // over all sessions (sensors/barometer.h)
+  uint64_t frames_floor_unknown = 0;  // frames on the stairs or before a session's first level
+  uint64_t new_templates_by_floor_rule = 0;  // would have matched a template on another floor
+  uint64_t templates_with_floor = 0;
+  uint64_t floor_offset_changes = 0;  // times Wi-Fi votes moved a session's floor offset
+  // By session: the offset of its floors to the first session's.
+  std::vector<int> session_floor_offsets;
 };
 
 // Where the FABMAP front end's Wi-Fi words, tree and unknown world come from.
@@ -221,6 +258,9 @@ class FrontEnd {
     return std::optional<FrameDecision>();
   }
   virtual void OnCompass(double /*time_s*/, double /*heading_rad*/) {}
+  // A barometer reading (hPa). Front ends that track floors fail on a bad reading (time going
+  // backwards, pressure outside 100-1,100 hPa); the default ignores it.
+  virtual Status OnPressure(double /*time_s*/, double /*pressure_hpa*/) { return Status::Ok(); }
   // A place descriptor computed outside this program for the frame at `time_s` (a live
   // source, or Python's frame-by-frame session); only the descriptor front end takes them.
   virtual StatusOr<std::optional<FrameDecision>> OnDescriptor(
@@ -248,6 +288,10 @@ class FrontEnd {
   // another clock, so a match to one of them is never recent. Front ends with a recency rule
   // in seconds must honour this; the default does nothing.
   virtual void SettleForLocalisation() {}
+  // Front ends that track floors report them; others return nothing.
+  virtual std::optional<FloorReport> floor_report() const { return std::nullopt; }
+  // A template's floor relative to the first session's first level, when known.
+  virtual std::optional<int> TemplateFloor(uint32_t /*id*/) const { return std::nullopt; }
   // FABMAP front ends say how their Wi-Fi model was learnt; others return nothing.
   virtual std::optional<FabmapLearningReport> fabmap_learning() const { return std::nullopt; }
 };
@@ -258,6 +302,7 @@ struct FrontEndSettings {
   FusedOptions fused;
   KernelCameraOptions camera_12x9;
   WifiMatcherOptions wifi;
+  BarometerOptions barometer;
   FabmapSettings fabmap;
   DescriptorOptions descriptors;
 };

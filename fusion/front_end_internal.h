@@ -35,7 +35,8 @@ inline bool OldEnough(int64_t count, int64_t best, double now_s, double created_
 std::unique_ptr<FrontEnd> MakeClassicCameraFrontEnd(const ClassicCameraOptions& options);
 std::unique_ptr<FrontEnd> MakeFusedFrontEnd(const FusedOptions& options,
                                             const KernelCameraOptions& camera,
-                                            const WifiMatcherOptions& wifi);
+                                            const WifiMatcherOptions& wifi,
+                                            const BarometerOptions& barometer);
 std::unique_ptr<FrontEnd> MakeNoViewFrontEnd();
 std::unique_ptr<FrontEnd> MakeDescriptorFrontEnd(const DescriptorOptions& options,
                                                  std::shared_ptr<const DescriptorTable> table);

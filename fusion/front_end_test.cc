@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <functional>
+#include <tuple>
 
 namespace ratslam {
 namespace {
@@ -310,6 +313,170 @@ TEST(FusedFrontEndTest, OnlineRssiOffsetBridgesTwoPhones) {
   // Without the option the state has the format of earlier releases (shorter).
   settings.fused.online_rssi_offset = false;
   EXPECT_FALSE(CreateFrontEnd(settings)->DecodeState(state).ok());
+}
+
+// A walk through a two-storey building for the floor rule: scans every 2 s along a 78 m
+// corridor; `height(t)` gives the barometer (10 Hz) through the hypsometric formula.
+class FloorWalk {
+ public:
+  FloorWalk(bool barometer, int min_votes = 3) {
+    settings_.front_end.kind = FrontEndKind::kFused;
+    settings_.fused.recency_s = 0.0;
+    settings_.fused.use_barometer = barometer;
+    settings_.fused.floor_offset_min_votes = min_votes;
+    front_end = CreateFrontEnd(settings_);
+  }
+  // Pressure readings up to `t`, then the scan; returns the decision.
+  FrameDecision Scan(double t, const WifiScan& scan, const std::function<double(double)>& height) {
+    for (; next_pressure_s_ <= t; next_pressure_s_ += 0.1) {
+      const double h = height(next_pressure_s_);
+      EXPECT_TRUE(front_end->OnPressure(next_pressure_s_, 1000.0 * std::exp(-h / 8434.5)).ok());
+    }
+    const auto d = front_end->OnWifi(scan);
+    EXPECT_TRUE(d.ok() && d->has_value());
+    return **d;
+  }
+  void StartSession(double start_s) {
+    front_end->OnSessionStart(start_s);
+    next_pressure_s_ = start_s;
+  }
+  FrontEndSettings settings_;
+  std::unique_ptr<FrontEnd> front_end;
+  double next_pressure_s_ = 0.0;
+};
+
+// Floor 0 and floor 1 have the same Wi-Fi (the APs of one floor heard through the ceiling). The
+// walk goes along floor 0, up 3.5 m of stairs in 14 s, along floor 1 and back. A match is across
+// floors when the true heights of its two ends differ by more than half a storey.
+double TwoStoreys(double t) { return t < 80.0 ? 0.0 : (t < 94.0 ? 3.5 * (t - 80.0) / 14.0 : 3.5); }
+
+TEST(FusedFrontEndTest, BarometerKeepsMatchesOnTheirFloor) {
+  auto height = TwoStoreys;
+  auto walk = [&](bool barometer, std::string* state_mid, std::vector<int>* floors_of_templates) {
+    FloorWalk w(barometer);
+    std::vector<double> made_at_height;  // by template
+    int cross_floor = 0, same_floor = 0;
+    auto step = [&](double t, double x) {
+      const FrameDecision d = w.Scan(t, CorridorScan(t, x, 0.5), height);
+      if (d.view.is_new) {
+        made_at_height.push_back(height(t));
+      } else if (!d.recent) {
+        (std::abs(made_at_height[d.view.template_id] - height(t)) > 1.75 ? cross_floor
+                                                                         : same_floor) += 1;
+      }
+    };
+    for (int i = 0; i < 40; ++i) step(2.0 * i, 2.0 * i);     // floor 0
+    for (int i = 0; i < 7; ++i) step(80.0 + 2.0 * i, 78.0);  // stairs
+    if (state_mid) *state_mid = w.front_end->EncodeState();
+    for (int i = 0; i < 40; ++i) step(94.0 + 2.0 * i, 78.0 - 2.0 * i);  // floor 1, back
+    for (int i = 0; i < 40; ++i) step(174.0 + 2.0 * i, 2.0 * i);        // floor 1 again
+    if (floors_of_templates) {
+      for (uint32_t id = 0; id < made_at_height.size(); ++id) {
+        const std::optional<int> f = w.front_end->TemplateFloor(id);
+        floors_of_templates->push_back(f ? *f : -1);
+        // A floor, when known, is the true one; made mid-stairs, none.
+        const double h = made_at_height[id];
+        if (h > 0.5 && h < 3.0) {
+          EXPECT_FALSE(f.has_value()) << id;
+        } else if (f) {
+          EXPECT_EQ(*f, h > 1.75 ? 1 : 0) << id;
+        }
+      }
+    }
+    return std::make_pair(cross_floor, same_floor);
+  };
+  const auto [plain_cross, plain_same] = walk(false, nullptr, nullptr);
+  EXPECT_GE(plain_cross, 40);  // floor 1 re-uses floor 0's templates
+  std::string state_mid;
+  std::vector<int> floors;
+  const auto [cross, same] = walk(true, &state_mid, &floors);
+  EXPECT_EQ(cross, 0);
+  EXPECT_GE(same, 35);  // the second pass on floor 1 re-uses floor 1's templates
+  EXPECT_GE(std::count(floors.begin(), floors.end(), 0), 5);
+  EXPECT_GE(std::count(floors.begin(), floors.end(), 1), 5);
+
+  // The floors are part of the state: a front end restored halfway goes on identically.
+  FloorWalk original(true), restored(true);
+  for (int i = 0; i < 40; ++i) original.Scan(2.0 * i, CorridorScan(2.0 * i, 2.0 * i, 0.5), height);
+  for (int i = 0; i < 7; ++i) {
+    original.Scan(80.0 + 2.0 * i, CorridorScan(80.0 + 2.0 * i, 78.0, 0.5), height);
+  }
+  ASSERT_EQ(original.front_end->EncodeState(), state_mid);
+  ASSERT_TRUE(restored.front_end->DecodeState(state_mid).ok());
+  EXPECT_EQ(restored.front_end->EncodeState(), state_mid);
+  restored.next_pressure_s_ = original.next_pressure_s_;
+  for (int i = 0; i < 40; ++i) {
+    const double t = 94.0 + 2.0 * i;
+    const FrameDecision a = original.Scan(t, CorridorScan(t, 78.0 - 2.0 * i, 0.5), height);
+    const FrameDecision b = restored.Scan(t, CorridorScan(t, 78.0 - 2.0 * i, 0.5), height);
+    EXPECT_EQ(a.view.template_id, b.view.template_id);
+    EXPECT_EQ(a.view.is_new, b.view.is_new);
+  }
+  EXPECT_EQ(restored.front_end->EncodeState(), original.front_end->EncodeState());
+  for (size_t cut : {size_t{1}, size_t{9}, state_mid.size() / 2}) {
+    EXPECT_FALSE(restored.front_end->DecodeState(state_mid.substr(0, state_mid.size() - cut)).ok());
+  }
+  // Without the option the state has the format of earlier releases (shorter).
+  EXPECT_FALSE(FloorWalk(false).front_end->DecodeState(state_mid).ok());
+  // A reading the tracker refuses is an error, not a crash.
+  EXPECT_FALSE(restored.front_end->OnPressure(1.0, 1000.0).ok());  // time goes backwards
+  EXPECT_FALSE(restored.front_end->OnPressure(1e6, 5000.0).ok());  // not a pressure
+}
+
+// Two floors with different APs. A second walk starts upstairs: its first level is taken for the
+// first walk's floor 0 until its Wi-Fi matches vote it onto floor 1.
+TEST(FusedFrontEndTest, SecondSessionsFloorOffsetComesFromWifiVotes) {
+  auto floor_scan = [](double t, double x, int floor) {
+    WifiScan s = CorridorScan(t, x, 0.5);
+    if (floor == 1) {
+      for (WifiReading& r : s.readings) r.bssid = "up-" + r.bssid;
+    }
+    return s;
+  };
+  FloorWalk w(true, 3);
+  auto first = TwoStoreys;
+  std::vector<std::pair<uint32_t, int>> session_of_template;  // (session, true floor)
+  auto record = [&](const FrameDecision& d, uint32_t session, int floor) {
+    if (d.view.is_new) session_of_template.emplace_back(session, floor);
+  };
+  w.StartSession(0.0);
+  for (int i = 0; i < 40; ++i)
+    record(w.Scan(2.0 * i, floor_scan(2.0 * i, 2.0 * i, 0), first), 0, 0);
+  for (int i = 0; i < 7; ++i) {  // the stairs: downstairs APs, then upstairs ones
+    const double t = 80.0 + 2.0 * i;
+    record(w.Scan(t, floor_scan(t, 78.0, i < 4 ? 0 : 1), first), 0, i == 0 ? 0 : -1);
+  }
+  for (int i = 0; i < 40; ++i) {
+    const double t = 94.0 + 2.0 * i;
+    record(w.Scan(t, floor_scan(t, 78.0 - 2.0 * i, 1), first), 0, 1);
+  }
+  // The second walk: level all the way (its own floor 0), on the first walk's floor 1.
+  w.StartSession(1000.0);
+  int matched_before = 0, matched_after = 0, cross_floor = 0;
+  for (int i = 0; i < 40; ++i) {
+    const double t = 1000.0 + 2.0 * i;
+    const FrameDecision d = w.Scan(t, floor_scan(t, 2.0 * i, 1), [](double) { return 0.0; });
+    record(d, 1, 1);
+    if (d.view.is_new || d.recent) continue;
+    const auto [session, floor] = session_of_template[d.view.template_id];
+    if (session == 0) {
+      (i < 2 ? matched_before : matched_after) += 1;
+      cross_floor += floor != 1;
+    }
+  }
+  const std::optional<FloorReport> report = w.front_end->floor_report();
+  ASSERT_TRUE(report.has_value());
+  EXPECT_EQ(report->session_floor_offsets, (std::vector<int>{0, 1}));
+  EXPECT_EQ(report->floor_offset_changes, 1u);
+  EXPECT_EQ(matched_before,
+            0);  // the third scan's vote moves the offset; before, floor 1 is refused
+  EXPECT_GE(matched_after, 30);
+  EXPECT_EQ(cross_floor, 0);
+  for (uint32_t id = 0; id < session_of_template.size(); ++id) {
+    if (session_of_template[id].first == 1) {
+      EXPECT_EQ(w.front_end->TemplateFloor(id), 1) << id;
+    }
+  }
 }
 
 }  // namespace

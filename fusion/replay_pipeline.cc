@@ -18,6 +18,7 @@ bool PipelineOptions::IsValid(std::string* error) const {
          check(sensors.fused.IsValid(&inner), "fused") &&
          check(sensors.camera_12x9.IsValid(&inner), "camera_12x9") &&
          check(sensors.wifi.IsValid(&inner), "wifi") &&
+         check(sensors.barometer.IsValid(&inner), "barometer") &&
          check(sensors.descriptors.IsValid(&inner), "descriptors") &&
          check(pdr.IsValid(&inner), "pdr") &&
          check(visual_odometry.IsValid(&inner), "visual_odometry") && ratslam.IsValid(error) &&
@@ -103,6 +104,9 @@ Status ReplayPipeline::Run(const ReplayControl& control) {
         break;
       case EventType::kCompass:
         FeedCompass(dataset_.compass[event.index]);
+        break;
+      case EventType::kPressure:
+        status = HandlePressure(event);
         break;
     }
     if (!status.ok()) return status;
@@ -205,12 +209,26 @@ size_t ReplayPipeline::SessionAt(double time_s) const {
   return session;
 }
 
+void ReplayPipeline::AnnounceSession(double time_s) {
+  if (!dataset_.session_start_times_s.empty()) {
+    front_end_->OnSessionStart(dataset_.session_start_times_s[SessionAt(time_s)]);
+  }
+}
+
 Status ReplayPipeline::HandleWifi(const Event& event) {
   const WifiScan& scan = dataset_.wifi[event.index];
-  if (!dataset_.session_start_times_s.empty()) {
-    front_end_->OnSessionStart(dataset_.session_start_times_s[SessionAt(scan.time_s)]);
-  }
+  AnnounceSession(scan.time_s);
   return FeedWifi(scan);
+}
+
+Status ReplayPipeline::HandlePressure(const Event& event) {
+  const PressureSample& sample = dataset_.pressure[event.index];
+  AnnounceSession(sample.time_s);
+  return FeedPressure(sample).WithContext("pressure.csv row " + std::to_string(event.index + 1));
+}
+
+Status ReplayPipeline::FeedPressure(const PressureSample& sample) {
+  return front_end_->OnPressure(sample.time_s, sample.pressure_hpa);
 }
 
 Status ReplayPipeline::FeedWifi(const WifiScan& scan) {

@@ -50,6 +50,7 @@ struct PipelineOptions {
     v("fused", sensors.fused);
     v("camera_12x9", sensors.camera_12x9);
     v("wifi", sensors.wifi);
+    v("barometer", sensors.barometer);
     v("descriptors", sensors.descriptors);
     v("pdr", pdr);
     v("visual_odometry", visual_odometry);
@@ -132,6 +133,9 @@ class ReplayPipeline {
   // A place descriptor for the frame at `time_s` (the descriptor front end only).
   Status FeedDescriptor(double time_s, const std::vector<float>& values);
   void FeedCompass(const CompassRow& row);
+  // A barometer reading (floors; [fused] use_barometer). Fails on a reading the floor tracker
+  // refuses (time going backwards, pressure outside 100-1,100 hPa).
+  Status FeedPressure(const PressureSample& sample);
 
   bool finished() const { return state_.next_event >= events_.size(); }
   const Ratslam& slam() const { return *slam_; }
@@ -166,11 +170,17 @@ class ReplayPipeline {
   }
   // The RSSI offsets removed per session ([fused] online_rssi_offset); empty otherwise.
   std::vector<double> rssi_offsets_db() const { return front_end_->RssiOffsetsDb(); }
+  // What the barometer said ([fused] use_barometer with a pressure stream); nothing otherwise.
+  std::optional<FloorReport> floor_report() const { return front_end_->floor_report(); }
+  // A template's floor relative to the first session's first level, when the front end knows.
+  std::optional<int> template_floor(uint32_t id) const { return front_end_->TemplateFloor(id); }
 
  private:
   Status HandleOdometry(const Event& event);
   Status HandleImage(const Event& event);
   Status HandleWifi(const Event& event);
+  Status HandlePressure(const Event& event);
+  void AnnounceSession(double time_s);
   Status Apply(const FrameDecision& decision);
   Status AddSequencePose(const WifiScan& scan);
   // The data set's session (index into session_start_times_s; 0 without any) at `time_s`.

@@ -36,7 +36,8 @@ inline void CheckWritesAndReadsBack(const Dataset& d) {
     InvariantFailed("a written data set does not read back: " + back.status().message());
   if (back->odometry.size() != d.odometry.size() || back->images.size() != d.images.size() ||
       back->ground_truth.size() != d.ground_truth.size() ||
-      back->compass.size() != d.compass.size() || Readings(*back) != Readings(d)) {
+      back->compass.size() != d.compass.size() || back->pressure.size() != d.pressure.size() ||
+      Readings(*back) != Readings(d)) {
     InvariantFailed("a written data set reads back with other row counts");
   }
 }

@@ -3,6 +3,7 @@
 // few hundred events and summarises its outputs without touching an id that does not exist. The
 // fuzzer found a dangling trajectory id (Summarise) in 19 executions before restores were
 // validated.
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <numbers>
@@ -15,8 +16,9 @@
 namespace ratslam::fuzz {
 namespace {
 
-// Two laps of a 16 m square: odometry 10 Hz, scans every 2 s from four APs, compass 2 Hz, one
-// camera image a second whose content depends on the position (so templates re-match).
+// Two laps of a 16 m square: odometry 10 Hz, scans every 2 s from four APs, compass 2 Hz, a
+// barometer at 10 Hz, one camera image a second whose content depends on the position (so templates
+// re-match).
 Dataset MakeDataset() {
   Dataset d;
   d.name = "fuzz-square";
@@ -52,6 +54,11 @@ Dataset MakeDataset() {
     double x, y, h;
     where(t, &x, &y, &h);
     d.compass.push_back({t, h});
+  }
+  // The barometer: the second lap is a floor up (3.5 m climbed in 8 s at its start).
+  for (double t = 0.05; t < 2 * lap; t += 0.1) {
+    const double h = t < lap ? 0.0 : std::min(3.5, 3.5 * (t - lap) / 8.0);
+    d.pressure.push_back({t, 1000.0 * std::exp(-h / 8434.5)});
   }
   for (int t = 0; t < 2 * lap; ++t) {
     d.images.push_back({t + 0.7, std::to_string(t % static_cast<int>(lap)) + ".png", t + 2});
@@ -94,6 +101,7 @@ struct Setup {
     fused.sensors.fused.use_compass = true;
     fused.sensors.fused.recency_s = 20.0;
     fused.sensors.fused.online_rssi_offset = true;  // its estimates are part of the state
+    fused.sensors.fused.use_barometer = true;       // and so are its floors
     PipelineOptions fabmap_wifi;
     fabmap_wifi.sensors.front_end.kind = FrontEndKind::kFabmap;
     fabmap_wifi.sensors.fabmap.localiser.localiser.mode = fabmap::FabmapMode::kWifi;

@@ -342,6 +342,11 @@ class Session {
     if (!std::isfinite(heading_rad)) throw Error("compass: the heading must be finite");
     pipeline_->FeedCompass({time_s, heading_rad});
   }
+  void Pressure(double time_s, double pressure_hpa) {
+    Advance(time_s);
+    Check(pipeline_->FeedPressure({time_s, pressure_hpa})
+              .WithContext("pressure at t=" + std::to_string(time_s)));
+  }
 
   void SaveMap(const std::string& path) const {
     MapFile map;
@@ -501,6 +506,8 @@ PYBIND11_MODULE(ratslam, m) {
       .def("wifi", &Session::Wifi, py::arg("time_s"), py::arg("readings"),
            "A Wi-Fi scan: {bssid: rssi_dbm}.")
       .def("compass", &Session::Compass, py::arg("time_s"), py::arg("heading_rad"))
+      .def("pressure", &Session::Pressure, py::arg("time_s"), py::arg("pressure_hpa"),
+           "A barometer reading, hPa (floors: fused.use_barometer).")
       .def("descriptor", &Session::Descriptor, py::arg("time_s"), py::arg("values"),
            "A place descriptor for the frame at time_s (front_end.kind = \"descriptors\"): a "
            "1-D float array, compared by cosine similarity.")

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "common/byte_buffer.h"
+
 namespace ratslam {
 namespace {
 // R T / (g M) for dry air at 15 C: 287.05 J/(kg K) x 288.15 K / 9.80665 m/s^2 (metres).
@@ -117,7 +119,98 @@ StatusOr<FloorEstimate> BarometricFloorTracker::Add(const PressureSample& sample
   estimate.floor = floor();
   estimate.in_transit =
       current_ >= 0 && std::abs(height - levels_[current_].height_m) > options_.dwell_band_m;
+  estimate.level = current_;
   return estimate;
+}
+
+std::vector<int> BarometricFloorTracker::LevelFloors() const {
+  std::vector<int> floors;
+  floors.reserve(levels_.size());
+  for (const Level& l : levels_) floors.push_back(l.floor);
+  return floors;
+}
+
+void BarometricFloorTracker::Encode(ByteWriter* w) const {
+  w->Count(window_.size());
+  for (const PressureSample& s : window_) {
+    w->Pod(s.time_s);
+    w->Pod(s.pressure_hpa);
+  }
+  w->Pod(window_sum_);
+  w->Pod(reference_hpa_);
+  w->Bool(has_reference_);
+  w->Count(recent_.size());
+  for (const auto& [t, h] : recent_) {
+    w->Pod(t);
+    w->Pod(h);
+  }
+  w->Count(levels_.size());
+  for (const Level& l : levels_) {
+    w->Pod(l.height_m);
+    w->Pod(static_cast<int32_t>(l.floor));
+  }
+  w->Pod(static_cast<int32_t>(current_));
+  w->Pod(storey_m_);
+  w->Pod(last_time_s_);
+  w->Count(floor_changes_);
+}
+
+bool BarometricFloorTracker::Decode(ByteReader* r) {
+  auto finite = [](double x) { return std::isfinite(x); };
+  size_t n = 0;
+  std::deque<PressureSample> window;
+  if (!r->Count(16, &n)) return false;
+  for (size_t i = 0; i < n; ++i) {
+    PressureSample s;
+    if (!(r->Pod(&s.time_s) && r->Pod(&s.pressure_hpa))) return false;
+    if (!finite(s.time_s) || !(s.pressure_hpa >= 100 && s.pressure_hpa <= 1100)) {
+      return r->Fail("barometer: a reading is not finite or out of range");
+    }
+    window.push_back(s);
+  }
+  double window_sum = 0.0, reference = 0.0, storey = 0.0, last_time = 0.0;
+  bool has_reference = false;
+  if (!(r->Pod(&window_sum) && r->Pod(&reference) && r->Bool(&has_reference))) return false;
+  std::deque<std::pair<double, double>> recent;
+  if (!r->Count(16, &n)) return false;
+  for (size_t i = 0; i < n; ++i) {
+    double t = 0.0, h = 0.0;
+    if (!(r->Pod(&t) && r->Pod(&h))) return false;
+    if (!finite(t) || !finite(h)) return r->Fail("barometer: a height is not finite");
+    recent.emplace_back(t, h);
+  }
+  std::vector<Level> levels;
+  if (!r->Count(12, &n)) return false;
+  for (size_t i = 0; i < n; ++i) {
+    double h = 0.0;
+    int32_t floor = 0;
+    if (!(r->Pod(&h) && r->Pod(&floor))) return false;
+    if (!finite(h)) return r->Fail("barometer: a level height is not finite");
+    levels.push_back({h, floor});
+  }
+  int32_t current = 0;
+  uint64_t changes = 0;
+  if (!(r->Pod(&current) && r->Pod(&storey) && r->Pod(&last_time) && r->Pod(&changes))) {
+    return false;
+  }
+  if (current < -1 || current >= static_cast<int64_t>(levels.size()) ||
+      (current < 0) != levels.empty() || !finite(window_sum) || !(storey > 0 && storey <= 50) ||
+      !(last_time == -1e300 || finite(last_time)) ||
+      (has_reference && !(reference >= 100 && reference <= 1100)) ||
+      (!has_reference && !window.empty())) {
+    return r->Fail("barometer: state does not fit together");
+  }
+  window_ = std::move(window);
+  window_sum_ = window_sum;
+  reference_hpa_ = reference;
+  has_reference_ = has_reference;
+  recent_ = std::move(recent);
+  levels_ = std::move(levels);
+  current_ = current;
+  storey_m_ = storey;
+  last_time_s_ = last_time;
+  floor_changes_ = static_cast<size_t>(changes);
+  return true;
 }
 
 void BarometricFloorTracker::Renumber() {

@@ -26,14 +26,14 @@
 #include <string>
 #include <vector>
 
+#include "common/schema.h"
 #include "common/status.h"
+#include "sensors/pressure_sample.h"
 
 namespace ratslam {
 
-struct PressureSample {
-  double time_s = 0.0;
-  double pressure_hpa = 0.0;
-};
+class ByteWriter;
+class ByteReader;
 
 struct BarometerOptions {
   double smoothing_s = 2.0;         // moving mean of pressure over this window
@@ -43,6 +43,23 @@ struct BarometerOptions {
   double storey_m = 4.0;            // storey height until two levels have been seen
 
   bool IsValid(std::string* error) const;
+
+  template <typename Visitor>
+  void VisitFields(Visitor&& v) {
+    v("smoothing_s", smoothing_s, "moving mean of the pressure over this window",
+      schema::Unit("s").Above(0).AtMost(60));
+    v("dwell_s", dwell_s, "a floor: the smoothed height stays this long within dwell_band_m",
+      schema::Unit("s").Above(0).AtMost(600));
+    v("dwell_band_m", dwell_band_m, "spread of heights (max - min) a dwell may have",
+      schema::Unit("m").Above(0).AtMost(10));
+    v("min_floor_change_m", min_floor_change_m,
+      "smaller level changes are landings, ramps or noise (must exceed dwell_band_m)",
+      schema::Unit("m").AtMost(50));
+    v("storey_m", storey_m,
+      "storey height until two floors have been seen (then their smallest gap; at least "
+      "min_floor_change_m)",
+      schema::Unit("m").AtMost(50));
+  }
 };
 
 struct FloorEstimate {
@@ -50,6 +67,7 @@ struct FloorEstimate {
   int floor = 0;            // relative to the first level (0); up is positive
   double height_m = 0.0;    // smoothed height relative to the first reading
   bool in_transit = false;  // the height has left the current level's band
+  int level = -1;           // index of the current level (stable; -1 before the first dwell)
 };
 
 class BarometricFloorTracker {
@@ -65,6 +83,14 @@ class BarometricFloorTracker {
   double storey_m() const { return storey_m_; }
   size_t levels() const { return levels_.size(); }
   size_t floor_changes() const { return floor_changes_; }
+  // Floor of each level, by level index (levels keep their index; floors may be renumbered when
+  // a smaller storey height is learnt).
+  std::vector<int> LevelFloors() const;
+
+  // The whole state, for saved maps and resumed runs; Decode checks what it reads (sizes,
+  // finite numbers, indices) and fails with `reader`'s error.
+  void Encode(ByteWriter* writer) const;
+  bool Decode(ByteReader* reader);
 
  private:
   struct Level {

@@ -3,9 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <random>
 #include <vector>
+
+#include "common/byte_buffer.h"
 
 namespace ratslam {
 namespace {
@@ -127,6 +130,56 @@ TEST(BarometerTest, BadReadingsAreErrorsNamingTheReading) {
   StatusOr<std::vector<FloorEstimate>> e = EstimateFloors({{0.0, 1000.0}}, bad);
   ASSERT_FALSE(e.ok());
   EXPECT_NE(e.status().message().find("min_floor_change_m"), std::string::npos);
+}
+
+// A tracker saved halfway through a climb and restored goes on exactly as one never stopped, and
+// bytes it did not write (cut short, or a level index past its levels) are refused.
+TEST(BarometerTest, StateRoundTripsAndCorruptStatesAreRefused) {
+  const Trace trace =
+      MakeTrace({{20, 0.0}, {10, 3.5}, {20, 3.5}, {10, 0.0}, {20, 0.0}}, 0.03, 0.5, 4);
+  BarometricFloorTracker whole, first;
+  const size_t half = 280;  // on the way up
+  std::string bytes;
+  for (size_t i = 0; i < trace.samples.size(); ++i) {
+    const FloorEstimate a = whole.Add(trace.samples[i]).value();
+    if (i < half) {
+      first.Add(trace.samples[i]).value();
+      continue;
+    }
+    if (i == half) {
+      ByteWriter w;
+      first.Encode(&w);
+      bytes = w.bytes();
+    }
+    BarometricFloorTracker restored;
+    ByteReader r(bytes, "barometer state");
+    ASSERT_TRUE(restored.Decode(&r)) << r.error();
+    ASSERT_TRUE(r.AtEnd());
+    const FloorEstimate b = restored.Add(trace.samples[i]).value();
+    EXPECT_EQ(a.floor, b.floor);
+    EXPECT_EQ(a.level, b.level);
+    EXPECT_EQ(a.in_transit, b.in_transit);
+    EXPECT_EQ(a.height_m, b.height_m);
+    ByteWriter w;
+    restored.Encode(&w);
+    bytes = w.bytes();
+  }
+  EXPECT_EQ(whole.floor_changes(), 2u);
+  for (size_t cut = 1; cut < bytes.size(); cut += 7) {
+    BarometricFloorTracker t;
+    ByteReader r(std::string_view(bytes).substr(0, bytes.size() - cut), "barometer state");
+    EXPECT_FALSE(t.Decode(&r) && r.AtEnd()) << cut;
+  }
+  // The current level (an int32 just before the storey height, last time and change count)
+  // pointing past the levels.
+  std::string wrong = bytes;
+  const size_t current_at = wrong.size() - 8 - 8 - 8 - 4;
+  const int32_t past = 99;
+  std::memcpy(&wrong[current_at], &past, sizeof(past));
+  BarometricFloorTracker t;
+  ByteReader r(wrong, "barometer state");
+  EXPECT_FALSE(t.Decode(&r));
+  EXPECT_NE(r.error().find("does not fit"), std::string::npos) << r.error();
 }
 
 }  // namespace

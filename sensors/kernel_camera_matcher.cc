@@ -55,9 +55,11 @@ double KernelCameraMatcher::Similarity(const std::vector<float>& a,
   return std::exp(-sum / (2.0 * options_.kernel_sigma * options_.kernel_sigma));  // eq. 7
 }
 
-KernelCameraMatch KernelCameraMatcher::Best(const std::vector<float>& query) const {
+KernelCameraMatch KernelCameraMatcher::Best(const std::vector<float>& query,
+                                            const std::vector<uint8_t>* allowed) const {
   KernelCameraMatch best;
   for (uint32_t id = 0; id < templates_.size(); ++id) {
+    if (allowed && !(*allowed)[id]) continue;
     const double c = Similarity(query, templates_[id]);
     if (c > best.similarity) {
       best.similarity = c;

@@ -57,7 +57,9 @@ class KernelCameraMatcher {
   // The template of an image: block means, scaled to 0..1, optionally mean-subtracted.
   StatusOr<std::vector<float>> MakeTemplate(const GrayImageView& image) const;
   double Similarity(const std::vector<float>& a, const std::vector<float>& b) const;
-  KernelCameraMatch Best(const std::vector<float>& query) const;  // eq. 8
+  // Eq. 8; with `allowed` (one flag per template), the best among those whose flag is set.
+  KernelCameraMatch Best(const std::vector<float>& query,
+                         const std::vector<uint8_t>* allowed = nullptr) const;
   // Stores a template (an empty one never matches); returns its id.
   uint32_t Add(const std::vector<float>& t);
   uint32_t size() const { return static_cast<uint32_t>(templates_.size()); }

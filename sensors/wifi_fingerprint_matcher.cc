@@ -185,7 +185,8 @@ std::vector<double> WifiFingerprintMatcher::Weights(const Fingerprint& query) co
   return weights;
 }
 
-WifiMatch WifiFingerprintMatcher::Best(const Fingerprint& query) const {
+WifiMatch WifiFingerprintMatcher::Best(const Fingerprint& query,
+                                       const std::vector<uint8_t>* allowed) const {
   WifiMatch best;
   // w = exp(x) * H / (H + E + M) <= exp(x): a fingerprint whose exponent x is below log(best)
   // cannot win, and its exp is skipped. The margin of 1e-9 covers the rounding of exp, of the
@@ -193,6 +194,7 @@ WifiMatch WifiFingerprintMatcher::Best(const Fingerprint& query) const {
   double skip_below = -std::numeric_limits<double>::infinity();
   const double inv_two_sigma2 = 1.0 / (2.0 * options_.kernel_variance_dbm2);
   auto finish = [&](const Candidate& c) {
+    if (allowed && !(*allowed)[c.id]) return;
     // The penalties alone (hit >= 0) bound x from above: most candidates stop here, before the
     // divisions. The margin covers the reciprocal's rounding.
     if (!(-(c.extra + c.miss) * inv_two_sigma2 >= skip_below - 1e-9)) return;

@@ -90,8 +90,9 @@ class WifiFingerprintMatcher {
   double Weight(const Fingerprint& query, const Fingerprint& stored) const;
   // Weights against every stored fingerprint, by id (0 where no AP is shared).
   std::vector<double> Weights(const Fingerprint& query) const;
-  // The stored fingerprint with the largest weight (eq. 9).
-  WifiMatch Best(const Fingerprint& query) const;
+  // The stored fingerprint with the largest weight (eq. 9); with `allowed` (one flag per stored
+  // fingerprint), the largest among those whose flag is set.
+  WifiMatch Best(const Fingerprint& query, const std::vector<uint8_t>* allowed = nullptr) const;
 
   // Stores a fingerprint (possibly empty: a template with no Wi-Fi); returns its id.
   uint32_t Add(const Fingerprint& fingerprint);

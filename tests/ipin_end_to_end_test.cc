@@ -180,6 +180,65 @@ TEST(IpinEndToEndTest, RunsThatCannotDoAnythingSaySo) {
 // offset is the median over pairs of the median RSSI difference. The online estimate, which sees
 // no ground truth, must land within 3 dB of it for every session, and the multi-session run must
 // then match across sessions more often than without it.
+// Floors from the barometer keep matches on their floor (fusion/front_end.h, use_barometer).
+// Route 51 walks floors 0, -1 and -2 and back; without the barometer, its Wi-Fi matches across
+// floors (floors are judged only where the ground-truth points around a time agree, so matches on
+// the stairs are not counted either way). In a multi-session run of route 51 then routes 21
+// (floor -2) and 01 (floor 0), the later walks' floors are found relative to route 51's by Wi-Fi
+// votes; route 21's must come out two floors below route 51's start, as the ground truth says.
+TEST(IpinEndToEndTest, BarometerKeepsMatchesOnTheirFloors) {
+  const fs::path data = fs::path(RATSLAM_SHARED_DATA_DIR) / "ipin2023-t3";
+  std::vector<fs::path> logs;
+  for (const char* name : {"51_repetition02", "21_repetition01", "21_repetition02",
+                           "01_repetition01", "01_repetition02"}) {
+    logs.push_back(data / (std::string("IPIN2023_T3_TrainingTrial") + name + ".txt"));
+    if (!fs::exists(logs.back())) GTEST_SKIP() << "missing " << logs.back();
+  }
+  const fs::path root =
+      fs::temp_directory_path() / ("ratslam_ipin_floors_" + std::to_string(::getpid()));
+  fs::create_directories(root);
+  std::ifstream config_in(std::string(RATSLAM_SOURCE_DIR) + "/configs/ipin2023-wifi-compass.toml");
+  std::stringstream config_text;
+  config_text << config_in.rdbuf();
+  std::string without = config_text.str();
+  const size_t at = without.find("use_barometer = true");
+  ASSERT_NE(at, std::string::npos);
+  without.replace(at, 20, "use_barometer = false");
+  std::ofstream(root / "without.toml") << without;
+  auto replay = [&](bool barometer, size_t walks, const std::string& name) {
+    std::string command =
+        std::string(RATSLAM_BINARY) + " replay --quiet --config " +
+        (barometer ? std::string(RATSLAM_SOURCE_DIR) + "/configs/ipin2023-wifi-compass.toml"
+                   : (root / "without.toml").string());
+    for (size_t i = 0; i < walks; ++i) command += " --data " + logs[i].string();
+    command += " --out " + (root / name).string() + " > /dev/null";
+    EXPECT_EQ(std::system(command.c_str()), 0) << command;
+    std::ifstream in(root / name / "summary.json");
+    return nlohmann::json::parse(in);
+  };
+  const nlohmann::json with = replay(true, 1, "51");
+  const nlohmann::json plain = replay(false, 1, "51-plain");
+  EXPECT_TRUE(e2e::UndocumentedKeys(with).empty())
+      << "not in configs/README.md: " << e2e::Join(e2e::UndocumentedKeys(with));
+  EXPECT_GT(plain["floor_mistakes"].get<int>(), 0);  // measured 4 (16 before the stairs rule)
+  EXPECT_EQ(with["floor_mistakes"], 0);
+  EXPECT_GE(with["barometer"]["floor_changes"].get<int>(), 6);  // the walk changes floor 8 times
+  EXPECT_GE(with["matches"].get<int>() - with["floor_unverified_matches"].get<int>(), 10);
+  EXPECT_GE(with["match_rate_within_m"]["5"].get<double>(),
+            plain["match_rate_within_m"]["5"].get<double>());
+
+  const nlohmann::json all = replay(true, logs.size(), "all");
+  const nlohmann::json all_plain = replay(false, logs.size(), "all-plain");
+  EXPECT_GT(all_plain["floor_mistakes"].get<int>(), 0);  // measured 9
+  EXPECT_EQ(all["floor_mistakes"], 0);
+  const std::vector<int> offsets = all["barometer"]["session_floor_offsets"];
+  ASSERT_EQ(offsets.size(), 5u);
+  EXPECT_EQ(offsets[1], -2);
+  EXPECT_EQ(offsets[2], -2);
+  EXPECT_GE(all["cross_session_matches"].get<int>(), 20);
+  fs::remove_all(root);
+}
+
 TEST(IpinEndToEndTest, OnlineRssiOffsetFindsTheSecondPhonesOffset) {
   const fs::path data = fs::path(RATSLAM_SHARED_DATA_DIR) / "ipin2023-t3";
   for (const char* trial : {"02", "23"}) {

@@ -277,6 +277,8 @@ constexpr AddedKey kKeysAddedAfter[] = {
     {7, "fused.online_rssi_offset"},
     {7, "fused.rssi_offset_min_common_aps"},
     {7, "fused.rssi_offset_min_estimates"},
+    {7, "fused.use_barometer"},
+    {7, "fused.floor_offset_min_votes"},
 };
 
 // Whole sections added after a map format version: older maps resume only with every key at its
@@ -286,10 +288,7 @@ struct AddedSection {
   const char* name;
 };
 constexpr AddedSection kSectionsAddedAfter[] = {
-    {5, "wifi_sequence"},
-    {7, "bag"},
-    {7, "video"},
-    {7, "descriptors"},
+    {5, "wifi_sequence"}, {7, "bag"}, {7, "video"}, {7, "descriptors"}, {7, "barometer"},
 };
 
 }  // namespace

@@ -245,12 +245,21 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
     for (const FrameRecord& f : state.frames) {
       if (pipeline.localising()) break;    // templates stored on another data set's clock
       if (f.is_new || f.recent) continue;  // only matches that can close a loop
+      const double created_s = slam.local_view().at(f.template_id).created_time_s;
       const auto now = InterpolateGroundTruth(dataset.ground_truth, f.time_s);
-      const auto then = InterpolateGroundTruth(dataset.ground_truth,
-                                               slam.local_view().at(f.template_id).created_time_s);
+      const auto then = InterpolateGroundTruth(dataset.ground_truth, created_s);
       if (!now || !then) continue;
       ++s.evaluated_matches;
-      const bool other_floor = now->floor != then->floor;
+      // Floors are known only where the ground-truth points around a time agree. A match with
+      // either end between points on different floors (on the stairs) cannot be judged: it is
+      // counted as unverified and left out of the rates.
+      const std::optional<int> floor_now = KnownFloor(dataset.ground_truth, f.time_s);
+      const std::optional<int> floor_then = KnownFloor(dataset.ground_truth, created_s);
+      if (!floor_now || !floor_then) {
+        ++s.floor_unverified_matches;
+        continue;
+      }
+      const bool other_floor = *floor_now != *floor_then;
       const double distance = other_floor ? std::numeric_limits<double>::infinity()
                                           : std::hypot(now->x_m - then->x_m, now->y_m - then->y_m);
       s.match_distances_m.push_back(distance);
@@ -300,6 +309,15 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
   }
   if (const std::vector<double> offsets = pipeline.rssi_offsets_db(); !offsets.empty()) {
     j["wifi_rssi_offsets_db"] = offsets;  // removed from each session's scans
+  }
+  if (const std::optional<FloorReport> floors = pipeline.floor_report()) {
+    j["barometer"] = {{"pressure_readings", floors->pressure_readings},
+                      {"floor_changes", floors->floor_changes},
+                      {"frames_floor_unknown", floors->frames_floor_unknown},
+                      {"new_templates_by_floor_rule", floors->new_templates_by_floor_rule},
+                      {"templates_with_floor", floors->templates_with_floor},
+                      {"floor_offset_changes", floors->floor_offset_changes},
+                      {"session_floor_offsets", floors->session_floor_offsets}};
   }
   if (dataset.session_start_times_s.size() > 1)
     j["sessions"] = dataset.session_start_times_s.size();
@@ -363,6 +381,7 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
     j["matches"] = s.evaluated_matches;
     j["match_rate_within_m"] = RatesWithin(s.match_distances_m);
     j["floor_mistakes"] = s.floor_mistakes;
+    j["floor_unverified_matches"] = s.floor_unverified_matches;
     if (dataset.session_start_times_s.size() > 1) {
       j["cross_session_matches"] = s.cross_session_distances_m.size();
       j["cross_session_match_rate_within_m"] = RatesWithin(s.cross_session_distances_m);

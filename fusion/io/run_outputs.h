@@ -36,6 +36,8 @@ struct RunSummary {
   size_t evaluated_matches = 0;
   std::vector<double> match_distances_m;
   size_t floor_mistakes = 0;
+  // Matches with an end between ground-truth points on different floors (counted never within).
+  size_t floor_unverified_matches = 0;
   // Of them, matches to a template stored in another session (multi-session runs): with a
   // session per phone, the cross-device matches.
   std::vector<double> cross_session_distances_m;

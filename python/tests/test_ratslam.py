@@ -200,6 +200,13 @@ class RatslamModuleTest(unittest.TestCase):
             session.wifi(4.0, {"aa:bb": float("inf")})
         with self.assertRaisesRegex(ratslam.Error, "takes no descriptors"):
             session.descriptor(5.0, np.ones(4))
+        floors = ratslam.Config()
+        floors.set("front_end.kind", "fused")
+        floors.set("fused.use_barometer", True)
+        walker = ratslam.Session(floors)
+        walker.pressure(1.0, 976.8)
+        with self.assertRaisesRegex(ratslam.Error, "pressure at t=2.*outside"):
+            walker.pressure(2.0, 5000.0)
         fabmap = ratslam.Config()
         fabmap.set("front_end.kind", "fabmap")
         with self.assertRaisesRegex(ratslam.Error, "FABMAP"):

@@ -25,7 +25,7 @@ constexpr int kFormatVersion = 1;
 // The manifest's keys, bound by the common TOML binder (common/toml_binder.h). Streams are
 // optional except odometry; a stream that is named must be a path inside the data-set folder.
 struct ManifestStreams {
-  std::string odometry, images, image_folder, ground_truth, wifi, compass;
+  std::string odometry, images, image_folder, ground_truth, wifi, compass, pressure;
 
   template <typename V>
   void VisitFields(V&& v) {
@@ -37,6 +37,7 @@ struct ManifestStreams {
     v("ground_truth", ground_truth, "ground truth CSV: time_s, x_m, y_m, theta_rad, floor", file);
     v("wifi", wifi, "Wi-Fi CSV: time_s, bssid, rssi_dbm", file);
     v("compass", compass, "compass CSV: time_s, heading_rad", file);
+    v("pressure", pressure, "barometer CSV: time_s, pressure_hpa", file);
   }
 };
 
@@ -165,6 +166,22 @@ Status ReadCompass(const std::string& path, Dataset* d) {
   return Status::Ok();
 }
 
+Status ReadPressure(const std::string& path, Dataset* d) {
+  StatusOr<CsvTable> t = CsvTable::Read(path, {"time_s", "pressure_hpa"});
+  if (!t.ok()) return t.status();
+  for (size_t r = 0; r < t->rows(); ++r) {
+    PressureSample row;
+    ASSIGN_OR_RETURN_NUMBER(row.time_s, *t, r, "time_s");
+    ASSIGN_OR_RETURN_NUMBER(row.pressure_hpa, *t, r, "pressure_hpa");
+    if (!(row.pressure_hpa >= 100 && row.pressure_hpa <= 1100)) {
+      return t->ErrorAt(r, "pressure_hpa", "must be within [100, 1100] hPa");
+    }
+    RATSLAM_RETURN_IF_ERROR(CheckTimeOrder(*t, r, r ? d->pressure.back().time_s : 0.0, row.time_s));
+    d->pressure.push_back(row);
+  }
+  return Status::Ok();
+}
+
 std::string Number(double value) { return ShortestNumber(value); }
 
 }  // namespace
@@ -212,11 +229,10 @@ StatusOr<Dataset> ReadDataset(const std::string& folder) {
   d.name = parsed->contains("name") ? manifest.name : fs::path(folder).filename().string();
   d.session_start_times_s = manifest.session_start_times_s;
   if (!streams.image_folder.empty()) d.image_folder = streams.image_folder;
-  const std::map<std::string, std::string> files = {{"odometry", streams.odometry},
-                                                    {"images", streams.images},
-                                                    {"ground_truth", streams.ground_truth},
-                                                    {"wifi", streams.wifi},
-                                                    {"compass", streams.compass}};
+  const std::map<std::string, std::string> files = {
+      {"odometry", streams.odometry},         {"images", streams.images},
+      {"ground_truth", streams.ground_truth}, {"wifi", streams.wifi},
+      {"compass", streams.compass},           {"pressure", streams.pressure}};
   auto path_of = [&](const std::string& stream) {
     return (fs::path(folder) / files.at(stream)).string();
   };
@@ -226,6 +242,7 @@ StatusOr<Dataset> ReadDataset(const std::string& folder) {
   if (named("ground_truth")) RATSLAM_RETURN_IF_ERROR(ReadGroundTruth(path_of("ground_truth"), &d));
   if (named("wifi")) RATSLAM_RETURN_IF_ERROR(ReadWifi(path_of("wifi"), &d));
   if (named("compass")) RATSLAM_RETURN_IF_ERROR(ReadCompass(path_of("compass"), &d));
+  if (named("pressure")) RATSLAM_RETURN_IF_ERROR(ReadPressure(path_of("pressure"), &d));
   return d;
 }
 
@@ -292,6 +309,14 @@ Status WriteDataset(const Dataset& d, const std::string& folder) {
   for (const CompassRow& r : d.compass) {
     compass += num(r.time_s, "compass time") + ',' + num(r.heading_rad, "compass heading") + '\n';
   }
+  std::string pressure = "time_s,pressure_hpa\n";
+  for (const PressureSample& r : d.pressure) {
+    if (!(r.pressure_hpa >= 100 && r.pressure_hpa <= 1100)) {
+      return Status::Error(folder + ": pressure " + Number(r.pressure_hpa) +
+                           " hPa is not writable (the reader takes 100 to 1100)");
+    }
+    pressure += num(r.time_s, "pressure time") + ',' + num(r.pressure_hpa, "pressure") + '\n';
+  }
   std::string manifest =
       "format = \"ratslam-replay\"\nformat_version = " + std::to_string(kFormatVersion) +
       "\nname = " + TomlQuoted(d.name) + "\n";
@@ -312,7 +337,7 @@ Status WriteDataset(const Dataset& d, const std::string& folder) {
   }
   // The image folder sits beside the files written here; one named like them could not be both.
   for (const char* name : {"manifest.toml", "odometry.csv", "images.csv", "ground_truth.csv",
-                           "wifi.csv", "compass.csv"}) {
+                           "wifi.csv", "compass.csv", "pressure.csv"}) {
     if (*image_folder.begin() == name) {
       return Status::Error(folder + ": image folder '" + d.image_folder +
                            "' cannot be stored: it has the name of the data set's file " + name);
@@ -325,6 +350,7 @@ Status WriteDataset(const Dataset& d, const std::string& folder) {
   if (!d.ground_truth.empty()) manifest += "ground_truth = \"ground_truth.csv\"\n";
   if (!d.wifi.empty()) manifest += "wifi = \"wifi.csv\"\n";
   if (!d.compass.empty()) manifest += "compass = \"compass.csv\"\n";
+  if (!d.pressure.empty()) manifest += "pressure = \"pressure.csv\"\n";
 
   std::error_code ec;
   fs::create_directories(fs::path(folder) / d.image_folder, ec);
@@ -339,14 +365,19 @@ Status WriteDataset(const Dataset& d, const std::string& folder) {
   if (!d.ground_truth.empty()) RATSLAM_RETURN_IF_ERROR(write("ground_truth.csv", ground_truth));
   if (!d.wifi.empty()) RATSLAM_RETURN_IF_ERROR(write("wifi.csv", wifi));
   if (!d.compass.empty()) RATSLAM_RETURN_IF_ERROR(write("compass.csv", compass));
+  if (!d.pressure.empty()) RATSLAM_RETURN_IF_ERROR(write("pressure.csv", pressure));
   return write("manifest.toml", manifest);
 }
 
 std::vector<Event> MergeEvents(const Dataset& d) {
   std::vector<Event> events;
-  events.reserve(d.odometry.size() + d.images.size() + d.wifi.size() + d.compass.size());
+  events.reserve(d.odometry.size() + d.images.size() + d.wifi.size() + d.compass.size() +
+                 d.pressure.size());
   for (uint32_t i = 0; i < d.compass.size(); ++i) {
     events.push_back({d.compass[i].time_s, EventType::kCompass, i});
+  }
+  for (uint32_t i = 0; i < d.pressure.size(); ++i) {
+    events.push_back({d.pressure[i].time_s, EventType::kPressure, i});
   }
   for (uint32_t i = 0; i < d.wifi.size(); ++i) {
     events.push_back({d.wifi[i].time_s, EventType::kWifi, i});
@@ -357,9 +388,13 @@ std::vector<Event> MergeEvents(const Dataset& d) {
   for (uint32_t i = 0; i < d.odometry.size(); ++i) {
     events.push_back({d.odometry[i].time_s, EventType::kOdometry, i});
   }
-  std::stable_sort(events.begin(), events.end(), [](const Event& a, const Event& b) {
+  // At equal times: compass, pressure, Wi-Fi, images, odometry.
+  auto rank = [](EventType type) {
+    return type == EventType::kPressure ? 1 : 2 * static_cast<int>(type);
+  };
+  std::stable_sort(events.begin(), events.end(), [&rank](const Event& a, const Event& b) {
     if (a.time_s != b.time_s) return a.time_s < b.time_s;
-    return a.type < b.type;
+    return rank(a.type) < rank(b.type);
   });
   return events;
 }
@@ -382,6 +417,17 @@ std::optional<GroundTruthRow> InterpolateGroundTruth(const std::vector<GroundTru
   r.theta_rad = WrapAngle(a.theta_rad + f * WrapAngle(b.theta_rad - a.theta_rad));
   r.floor = f < 0.5 ? a.floor : b.floor;
   return r;
+}
+
+std::optional<int> KnownFloor(const std::vector<GroundTruthRow>& rows, double time_s) {
+  if (rows.empty() || time_s < rows.front().time_s || time_s > rows.back().time_s) {
+    return std::nullopt;
+  }
+  auto after = std::lower_bound(rows.begin(), rows.end(), time_s,
+                                [](const GroundTruthRow& r, double t) { return r.time_s < t; });
+  if (after->time_s == time_s || after == rows.begin()) return after->floor;
+  if ((after - 1)->floor != after->floor) return std::nullopt;
+  return after->floor;
 }
 
 }  // namespace ratslam

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "common/status.h"
+#include "sensors/pressure_sample.h"
 
 namespace ratslam {
 
@@ -59,6 +60,7 @@ struct Dataset {
   std::vector<GroundTruthRow> ground_truth;
   std::vector<WifiScan> wifi;
   std::vector<CompassRow> compass;
+  std::vector<PressureSample> pressure;       // barometer, hPa (floors: sensors/barometer.h)
   std::vector<double> session_start_times_s;  // more than one for a multi-session run
 
   // The image's path: `file` itself when absolute, else inside the image folder.
@@ -77,19 +79,30 @@ StatusOr<Dataset> ReadDataset(const std::string& folder);
 Status WriteDataset(const Dataset& dataset, const std::string& folder);
 
 // Events in replay order.
-enum class EventType : uint8_t { kCompass = 0, kWifi = 1, kImage = 2, kOdometry = 3 };
+enum class EventType : uint8_t {
+  kCompass = 0,
+  kWifi = 1,
+  kImage = 2,
+  kOdometry = 3,
+  kPressure = 4
+};
 struct Event {
   double time_s = 0.0;
   EventType type = EventType::kOdometry;
   uint32_t index = 0;  // into the stream's vector
 };
-// All events sorted by time; at equal times compass, Wi-Fi, images, then odometry (so that an
-// odometry step's action sees the view of the same instant), then by index.
+// All events sorted by time; at equal times compass, pressure, Wi-Fi, images, then odometry (so
+// that an odometry step's action sees the view of the same instant), then by index.
 std::vector<Event> MergeEvents(const Dataset& dataset);
 
 // Ground-truth position at `time_s`, linearly interpolated; nullopt outside the covered span.
 std::optional<GroundTruthRow> InterpolateGroundTruth(const std::vector<GroundTruthRow>& rows,
                                                      double time_s);
+
+// The floor at `time_s` when the ground-truth points either side of it agree (or one falls on it);
+// nullopt between two points on different floors (the walker changed floor somewhere between,
+// on the stairs) and outside the covered span.
+std::optional<int> KnownFloor(const std::vector<GroundTruthRow>& rows, double time_s);
 
 }  // namespace ratslam
 

@@ -109,6 +109,7 @@ StatusOr<Dataset> LoadSessions(const std::vector<std::string>& paths,
     for (const auto& r : d->images) span(r.time_s);
     for (const auto& r : d->wifi) span(r.time_s);
     for (const auto& r : d->compass) span(r.time_s);
+    for (const auto& r : d->pressure) span(r.time_s);
     for (const auto& r : d->ground_truth) span(r.time_s);
     if (!std::isfinite(first)) return Status::Error(path + ": empty data set");
     const double shift = std::isfinite(end_of_previous) ? end_of_previous + gap_s - first : 0.0;
@@ -132,6 +133,10 @@ StatusOr<Dataset> LoadSessions(const std::vector<std::string>& paths,
     for (auto r : d->compass) {
       r.time_s += shift;
       joined.compass.push_back(r);
+    }
+    for (auto r : d->pressure) {
+      r.time_s += shift;
+      joined.pressure.push_back(r);
     }
     for (auto r : d->ground_truth) {
       r.time_s += shift;

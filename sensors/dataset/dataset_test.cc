@@ -239,12 +239,61 @@ TEST_F(DatasetTest, EventsAreOrderedByTimeThenStream) {
   d.odometry = {{0.0, 0, 0}, {0.1, 0, 0}};
   d.images = {{0.1, "a.png", 2}};
   d.compass = {{0.1, 0.0}};
+  d.pressure = {{0.1, 1000.0}};
+  d.wifi = {{0.1, {{"aa:bb", -50.0}}}};
   const std::vector<Event> events = MergeEvents(d);
-  ASSERT_EQ(events.size(), 4u);
+  ASSERT_EQ(events.size(), 6u);
   EXPECT_EQ(events[0].type, EventType::kOdometry);
   EXPECT_EQ(events[1].type, EventType::kCompass);
-  EXPECT_EQ(events[2].type, EventType::kImage);
-  EXPECT_EQ(events[3].type, EventType::kOdometry);
+  EXPECT_EQ(events[2].type, EventType::kPressure);
+  EXPECT_EQ(events[3].type, EventType::kWifi);
+  EXPECT_EQ(events[4].type, EventType::kImage);
+  EXPECT_EQ(events[5].type, EventType::kOdometry);
+}
+
+TEST_F(DatasetTest, PressureRoundTripsAndBadReadingsNameFileLineAndColumn) {
+  Dataset d = ReadDataset(folder_.string()).value();
+  d.pressure = {{0.0, 976.8699}, {0.1, 976.8628}, {0.1 + 0.2, 1013.25}};
+  const fs::path copy = folder_ / "copy";
+  ASSERT_TRUE(WriteDataset(d, copy.string()).ok());
+  Dataset back = ReadDataset(copy.string()).value();
+  ASSERT_EQ(back.pressure.size(), 3u);
+  for (size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(back.pressure[i].time_s, d.pressure[i].time_s);
+    EXPECT_EQ(back.pressure[i].pressure_hpa, d.pressure[i].pressure_hpa);
+  }
+  d.pressure.push_back({0.5, 5000.0});  // a reader would refuse it: not written
+  const Status refused = WriteDataset(d, (folder_ / "refused").string());
+  EXPECT_NE(refused.message().find("not writable"), std::string::npos) << refused.message();
+
+  Write("manifest.toml",
+        "format = \"ratslam-replay\"\nformat_version = 1\nname = \"t\"\n[streams]\n"
+        "odometry = \"odometry.csv\"\npressure = \"pressure.csv\"\n");
+  const std::pair<const char*, const char*> bad[] = {
+      {"time_s,pressure_hpa\n0,1000\n1,nan\n", "pressure.csv:3: column 'pressure_hpa'"},
+      {"time_s,pressure_hpa\n0,1000\n1,50\n", "pressure.csv:3: column 'pressure_hpa': must be"},
+      {"time_s,pressure_hpa\n1,1000\n0.5,1000\n", "pressure.csv:3: column 'time_s': time goes"},
+      {"time_s,pressure_hpa\n1,1000\n2\n", "pressure.csv:3"},
+      {"time_s,hpa\n1,1000\n", "pressure.csv"},
+  };
+  for (const auto& [text, expected] : bad) {
+    Write("pressure.csv", text);
+    const std::string error = ReadError();
+    EXPECT_NE(error.find(expected), std::string::npos) << error;
+  }
+}
+
+TEST(GroundTruthTest, FloorIsKnownOnlyWhereThePointsAroundAgree) {
+  const std::vector<GroundTruthRow> rows = {
+      {0.0, 0, 0, 0, 0}, {10.0, 5, 0, 0, 0}, {20.0, 5, 5, 0, -1}, {30.0, 0, 5, 0, -1}};
+  EXPECT_EQ(KnownFloor(rows, 5.0), 0);
+  EXPECT_EQ(KnownFloor(rows, 10.0), 0);              // on a point
+  EXPECT_FALSE(KnownFloor(rows, 10.5).has_value());  // on the stairs
+  EXPECT_FALSE(KnownFloor(rows, 19.9).has_value());
+  EXPECT_EQ(KnownFloor(rows, 20.0), -1);
+  EXPECT_EQ(KnownFloor(rows, 25.0), -1);
+  EXPECT_FALSE(KnownFloor(rows, 31.0).has_value());  // outside the span
+  EXPECT_FALSE(KnownFloor({}, 1.0).has_value());
 }
 
 TEST(GroundTruthTest, InterpolatesAndRefusesOutsideSpan) {

@@ -46,6 +46,7 @@ StatusOr<Dataset> PhoneLogToDataset(PhoneLog log, const PhoneLogOptions& options
   std::stable_sort(streams.accelerometer.begin(), streams.accelerometer.end(), by_time);
   std::stable_sort(streams.headings.begin(), streams.headings.end(), by_time);
   std::stable_sort(streams.ground_truth.begin(), streams.ground_truth.end(), by_time);
+  std::stable_sort(streams.pressure.begin(), streams.pressure.end(), by_time);
   Dataset d;
   d.name = log.name;
   PdrReport pdr;
@@ -64,6 +65,7 @@ StatusOr<Dataset> PhoneLogToDataset(PhoneLog log, const PhoneLogOptions& options
       last_compass = h.time_s;
     }
   }
+  d.pressure = std::move(streams.pressure);
   d.ground_truth = std::move(streams.ground_truth);
   // Heading of the ground truth: the direction of travel towards the next point (the last point
   // keeps the direction from its predecessor).

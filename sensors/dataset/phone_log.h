@@ -12,9 +12,9 @@
 #include <vector>
 
 #include "common/status.h"
-#include "sensors/barometer.h"
 #include "sensors/dataset/dataset.h"
 #include "sensors/pedestrian_dead_reckoning.h"
+#include "sensors/pressure_sample.h"
 
 namespace ratslam {
 

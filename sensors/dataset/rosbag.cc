@@ -444,9 +444,9 @@ Status WriteRosbag(const Dataset& dataset, ImageLoader* images, const BagTopics&
                    const std::string& path, uint32_t time_offset_s) {
   std::string error;
   if (!topics.IsValid(&error)) return Status::Error(error);
-  if (!dataset.wifi.empty() || !dataset.compass.empty()) {
-    return Status::Error(path + ": Wi-Fi scans and compass readings have no standard ROS 1 " +
-                         "message; a bag holds images, odometry and ground truth");
+  if (!dataset.wifi.empty() || !dataset.compass.empty() || !dataset.pressure.empty()) {
+    return Status::Error(path + ": Wi-Fi scans, compass and barometer readings are not written " +
+                         "to bags; a bag holds images, odometry and ground truth");
   }
   if (!dataset.images.empty() && topics.image_topic.empty()) {
     return Status::Error(path + ": name the image topic");

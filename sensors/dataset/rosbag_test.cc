@@ -358,7 +358,7 @@ TEST_F(RosbagTest, WriterRefusesWhatABagCannotHold) {
   d.wifi.push_back({0.5, {{"aa:bb", -50}}});
   Status s = WriteRosbag(d, &images, {"/c", "/o", ""}, Path("w.bag"));
   ASSERT_FALSE(s.ok());
-  EXPECT_NE(s.message().find("Wi-Fi scans and compass readings have no standard ROS 1 message"),
+  EXPECT_NE(s.message().find("Wi-Fi scans, compass and barometer readings are not written"),
             std::string::npos);
   EXPECT_FALSE(fs::exists(Path("w.bag")));
   s = WriteRosbag(Sample(3), &images, {"", "/o", ""}, Path("w.bag"));
