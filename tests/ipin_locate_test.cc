@@ -235,9 +235,9 @@ TEST(IpinLocateTest, ARunsMapLocatesThePhoneAndTheRobotIsCalled) {
     EXPECT_EQ(magic, "%PDF-");
   }
   EXPECT_LT(c["nearest_candidate_error_m"].get<double>(), 0.3 * chance);
-  StatusOr<CsvTable> ex = CsvTable::Read(
-      run + "/experiences.csv", {"id", "x_m", "y_m"},
-      {"theta_rad", "template_id", "time_s", "pose_cell_x", "pose_cell_y", "pose_cell_theta"});
+  StatusOr<CsvTable> ex = CsvTable::Read(run + "/experiences.csv", {"id", "x_m", "y_m"},
+                                         {"theta_rad", "template_id", "time_s", "pose_cell_x",
+                                          "pose_cell_y", "pose_cell_theta", "floor"});
   StatusOr<CsvTable> links = CsvTable::Read(
       run + "/links.csv", {"from_id", "to_id"},
       {"id", "distance_m", "heading_rad", "facing_rad", "duration_s", "loop_closure", "kind"});

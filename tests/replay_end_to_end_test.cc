@@ -775,9 +775,9 @@ TEST_F(ReplayEndToEndTest, PrintConfigFailsWithLineNumber) {
 TEST_F(ReplayEndToEndTest, RouteIsTheShortestPathOverTheExperienceGraph) {
   const fs::path run = root_ / "route_run";
   ASSERT_EQ(RunRatslam(ReplayArgs(run), root_).exit_code, 0);
-  StatusOr<CsvTable> ex = CsvTable::Read(
-      (run / "experiences.csv").string(), {"id", "x_m", "y_m"},
-      {"theta_rad", "template_id", "time_s", "pose_cell_x", "pose_cell_y", "pose_cell_theta"});
+  StatusOr<CsvTable> ex = CsvTable::Read((run / "experiences.csv").string(), {"id", "x_m", "y_m"},
+                                         {"theta_rad", "template_id", "time_s", "pose_cell_x",
+                                          "pose_cell_y", "pose_cell_theta", "floor"});
   StatusOr<CsvTable> li = CsvTable::Read(
       (run / "links.csv").string(), {"from_id", "to_id"},
       {"id", "distance_m", "heading_rad", "facing_rad", "duration_s", "loop_closure", "kind"});
@@ -894,9 +894,9 @@ TEST_F(ReplayEndToEndTest, LocalisationOnASavedMapFollowsTheNextSession) {
   EXPECT_EQ(l["frames"].get<size_t>(), next_data->images.size());
 
   // The map run's frame against the world's, from its experiences and its ground truth.
-  StatusOr<CsvTable> ex =
-      CsvTable::Read((map_run / "experiences.csv").string(), {"id", "x_m", "y_m", "time_s"},
-                     {"theta_rad", "template_id", "pose_cell_x", "pose_cell_y", "pose_cell_theta"});
+  StatusOr<CsvTable> ex = CsvTable::Read(
+      (map_run / "experiences.csv").string(), {"id", "x_m", "y_m", "time_s"},
+      {"theta_rad", "template_id", "pose_cell_x", "pose_cell_y", "pose_cell_theta", "floor"});
   ASSERT_TRUE(ex.ok()) << ex.status().message();
   std::vector<Point2> map_xy, world_xy;
   for (size_t i = 0; i < ex->rows(); ++i) {

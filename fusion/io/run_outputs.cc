@@ -402,7 +402,11 @@ StatusOr<RunSummary> WriteRunOutputs(OutputFolder& folder, const ReplayPipeline&
   for (const Experience& e : map.experiences()) {
     experiences << e.id << ',' << Num(e.x_m) << ',' << Num(e.y_m) << ',' << Num(e.theta_rad) << ','
                 << e.template_id << ',' << Num(e.time_s) << ',' << Num(e.pose_cells.x) << ','
-                << Num(e.pose_cells.y) << ',' << Num(e.pose_cells.theta) << '\n';
+                << Num(e.pose_cells.y) << ',' << Num(e.pose_cells.theta) << ',';
+    if (const std::optional<int> floor = pipeline.template_floor(e.template_id)) {
+      experiences << *floor;
+    }
+    experiences << '\n';
   }
   files.emplace_back("experiences.csv", experiences.str());
 
