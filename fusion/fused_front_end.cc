@@ -378,11 +378,11 @@ class FusedFrontEnd : public FrontEnd {
     }
     for (const auto& floors : f->level_floors) {
       for (int32_t floor : floors) {
-        if (std::abs(floor) > 100000) return r->Fail("a floor number is out of range");
+        if (floor < -100000 || floor > 100000) return r->Fail("a floor number is out of range");
       }
     }
     for (int32_t o : f->offsets) {
-      if (std::abs(o) > 100000) return r->Fail("a floor offset is out of range");
+      if (o < -100000 || o > 100000) return r->Fail("a floor offset is out of range");
     }
     return true;
   }

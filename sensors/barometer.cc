@@ -185,7 +185,9 @@ bool BarometricFloorTracker::Decode(ByteReader* r) {
     double h = 0.0;
     int32_t floor = 0;
     if (!(r->Pod(&h) && r->Pod(&floor))) return false;
-    if (!finite(h)) return r->Fail("barometer: a level height is not finite");
+    if (!finite(h) || floor < -100000 || floor > 100000) {
+      return r->Fail("barometer: a level's height or floor is out of range");
+    }
     levels.push_back({h, floor});
   }
   int32_t current = 0;
