@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "common/byte_buffer.h"
+#include "fusion/floor_rule.h"
 #include "fusion/front_end_internal.h"
 
 namespace ratslam {
@@ -14,8 +15,12 @@ namespace {
 
 class FabmapFrontEnd : public FrontEnd {
  public:
-  FabmapFrontEnd(const FabmapSettings& settings, std::shared_ptr<const FabmapResources> resources)
-      : settings_(settings), resources_(std::move(resources)) {
+  FabmapFrontEnd(const FabmapSettings& settings, const FloorOptions& floors,
+                 std::shared_ptr<const FabmapResources> resources)
+      : settings_(settings),
+        resources_(std::move(resources)),
+        use_barometer_(floors.use_barometer),
+        floors_(floors) {
     if (!resources_ || (!online() && !resources_->empty_localiser)) {
       throw std::invalid_argument("the FABMAP front end needs PrepareFabmapResources' models");
     }
@@ -48,10 +53,26 @@ class FabmapFrontEnd : public FrontEnd {
   }
 
   void OnCompass(double, double) override {}
+  Status OnPressure(double time_s, double pressure_hpa) override {
+    return use_barometer_ ? floors_.OnPressure(time_s, pressure_hpa) : Status::Ok();
+  }
+  void OnSessionStart(double start_s) override {
+    if (use_barometer_) floors_.OnSessionStart(start_s);
+  }
+  std::optional<FloorReport> floor_report() const override {
+    if (!use_barometer_ || !floors_.active()) return std::nullopt;
+    return floors_.Report();
+  }
+  std::optional<int> TemplateFloor(uint32_t id) const override {
+    return use_barometer_ ? floors_.TemplateFloor(id) : std::nullopt;
+  }
   std::optional<double> CompassHeading() const override { return std::nullopt; }
   bool WantsImages() const override { return fabmap::UsesVision(mode()); }
   uint32_t size() const override { return static_cast<uint32_t>(places_.size()); }
-  void SettleForLocalisation() override { settled_ = size(); }
+  void SettleForLocalisation() override {
+    settled_ = size();
+    if (use_barometer_) floors_.SettleForLocalisation();
+  }
   std::optional<FabmapLearningReport> fabmap_learning() const override {
     return FabmapLearningReport{
         settings_.front_end.wifi_learning,
@@ -84,6 +105,7 @@ class FabmapFrontEnd : public FrontEnd {
       w.Pod(learned_from_);
       w.Pod(relearnt_);
     }
+    if (use_barometer_) floors_.Encode(&w);  // likewise
     return std::move(w.bytes());
   }
 
@@ -115,9 +137,10 @@ class FabmapFrontEnd : public FrontEnd {
     std::optional<double> newest_time;
     std::vector<WifiReading> newest;
     uint64_t scans_seen = 0, learned_from = 0, relearnt = 0;
+    FloorRule floors = floors_;
     ok = ok && r.Optional(&newest_time) && readings(&newest) &&
          (!online() || (r.Pod(&scans_seen) && r.Pod(&learned_from) && r.Pod(&relearnt))) &&
-         (r.AtEnd() || r.Fail("trailing bytes"));
+         (!use_barometer_ || floors.Decode(&r, count)) && (r.AtEnd() || r.Fail("trailing bytes"));
     if (!ok) return Status::Error(r.error());
     if (online() &&
         (scans_seen > resources_->scans.scans.size() || learned_from > scans_seen ||
@@ -139,6 +162,7 @@ class FabmapFrontEnd : public FrontEnd {
     created_time_s_ = std::move(times);
     newest_scan_time_s_ = newest_time;
     newest_scan_ = std::move(newest);
+    floors_ = std::move(floors);
     scans_seen_ = scans_seen;
     relearnt_ = relearnt;
     if (online()) {
@@ -197,6 +221,7 @@ class FabmapFrontEnd : public FrontEnd {
 
   StatusOr<std::optional<FrameDecision>> Decide(double time_s, fabmap::Query q) {
     if (!localiser_) {  // online, before the first model: every frame is a new place
+      if (use_barometer_) floors_.AddTemplate();
       places_.push_back(std::move(q));
       created_time_s_.push_back(time_s);
       FrameDecision d;
@@ -211,17 +236,54 @@ class FabmapFrontEnd : public FrontEnd {
     d.view.time_s = time_s;
     d.source = fabmap::UsesVision(mode()) ? DecisionSource::kCamera : DecisionSource::kWifi;
     const int64_t n = static_cast<int64_t>(places_.size());
-    if (r.best_place >= 0 && r.best_probability >= settings_.front_end.match_probability) {
+    const double enough = settings_.front_end.match_probability;
+    int64_t best = r.best_place;
+    double best_probability = r.best_probability;
+    if (use_barometer_ && floors_.active()) {
+      // The floor rule (front_end.h): the most probable place the barometer allows. The
+      // posterior is per place except in the sequential modes (per candidate): there a
+      // disallowed best place is simply not matched.
+      const bool per_place = r.place_probability.size() == places_.size();
+      if (per_place) {
+        floors_.Vote(
+            [&](const std::vector<uint8_t>& mask) {
+              std::pair<int64_t, double> top(-1, 0.0);
+              for (size_t p = 0; p < mask.size(); ++p) {
+                if (mask[p] && (top.first < 0 || r.place_probability[p] > top.second)) {
+                  top = {static_cast<int64_t>(p), r.place_probability[p]};
+                }
+              }
+              return top;
+            },
+            enough);
+      }
+      const std::vector<uint8_t> agrees = floors_.BeginFrame(static_cast<uint32_t>(n));
+      if (best >= 0 && !agrees[best]) {
+        best = -1;
+        best_probability = 0.0;
+        for (size_t p = 0; per_place && p < agrees.size(); ++p) {
+          if (agrees[p] && (best < 0 || r.place_probability[p] > best_probability)) {
+            best = static_cast<int64_t>(p);
+            best_probability = r.place_probability[p];
+          }
+        }
+        if (r.best_probability >= enough && !(best >= 0 && best_probability >= enough)) {
+          floors_.CountRefused();
+        }
+      }
+    }
+    if (best >= 0 && best_probability >= enough) {
       const bool old_enough =
-          OldEnough(n, r.best_place, time_s, created_time_s_[r.best_place],
-                    settings_.front_end.recency_templates, settings_.front_end.recency_s, settled_);
-      d.view.template_id = static_cast<uint32_t>(r.best_place);
+          OldEnough(n, best, time_s, created_time_s_[best], settings_.front_end.recency_templates,
+                    settings_.front_end.recency_s, settled_);
+      d.view.template_id = static_cast<uint32_t>(best);
       d.view.is_new = false;
       d.recent = !old_enough;
       d.view.allow_injection = old_enough;
       return std::optional<FrameDecision>(d);
     }
     RATSLAM_RETURN_IF_ERROR(localiser_->AddPlace(q));
+    if (use_barometer_) floors_.AddTemplate();
     places_.push_back(std::move(q));
     created_time_s_.push_back(time_s);
     d.view.template_id = static_cast<uint32_t>(n);
@@ -241,13 +303,17 @@ class FabmapFrontEnd : public FrontEnd {
   uint64_t scans_seen_ = 0;    // Wi-Fi scans received
   uint64_t learned_from_ = 0;  // online: scans behind the current model (0: none yet)
   uint64_t relearnt_ = 0;      // online: models built so far
+  // Floors ([barometer] use_barometer): see fusion/floor_rule.h.
+  bool use_barometer_;
+  FloorRule floors_;
 };
 
 }  // namespace
 
 std::unique_ptr<FrontEnd> MakeFabmapFrontEnd(const FabmapSettings& settings,
+                                             const FloorOptions& floors,
                                              std::shared_ptr<const FabmapResources> resources) {
-  return std::make_unique<FabmapFrontEnd>(settings, std::move(resources));
+  return std::make_unique<FabmapFrontEnd>(settings, floors, std::move(resources));
 }
 
 }  // namespace front_end_internal

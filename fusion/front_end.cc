@@ -113,6 +113,11 @@ StatusOr<WifiLearning> WifiLearningFromString(const std::string& name) {
   return Status::Error("unknown Wi-Fi learning '" + name + "' (whole_data_set or online)");
 }
 
+bool FloorOptions::IsValid(std::string* error) const {
+  if (!schema::CheckFields(*this, error)) return false;
+  return tracker.IsValid(error);
+}
+
 bool FusedOptions::IsValid(std::string* error) const {
   if (!schema::CheckFields(*this, error)) return false;
   if (!use_camera && !use_wifi) {
@@ -130,7 +135,7 @@ std::unique_ptr<FrontEnd> CreateFrontEnd(const FrontEndSettings& s,
     case FrontEndKind::kFused:
       return front_end_internal::MakeFusedFrontEnd(s.fused, s.camera_12x9, s.wifi, s.barometer);
     case FrontEndKind::kFabmap:
-      return front_end_internal::MakeFabmapFrontEnd(s.fabmap, resources.fabmap);
+      return front_end_internal::MakeFabmapFrontEnd(s.fabmap, s.barometer, resources.fabmap);
     case FrontEndKind::kNone:
       return front_end_internal::MakeNoViewFrontEnd();
     case FrontEndKind::kDescriptors:

@@ -21,19 +21,20 @@
 // templates); only both sensors below threshold make a new template.
 // Wi-Fi is evaluated at the camera rate with the newest scan; scans older than max_wifi_age_s
 // count as absent. Any sensor can be switched off (Wi-Fi only, camera only, fused).
-// Floors (use_barometer, with a pressure stream): each session's barometer gives levels
-// (sensors/barometer.h); a template stores its session and level, or "unknown" when made on
-// the stairs (in transit). A session is on its first level until the first dwell (walks start
-// standing). A match needs the barometer to agree: within a session the same level; across
-// sessions the same floor in the map's frame, where a later session starts with offset 0 to the
-// first (walks of one building usually start on one floor) and Wi-Fi revises it: each scan on a
-// level votes with its best confident match among earlier sessions' templates on a level,
-// whatever their floor, when that match beats the best on every other floor by 1.5 times (an
-// ambiguous scan abstains); a vote says the template's floor minus ours, and a value other than
-// 0 that leads every other (0 included) by floor_offset_min_votes moves the session's offset.
-// A query or template of unknown floor matches nothing that has a floor, so a scan taken on the
-// stairs becomes a new template.
-// Sessions without barometer readings are unconstrained, as before.
+// Floors ([barometer] use_barometer with a pressure stream; fused and FABMAP front ends): each
+// session's barometer gives levels (sensors/barometer.h); a template stores its session and
+// level, or "unknown" when made on the stairs (in transit). A session is on its first level
+// until the first dwell (walks start standing). A match needs the barometer to agree: within a
+// session the same level; across sessions the same floor in the map's frame, where a later
+// session starts with offset 0 to the first (walks of one building usually start on one floor)
+// and Wi-Fi revises it: each scan on a level votes with its best confident match among earlier
+// sessions' templates on a level, whatever their floor, when that match beats the best on every
+// other floor by 1.5 times (an ambiguous scan abstains); a vote says the template's floor minus
+// ours, and a value other than 0 that leads every other (0 included) by floor_offset_min_votes
+// moves the session's offset. A query or template of unknown floor matches nothing that has a
+// floor, so a scan taken on the stairs becomes a new template. Sessions without barometer
+// readings are unconstrained, as before. FABMAP: the best place the barometer allows must still
+// reach match_probability; its votes use the posterior of places as the score.
 // kDescriptors: per-image descriptors computed elsewhere (fusion/descriptor_table.h) matched by
 // cosine similarity with min_similarity and the same recency rule; pixels are never loaded.
 // kCustom: a front end of your own (see "Writing a front end" below FrontEnd).
@@ -98,8 +99,6 @@ struct FusedOptions {
   bool online_rssi_offset = false;
   int rssi_offset_min_common_aps = 5;  // an estimate needs this many APs in common
   int rssi_offset_min_estimates = 10;  // estimates before the offset is applied
-  bool use_barometer = false;          // floors from a pressure stream, when there is one
-  int floor_offset_min_votes = 3;      // lead of a floor offset over any other value
 
   bool IsValid(std::string* error) const;
 
@@ -129,15 +128,29 @@ struct FusedOptions {
     v("rssi_offset_min_estimates", rssi_offset_min_estimates,
       "offset estimates of a session before its median is applied",
       schema::Unit("scans").AtLeast(1));
+  }
+};
+
+// Floors from the barometer for the front ends that match Wi-Fi (fused and FABMAP; see
+// "Floors" above): the switch, the vote lead, and the floor tracker's own settings.
+struct FloorOptions {
+  bool use_barometer = false;      // floors from a pressure stream, when there is one
+  int floor_offset_min_votes = 3;  // lead of a floor offset over any other value
+  BarometerOptions tracker;
+
+  bool IsValid(std::string* error) const;
+  template <typename Visitor>
+  void VisitFields(Visitor&& v) {
     v("use_barometer", use_barometer,
-      "with a pressure stream: give templates a floor (level) from the barometer ([barometer]) "
-      "and never match across floors or from the stairs; without one, no effect",
+      "with a pressure stream: give templates a floor (level) from the barometer and never match "
+      "across floors or from the stairs (fused and FABMAP front ends); without one, no effect",
       schema::Any());
     v("floor_offset_min_votes", floor_offset_min_votes,
       "a later session's floors start level with the first session's; its Wi-Fi matches to "
       "earlier sessions vote, and a floor offset that leads every other by this many votes "
       "replaces the current one",
       schema::Unit("votes").AtLeast(1));
+    tracker.VisitFields(v);
   }
 };
 
@@ -302,7 +315,7 @@ struct FrontEndSettings {
   FusedOptions fused;
   KernelCameraOptions camera_12x9;
   WifiMatcherOptions wifi;
-  BarometerOptions barometer;
+  FloorOptions barometer;
   FabmapSettings fabmap;
   DescriptorOptions descriptors;
 };

@@ -36,11 +36,12 @@ std::unique_ptr<FrontEnd> MakeClassicCameraFrontEnd(const ClassicCameraOptions& 
 std::unique_ptr<FrontEnd> MakeFusedFrontEnd(const FusedOptions& options,
                                             const KernelCameraOptions& camera,
                                             const WifiMatcherOptions& wifi,
-                                            const BarometerOptions& barometer);
+                                            const FloorOptions& floors);
 std::unique_ptr<FrontEnd> MakeNoViewFrontEnd();
 std::unique_ptr<FrontEnd> MakeDescriptorFrontEnd(const DescriptorOptions& options,
                                                  std::shared_ptr<const DescriptorTable> table);
 std::unique_ptr<FrontEnd> MakeFabmapFrontEnd(const FabmapSettings& settings,
+                                             const FloorOptions& floors,
                                              std::shared_ptr<const FabmapResources> resources);
 
 }  // namespace ratslam::front_end_internal

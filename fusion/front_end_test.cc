@@ -184,7 +184,8 @@ WifiScan CorridorScan(double t, double x, double noise_db) {
   return s;
 }
 
-TEST(FabmapFrontEndTest, SecondLapRecognisesTheFirstLapsPlaces) {
+// FABMAP on Wi-Fi words (8 incremental bins, virtual samples from the exploration scans).
+FrontEndSettings FabmapWifiSettings() {
   FrontEndSettings settings;
   settings.front_end.kind = FrontEndKind::kFabmap;
   settings.fabmap.localiser.localiser.mode = fabmap::FabmapMode::kWifi;
@@ -192,6 +193,11 @@ TEST(FabmapFrontEndTest, SecondLapRecognisesTheFirstLapsPlaces) {
   settings.fabmap.localiser.wifi_words.encoding = fabmap::WifiEncoding::kIncremental;
   settings.fabmap.localiser.virtual_wifi.use_exploration_scans = true;
   settings.fabmap.front_end.recency_s = 30.0;
+  return settings;
+}
+
+TEST(FabmapFrontEndTest, SecondLapRecognisesTheFirstLapsPlaces) {
+  FrontEndSettings settings = FabmapWifiSettings();
   Dataset data;
   std::vector<double> x_of_scan;
   for (int lap = 0; lap < 2; ++lap) {
@@ -237,6 +243,60 @@ TEST(FabmapFrontEndTest, SecondLapRecognisesTheFirstLapsPlaces) {
   corrupt.resize(corrupt.size() - 3);
   EXPECT_FALSE(b->DecodeState(corrupt).ok());
   EXPECT_THROW(CreateFrontEnd(settings, FrontEndResources{}), std::invalid_argument);
+}
+
+// The FABMAP front end under the floor rule: a second lap of the same corridor one floor up, with
+// the same Wi-Fi (aliased floors). Without the barometer it re-uses the first lap's places; with
+// it, none; the floors survive a state round trip.
+TEST(FabmapFrontEndTest, BarometerKeepsPlacesOnTheirFloor) {
+  auto run = [](bool barometer, std::string* state) {
+    FrontEndSettings settings = FabmapWifiSettings();
+    settings.barometer.use_barometer = barometer;
+    Dataset data;
+    for (int lap = 0; lap < 2; ++lap) {
+      for (int i = 0; i < 40; ++i) {
+        const double t = lap * 100.0 + i * 2.0;
+        data.wifi.push_back(CorridorScan(t, 2.0 * i, lap == 0 ? 1.0 : 2.0));
+        data.odometry.push_back({t, 1.0, 0.0});
+      }
+    }
+    auto resources = PrepareFabmapResources(settings, data, std::nullopt);
+    EXPECT_TRUE(resources.ok());
+    std::unique_ptr<FrontEnd> f = CreateFrontEnd(settings, *resources);
+    std::vector<int> lap_of_template;
+    int cross_floor = 0;
+    double next_pressure = 0.0;
+    for (size_t i = 0; i < data.wifi.size(); ++i) {
+      for (; next_pressure <= data.wifi[i].time_s; next_pressure += 0.1) {
+        const double h =
+            next_pressure < 82.0 ? 0.0 : std::min(3.5, 3.5 * (next_pressure - 82.0) / 14.0);
+        EXPECT_TRUE(f->OnPressure(next_pressure, 1000.0 * std::exp(-h / 8434.5)).ok());
+      }
+      const auto d = f->OnWifi(data.wifi[i]);
+      EXPECT_TRUE(d.ok() && d->has_value());
+      const int lap = i < 40 ? 0 : 1;
+      if ((*d)->view.is_new) {
+        lap_of_template.push_back(lap);
+      } else if (!(*d)->recent) {
+        cross_floor += lap_of_template[(*d)->view.template_id] != lap;
+      }
+    }
+    if (state) *state = f->EncodeState();
+    if (barometer) {
+      std::unique_ptr<FrontEnd> g = CreateFrontEnd(settings, *resources);
+      EXPECT_TRUE(g->DecodeState(f->EncodeState()).ok());
+      EXPECT_EQ(g->EncodeState(), f->EncodeState());
+      EXPECT_EQ(g->TemplateFloor(0), 0);
+      EXPECT_EQ(g->TemplateFloor(static_cast<uint32_t>(g->size() - 1)), 1);
+      std::string cut = f->EncodeState();
+      cut.pop_back();
+      EXPECT_FALSE(g->DecodeState(cut).ok());
+    }
+    return cross_floor;
+  };
+  std::string state;
+  EXPECT_GE(run(false, &state), 15);
+  EXPECT_EQ(run(true, &state), 0);
 }
 
 TEST(FabmapFrontEndTest, VisionWithoutAModelIsAClearError) {
@@ -322,8 +382,8 @@ class FloorWalk {
   FloorWalk(bool barometer, int min_votes = 3) {
     settings_.front_end.kind = FrontEndKind::kFused;
     settings_.fused.recency_s = 0.0;
-    settings_.fused.use_barometer = barometer;
-    settings_.fused.floor_offset_min_votes = min_votes;
+    settings_.barometer.use_barometer = barometer;
+    settings_.barometer.floor_offset_min_votes = min_votes;
     front_end = CreateFrontEnd(settings_);
   }
   // Pressure readings up to `t`, then the scan; returns the decision.

@@ -133,7 +133,7 @@ class ReplayPipeline {
   // A place descriptor for the frame at `time_s` (the descriptor front end only).
   Status FeedDescriptor(double time_s, const std::vector<float>& values);
   void FeedCompass(const CompassRow& row);
-  // A barometer reading (floors; [fused] use_barometer). Fails on a reading the floor tracker
+  // A barometer reading (floors; [barometer] use_barometer). Fails on a reading the floor tracker
   // refuses (time going backwards, pressure outside 100-1,100 hPa).
   Status FeedPressure(const PressureSample& sample);
 
@@ -170,7 +170,7 @@ class ReplayPipeline {
   }
   // The RSSI offsets removed per session ([fused] online_rssi_offset); empty otherwise.
   std::vector<double> rssi_offsets_db() const { return front_end_->RssiOffsetsDb(); }
-  // What the barometer said ([fused] use_barometer with a pressure stream); nothing otherwise.
+  // What the barometer said ([barometer] use_barometer with a pressure stream); nothing otherwise.
   std::optional<FloorReport> floor_report() const { return front_end_->floor_report(); }
   // A template's floor relative to the first session's first level, when the front end knows.
   std::optional<int> template_floor(uint32_t id) const { return front_end_->TemplateFloor(id); }

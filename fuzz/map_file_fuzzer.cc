@@ -101,11 +101,12 @@ struct Setup {
     fused.sensors.fused.use_compass = true;
     fused.sensors.fused.recency_s = 20.0;
     fused.sensors.fused.online_rssi_offset = true;  // its estimates are part of the state
-    fused.sensors.fused.use_barometer = true;       // and so are its floors
+    fused.sensors.barometer.use_barometer = true;   // and so are its floors
     PipelineOptions fabmap_wifi;
     fabmap_wifi.sensors.front_end.kind = FrontEndKind::kFabmap;
     fabmap_wifi.sensors.fabmap.localiser.localiser.mode = fabmap::FabmapMode::kWifi;
     fabmap_wifi.sensors.fabmap.localiser.virtual_wifi.use_exploration_scans = true;
+    fabmap_wifi.sensors.barometer.use_barometer = true;
     // Wi-Fi sequence loop closure alone (its poses, loops and links in the saved state).
     PipelineOptions sequence;
     sequence.sensors.front_end.kind = FrontEndKind::kNone;

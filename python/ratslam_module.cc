@@ -507,7 +507,7 @@ PYBIND11_MODULE(ratslam, m) {
            "A Wi-Fi scan: {bssid: rssi_dbm}.")
       .def("compass", &Session::Compass, py::arg("time_s"), py::arg("heading_rad"))
       .def("pressure", &Session::Pressure, py::arg("time_s"), py::arg("pressure_hpa"),
-           "A barometer reading, hPa (floors: fused.use_barometer).")
+           "A barometer reading, hPa (floors: barometer.use_barometer).")
       .def("descriptor", &Session::Descriptor, py::arg("time_s"), py::arg("values"),
            "A place descriptor for the frame at time_s (front_end.kind = \"descriptors\"): a "
            "1-D float array, compared by cosine similarity.")

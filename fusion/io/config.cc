@@ -277,8 +277,6 @@ constexpr AddedKey kKeysAddedAfter[] = {
     {7, "fused.online_rssi_offset"},
     {7, "fused.rssi_offset_min_common_aps"},
     {7, "fused.rssi_offset_min_estimates"},
-    {7, "fused.use_barometer"},
-    {7, "fused.floor_offset_min_votes"},
 };
 
 // Whole sections added after a map format version: older maps resume only with every key at its

@@ -23,7 +23,7 @@ struct RunCsvColumns {
 };
 
 // experiences.csv's `floor`: the floor of the experience's template relative to the first
-// session's first level ([fused] use_barometer), empty when unknown (no barometer, the stairs).
+// session's first level ([barometer] use_barometer), empty when unknown (no barometer, the stairs).
 inline const RunCsvColumns kExperienceColumns = {
     {"id", "x_m", "y_m", "theta_rad", "template_id", "time_s"},
     {"pose_cell_x", "pose_cell_y", "pose_cell_theta", "floor"}};

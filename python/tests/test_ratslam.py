@@ -202,7 +202,7 @@ class RatslamModuleTest(unittest.TestCase):
             session.descriptor(5.0, np.ones(4))
         floors = ratslam.Config()
         floors.set("front_end.kind", "fused")
-        floors.set("fused.use_barometer", True)
+        floors.set("barometer.use_barometer", True)
         walker = ratslam.Session(floors)
         walker.pressure(1.0, 976.8)
         with self.assertRaisesRegex(ratslam.Error, "pressure at t=2.*outside"):
