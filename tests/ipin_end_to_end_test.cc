@@ -285,6 +285,41 @@ TEST(IpinEndToEndTest, BarometerKeepsMatchesOnTheirFloors) {
   fs::remove_all(root);
 }
 
+// A run stopped on the stairs of route 51 and resumed from its saved map ends exactly where an
+// uninterrupted run ends: the barometer's tracker, the levels and the floors are in the state.
+TEST(IpinEndToEndTest, BarometerStateResumesBitForBit) {
+  const fs::path log = fs::path(RATSLAM_SHARED_DATA_DIR) / "ipin2023-t3" /
+                       "IPIN2023_T3_TrainingTrial51_repetition02.txt";
+  if (!fs::exists(log)) GTEST_SKIP() << "missing " << log;
+  const fs::path root =
+      fs::temp_directory_path() / ("ratslam_ipin_resume_" + std::to_string(::getpid()));
+  fs::create_directories(root);
+  const std::string base = std::string(RATSLAM_BINARY) + " replay --quiet --config " +
+                           RATSLAM_SOURCE_DIR + "/configs/ipin2023-wifi-compass.toml --data " +
+                           log.string();
+  auto run = [&](const std::string& extra, const std::string& name) {
+    const std::string command = base + extra + " --out " + (root / name).string() + " > /dev/null";
+    EXPECT_EQ(std::system(command.c_str()), 0) << command;
+  };
+  run("", "whole");
+  // 230 s: between ground-truth points on floors -1 and -2, on the way down.
+  run(" --until 230 --save-map " + (root / "half.map").string(), "first");
+  run(" --load-map " + (root / "half.map").string(), "second");
+  for (const char* name : {"frames.csv", "experiences.csv", "links.csv"}) {
+    std::ifstream a(root / "whole" / name), b(root / "second" / name);
+    std::stringstream x, y;
+    x << a.rdbuf();
+    y << b.rdbuf();
+    EXPECT_FALSE(x.str().empty());
+    EXPECT_EQ(x.str(), y.str()) << name;
+  }
+  std::ifstream a(root / "whole" / "summary.json"), b(root / "second" / "summary.json");
+  const nlohmann::json whole = nlohmann::json::parse(a), second = nlohmann::json::parse(b);
+  EXPECT_EQ(whole["barometer"], second["barometer"]);
+  EXPECT_GT(whole["barometer"]["floor_changes"].get<int>(), 0);
+  fs::remove_all(root);
+}
+
 TEST(IpinEndToEndTest, OnlineRssiOffsetFindsTheSecondPhonesOffset) {
   const fs::path data = fs::path(RATSLAM_SHARED_DATA_DIR) / "ipin2023-t3";
   for (const char* trial : {"02", "23"}) {
