@@ -17,10 +17,7 @@ class FabmapFrontEnd : public FrontEnd {
  public:
   FabmapFrontEnd(const FabmapSettings& settings, const FloorOptions& floors,
                  std::shared_ptr<const FabmapResources> resources)
-      : settings_(settings),
-        resources_(std::move(resources)),
-        use_barometer_(floors.use_barometer),
-        floors_(floors) {
+      : settings_(settings), resources_(std::move(resources)), floors_(floors) {
     if (!resources_ || (!online() && !resources_->empty_localiser)) {
       throw std::invalid_argument("the FABMAP front end needs PrepareFabmapResources' models");
     }
@@ -54,24 +51,17 @@ class FabmapFrontEnd : public FrontEnd {
 
   void OnCompass(double, double) override {}
   Status OnPressure(double time_s, double pressure_hpa) override {
-    return use_barometer_ ? floors_.OnPressure(time_s, pressure_hpa) : Status::Ok();
+    return floors_.OnPressure(time_s, pressure_hpa);
   }
-  void OnSessionStart(double start_s) override {
-    if (use_barometer_) floors_.OnSessionStart(start_s);
-  }
-  std::optional<FloorReport> floor_report() const override {
-    if (!use_barometer_ || !floors_.active()) return std::nullopt;
-    return floors_.Report();
-  }
-  std::optional<int> TemplateFloor(uint32_t id) const override {
-    return use_barometer_ ? floors_.TemplateFloor(id) : std::nullopt;
-  }
+  void OnSessionStart(double start_s) override { floors_.OnSessionStart(start_s); }
+  std::optional<FloorReport> floor_report() const override { return floors_.Report(); }
+  std::optional<int> TemplateFloor(uint32_t id) const override { return floors_.TemplateFloor(id); }
   std::optional<double> CompassHeading() const override { return std::nullopt; }
   bool WantsImages() const override { return fabmap::UsesVision(mode()); }
   uint32_t size() const override { return static_cast<uint32_t>(places_.size()); }
   void SettleForLocalisation() override {
     settled_ = size();
-    if (use_barometer_) floors_.SettleForLocalisation();
+    floors_.SettleForLocalisation();
   }
   std::optional<FabmapLearningReport> fabmap_learning() const override {
     return FabmapLearningReport{
@@ -105,7 +95,7 @@ class FabmapFrontEnd : public FrontEnd {
       w.Pod(learned_from_);
       w.Pod(relearnt_);
     }
-    if (use_barometer_) floors_.Encode(&w);  // likewise
+    floors_.Encode(&w);
     return std::move(w.bytes());
   }
 
@@ -140,7 +130,7 @@ class FabmapFrontEnd : public FrontEnd {
     FloorRule floors = floors_;
     ok = ok && r.Optional(&newest_time) && readings(&newest) &&
          (!online() || (r.Pod(&scans_seen) && r.Pod(&learned_from) && r.Pod(&relearnt))) &&
-         (!use_barometer_ || floors.Decode(&r, count)) && (r.AtEnd() || r.Fail("trailing bytes"));
+         floors.Decode(&r, count) && (r.AtEnd() || r.Fail("trailing bytes"));
     if (!ok) return Status::Error(r.error());
     if (online() &&
         (scans_seen > resources_->scans.scans.size() || learned_from > scans_seen ||
@@ -221,7 +211,7 @@ class FabmapFrontEnd : public FrontEnd {
 
   StatusOr<std::optional<FrameDecision>> Decide(double time_s, fabmap::Query q) {
     if (!localiser_) {  // online, before the first model: every frame is a new place
-      if (use_barometer_) floors_.AddTemplate();
+      floors_.AddTemplate();
       places_.push_back(std::move(q));
       created_time_s_.push_back(time_s);
       FrameDecision d;
@@ -239,7 +229,7 @@ class FabmapFrontEnd : public FrontEnd {
     const double enough = settings_.front_end.match_probability;
     int64_t best = r.best_place;
     double best_probability = r.best_probability;
-    if (use_barometer_ && floors_.active()) {
+    if (floors_.active()) {
       // The floor rule (front_end.h): the most probable place the barometer allows. The
       // posterior is per place except in the sequential modes (per candidate): there a
       // disallowed best place is simply not matched.
@@ -283,7 +273,7 @@ class FabmapFrontEnd : public FrontEnd {
       return std::optional<FrameDecision>(d);
     }
     RATSLAM_RETURN_IF_ERROR(localiser_->AddPlace(q));
-    if (use_barometer_) floors_.AddTemplate();
+    floors_.AddTemplate();
     places_.push_back(std::move(q));
     created_time_s_.push_back(time_s);
     d.view.template_id = static_cast<uint32_t>(n);
@@ -303,9 +293,7 @@ class FabmapFrontEnd : public FrontEnd {
   uint64_t scans_seen_ = 0;    // Wi-Fi scans received
   uint64_t learned_from_ = 0;  // online: scans behind the current model (0: none yet)
   uint64_t relearnt_ = 0;      // online: models built so far
-  // Floors ([barometer] use_barometer): see fusion/floor_rule.h.
-  bool use_barometer_;
-  FloorRule floors_;
+  FloorRule floors_;           // [barometer] use_barometer: see fusion/floor_rule.h
 };
 
 }  // namespace

@@ -13,6 +13,7 @@ FloorRule::FloorRule(const FloorOptions& options) : options_(options), tracker_(
 }
 
 Status FloorRule::OnPressure(double time_s, double pressure_hpa) {
+  if (!enabled()) return Status::Ok();
   StatusOr<FloorEstimate> e = tracker_.Add({time_s, pressure_hpa});
   if (!e.ok()) return e.status();
   ++pressure_readings_;
@@ -29,12 +30,13 @@ Status FloorRule::OnPressure(double time_s, double pressure_hpa) {
 }
 
 void FloorRule::OnSessionStart(double start_s) {
-  if (session_start_s_ == start_s) return;
+  if (!enabled() || session_start_s_ == start_s) return;
   if (session_start_s_) NewSession();
   session_start_s_ = start_s;
 }
 
 void FloorRule::SettleForLocalisation() {
+  if (!enabled()) return;
   NewSession();
   session_start_s_.reset();
 }
@@ -104,6 +106,7 @@ void FloorRule::CountVote(uint32_t template_id) {
 }
 
 void FloorRule::AddTemplate() {
+  if (!enabled()) return;
   template_session_.push_back(session_);
   template_level_.push_back(level_);
 }
@@ -113,7 +116,8 @@ std::optional<int> FloorRule::TemplateFloor(uint32_t id) const {
   return MapFloor(template_session_[id], template_level_[id]);
 }
 
-FloorReport FloorRule::Report() const {
+std::optional<FloorReport> FloorRule::Report() const {
+  if (!active()) return std::nullopt;
   FloorReport r;
   r.pressure_readings = pressure_readings_;
   r.floor_changes = floor_changes_before_ + tracker_.floor_changes();
@@ -127,6 +131,7 @@ FloorReport FloorRule::Report() const {
 }
 
 void FloorRule::Encode(ByteWriter* w) const {
+  if (!enabled()) return;  // states without floors keep the format of earlier releases
   tracker_.Encode(w);
   w->Pod(pressure_readings_);
   w->Pod(floor_changes_before_);
@@ -145,6 +150,7 @@ void FloorRule::Encode(ByteWriter* w) const {
 }
 
 bool FloorRule::Decode(ByteReader* r, size_t templates) {
+  if (!enabled()) return true;
   FloorRule f(options_);
   size_t n = 0;
   if (!(f.tracker_.Decode(r) && r->Pod(&f.pressure_readings_) && r->Pod(&f.floor_changes_before_) &&

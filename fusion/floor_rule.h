@@ -1,7 +1,9 @@
 // The floor rule of front_end.h ("Floors"), shared by the front ends that match Wi-Fi (fused and
 // FABMAP): the current session's barometer (sensors/barometer.h) gives its level; each template
 // keeps its session and level; a match needs the barometer to agree; a later session's floor
-// offset to the first starts at 0 and follows Wi-Fi votes. Internal to the front ends.
+// offset to the first starts at 0 and follows Wi-Fi votes. Internal to the front ends. With
+// use_barometer off every call does nothing (and the state holds nothing), so a front end calls
+// it unconditionally.
 #ifndef RATSLAM_FUSION_FLOOR_RULE_H_
 #define RATSLAM_FUSION_FLOOR_RULE_H_
 
@@ -25,6 +27,7 @@ class FloorRule {
   // `options` must be valid (FloorOptions::IsValid); throws std::invalid_argument otherwise.
   explicit FloorRule(const FloorOptions& options);
 
+  bool enabled() const { return options_.use_barometer; }
   Status OnPressure(double time_s, double pressure_hpa);
   // A new session starting at `start_s` (repeats are no news).
   void OnSessionStart(double start_s);
@@ -32,7 +35,7 @@ class FloorRule {
   void SettleForLocalisation();
 
   // The barometer has spoken (a reading arrived): before that nothing is constrained.
-  bool active() const { return pressure_readings_ > 0; }
+  bool active() const { return enabled() && pressure_readings_ > 0; }
   // Before a frame is decided among `templates` stored: counts a frame on the stairs and returns
   // a flag per template, set where the barometer lets the current observation match it.
   std::vector<uint8_t> BeginFrame(uint32_t templates);
@@ -48,7 +51,8 @@ class FloorRule {
 
   // A template's floor relative to the first session's first level, when known.
   std::optional<int> TemplateFloor(uint32_t id) const;
-  FloorReport Report() const;
+  // What the barometer said, once it has said anything.
+  std::optional<FloorReport> Report() const;
 
   void Encode(ByteWriter* writer) const;
   // Reads what Encode wrote for a front end holding `templates` templates; on failure this rule
@@ -89,6 +93,7 @@ class FloorRule {
 
 template <typename Best>
 void FloorRule::Vote(Best&& best, double threshold) {
+  if (!active()) return;
   std::vector<uint8_t> candidates;
   if (!VoteCandidates(&candidates)) return;
   const std::pair<int64_t, double> top = best(candidates);

@@ -19,11 +19,7 @@ class FusedFrontEnd : public FrontEnd {
  public:
   FusedFrontEnd(const FusedOptions& options, const KernelCameraOptions& camera,
                 const WifiMatcherOptions& wifi, const FloorOptions& floors)
-      : options_(options),
-        camera_(camera),
-        wifi_(wifi),
-        use_barometer_(floors.use_barometer),
-        floors_(floors) {}
+      : options_(options), camera_(camera), wifi_(wifi), floors_(floors) {}
 
   StatusOr<std::optional<FrameDecision>> OnImage(double time_s, const GrayImage& image) override {
     if (!options_.use_camera) return std::optional<FrameDecision>();
@@ -44,6 +40,15 @@ class FusedFrontEnd : public FrontEnd {
     newest_scan_ = wifi_.MakeFingerprint(readings);
     if (options_.online_rssi_offset) RemoveRssiOffset(&newest_scan_);
     newest_scan_time_s_ = scan.time_s;
+    // One floor vote per scan (a scan re-used by several camera frames votes once).
+    if (!newest_scan_.empty()) {
+      floors_.Vote(
+          [&](const std::vector<uint8_t>& mask) {
+            const WifiMatch m = wifi_.Best(newest_scan_, &mask);
+            return std::pair<int64_t, double>(m.id, m.weight);
+          },
+          wifi_.options().match_threshold);
+    }
     if (options_.use_camera) return std::optional<FrameDecision>();  // images are the frames
     return std::optional<FrameDecision>(Decide(scan.time_s, nullptr, &newest_scan_));
   }
@@ -51,15 +56,10 @@ class FusedFrontEnd : public FrontEnd {
   void OnCompass(double, double heading_rad) override { heading_rad_ = heading_rad; }
 
   Status OnPressure(double time_s, double pressure_hpa) override {
-    return use_barometer_ ? floors_.OnPressure(time_s, pressure_hpa) : Status::Ok();
+    return floors_.OnPressure(time_s, pressure_hpa);
   }
-  std::optional<FloorReport> floor_report() const override {
-    if (!use_barometer_ || !floors_.active()) return std::nullopt;
-    return floors_.Report();
-  }
-  std::optional<int> TemplateFloor(uint32_t id) const override {
-    return use_barometer_ ? floors_.TemplateFloor(id) : std::nullopt;
-  }
+  std::optional<FloorReport> floor_report() const override { return floors_.Report(); }
+  std::optional<int> TemplateFloor(uint32_t id) const override { return floors_.TemplateFloor(id); }
   std::optional<double> CompassHeading() const override {
     return options_.use_compass ? heading_rad_ : std::nullopt;
   }
@@ -67,11 +67,11 @@ class FusedFrontEnd : public FrontEnd {
   uint32_t size() const override { return static_cast<uint32_t>(created_time_s_.size()); }
   void SettleForLocalisation() override {
     settled_ = size();
-    if (use_barometer_) floors_.SettleForLocalisation();
+    floors_.SettleForLocalisation();
   }
 
   void OnSessionStart(double start_s) override {
-    if (use_barometer_) floors_.OnSessionStart(start_s);
+    floors_.OnSessionStart(start_s);
     if (!options_.online_rssi_offset || (session_start_s_ && *session_start_s_ == start_s)) return;
     if (session_start_s_) offsets_db_.push_back(CurrentOffset());
     session_start_s_ = start_s;
@@ -111,7 +111,7 @@ class FusedFrontEnd : public FrontEnd {
       w.PodVector(offsets_db_);
       w.PodVector(calibrated_);
     }
-    if (use_barometer_) floors_.Encode(&w);  // likewise
+    floors_.Encode(&w);
     return std::move(w.bytes());
   }
 
@@ -158,7 +158,7 @@ class FusedFrontEnd : public FrontEnd {
       return Status::Error(r.error());
     }
     FloorRule floors = floors_;
-    if (use_barometer_ && !floors.Decode(&r, created.size())) return Status::Error(r.error());
+    if (!floors.Decode(&r, created.size())) return Status::Error(r.error());
     if (!r.AtEnd()) return Status::Error("fused front-end state: trailing bytes");
     if (camera.size() != created.size() || ws.fingerprints.size() != created.size() ||
         headings.size() != created.size()) {
@@ -267,19 +267,9 @@ class FusedFrontEnd : public FrontEnd {
     Verdict camera_verdict = Verdict::kNovel, wifi_verdict = Verdict::kNovel;
     int32_t camera_best = -1, wifi_best = -1;
     // The floor rule, when the barometer has spoken: a flag per template.
-    const bool floors = use_barometer_ && floors_.active();
+    const bool floors = floors_.active();
     std::vector<uint8_t> agrees;
-    if (floors) {
-      if (scan && !scan->empty()) {
-        floors_.Vote(
-            [&](const std::vector<uint8_t>& mask) {
-              const WifiMatch m = wifi_.Best(*scan, &mask);
-              return std::pair<int64_t, double>(m.id, m.weight);
-            },
-            wifi_.options().match_threshold);
-      }
-      agrees = floors_.BeginFrame(n);
-    }
+    if (floors) agrees = floors_.BeginFrame(n);
     const std::vector<uint8_t>* allowed = floors ? &agrees : nullptr;
     if (view) {
       const KernelCameraMatch best = camera_.Best(*view, allowed);  // eq. 8
@@ -336,7 +326,7 @@ class FusedFrontEnd : public FrontEnd {
     created_time_s_.push_back(time_s);
     headings_.push_back(options_.use_compass ? heading_rad_ : std::nullopt);
     if (options_.online_rssi_offset) calibrated_.push_back(InReferenceUnits());
-    if (use_barometer_) floors_.AddTemplate();
+    floors_.AddTemplate();
     d.view.template_id = n;
     d.view.is_new = true;
     d.source = DecisionSource::kNew;
@@ -359,9 +349,7 @@ class FusedFrontEnd : public FrontEnd {
   std::vector<double> offset_estimates_db_;
   std::vector<double> offsets_db_;
   std::vector<uint8_t> calibrated_;  // by template: stored in the reference units (see above)
-  // Floors ([barometer] use_barometer): see fusion/floor_rule.h.
-  bool use_barometer_;
-  FloorRule floors_;
+  FloorRule floors_;                 // [barometer] use_barometer: see fusion/floor_rule.h
 };
 
 }  // namespace
