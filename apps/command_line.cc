@@ -231,7 +231,9 @@ const std::vector<CommandSpec>& Commands() {
        "FABMAP localisation benchmark",
        "Maps M, localises every node of Q and writes evaluation.json, queries.csv, "
        "pr_curve.csv, localisation.png and pr_curve.png to O. M and Q may be the same data set: "
-       "[evaluation] split and map_fraction then divide it.",
+       "[evaluation] split and map_fraction then divide it. A data set is a replay folder, a "
+       "phone log or a folder of them, a UJIIndoorLoc CSV, a long-term UJI library set (any of "
+       "its files, e.g. db/01/trn01rss.csv) or an image folder.",
        {kConfig, Text("--map", "M", "data set to map", true),
         Text("--query", "Q", "data set to localise", true),
         Text("--out", "O", "output folder", true), kOverwrite, kLenient, kQuiet, kJson,

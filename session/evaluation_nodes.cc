@@ -2,13 +2,17 @@
 
 #include <algorithm>
 #include <cctype>
+#include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <limits>
 #include <system_error>
+#include <tuple>
+#include <utility>
 
 #include "fusion/io/visual_model_file.h"
 #include "sensors/dataset/dataset_loader.h"
+#include "sensors/dataset/uji_long_term.h"
 #include "sensors/dataset/ujiindoorloc.h"
 
 namespace ratslam {
@@ -25,8 +29,11 @@ int FloorOfFolder(const std::string& name, int fallback) {
   for (char c : name) {
     if (std::isdigit(static_cast<unsigned char>(c)) || (c == '-' && digits.empty())) digits += c;
   }
-  if (digits.empty() || digits == "-") return fallback;
-  return std::stoi(digits);
+  int value = 0;
+  const auto r = std::from_chars(digits.data(), digits.data() + digits.size(), value);
+  // No digits, or too many for an int (a folder named by the user): the fallback.
+  if (r.ec != std::errc() || r.ptr != digits.data() + digits.size()) return fallback;
+  return value;
 }
 
 // Image folder: each sub-folder is a floor (the number in its name), frames along a line.
@@ -58,28 +65,50 @@ StatusOr<std::vector<EvaluationNode>> ImageFolderNodes(const std::string& path,
   return nodes;
 }
 
-StatusOr<std::vector<EvaluationNode>> UjiNodes(const std::string& path, bool lenient) {
-  auto rows = ReadUjiIndoorLoc(path, lenient);
-  if (!rows.ok()) return rows.status();
+// Labelled single captures (UJIIndoorLoc, long-term UJI library) as nodes, with the floor and
+// session each reader defines, in time order, so that an interleaved split alternates captures.
+// No travel between rows: the Wi-Fi tree spaces them by time only (every map row learns it by
+// default).
+template <typename FloorAndSession>
+std::vector<EvaluationNode> CaptureNodes(const std::vector<LabelledScan>& rows,
+                                         FloorAndSession floor_and_session) {
   std::vector<EvaluationNode> nodes;
-  for (const LabelledScan& s : *rows) {
+  for (const LabelledScan& s : rows) {
     EvaluationNode n;
     n.x_m = s.x_m;
     n.y_m = s.y_m;
-    n.floor = s.building * 100 + s.floor;  // another building counts as another floor
+    std::tie(n.floor, n.session) = floor_and_session(s);
     n.time_s = s.time_s;
-    n.session = s.user * 100 + s.phone;
-    // Fingerprints are single captures: no travel between rows, so the Wi-Fi tree spaces
-    // them by time only (every map row learns it by default).
     n.travelled_m = std::numeric_limits<double>::quiet_NaN();
     n.wifi = s.readings;
     nodes.push_back(std::move(n));
   }
-  // In time order, so that an interleaved split alternates captures.
   std::stable_sort(
       nodes.begin(), nodes.end(),
       [](const EvaluationNode& a, const EvaluationNode& b) { return a.time_s < b.time_s; });
   return nodes;
+}
+
+// UJIIndoorLoc: another building counts as another floor; a session is a user and phone.
+StatusOr<std::vector<EvaluationNode>> UjiNodes(const std::string& path, bool lenient) {
+  auto rows = ReadUjiIndoorLoc(path, lenient);
+  if (!rows.ok()) return rows.status();
+  return CaptureNodes(*rows, [](const LabelledScan& s) {
+    return std::pair(s.building * 100 + s.floor, s.user * 100 + s.phone);
+  });
+}
+
+// A long-term UJI library set (db/<month>/<set>rss.csv and its siblings): the session is 100 x
+// the month (the folder's number) + the set's number (tst03 -> 3; 0 to 99), so that sets of
+// different months never share one.
+StatusOr<std::vector<EvaluationNode>> LongTermNodes(const std::string& path, bool lenient) {
+  auto rows = ReadUjiLongTermSet(path, lenient);
+  if (!rows.ok()) return rows.status();
+  const fs::path p(path);
+  const int month = std::clamp(FloorOfFolder(p.parent_path().filename().string(), 0), 0, 1000000);
+  const int set = std::clamp(FloorOfFolder(p.filename().string(), 0), 0, 99);
+  return CaptureNodes(*rows,
+                      [&](const LabelledScan& s) { return std::pair(s.floor, month * 100 + set); });
 }
 
 std::vector<EvaluationNode> DatasetNodes(const Dataset& d, bool as_map, bool want_images,
@@ -154,6 +183,7 @@ StatusOr<std::vector<EvaluationNode>> LoadEvaluationNodes(
   std::error_code ec;
   if (!fs::exists(path, ec)) return Status::Error(path + ": no such file or folder");
   if (fs::is_regular_file(path, ec) && fs::path(path).extension() == ".csv") {
+    if (IsUjiLongTermSet(path)) return LongTermNodes(path, phone.lenient);
     return UjiNodes(path, phone.lenient);
   }
   if (fs::is_directory(path, ec) && !HasManifest(path)) {

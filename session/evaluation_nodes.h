@@ -1,6 +1,6 @@
 // Loading the localisation benchmark's places from data: replay folders, IPIN or Microsoft logs
-// (one, or a folder of them), UJIIndoorLoc CSVs and image folders with one sub-folder per floor.
-// File reading lives here, beside the sessions, not in FABMAP.
+// (one, or a folder of them), UJIIndoorLoc CSVs, long-term UJI library sets and image folders with
+// one sub-folder per floor. File reading lives here, beside the sessions, not in FABMAP.
 #ifndef RATSLAM_SESSION_EVALUATION_NODES_H_
 #define RATSLAM_SESSION_EVALUATION_NODES_H_
 

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "tests/documented_keys.h"
+#include "tests/uji_long_term_fixture.h"
 
 namespace {
 namespace fs = std::filesystem;
@@ -198,6 +199,55 @@ TEST(EvaluateEndToEndTest, FingerprintRowsAllLearnTheWifiTree) {
   EXPECT_EQ(last_accepted, best_mapped.size());
   EXPECT_TRUE(fs::exists(out / "pr_curve.png"));
   fs::remove_all(out);
+}
+
+// The long-term UJI library layout (tests/uji_long_term_fixture.h): the map is month 01's
+// training set, the queries month 12's test set 1.5 m from the map places, with two access points
+// gone and four new. `ratslam evaluate --map db/01/trn01rss.csv --query db/12/tst01rss.csv` finds
+// the sibling files. Thresholds come from the fixture: an answer drawn at random among the map
+// places is within 5 m of the query in 4 of 48 cases (8 %) and on the wrong floor in half.
+TEST(EvaluateEndToEndTest, LongTermLibraryLayout) {
+  const fs::path root = Scratch("evaluate_long_term");
+  ratslam::fixture::WriteLongTermLibrary(root);
+  const fs::path out = root / "out";
+  const std::string command = std::string(RATSLAM_BINARY) + " evaluate --quiet --config " +
+                              RATSLAM_SOURCE_DIR + "/configs/ujiindoorloc-wifi.toml --map " +
+                              (root / "db/01/trn01rss.csv").string() + " --query " +
+                              (root / "db/12/tst01rss.csv").string() + " --out " + out.string() +
+                              " > /dev/null";
+  ASSERT_EQ(std::system(command.c_str()), 0) << command;
+  std::ifstream in(out / "evaluation.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  const int rows =
+      2 * ratslam::fixture::kLongTermPlacesPerFloor * ratslam::fixture::kLongTermScansPerPlace;
+  EXPECT_EQ(j["map_nodes"].get<int>(), rows);
+  EXPECT_EQ(j["queries"].get<int>(), rows);
+  EXPECT_EQ(j["wifi_tree_scans"].get<int>(), rows);  // single captures: every row learns the tree
+  double chance_5m = 0.0;  // mean over queries of the share of map places within 5 m
+  for (int floor = 0; floor < 2; ++floor) {
+    for (int q = 0; q < ratslam::fixture::kLongTermPlacesPerFloor; ++q) {
+      int near = 0;
+      for (int m = 0; m < ratslam::fixture::kLongTermPlacesPerFloor; ++m) {
+        near += std::abs((q - m) * ratslam::fixture::kLongTermSpacingM + 1.5) <= 5.0;
+      }
+      chance_5m += near / (2.0 * ratslam::fixture::kLongTermPlacesPerFloor);
+    }
+  }
+  chance_5m /= 2.0 * ratslam::fixture::kLongTermPlacesPerFloor;
+  EXPECT_GT(j["correct_within_m"]["5"].get<double>(), 4.0 * chance_5m);
+  EXPECT_LE(j["floor_mistake_rate"].get<double>(), 0.05);
+  for (const char* baseline : {"knn", "fingerprint"}) {
+    EXPECT_GT(j["baselines"][baseline]["correct_within_m"]["5"].get<double>(), 2.0 * chance_5m)
+        << baseline;
+    EXPECT_LE(j["baselines"][baseline]["floor_mistake_rate"].get<double>(), 0.05) << baseline;
+  }
+  // The first query is month 12's first row: 1.5 m along the corridor on floor 3.
+  std::ifstream csv(out / "queries.csv");
+  std::string line;
+  std::getline(csv, line);
+  std::getline(csv, line);
+  EXPECT_EQ(line.rfind("0,1.5,0,3,", 0), 0u) << line;
+  fs::remove_all(root);
 }
 
 TEST(EvaluateEndToEndTest, BadInputIsAClearError) {
