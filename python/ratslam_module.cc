@@ -451,6 +451,7 @@ py::dict Evaluate(const std::string& map, const std::string& query, const std::s
   Column<double>(&queries, "new_place_probability", r.new_place_probability, same);
   Column<int64_t>(&queries, "best_mapped_place", r.best_mapped_place, same);
   Column<double>(&queries, "best_mapped_probability", r.best_mapped_probability, same);
+  Column<double>(&queries, "best_mapped_log_odds", r.best_mapped_log_odds, same);
   run["queries"] = std::move(queries);
   return run;
 }

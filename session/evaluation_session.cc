@@ -4,7 +4,10 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
+#include <map>
 #include <nlohmann/json.hpp>
+#include <numeric>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
@@ -36,12 +39,25 @@ nlohmann::ordered_json ByDistance(const std::vector<double>& values) {
   return o;
 }
 
-// The rates of one method: correct within d, misplaced beyond d, rejections, floor mistakes.
-void AddRates(const fabmap::EvaluationMetrics& m, nlohmann::ordered_json* j) {
+// The rates of one method: correct within d, misplaced beyond d, rejections, floor mistakes, and
+// those of queries near and far from the map (`nearest_m` as ByMapDistance takes it).
+void AddRates(const fabmap::EvaluationMetrics& m, const std::vector<double>& nearest_m,
+              const fabmap::EvaluationOptions& options, nlohmann::ordered_json* j) {
   (*j)["correct_within_m"] = ByDistance(m.correct_within);
   (*j)["misplaced_beyond_m"] = ByDistance(m.misplaced_beyond);
   (*j)["rejection_rate"] = m.rejection_rate;
   (*j)["floor_mistake_rate"] = m.floor_mistake_rate;
+  const fabmap::MapDistanceReport r =
+      fabmap::ByMapDistance(m, nearest_m, options.near_place_m, options.far_place_m);
+  nlohmann::ordered_json& o = (*j)["by_map_distance"];
+  o["near_m"] = r.near_m;
+  o["far_m"] = r.far_m;
+  for (const auto& [name, g] : {std::pair("near", &r.near), std::pair("far", &r.far)}) {
+    o[name]["queries"] = g->queries;
+    o[name]["rejection_rate"] = g->rejection_rate;
+    o[name]["floor_mistake_rate"] = g->floor_mistake_rate;
+    o[name]["located_rate"] = g->located_rate;
+  }
 }
 
 }  // namespace
@@ -139,8 +155,27 @@ Status EvaluationSession::Prepare() {
     RATSLAM_RETURN_IF_ERROR(Words(result_.map, "map", &map_words_));
     RATSLAM_RETURN_IF_ERROR(Words(result_.queries, "queries", &query_words_));
   }
+  std::vector<size_t> all(result_.map.size());
+  std::iota(all.begin(), all.end(), size_t{0});
+  auto localiser = BuildLocaliser(all);
+  if (!localiser.ok()) return localiser.status();
+  localiser_ = *std::move(localiser);
+  result_.wifi_words = localiser_->wifi_words();
+  result_.wifi_map_scans = localiser_->wifi_exploration_scans();
+  result_.wifi_tree_scans = localiser_->wifi_tree_scans();
+  result_.visual_words = visual_ ? visual_->vocabulary.size() : 0u;
+  result_.new_place = fabmap::NewPlaceThreshold();
+  if (options_.pipeline.evaluation.calibrate_new_place) {
+    RATSLAM_RETURN_IF_ERROR(CalibrateNewPlace());
+  }
+  return Status::Ok();
+}
+
+StatusOr<std::unique_ptr<fabmap::Localiser>> EvaluationSession::BuildLocaliser(
+    const std::vector<size_t>& map_nodes) const {
+  const bool vision = fabmap::UsesVision(mode());
   std::vector<fabmap::MapNode> places;
-  for (size_t i = 0; i < result_.map.size(); ++i) {
+  for (size_t i : map_nodes) {
     fabmap::MapNode n;
     if (vision) n.visual = map_words_[i];
     n.wifi = result_.map[i].wifi;
@@ -148,14 +183,58 @@ Status EvaluationSession::Prepare() {
     n.time_s = result_.map[i].time_s;
     places.push_back(std::move(n));
   }
-  auto localiser =
-      fabmap::Localiser::Build(settings.localiser, visual_ ? &visual_->model : nullptr, places);
-  if (!localiser.ok()) return localiser.status();
-  localiser_ = *std::move(localiser);
-  result_.wifi_words = localiser_->wifi_words();
-  result_.wifi_map_scans = localiser_->wifi_exploration_scans();
-  result_.wifi_tree_scans = localiser_->wifi_tree_scans();
-  result_.visual_words = visual_ ? visual_->vocabulary.size() : 0u;
+  return fabmap::Localiser::Build(options_.pipeline.sensors.fabmap.localiser,
+                                  visual_ ? &visual_->model : nullptr, places);
+}
+
+Status EvaluationSession::CalibrateNewPlace() {
+  const fabmap::EvaluationOptions& evaluation = options_.pipeline.evaluation;
+  const bool vision = fabmap::UsesVision(mode());
+  std::vector<int> sessions;
+  for (const fabmap::EvaluationNode& n : result_.map) sessions.push_back(n.session);
+  std::sort(sessions.begin(), sessions.end());
+  sessions.erase(std::unique(sessions.begin(), sessions.end()), sessions.end());
+  if (sessions.size() < 2) {
+    return Status::Error(
+        "[evaluation] calibrate_new_place needs at least two map sessions; the "
+        "map has " +
+        std::to_string(sessions.size()));
+  }
+  // Each fold of sessions in turn is held out: localised against a map of the others, its nodes
+  // labelled near or far by their distance to that map.
+  const size_t folds = std::min(sessions.size(), static_cast<size_t>(evaluation.calibration_folds));
+  std::map<int, size_t> fold_of;
+  for (size_t k = 0; k < sessions.size(); ++k) fold_of[sessions[k]] = k % folds;
+  std::vector<double> log_odds;
+  std::vector<bool> near;
+  for (size_t k = 0; k < folds; ++k) {
+    if (stopped()) return Status::Error("evaluation stopped by request");
+    std::vector<size_t> rest, held;
+    std::vector<fabmap::EvaluationNode> rest_nodes, held_nodes;
+    for (size_t i = 0; i < result_.map.size(); ++i) {
+      const bool out = fold_of[result_.map[i].session] == k;
+      (out ? held : rest).push_back(i);
+      (out ? held_nodes : rest_nodes).push_back(result_.map[i]);
+    }
+    auto localiser = BuildLocaliser(rest);
+    if (!localiser.ok()) return localiser.status().WithContext("calibrating the new place");
+    const std::vector<double> nearest = fabmap::NearestPlaceDistances(
+        rest_nodes, held_nodes, std::numeric_limits<double>::infinity());
+    for (size_t h = 0; h < held.size(); ++h) {
+      const bool is_near = nearest[h] <= evaluation.near_place_m;
+      if (!is_near && !(nearest[h] > evaluation.far_place_m)) continue;
+      fabmap::Query q;
+      if (vision) q.visual = map_words_[held[h]];
+      q.wifi = result_.map[held[h]].wifi;
+      log_odds.push_back((*localiser)->Localise(q).best_mapped_log_odds);
+      near.push_back(is_near);
+    }
+    progress_->Update({"calibrating the new place", k + 1, folds});
+  }
+  progress_->Finish();
+  result_.new_place = fabmap::LearnNewPlaceThreshold(log_odds, near);
+  result_.new_place_sessions = sessions.size();
+  result_.new_place_folds = folds;
   return Status::Ok();
 }
 
@@ -167,18 +246,27 @@ Status EvaluationSession::Localise() {
   result_.new_place_probability.clear();
   result_.best_mapped_place.clear();
   result_.best_mapped_probability.clear();
+  result_.best_mapped_log_odds.clear();
   const double start = clock_->Seconds();
   for (size_t i = 0; i < result_.queries.size(); ++i) {
     if (stopped()) return Status::Error("evaluation stopped by request");
     fabmap::Query q;
     if (vision) q.visual = query_words_[i];
     q.wifi = result_.queries[i].wifi;
-    const fabmap::LocalisationResult r = localiser_->Localise(q);
+    fabmap::LocalisationResult r = localiser_->Localise(q);
+    if (result_.new_place.calibrated) {
+      // The learnt threshold decides between the best mapped place and the new place.
+      const bool accept =
+          r.best_mapped_place >= 0 && r.best_mapped_log_odds > result_.new_place.log_odds;
+      r.best_place = accept ? r.best_mapped_place : -1;
+      r.best_probability = accept ? r.best_mapped_probability : r.new_place_probability;
+    }
     result_.matches.push_back(r.best_place);
     result_.match_probability.push_back(r.best_probability);
     result_.new_place_probability.push_back(r.new_place_probability);
     result_.best_mapped_place.push_back(r.best_mapped_place);
     result_.best_mapped_probability.push_back(r.best_mapped_probability);
+    result_.best_mapped_log_odds.push_back(r.best_mapped_log_odds);
     progress_->Update({"queries", i + 1, result_.queries.size()});
   }
   progress_->Finish();
@@ -224,7 +312,10 @@ Status EvaluationSession::WriteOutputs() {
   j["config"] = options_.config_path;
   j["map_nodes"] = result_.map.size();
   j["queries"] = m.queries;
-  AddRates(m, &j);
+  const fabmap::EvaluationOptions& evaluation = options_.pipeline.evaluation;
+  const std::vector<double> nearest = fabmap::NearestPlaceDistances(
+      result_.map, result_.queries, std::numeric_limits<double>::infinity());
+  AddRates(m, nearest, evaluation, &j);
   j["nearest_place_within_m"] =
       ByDistance(fabmap::NearestPlaceWithin(result_.map, result_.queries, kDistancesM));
   {
@@ -239,8 +330,22 @@ Status EvaluationSession::WriteOutputs() {
     }
     j["average_precision_within_m"] = ByDistance(average);
   }
+  if (evaluation.calibrate_new_place) {
+    const fabmap::NewPlaceThreshold& t = result_.new_place;
+    nlohmann::ordered_json& c = j["new_place_calibration"];
+    c["sessions"] = result_.new_place_sessions;
+    c["folds"] = result_.new_place_folds;
+    c["near_nodes"] = t.near;
+    c["far_nodes"] = t.far;
+    c["calibrated"] = t.calibrated;
+    c["log_odds_threshold"] = t.log_odds;
+    c["near_accepted"] = t.near_accepted;
+    c["far_rejected"] = t.far_rejected;
+  }
   j["baselines"] = nlohmann::ordered_json::object();
-  for (const auto& [name, b] : result_.baselines) AddRates(b, &j["baselines"][name]);
+  for (const auto& [name, b] : result_.baselines) {
+    AddRates(b, nearest, evaluation, &j["baselines"][name]);
+  }
   j["wifi_words"] = result_.wifi_words;
   j["wifi_map_scans"] = result_.wifi_map_scans;
   j["wifi_tree_scans"] = result_.wifi_tree_scans;
@@ -258,7 +363,8 @@ Status EvaluationSession::WriteOutputs() {
   // rejection) and status says which case it is.
   std::ostringstream csv;
   csv << "query,x_m,y_m,floor,match,match_x_m,match_y_m,match_floor,error_m,status,"
-         "match_probability,new_place_probability,best_mapped_place,best_mapped_probability\n";
+         "match_probability,new_place_probability,best_mapped_place,best_mapped_probability,"
+         "best_mapped_log_odds,nearest_place_m\n";
   for (size_t i = 0; i < result_.queries.size(); ++i) {
     const auto& q = result_.queries[i];
     const int64_t match = result_.matches[i];
@@ -278,9 +384,13 @@ Status EvaluationSession::WriteOutputs() {
         << ',' << ShortestNumber(result_.match_probability[i]) << ','
         << ShortestNumber(result_.new_place_probability[i]) << ',' << result_.best_mapped_place[i]
         << ',';
-    if (result_.best_mapped_place[i] >= 0)
-      csv << ShortestNumber(result_.best_mapped_probability[i]);
-    csv << '\n';
+    if (result_.best_mapped_place[i] >= 0) {
+      csv << ShortestNumber(result_.best_mapped_probability[i]) << ','
+          << ShortestNumber(result_.best_mapped_log_odds[i]);
+    } else {
+      csv << ',';
+    }
+    csv << ',' << ShortestNumber(nearest[i]) << '\n';
   }
   // Precision-recall: one row per distinct best-mapped-place posterior, highest first.
   std::ostringstream pr;

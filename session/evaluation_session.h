@@ -44,6 +44,7 @@ struct EvaluationResult {
   std::vector<double> match_probability, new_place_probability;
   std::vector<int64_t> best_mapped_place;
   std::vector<double> best_mapped_probability;
+  std::vector<double> best_mapped_log_odds;  // LocalisationResult's: best mapped vs new place
   // Precision and recall of accepting the best mapped place above each posterior (pr_curve.csv).
   std::vector<fabmap::PrecisionRecallPoint> precision_recall;
   fabmap::EvaluationMetrics metrics;
@@ -53,6 +54,10 @@ struct EvaluationResult {
   // The Wi-Fi baselines on the same map and queries (evaluation_baselines.h), by name ("knn",
   // "fingerprint"); empty when the map has no scan.
   std::vector<std::pair<std::string, fabmap::EvaluationMetrics>> baselines;
+  // With [evaluation] calibrate_new_place: the threshold learnt, the map's sessions and the folds
+  // they were held out in (Localise then answers with the threshold).
+  fabmap::NewPlaceThreshold new_place;
+  size_t new_place_sessions = 0, new_place_folds = 0;
   double query_time_ms = 0.0;  // mean per query (FABMAP)
   double wall_time_s = 0.0;    // of the whole session so far
   std::string json;            // evaluation.json
@@ -84,6 +89,10 @@ class EvaluationSession {
  private:
   Status Words(const std::vector<fabmap::EvaluationNode>& nodes, const std::string& what,
                std::vector<fabmap::Observation>* words);
+  // A localiser over the given map nodes (indices into result_.map), with the session's settings.
+  StatusOr<std::unique_ptr<fabmap::Localiser>> BuildLocaliser(
+      const std::vector<size_t>& map_nodes) const;
+  Status CalibrateNewPlace();
 
   EvaluationSessionOptions options_;
   OutputFolder* out_;

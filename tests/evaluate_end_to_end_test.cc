@@ -1,9 +1,10 @@
 // `ratslam evaluate` and the FABMAP front end on real data (../shared/data/).
 //
-// Microsoft ILC 2.0 walks, Wi-Fi-only FABMAP, split by walk: with 16 incremental RSSI words 35.2 %
-// of the 640 queries are within 5 m and 4.2 % on another floor (README). We check the report's
-// consistency and a floor well below that (25 % within 5 m; floor mistakes under 20 %, against
-// 80 % for an answer drawn at random among 5 floors).
+// Microsoft ILC 2.0 walks, Wi-Fi-only FABMAP, split by walk: with 16 incremental RSSI words and
+// the new-place decision learnt from the map's walks 33.4 % of the 640 queries are within 5 m and
+// 0.5 % on another floor (README; 35.2 % and 4.2 % without the calibration). We check the
+// report's consistency and a floor well below that (25 % within 5 m; floor mistakes under 20 %,
+// against 80 % for an answer drawn at random among 5 floors), and the calibration below.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -22,6 +23,14 @@
 namespace {
 namespace fs = std::filesystem;
 namespace e2e = ratslam::e2e;
+
+// A CSV line's comma-separated fields (a trailing empty field is dropped, as getline does).
+std::vector<std::string> Fields(const std::string& line) {
+  std::vector<std::string> f;
+  std::stringstream fields(line);
+  for (std::string x; std::getline(fields, x, ',');) f.push_back(x);
+  return f;
+}
 
 fs::path Scratch(const std::string& name) {
   return fs::temp_directory_path() / ("ratslam_" + name + "_" + std::to_string(::getpid()));
@@ -75,6 +84,46 @@ TEST(EvaluateEndToEndTest, MicrosoftWalksWifiOnly) {
     EXPECT_LE(j["correct_within_m"][d].get<double>(), j["nearest_place_within_m"][d].get<double>());
   }
   EXPECT_LT(j["floor_mistake_rate"].get<double>(), 0.2);
+  // The shipped config learns the new-place decision from the map's walks. Without it FABMAP
+  // answered 17 % of the queries far from every map place (> 10 m) on another floor and
+  // rejected 3.4 % of them, for 4.2 % floor mistakes over all queries; issue 12 asks for at most
+  // 3 %. We require that, most far queries rejected, and near ones (<= 5 m) still located:
+  // rejecting everything would reject all near ones too.
+  const nlohmann::json& calibration = j["new_place_calibration"];
+  EXPECT_TRUE(calibration["calibrated"].get<bool>());
+  EXPECT_EQ(calibration["folds"].get<int>(), 4);
+  EXPECT_GT(calibration["near_nodes"].get<int>(), 0);
+  EXPECT_GT(calibration["far_nodes"].get<int>(), 0);
+  EXPECT_LE(j["floor_mistake_rate"].get<double>(), 0.03);
+  const nlohmann::json& by_distance = j["by_map_distance"];
+  EXPECT_GE(by_distance["far"]["rejection_rate"].get<double>(), 0.5);
+  EXPECT_LE(by_distance["near"]["rejection_rate"].get<double>(), 0.15);
+  // The groups recounted from queries.csv's nearest_place_m, and the decision rule: a located or
+  // other-floor answer has log odds above the threshold, a rejection with a best mapped place
+  // at most that.
+  {
+    const double threshold = calibration["log_odds_threshold"].get<double>();
+    std::ifstream csv(out / "queries.csv");
+    std::string line;
+    std::getline(csv, line);
+    int near = 0, far = 0;
+    while (std::getline(csv, line)) {
+      const std::vector<std::string> f = Fields(line);
+      ASSERT_EQ(f.size(), 16u) << line;
+      const double nearest = std::stod(f[15]);
+      near += nearest <= 5.0;
+      far += nearest > 10.0;
+      if (f[12] == "-1") continue;  // no mapped place at all
+      const double log_odds = std::stod(f[14]);
+      if (f[9] == "rejected") {
+        EXPECT_LE(log_odds, threshold) << line;
+      } else {
+        EXPECT_GT(log_odds, threshold) << line;
+      }
+    }
+    EXPECT_EQ(by_distance["near"]["queries"].get<int>(), near);
+    EXPECT_EQ(by_distance["far"]["queries"].get<int>(), far);
+  }
   EXPECT_TRUE(fs::exists(out / "localisation.png"));
   EXPECT_TRUE(fs::exists(out / "queries.csv"));
   EXPECT_TRUE(fs::exists(out / "config.toml"));
@@ -133,15 +182,13 @@ TEST(EvaluateEndToEndTest, FingerprintRowsAllLearnTheWifiTree) {
   std::getline(csv, line);
   EXPECT_EQ(line,
             "query,x_m,y_m,floor,match,match_x_m,match_y_m,match_floor,error_m,status,"
-            "match_probability,new_place_probability,best_mapped_place,best_mapped_probability");
+            "match_probability,new_place_probability,best_mapped_place,best_mapped_probability,"
+            "best_mapped_log_odds,nearest_place_m");
   size_t located = 0, rows = 0;
   std::vector<double> best_mapped;  // posteriors of the rows that have a best mapped place
   while (std::getline(csv, line)) {
-    std::vector<std::string> f;
-    std::stringstream fields(line);
-    for (std::string x; std::getline(fields, x, ',');) f.push_back(x);
-    if (f.size() == 13) f.push_back("");  // a trailing empty field
-    ASSERT_EQ(f.size(), 14u) << line;
+    const std::vector<std::string> f = Fields(line);
+    ASSERT_EQ(f.size(), 16u) << line;
     ++rows;
     // Posteriors: the chosen hypothesis is the match (then also the best mapped place) or the
     // new place; every posterior is a probability.
@@ -166,6 +213,8 @@ TEST(EvaluateEndToEndTest, FingerprintRowsAllLearnTheWifiTree) {
     const double error =
         std::hypot(std::stod(f[1]) - std::stod(f[5]), std::stod(f[2]) - std::stod(f[6]));
     ASSERT_EQ(error, std::stod(f[8])) << line;
+    // No answer on the query's floor is closer than its nearest map place there.
+    EXPECT_GE(error, std::stod(f[15])) << line;
   }
   EXPECT_EQ(rows, j["queries"].get<size_t>());
   EXPECT_GT(located, rows / 2);
@@ -177,9 +226,7 @@ TEST(EvaluateEndToEndTest, FingerprintRowsAllLearnTheWifiTree) {
   double last_threshold = 2.0, last_recall = 0.0;
   size_t last_accepted = 0, points = 0;
   while (std::getline(pr, line)) {
-    std::vector<std::string> f;
-    std::stringstream fields(line);
-    for (std::string x; std::getline(fields, x, ',');) f.push_back(x);
+    const std::vector<std::string> f = Fields(line);
     ASSERT_EQ(f.size(), 14u) << line;
     const double threshold = std::strtod(f[0].c_str(), nullptr), recall_5 = std::stod(f[7]);
     const size_t accepted = std::stoul(f[1]);

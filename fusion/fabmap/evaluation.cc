@@ -30,7 +30,93 @@ StatusOr<SplitUnit> SplitUnitFromString(const std::string& name) {
 }
 
 bool EvaluationOptions::IsValid(std::string* error) const {
-  return schema::CheckFields(*this, error);
+  if (!schema::CheckFields(*this, error)) return false;
+  if (far_place_m < near_place_m) {
+    if (error) *error = "far_place_m must be at least near_place_m";
+    return false;
+  }
+  return true;
+}
+
+NewPlaceThreshold LearnNewPlaceThreshold(const std::vector<double>& log_odds,
+                                         const std::vector<bool>& near) {
+  NewPlaceThreshold result;
+  std::vector<std::pair<double, bool>> scored;
+  for (size_t i = 0; i < log_odds.size() && i < near.size(); ++i) {
+    const double v =
+        std::isnan(log_odds[i]) ? -std::numeric_limits<double>::infinity() : log_odds[i];
+    scored.push_back({v, near[i]});
+    ++(near[i] ? result.near : result.far);
+  }
+  if (result.near == 0 || result.far == 0) return result;
+  std::sort(scored.begin(), scored.end());
+  // Sweep t upwards: below every finite score first, then past each run of equal scores.
+  const double lowest = -std::numeric_limits<double>::infinity();
+  size_t far_rejected = 0, near_rejected = 0, i = 0;
+  while (i < scored.size() && scored[i].first == lowest) {
+    ++(scored[i].second ? near_rejected : far_rejected);
+    ++i;
+  }
+  auto j_of = [&] {
+    return 1.0 - static_cast<double>(near_rejected) / static_cast<double>(result.near) +
+           static_cast<double>(far_rejected) / static_cast<double>(result.far) - 1.0;
+  };
+  double best_j = j_of();
+  double best_t = lowest;
+  size_t best_far = far_rejected, best_near = near_rejected;
+  while (i < scored.size()) {
+    const double v = scored[i].first;
+    while (i < scored.size() && scored[i].first == v) {
+      ++(scored[i].second ? near_rejected : far_rejected);
+      ++i;
+    }
+    const double j = j_of();
+    if (j > best_j) {
+      best_j = j;
+      best_t = i < scored.size() && std::isfinite(v) && std::isfinite(scored[i].first)
+                   ? v + 0.5 * (scored[i].first - v)
+                   : v;
+      best_far = far_rejected;
+      best_near = near_rejected;
+    }
+  }
+  // "Accept every finite score": the largest threshold below them all is -inf itself, which
+  // rejects exactly the nodes without a mapped place.
+  result.log_odds = best_t;
+  result.near_accepted = 1.0 - static_cast<double>(best_near) / static_cast<double>(result.near);
+  result.far_rejected = static_cast<double>(best_far) / static_cast<double>(result.far);
+  result.calibrated = true;
+  return result;
+}
+
+MapDistanceReport ByMapDistance(const EvaluationMetrics& metrics,
+                                const std::vector<double>& nearest_m, double near_m, double far_m) {
+  MapDistanceReport report;
+  report.near_m = near_m;
+  report.far_m = far_m;
+  for (size_t i = 0; i < metrics.errors_m.size() && i < nearest_m.size(); ++i) {
+    MapDistanceGroup* group = nearest_m[i] <= near_m ? &report.near
+                              : nearest_m[i] > far_m ? &report.far
+                                                     : nullptr;
+    if (!group) continue;
+    const double e = metrics.errors_m[i];
+    ++group->queries;
+    if (std::isnan(e)) {
+      group->rejection_rate += 1.0;
+    } else if (std::isinf(e)) {
+      group->floor_mistake_rate += 1.0;
+    } else {
+      group->located_rate += 1.0;
+    }
+  }
+  for (MapDistanceGroup* g : {&report.near, &report.far}) {
+    if (g->queries == 0) continue;
+    const double n = static_cast<double>(g->queries);
+    g->rejection_rate /= n;
+    g->floor_mistake_rate /= n;
+    g->located_rate /= n;
+  }
+  return report;
 }
 
 SplitNodes SplitEvaluationNodes(const std::vector<EvaluationNode>& nodes,

@@ -39,6 +39,10 @@ struct EvaluationOptions {
   double map_fraction = 0.4;     // share of nodes (or sessions) that make the map (paper: 40%)
   double frame_spacing_m = 0.5;  // image folders without positions: metres per frame
   double image_wifi_max_gap_s = 10.0;  // an image takes a scan at most this far in time
+  double near_place_m = 5.0;           // a map place on the query's floor this close: "near"
+  double far_place_m = 10.0;           // no map place on the query's floor this close: "far"
+  bool calibrate_new_place = false;    // learn the new-place threshold from held-out map sessions
+  int calibration_folds = 4;           // map sessions held out in this many interleaved groups
 
   bool IsValid(std::string* error) const;
   template <typename Visitor>
@@ -55,8 +59,42 @@ struct EvaluationOptions {
     v("image_wifi_max_gap_s", image_wifi_max_gap_s,
       "an image is paired with a Wi-Fi scan at most this far in time",
       schema::Unit("s").NonNegative());
+    v("near_place_m", near_place_m,
+      "by_map_distance: queries with a map place on their floor at most this far are near (they "
+      "should be located)",
+      schema::Unit("m").Positive());
+    v("far_place_m", far_place_m,
+      "by_map_distance: queries with no map place on their floor this close are far (the map "
+      "never saw them: they should be rejected); at least near_place_m",
+      schema::Unit("m").Positive());
+    v("calibrate_new_place", calibrate_new_place,
+      "learn the new-place decision from the map: its sessions are held out in groups "
+      "(calibration_folds), each localised against a map of the others, and a query is answered "
+      "with its best mapped place only when that place's log odds against the new place exceed "
+      "the threshold that best separates held-out nodes near the rest of the map from those far "
+      "from it (needs two map sessions)",
+      schema::Any());
+    v("calibration_folds", calibration_folds,
+      "calibrate_new_place: map session k (in order of id) is held out with fold k mod this; "
+      "more folds cost more localiser builds (at most one per session)",
+      schema::Unit("").Within(2, 1000));
   }
 };
+
+// The new-place threshold learnt from labelled scores: `log_odds[i]` is a held-out node's best
+// mapped place's log odds against the new place, `near[i]` whether that node was near the rest
+// of the map (true) or far from it (false). The threshold t maximises Youden's J, the share of
+// near nodes accepted (log odds > t) plus the share of far ones rejected (<= t), minus 1. The
+// candidates are "accept every finite score" and the midpoints between consecutive distinct
+// scores; ties go to the lowest t (accept more). NaN counts as -inf (no mapped place).
+struct NewPlaceThreshold {
+  double log_odds = 0.0;  // t; 0 without both kinds of node (FABMAP's own arg-max rule)
+  size_t near = 0, far = 0;
+  double near_accepted = 0.0, far_rejected = 0.0;  // at t, of the labelled nodes
+  bool calibrated = false;
+};
+NewPlaceThreshold LearnNewPlaceThreshold(const std::vector<double>& log_odds,
+                                         const std::vector<bool>& near);
 
 // The places of one data set divided into map and queries by `options.split`: interleaved by
 // node or by session (InterleavedSplit with map_fraction), or the first session as the map.
@@ -99,6 +137,24 @@ struct Estimate {
   double x_m = 0.0, y_m = 0.0;
   int floor = 0;
 };
+// Answers grouped by how far the query is from the map: `near` queries have a map place on their
+// floor within `near_m` (a localiser should locate them), `far` ones none within `far_m` (places
+// the map never saw: the right answer is a rejection). Queries in between are in neither.
+struct MapDistanceGroup {
+  size_t queries = 0;
+  double rejection_rate = 0.0;      // of the group's queries
+  double floor_mistake_rate = 0.0;  // answered with a place on another floor
+  double located_rate = 0.0;        // answered on the right floor (any distance)
+};
+struct MapDistanceReport {
+  double near_m = 0.0, far_m = 0.0;
+  MapDistanceGroup near, far;
+};
+// `nearest_m[i]`: query i's distance to the nearest map place on its floor, infinity when there
+// is none within at least `far_m` (NearestPlaceDistances with reach far_m).
+MapDistanceReport ByMapDistance(const EvaluationMetrics& metrics,
+                                const std::vector<double>& nearest_m, double near_m, double far_m);
+
 // The same metrics from positions; `estimates[i]` answers query i (missing: a rejection).
 EvaluationMetrics ComputeMetrics(const std::vector<EvaluationNode>& queries,
                                  const std::vector<Estimate>& estimates,

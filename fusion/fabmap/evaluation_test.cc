@@ -158,5 +158,72 @@ TEST(PrecisionRecallTest, NearestPlaceDistancesRespectFloorAndReach) {
   EXPECT_TRUE(std::isinf(d[2]));
 }
 
+// Six queries with known nearest map distances and answers: near ones (<= 5 m) were answered
+// located, rejected and on another floor; far ones (> 10 m) rejected twice and located once; one
+// at 7 m is in neither group.
+TEST(MapDistanceTest, GroupsByNearestPlace) {
+  const double inf = std::numeric_limits<double>::infinity();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EvaluationMetrics m;
+  m.errors_m = {1.0, nan, inf, nan, nan, 14.0, 3.0};
+  const std::vector<double> nearest = {0.5, 5.0, 2.0, 11.0, inf, 12.0, 7.0};
+  const MapDistanceReport r = ByMapDistance(m, nearest, 5.0, 10.0);
+  EXPECT_EQ(r.near.queries, 3u);
+  EXPECT_DOUBLE_EQ(r.near.rejection_rate, 1.0 / 3.0);
+  EXPECT_DOUBLE_EQ(r.near.floor_mistake_rate, 1.0 / 3.0);
+  EXPECT_DOUBLE_EQ(r.near.located_rate, 1.0 / 3.0);
+  EXPECT_EQ(r.far.queries, 3u);
+  EXPECT_DOUBLE_EQ(r.far.rejection_rate, 2.0 / 3.0);
+  EXPECT_DOUBLE_EQ(r.far.floor_mistake_rate, 0.0);
+  EXPECT_DOUBLE_EQ(r.far.located_rate, 1.0 / 3.0);
+}
+
+TEST(NewPlaceThresholdTest, SeparableScoresGetTheMidpoint) {
+  // Near nodes score 5, 6, 7; far ones 1, 2, 3: any t in [3, 5) separates them; the sweep takes
+  // the first maximum, past the score 3, at the midpoint 4.
+  const NewPlaceThreshold t =
+      LearnNewPlaceThreshold({5, 1, 6, 2, 7, 3}, {true, false, true, false, true, false});
+  ASSERT_TRUE(t.calibrated);
+  EXPECT_DOUBLE_EQ(t.log_odds, 4.0);
+  EXPECT_EQ(t.near, 3u);
+  EXPECT_EQ(t.far, 3u);
+  EXPECT_DOUBLE_EQ(t.near_accepted, 1.0);
+  EXPECT_DOUBLE_EQ(t.far_rejected, 1.0);
+}
+
+TEST(NewPlaceThresholdTest, OverlappingScoresMaximiseYoudensJ) {
+  // Near 2, 6, 7, 9; far 1, 3, 4, -inf (no mapped place), NaN (counted as -inf). By hand, J at
+  // each candidate (near accepted + far rejected - 1): accept all finite: 1 + 2/5 - 1 = 0.4;
+  // t between 1 and 2: 1 + 3/5 - 1 = 0.6; between 2 and 3: 3/4 + 3/5 - 1 = 0.35; between 3
+  // and 4: 3/4 + 4/5 - 1 = 0.55; between 4 and 6: 3/4 + 1 - 1 = 0.75 (the best); higher t
+  // accepts fewer near nodes at no gain.
+  const double inf = std::numeric_limits<double>::infinity();
+  const NewPlaceThreshold t =
+      LearnNewPlaceThreshold({2, 6, 7, 9, 1, 3, 4, -inf, std::nan("")},
+                             {true, true, true, true, false, false, false, false, false});
+  ASSERT_TRUE(t.calibrated);
+  EXPECT_DOUBLE_EQ(t.log_odds, 5.0);
+  EXPECT_DOUBLE_EQ(t.near_accepted, 0.75);
+  EXPECT_DOUBLE_EQ(t.far_rejected, 1.0);
+}
+
+TEST(MapDistanceTest, FarMustNotBeNearerThanNear) {
+  EvaluationOptions options;
+  std::string error;
+  EXPECT_TRUE(options.IsValid(&error)) << error;
+  options.far_place_m = 4.0;  // below near_place_m = 5
+  EXPECT_FALSE(options.IsValid(&error));
+  EXPECT_NE(error.find("far_place_m"), std::string::npos) << error;
+}
+
+TEST(NewPlaceThresholdTest, OneKindOfNodeOnlyIsNotCalibrated) {
+  const NewPlaceThreshold t = LearnNewPlaceThreshold({5, 6}, {true, true});
+  EXPECT_FALSE(t.calibrated);
+  EXPECT_EQ(t.log_odds, 0.0);
+  EXPECT_EQ(t.near, 2u);
+  EXPECT_EQ(t.far, 0u);
+  EXPECT_FALSE(LearnNewPlaceThreshold({}, {}).calibrated);
+}
+
 }  // namespace
 }  // namespace ratslam::fabmap

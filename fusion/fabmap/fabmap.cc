@@ -291,6 +291,7 @@ LocalisationResult FabmapModel::Normalise(std::vector<double> log_likelihood,
   if (n > 0) {
     result.best_mapped_place = static_cast<int64_t>(best);
     result.best_mapped_probability = p[best];
+    result.best_mapped_log_odds = best_log_likelihood + log_place_prior - log_new;
   }
   if (n > 0 && p[best] > result.best_probability) {  // a tie goes to the new place
     result.best_probability = p[best];

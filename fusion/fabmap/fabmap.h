@@ -29,6 +29,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -93,6 +94,10 @@ struct LocalisationResult {
   // or not the new place beats it: what a precision-recall curve thresholds.
   int64_t best_mapped_place = -1;
   double best_mapped_probability = 0.0;
+  // log(posterior of the best mapped place / posterior of the new place), computed from the
+  // log-likelihoods so that it stays finite where both posteriors saturate (0 and 1): the margin
+  // by which the best mapped place beat (> 0) or lost to the new place. -inf with no place.
+  double best_mapped_log_odds = -std::numeric_limits<double>::infinity();
 };
 
 class FabmapModel {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 namespace ratslam::fabmap {
@@ -231,6 +232,12 @@ LocalisationResult Localiser::Localise(const Query& query) const {
           fused.best_place = i;
         }
       }
+      // Each sensor's odds of the best place against the new place multiply (eq. 4); from the
+      // posteriors, so saturated ones give +-inf.
+      if (fused.best_mapped_place >= 0) {
+        fused.best_mapped_log_odds =
+            std::log(fused.best_mapped_probability) - std::log(fused.new_place_probability);
+      }
       return fused;
     }
     case FabmapMode::kWifiGuided:
@@ -248,6 +255,7 @@ LocalisationResult Localiser::Localise(const Query& query) const {
           }
           r.best_mapped_place = -1;  // and at any threshold
           r.best_mapped_probability = 0.0;
+          r.best_mapped_log_odds = -std::numeric_limits<double>::infinity();
         }
       }
       return r;

@@ -277,6 +277,10 @@ constexpr AddedKey kKeysAddedAfter[] = {
     {7, "fused.online_rssi_offset"},
     {7, "fused.rssi_offset_min_common_aps"},
     {7, "fused.rssi_offset_min_estimates"},
+    {7, "evaluation.near_place_m"},
+    {7, "evaluation.far_place_m"},
+    {7, "evaluation.calibrate_new_place"},
+    {7, "evaluation.calibration_folds"},
 };
 
 // Whole sections added after a map format version: older maps resume only with every key at its
