@@ -53,7 +53,8 @@ double WifiFingerprintMatcher::Weight(const Fingerprint& q, const Fingerprint& j
   double hit = 0.0, diff = 0.0, extra = 0.0, miss = 0.0;
   while (a < q.ap_ids.size() || b < j.ap_ids.size()) {
     if (b == j.ap_ids.size() || (a < q.ap_ids.size() && q.ap_ids[a] < j.ap_ids[b])) {
-      extra += Penalty2(q.rssi_dbm[a++]);
+      if (Counts(q.ap_ids[a])) extra += Penalty2(q.rssi_dbm[a]);
+      ++a;
     } else if (a == q.ap_ids.size() || j.ap_ids[b] < q.ap_ids[a]) {
       miss += Penalty2(j.rssi_dbm[b++]);
     } else {
@@ -65,7 +66,7 @@ double WifiFingerprintMatcher::Weight(const Fingerprint& q, const Fingerprint& j
   }
   if (common == 0) return 0.0;
   if (options_.offset_invariant) hit = std::max(0.0, hit - diff * diff / common);
-  const double e = static_cast<double>(q.ap_ids.size()) - common;
+  const double e = static_cast<double>(CountedSize(q)) - common;
   const double m = static_cast<double>(j.ap_ids.size()) - common;
   // w_hit^(1/H): the H-th root of a product of exponentials is the exponential of the mean.
   return std::exp(-hit / (two_sigma2 * common) - extra / two_sigma2 - miss / two_sigma2) * common /
@@ -80,7 +81,7 @@ void WifiFingerprintMatcher::Scan(const Fingerprint& query, Finish&& finish) con
   double extra_total = 0.0;
   for (size_t a = 0; a < query.ap_ids.size(); ++a) {
     const double extra = Penalty2(query.rssi_dbm[a]);
-    extra_total += extra;
+    if (Counts(query.ap_ids[a])) extra_total += extra;
     if (query.ap_ids[a] >= postings_.size()) continue;
     const std::vector<Posting>& list = postings_[query.ap_ids[a]];
     if (!list.empty()) {
@@ -169,8 +170,9 @@ double WifiFingerprintMatcher::CandidateWeight(const Candidate& c, double expone
 
 template <typename Visit>
 void WifiFingerprintMatcher::ForEachCandidate(const Fingerprint& query, Visit&& visit) const {
+  const size_t query_size = CountedSize(query);
   auto finish = [&](const Candidate& c) {
-    visit(c.id, CandidateWeight(c, Exponent(c), query.ap_ids.size()));
+    visit(c.id, CandidateWeight(c, Exponent(c), query_size));
   };
   if (options_.offset_invariant) {
     Scan<true>(query, finish);
@@ -192,6 +194,7 @@ WifiMatch WifiFingerprintMatcher::Best(const Fingerprint& query,
   // cannot win, and its exp is skipped. The margin of 1e-9 covers the rounding of exp, of the
   // log and of the product (each within a few ulps), so the answer is the exhaustive one.
   double skip_below = -std::numeric_limits<double>::infinity();
+  const size_t query_size = CountedSize(query);
   const double inv_two_sigma2 = 1.0 / (2.0 * options_.kernel_variance_dbm2);
   auto finish = [&](const Candidate& c) {
     if (allowed && !(*allowed)[c.id]) return;
@@ -201,7 +204,7 @@ WifiMatch WifiFingerprintMatcher::Best(const Fingerprint& query,
     const double x = Exponent(c);
     if (!(x >= skip_below)) return;
     const uint32_t id = c.id;
-    const double w = CandidateWeight(c, x, query.ap_ids.size());
+    const double w = CandidateWeight(c, x, query_size);
     // Ties go to the older template, independent of the order the index visits them in.
     if (w > best.weight ||
         (w == best.weight && best.id >= 0 && id < static_cast<uint32_t>(best.id))) {
@@ -216,6 +219,13 @@ WifiMatch WifiFingerprintMatcher::Best(const Fingerprint& query,
     Scan<false>(query, finish);
   }
   return best;
+}
+
+size_t WifiFingerprintMatcher::CountedSize(const Fingerprint& query) const {
+  if (!options_.unmapped_aps_neutral) return query.ap_ids.size();
+  size_t n = 0;
+  for (uint32_t id : query.ap_ids) n += Mapped(id);
+  return n;
 }
 
 void WifiFingerprintMatcher::Index(uint32_t id) {

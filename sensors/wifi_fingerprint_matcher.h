@@ -9,6 +9,12 @@
 // strong AP that should be there and is not is strong evidence against a match and an AP near
 // the sensitivity floor (often missed by a scan) is almost none.
 //
+// With `unmapped_aps_neutral`, a query's APs that no stored fingerprint holds (access points
+// installed since the map was made) are left out of eq. 4 and of E: every stored fingerprint
+// misses them alike, so they cannot tell places apart, and on long-term data (months of AP
+// changes) their penalty only pushes known places below t_wifi. APs the map holds but the query
+// does not hear still count in eq. 5.
+//
 // With `offset_invariant`, the hit term of eq. 3 compares the RSSI differences around their
 // mean over the H common APs, sum (d - mean d)^2 instead of sum d^2: a constant offset between
 // the two scans (two phones that read several dB apart: 6-8 dB between the IPIN 2023 phones)
@@ -37,6 +43,7 @@ struct WifiMatcherOptions {
   double match_threshold = 0.25;       // t_wifi: smallest weight w that is a match
   double min_rssi_dbm = -100.0;        // readings weaker than this are dropped from scans
   bool offset_invariant = false;       // eq. 3 on differences around their mean (see above)
+  bool unmapped_aps_neutral = false;   // APs no stored fingerprint holds: not in eq. 4 nor in E
 
   bool IsValid(std::string* error) const;
 
@@ -56,6 +63,10 @@ struct WifiMatcherOptions {
     v("offset_invariant", offset_invariant,
       "eq. 3 compares RSSI differences around their mean over the common APs, so a constant "
       "offset between phones costs nothing",
+      schema::Any());
+    v("unmapped_aps_neutral", unmapped_aps_neutral,
+      "a query's APs that no stored fingerprint holds (new since the map was made) take no part "
+      "in eq. 4's penalty nor in E of eq. 6: they say the world changed, not which place this is",
       schema::Any());
   }
 };
@@ -108,6 +119,12 @@ class WifiFingerprintMatcher {
     double penalty2;  // P(rssi)^2, precomputed for eq. 5
   };
   double Penalty2(double rssi_dbm) const;
+  // Whether some stored fingerprint holds AP `id`.
+  bool Mapped(uint32_t id) const { return id < postings_.size() && !postings_[id].empty(); }
+  // Whether the query's AP takes part in eq. 4 and E (every AP, or with unmapped_aps_neutral
+  // the mapped ones), and how many of the query's APs do.
+  bool Counts(uint32_t id) const { return !options_.unmapped_aps_neutral || Mapped(id); }
+  size_t CountedSize(const Fingerprint& query) const;
   // Per stored fingerprint, sums over the APs it shares with the query (one record, so a posting
   // costs one cache line).
   struct alignas(32) Accumulator {

@@ -95,33 +95,60 @@ TEST(WifiFingerprintMatcherTest, NoSharedApScoresZero) {
 
 // The inverted index computes the same weights as the direct pairwise formula.
 TEST(WifiFingerprintMatcherTest, IndexedWeightsEqualDirectWeights) {
-  WifiFingerprintMatcher m({});
-  Random rng(11);
-  auto random_scan = [&]() {
-    Readings r;
-    const int n = 5 + static_cast<int>(rng.Uniform() * 30);
-    for (int i = 0; i < n; ++i) {
-      r.push_back(
-          {"ap" + std::to_string(static_cast<int>(rng.Uniform() * 200)), rng.Uniform(-95, -30)});
+  for (const bool neutral : {false, true}) {
+    WifiMatcherOptions options;
+    options.unmapped_aps_neutral = neutral;
+    WifiFingerprintMatcher m(options);
+    Random rng(11);
+    // Stored scans hear APs 0-199, queries 0-259: some query APs are in no stored fingerprint.
+    auto random_scan = [&](int universe) {
+      Readings r;
+      const int n = 5 + static_cast<int>(rng.Uniform() * 30);
+      for (int i = 0; i < n; ++i) {
+        r.push_back({"ap" + std::to_string(static_cast<int>(rng.Uniform() * universe)),
+                     rng.Uniform(-95, -30)});
+      }
+      return m.MakeFingerprint(r);
+    };
+    std::vector<Fingerprint> stored;
+    for (int i = 0; i < 300; ++i) {
+      stored.push_back(random_scan(200));
+      m.Add(stored.back());
     }
-    return m.MakeFingerprint(r);
-  };
-  std::vector<Fingerprint> stored;
-  for (int i = 0; i < 300; ++i) {
-    stored.push_back(random_scan());
-    m.Add(stored.back());
-  }
-  for (int k = 0; k < 20; ++k) {
-    const Fingerprint q = random_scan();
-    const std::vector<double> indexed = m.Weights(q);
-    for (size_t i = 0; i < stored.size(); ++i) {
-      ASSERT_NEAR(indexed[i], m.Weight(q, stored[i]), 1e-9 * std::max(1.0, indexed[i]));
+    for (int k = 0; k < 20; ++k) {
+      const Fingerprint q = random_scan(260);
+      const std::vector<double> indexed = m.Weights(q);
+      for (size_t i = 0; i < stored.size(); ++i) {
+        ASSERT_NEAR(indexed[i], m.Weight(q, stored[i]), 1e-9 * std::max(1.0, indexed[i]));
+      }
     }
+    WifiFingerprintMatcher restored(options);
+    ASSERT_TRUE(restored.SetState(m.state()).ok());
+    const Fingerprint q = stored[17];
+    EXPECT_EQ(restored.Best(q).id, m.Best(q).id);
   }
-  WifiFingerprintMatcher restored({});
-  ASSERT_TRUE(restored.SetState(m.state()).ok());
-  const Fingerprint q = stored[17];
-  EXPECT_EQ(restored.Best(q).id, m.Best(q).id);
+}
+
+// Worked example: stored A = {a -50, b -60}, B = {c -50}. The query hears A's APs exactly and a
+// new AP n at -40 that nothing stored holds. Eq. 4 charges n P = 0.1 * (-40 + 90) = 5, P^2 = 25,
+// over 2 sigma^2 = 40: w_A = exp(-0.625) * 2 / 3 = 0.3568. With unmapped_aps_neutral n is left
+// out: w_A = 2 / 2 = 1. A stored AP the query misses still costs eq. 5 either way: the query
+// {a -50} against A misses b (P = 3, P^2 = 9): w = exp(-9 / 40) * 1 / 2 = 0.3993.
+TEST(WifiFingerprintMatcherTest, UnmappedApsNeutralWorkedExample) {
+  for (const bool neutral : {false, true}) {
+    WifiMatcherOptions options;
+    options.unmapped_aps_neutral = neutral;
+    WifiFingerprintMatcher m(options);
+    const Fingerprint a = m.MakeFingerprint({{"a", -50}, {"b", -60}});
+    m.Add(a);
+    m.Add(m.MakeFingerprint({{"c", -50}}));
+    const Fingerprint q = m.MakeFingerprint({{"a", -50}, {"b", -60}, {"n", -40}});
+    const double expected = neutral ? 1.0 : std::exp(-25.0 / 40.0) * 2.0 / 3.0;
+    EXPECT_NEAR(m.Weights(q)[0], expected, 1e-12) << neutral;
+    EXPECT_NEAR(m.Best(q).weight, expected, 1e-12) << neutral;
+    const Fingerprint partial = m.MakeFingerprint({{"a", -50}});
+    EXPECT_NEAR(m.Weights(partial)[0], std::exp(-9.0 / 40.0) / 2.0, 1e-12) << neutral;
+  }
 }
 
 // Best, which skips the exp of fingerprints whose penalties alone rule them out and scans the
@@ -134,6 +161,7 @@ TEST(WifiFingerprintMatcherTest, BestIsTheExhaustiveArgmax) {
     for (const bool offset_invariant : {false, true}) {
       WifiMatcherOptions options;
       options.offset_invariant = offset_invariant;
+      options.unmapped_aps_neutral = offset_invariant;  // both paths, and unmapped APs below
       WifiFingerprintMatcher m(options);
       Random rng(universe + offset_invariant);
       auto scan = [&]() {
