@@ -284,12 +284,17 @@ class RatslamModuleTest(unittest.TestCase):
             expected = json.load(f)
         got = result["evaluation"]
         for key in ("mode", "map_nodes", "queries", "correct_within_m", "misplaced_beyond_m",
-                    "rejection_rate", "floor_mistake_rate", "baselines", "wifi_words"):
+                    "rejection_rate", "floor_mistake_rate", "by_map_distance",
+                    "new_place_calibration", "baselines", "wifi_words"):
             self.assertEqual(got[key], expected[key], key)
         rows = read_csv(os.path.join(cli, "queries.csv"))
         np.testing.assert_array_equal(result["queries"]["match"],
                                       [int(r["match"]) if r["match"] else -1 for r in rows])
         np.testing.assert_array_equal(result["queries"]["x_m"], [float(r["x_m"]) for r in rows])
+        np.testing.assert_array_equal(
+            result["queries"]["best_mapped_log_odds"],
+            [float(r["best_mapped_log_odds"]) if r["best_mapped_log_odds"] else -np.inf
+             for r in rows])
         self.assertEqual(len(result["map"]["x_m"]), expected["map_nodes"])
         with self.assertRaisesRegex(ratslam.Error, "overwrite"):
             ratslam.evaluate(data, data, out, config=ratslam.Config.load(config))
