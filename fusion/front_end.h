@@ -99,6 +99,12 @@ struct FusedOptions {
   bool online_rssi_offset = false;
   int rssi_offset_min_common_aps = 5;  // an estimate needs this many APs in common
   int rssi_offset_min_estimates = 10;  // estimates before the offset is applied
+  // Maps that keep up with access points changing after them (long-term data): a scan whose
+  // Wi-Fi match to an old template (a revisit, past the recency of eqs. 10-11) reaches this
+  // weight updates that template's fingerprint (WifiFingerprintMatcher::FollowRevisit: the APs
+  // it heard that the template lacks are added, the template's strong APs it did not hear are
+  // dropped), once per scan. 0: off.
+  double revisit_update_weight = 0.0;
 
   bool IsValid(std::string* error) const;
 
@@ -128,6 +134,12 @@ struct FusedOptions {
     v("rssi_offset_min_estimates", rssi_offset_min_estimates,
       "offset estimates of a session before its median is applied",
       schema::Unit("scans").AtLeast(1));
+    v("revisit_update_weight", revisit_update_weight,
+      "a revisit whose Wi-Fi match reaches this weight (eq. 6) updates the template's "
+      "fingerprint once per scan: the scan's APs it lacks are added, its APs above "
+      "penalty_floor_dbm that the scan did not hear are dropped (APs changed since the map was "
+      "made); 0: off",
+      schema::Unit("").Within(0, 1));
   }
 };
 
@@ -297,6 +309,11 @@ class FrontEnd {
   // The RSSI offset (dB) removed from each session's scans so far, by session (front ends that
   // estimate one); the last entry is the current session's.
   virtual std::vector<double> RssiOffsetsDb() const { return {}; }
+  // APs that revisits added to and dropped from templates ([fused] revisit_update_weight);
+  // nothing when off.
+  virtual std::optional<std::pair<uint64_t, uint64_t>> RevisitApUpdates() const {
+    return std::nullopt;
+  }
   // Localisation on a saved map: the templates stored so far were made by another run on
   // another clock, so a match to one of them is never recent. Front ends with a recency rule
   // in seconds must honour this; the default does nothing.

@@ -40,6 +40,7 @@ class FusedFrontEnd : public FrontEnd {
     newest_scan_ = wifi_.MakeFingerprint(readings);
     if (options_.online_rssi_offset) RemoveRssiOffset(&newest_scan_);
     newest_scan_time_s_ = scan.time_s;
+    newest_scan_followed_ = false;
     // One floor vote per scan (a scan re-used by several camera frames votes once).
     if (!newest_scan_.empty()) {
       floors_.Vote(
@@ -78,6 +79,10 @@ class FusedFrontEnd : public FrontEnd {
     templates_before_session_ = size();
     offset_estimates_db_.clear();
   }
+  std::optional<std::pair<uint64_t, uint64_t>> RevisitApUpdates() const override {
+    if (options_.revisit_update_weight > 0) return std::pair(aps_added_, aps_dropped_);
+    return std::nullopt;
+  }
   std::vector<double> RssiOffsetsDb() const override {
     if (!options_.online_rssi_offset) return {};
     std::vector<double> all = offsets_db_;
@@ -110,6 +115,11 @@ class FusedFrontEnd : public FrontEnd {
       w.PodVector(offset_estimates_db_);
       w.PodVector(offsets_db_);
       w.PodVector(calibrated_);
+    }
+    if (options_.revisit_update_weight > 0) {  // likewise
+      w.Pod(static_cast<uint8_t>(newest_scan_followed_));
+      w.Pod(aps_added_);
+      w.Pod(aps_dropped_);
     }
     floors_.Encode(&w);
     return std::move(w.bytes());
@@ -157,6 +167,13 @@ class FusedFrontEnd : public FrontEnd {
           r.PodVector(&offsets) && r.PodVector(&calibrated))) {
       return Status::Error(r.error());
     }
+    uint8_t followed = 0;
+    uint64_t added = 0, dropped = 0;
+    if (options_.revisit_update_weight > 0 &&
+        !(r.Pod(&followed) && r.Pod(&added) && r.Pod(&dropped))) {
+      return Status::Error(r.error());
+    }
+    if (followed > 1) return Status::Error("fused front-end state: revisit flag is not 0 or 1");
     FloorRule floors = floors_;
     if (!floors.Decode(&r, created.size())) return Status::Error(r.error());
     if (!r.AtEnd()) return Status::Error("fused front-end state: trailing bytes");
@@ -197,6 +214,9 @@ class FusedFrontEnd : public FrontEnd {
     offset_estimates_db_ = std::move(estimates);
     offsets_db_ = std::move(offsets);
     calibrated_ = std::move(calibrated);
+    newest_scan_followed_ = followed != 0;
+    aps_added_ = added;
+    aps_dropped_ = dropped;
     floors_ = std::move(floors);
     return Status::Ok();
   }
@@ -266,6 +286,7 @@ class FusedFrontEnd : public FrontEnd {
     const uint32_t n = size();
     Verdict camera_verdict = Verdict::kNovel, wifi_verdict = Verdict::kNovel;
     int32_t camera_best = -1, wifi_best = -1;
+    double wifi_best_weight = 0.0;
     // The floor rule, when the barometer has spoken: a flag per template.
     const bool floors = floors_.active();
     std::vector<uint8_t> agrees;
@@ -279,6 +300,7 @@ class FusedFrontEnd : public FrontEnd {
     if (scan && !scan->empty()) {
       const WifiMatch best = wifi_.Best(*scan, allowed);  // eq. 9
       wifi_best = best.id;
+      wifi_best_weight = best.weight;
       wifi_verdict = Judge(best.id, best.weight, wifi_.options().match_threshold, time_s);
     }
     if (floors && camera_verdict == Verdict::kNovel && wifi_verdict == Verdict::kNovel) {
@@ -308,6 +330,16 @@ class FusedFrontEnd : public FrontEnd {
       chosen = wifi_best;
       d.source = DecisionSource::kWifi;
       d.recent = true;
+    }
+    if (chosen && options_.revisit_update_weight > 0 && scan == &newest_scan_ &&
+        !newest_scan_followed_ && wifi_verdict == Verdict::kMatch &&
+        static_cast<int32_t>(*chosen) == wifi_best &&
+        wifi_best_weight >= options_.revisit_update_weight) {
+      // A revisit the scan is sure of: the template follows the APs changed since.
+      const WifiFingerprintMatcher::Update u = wifi_.FollowRevisit(*chosen, *scan);
+      aps_added_ += u.added;
+      aps_dropped_ += u.dropped;
+      newest_scan_followed_ = true;
     }
     if (chosen) {
       d.view.template_id = *chosen;
@@ -341,6 +373,8 @@ class FusedFrontEnd : public FrontEnd {
   std::vector<std::optional<double>> headings_;  // by template
   Fingerprint newest_scan_;
   std::optional<double> newest_scan_time_s_;
+  bool newest_scan_followed_ = false;  // the newest scan updated a template (revisit_update_weight)
+  uint64_t aps_added_ = 0, aps_dropped_ = 0;  // by revisit_update_weight, so far
   std::optional<double> heading_rad_;
   // Online RSSI offset: where the current session began, the templates stored before it, this
   // session's estimates and the offsets of the sessions before it.

@@ -170,6 +170,10 @@ class ReplayPipeline {
   }
   // The RSSI offsets removed per session ([fused] online_rssi_offset); empty otherwise.
   std::vector<double> rssi_offsets_db() const { return front_end_->RssiOffsetsDb(); }
+  // APs added to and dropped from templates by revisits ([fused] revisit_update_weight).
+  std::optional<std::pair<uint64_t, uint64_t>> revisit_ap_updates() const {
+    return front_end_->RevisitApUpdates();
+  }
   // What the barometer said ([barometer] use_barometer with a pressure stream); nothing otherwise.
   std::optional<FloorReport> floor_report() const { return front_end_->floor_report(); }
   // A template's floor relative to the first session's first level, when the front end knows.

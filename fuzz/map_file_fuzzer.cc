@@ -100,8 +100,9 @@ struct Setup {
     fused.sensors.fused.use_camera = true;
     fused.sensors.fused.use_compass = true;
     fused.sensors.fused.recency_s = 20.0;
-    fused.sensors.fused.online_rssi_offset = true;  // its estimates are part of the state
-    fused.sensors.barometer.use_barometer = true;   // and so are its floors
+    fused.sensors.fused.online_rssi_offset = true;     // its estimates are part of the state
+    fused.sensors.barometer.use_barometer = true;      // and so are its floors
+    fused.sensors.fused.revisit_update_weight = 0.25;  // and the revisit counts
     PipelineOptions fabmap_wifi;
     fabmap_wifi.sensors.front_end.kind = FrontEndKind::kFabmap;
     fabmap_wifi.sensors.fabmap.localiser.localiser.mode = fabmap::FabmapMode::kWifi;

@@ -248,6 +248,52 @@ uint32_t WifiFingerprintMatcher::Add(const Fingerprint& fingerprint) {
   return id;
 }
 
+WifiFingerprintMatcher::Update WifiFingerprintMatcher::FollowRevisit(uint32_t id,
+                                                                     const Fingerprint& scan) {
+  Fingerprint& f = state_.fingerprints.at(id);
+  Fingerprint merged;
+  Update update;
+  auto position = [id](std::vector<Posting>& list) {
+    return std::lower_bound(list.begin(), list.end(), id,
+                            [](const Posting& p, uint32_t i) { return p.fingerprint < i; });
+  };
+  size_t a = 0, b = 0;
+  while (a < f.ap_ids.size() || b < scan.ap_ids.size()) {
+    if (b == scan.ap_ids.size() || (a < f.ap_ids.size() && f.ap_ids[a] <= scan.ap_ids[b])) {
+      const bool heard = b < scan.ap_ids.size() && f.ap_ids[a] == scan.ap_ids[b];
+      if (heard) ++b;  // held and heard: keeps the template's RSSI
+      if (!heard && f.rssi_dbm[a] > options_.penalty_floor_dbm) {
+        // Held strongly enough to cost eq. 5, and not heard on a sure revisit: gone.
+        std::vector<Posting>& list = postings_[f.ap_ids[a]];
+        list.erase(position(list));
+        ++update.dropped;
+        ++a;
+        continue;
+      }
+      merged.ap_ids.push_back(f.ap_ids[a]);
+      merged.rssi_dbm.push_back(f.rssi_dbm[a++]);
+      continue;
+    }
+    const uint32_t ap = scan.ap_ids[b];
+    const float rssi = scan.rssi_dbm[b++];
+    merged.ap_ids.push_back(ap);
+    merged.rssi_dbm.push_back(rssi);
+    // The AP's posting list stays in fingerprint-id order (the scan relies on it).
+    if (ap >= postings_.size()) postings_.resize(ap + 1);
+    std::vector<Posting>& list = postings_[ap];
+    list.insert(position(list), Posting{id, rssi, Penalty2(rssi)});
+    ++update.added;
+  }
+  f = std::move(merged);
+  // Summed in AP order as Index does, so a restored matcher (SetState re-indexes) agrees to the
+  // bit.
+  double miss_total = 0.0;
+  for (float rssi : f.rssi_dbm) miss_total += Penalty2(rssi);
+  miss_penalty_total_[id] = miss_total;
+  sizes_[id] = static_cast<uint32_t>(f.ap_ids.size());
+  return update;
+}
+
 Status WifiFingerprintMatcher::SetState(State state) {
   for (const Fingerprint& f : state.fingerprints) {
     if (f.ap_ids.size() != f.rssi_dbm.size()) {

@@ -107,6 +107,15 @@ class WifiFingerprintMatcher {
 
   // Stores a fingerprint (possibly empty: a template with no Wi-Fi); returns its id.
   uint32_t Add(const Fingerprint& fingerprint);
+  // A revisit the caller is sure of (`scan` matched stored fingerprint `id`): the fingerprint
+  // follows the access points that changed since it was stored. The scan's APs it lacks are added
+  // at the RSSI heard; its APs the scan did not hear although stored above penalty_floor_dbm
+  // (strong enough to cost eq. 5) are dropped; APs both hold keep the stored RSSI. `id` must be
+  // < size().
+  struct Update {
+    size_t added = 0, dropped = 0;
+  };
+  Update FollowRevisit(uint32_t id, const Fingerprint& scan);
   uint32_t size() const { return static_cast<uint32_t>(state_.fingerprints.size()); }
   const WifiMatcherOptions& options() const { return options_; }
   const State& state() const { return state_; }

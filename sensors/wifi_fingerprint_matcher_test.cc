@@ -151,6 +151,48 @@ TEST(WifiFingerprintMatcherTest, UnmappedApsNeutralWorkedExample) {
   }
 }
 
+// FollowRevisit makes a stored fingerprint follow the scan's APs and keeps the index exact:
+// afterwards the indexed weights equal the pairwise formula on the updated fingerprint, and a
+// matcher restored from the state (re-indexed from scratch) gives the same weights to the bit.
+TEST(WifiFingerprintMatcherTest, FollowRevisitAddsNewAndDropsGoneApsAndKeepsTheIndexExact) {
+  WifiFingerprintMatcher m({});
+  const Fingerprint a = m.MakeFingerprint({{"a", -50}, {"c", -70}, {"f", -95}});
+  m.Add(m.MakeFingerprint({{"b", -60}, {"c", -65}}));
+  m.Add(a);
+  m.Add(m.MakeFingerprint({{"a", -55}, {"d", -80}}));
+  // The scan hears a (at another RSSI: the template keeps -50), misses c (-70, above the
+  // penalty floor of -90: dropped) and f (-95, below it: kept), and hears new e and d.
+  const Fingerprint scan = m.MakeFingerprint({{"a", -45}, {"e", -58}, {"d", -75}});
+  const WifiFingerprintMatcher::Update u = m.FollowRevisit(1, scan);
+  EXPECT_EQ(u.added, 2u);
+  EXPECT_EQ(u.dropped, 1u);
+  const Fingerprint& updated = m.state().fingerprints[1];
+  const Fingerprint expected = m.MakeFingerprint({{"a", -50}, {"f", -95}, {"e", -58}, {"d", -75}});
+  EXPECT_EQ(updated.ap_ids, expected.ap_ids);
+  EXPECT_EQ(updated.rssi_dbm, expected.rssi_dbm);
+  const WifiFingerprintMatcher::Update again = m.FollowRevisit(1, scan);  // nothing left to do
+  EXPECT_EQ(again.added + again.dropped, 0u);
+  WifiFingerprintMatcher restored({});
+  ASSERT_TRUE(restored.SetState(m.state()).ok());
+  for (const Fingerprint& q : {scan, a, m.MakeFingerprint({{"c", -70}, {"e", -60}})}) {
+    const std::vector<double> w = m.Weights(q);
+    for (uint32_t i = 0; i < m.size(); ++i) {
+      EXPECT_NEAR(w[i], m.Weight(q, m.state().fingerprints[i]), 1e-12) << i;
+    }
+    EXPECT_EQ(w, restored.Weights(q));
+    EXPECT_EQ(m.Best(q).id, restored.Best(q).id);
+    EXPECT_EQ(m.Best(q).weight, restored.Best(q).weight);
+  }
+  // c's posting for the template is gone: a scan hearing only c no longer reaches it.
+  EXPECT_EQ(m.Weights(m.MakeFingerprint({{"c", -70}}))[1], 0.0);
+  // The scan now matches the template better than before.
+  WifiFingerprintMatcher before({});
+  before.Add(before.MakeFingerprint({{"a", -50}, {"c", -70}, {"f", -95}}));
+  const double w_before =
+      before.Weights(before.MakeFingerprint({{"a", -45}, {"e", -58}, {"d", -75}}))[0];
+  EXPECT_GT(m.Weights(scan)[1], w_before);
+}
+
 // Best, which skips the exp of fingerprints whose penalties alone rule them out and scans the
 // index in blocks of ids, returns exactly the exhaustive argmax of the weights (largest weight,
 // ties to the lower id): against the pairwise formula on every stored fingerprint, in one building

@@ -278,6 +278,7 @@ constexpr AddedKey kKeysAddedAfter[] = {
     {7, "fused.rssi_offset_min_common_aps"},
     {7, "fused.rssi_offset_min_estimates"},
     {7, "wifi.unmapped_aps_neutral"},
+    {7, "fused.revisit_update_weight"},
     {7, "evaluation.near_place_m"},
     {7, "evaluation.far_place_m"},
     {7, "evaluation.calibrate_new_place"},

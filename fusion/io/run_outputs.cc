@@ -310,6 +310,10 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
   if (const std::vector<double> offsets = pipeline.rssi_offsets_db(); !offsets.empty()) {
     j["wifi_rssi_offsets_db"] = offsets;  // removed from each session's scans
   }
+  if (const auto updates = pipeline.revisit_ap_updates()) {
+    j["wifi_revisit_aps_added"] = updates->first;
+    j["wifi_revisit_aps_dropped"] = updates->second;
+  }
   if (const std::optional<FloorReport> floors = pipeline.floor_report()) {
     j["barometer"] = {{"pressure_readings", floors->pressure_readings},
                       {"floor_changes", floors->floor_changes},
