@@ -176,6 +176,78 @@ Status BagError(const std::string& path, const std::exception& e) {
   return Status::Error(path + ": not a readable ROS bag (truncated or corrupted?): " + e.what());
 }
 
+// librosbag deserialises a message by trusting its array lengths: it resizes a vector to the
+// length a message claims before checking that the bytes are there, so a 20 kB bag whose image
+// claims 4 GB of data allocated 4 GB (a fuzzer finding). Before instantiating, the message's own
+// bytes are walked by its type's layout: every string or array length must fit in what is left.
+// Layout letters: 'H' a std_msgs/Header (seq, stamp, frame_id), 'S' a string or uint8[], 'u' a
+// uint32, 'b' a uint8, 'd' a float64.
+bool LayoutFits(const std::vector<uint8_t>& bytes, const char* layout) {
+  size_t p = 0;
+  auto take = [&](size_t n) {
+    if (n > bytes.size() - p) return false;
+    p += n;
+    return true;
+  };
+  auto string = [&] {
+    if (!take(4)) return false;
+    uint32_t n = 0;
+    for (int k = 3; k >= 0; --k) n = (n << 8) | bytes[p - 4 + static_cast<size_t>(k)];
+    return take(n);
+  };
+  for (const char* c = layout; *c; ++c) {
+    const bool ok = *c == 'H'   ? take(12) && string()
+                    : *c == 'S' ? string()
+                    : *c == 'u' ? take(4)
+                    : *c == 'b' ? take(1)
+                                : take(8);
+    if (!ok) return false;
+  }
+  return true;
+}
+
+template <typename T>
+const char* LayoutOf();
+// header, format, data
+template <>
+const char* LayoutOf<sensor_msgs::CompressedImage>() {
+  return "HSS";
+}
+// header, height, width, encoding, is_bigendian, step, data
+template <>
+const char* LayoutOf<sensor_msgs::Image>() {
+  return "HuuSbuS";
+}
+// header, child_frame_id, pose (7) + covariance (36), twist (6) + covariance (36)
+template <>
+const char* LayoutOf<nav_msgs::Odometry>() {
+  return "HS"
+         "ddddddd"
+         "dddddddddddddddddddddddddddddddddddd"
+         "dddddd"
+         "dddddddddddddddddddddddddddddddddddd";
+}
+// header, pose (7)
+template <>
+const char* LayoutOf<geometry_msgs::PoseStamped>() {
+  return "Hddddddd";
+}
+
+// m.instantiate<T>() once the message's lengths are known to fit; throws otherwise (the callers
+// turn exceptions into errors naming the bag).
+template <typename T>
+boost::shared_ptr<T> Instantiate(const rosbag::MessageInstance& m) {
+  if (!m.isType<T>()) return nullptr;  // as instantiate: the caller names the type it wanted
+  std::vector<uint8_t> bytes(m.size());
+  ros::serialization::OStream stream(bytes.data(), static_cast<uint32_t>(bytes.size()));
+  m.write(stream);
+  if (!LayoutFits(bytes, LayoutOf<T>())) {
+    throw std::runtime_error("message " + m.getDataType() + " on " + m.getTopic() +
+                             " holds a field longer than the message");
+  }
+  return m.instantiate<T>();
+}
+
 }  // namespace
 
 bool RosbagSupported() { return true; }
@@ -234,11 +306,11 @@ StatusOr<Dataset> ReadRosbag(const std::string& path, const BagTopics& topics) {
       if (topic == *image_topic) {
         ImageRow row;
         if (m.getDataType() == kCompressedImage) {
-          auto msg = m.instantiate<sensor_msgs::CompressedImage>();
+          auto msg = Instantiate<sensor_msgs::CompressedImage>(m);
           if (!msg) return Status::Error(where + ": not a " + std::string(kCompressedImage));
           time_ns = Nanoseconds(msg->header.stamp, m.getTime());
         } else {
-          auto msg = m.instantiate<sensor_msgs::Image>();
+          auto msg = Instantiate<sensor_msgs::Image>(m);
           if (!msg) return Status::Error(where + ": not a " + std::string(kRawImage));
           time_ns = Nanoseconds(msg->header.stamp, m.getTime());
         }
@@ -247,7 +319,7 @@ StatusOr<Dataset> ReadRosbag(const std::string& path, const BagTopics& topics) {
         row.line = static_cast<int>(std::min<uint64_t>(index, 0x7fffffff));
         d.images.push_back(row);
       } else if (topic == *odometry_topic) {
-        auto msg = m.instantiate<nav_msgs::Odometry>();
+        auto msg = Instantiate<nav_msgs::Odometry>(m);
         if (!msg) return Status::Error(where + ": not a " + std::string(kOdometry));
         time_ns = Nanoseconds(msg->header.stamp, m.getTime());
         OdometryRow row;
@@ -264,12 +336,12 @@ StatusOr<Dataset> ReadRosbag(const std::string& path, const BagTopics& topics) {
       } else {
         geometry_msgs::Pose pose;
         if (m.getDataType() == kPoseStamped) {
-          auto msg = m.instantiate<geometry_msgs::PoseStamped>();
+          auto msg = Instantiate<geometry_msgs::PoseStamped>(m);
           if (!msg) return Status::Error(where + ": not a " + std::string(kPoseStamped));
           time_ns = Nanoseconds(msg->header.stamp, m.getTime());
           pose = msg->pose;
         } else {
-          auto msg = m.instantiate<nav_msgs::Odometry>();
+          auto msg = Instantiate<nav_msgs::Odometry>(m);
           if (!msg) return Status::Error(where + ": not a " + std::string(kOdometry));
           time_ns = Nanoseconds(msg->header.stamp, m.getTime());
           pose = msg->pose.pose;
@@ -383,10 +455,10 @@ StatusOr<GrayImage> BagImageReader::Load(const std::string& reference) {
   if (!m.ok()) return m.status();
   try {
     if ((*m)->getDataType() == kCompressedImage) {
-      auto msg = (*m)->instantiate<sensor_msgs::CompressedImage>();
+      auto msg = Instantiate<sensor_msgs::CompressedImage>(**m);
       if (msg) return DecodeCompressed(*msg, reference);
     } else if ((*m)->getDataType() == kRawImage) {
-      auto msg = (*m)->instantiate<sensor_msgs::Image>();
+      auto msg = Instantiate<sensor_msgs::Image>(**m);
       if (msg) {
         StatusOr<cv::Mat> mat = RawToMat(*msg, reference);
         if (!mat.ok()) return mat.status();
@@ -406,7 +478,7 @@ StatusOr<EncodedImage> BagImageReader::Encoded(const std::string& reference) {
   if (!m.ok()) return m.status();
   try {
     if ((*m)->getDataType() == kCompressedImage) {
-      auto msg = (*m)->instantiate<sensor_msgs::CompressedImage>();
+      auto msg = Instantiate<sensor_msgs::CompressedImage>(**m);
       if (msg) {
         EncodedImage out;
         out.extension = ExtensionOf(*msg);
@@ -418,7 +490,7 @@ StatusOr<EncodedImage> BagImageReader::Encoded(const std::string& reference) {
         return out;
       }
     } else if ((*m)->getDataType() == kRawImage) {
-      auto msg = (*m)->instantiate<sensor_msgs::Image>();
+      auto msg = Instantiate<sensor_msgs::Image>(**m);
       if (msg) {
         StatusOr<cv::Mat> mat = RawToMat(*msg, reference);
         if (!mat.ok()) return mat.status();

@@ -297,6 +297,16 @@ TEST_F(RosbagTest, TruncatedAndCorruptedBagsAreErrorsNotPartialDataSets) {
   std::ofstream(Path("long.bag"), std::ios::binary) << corrupt;
   e = ReadError(Path("long.bag"));
   EXPECT_NE(e.find("a header field longer than its header"), std::string::npos) << e;
+  // A message whose image data claims 4 GB in a 20 kB bag: librosbag resized the vector to the
+  // claimed length before finding the bytes missing (rosbag_fuzzer: out of memory). The layout
+  // of each message is checked first now.
+  e = ReadError(
+      std::string(RATSLAM_SOURCE_DIR) + "/fuzz/regressions/rosbag_fuzzer/oom-image-data-length-4gb",
+      {"", "", "/r/pose"});
+  EXPECT_NE(e.find("sensor_msgs/CompressedImage on /r/camera/image/compressed holds a field "
+                   "longer than the message"),
+            std::string::npos)
+      << e;
   // An unindexed bag (a recording that was killed) says how to repair it.
   corrupt = bytes;
   const size_t index_pos = corrupt.find("index_pos=") + 10;
