@@ -232,7 +232,8 @@ Status EvaluationSession::CalibrateNewPlace() {
     progress_->Update({"calibrating the new place", k + 1, folds});
   }
   progress_->Finish();
-  result_.new_place = fabmap::LearnNewPlaceThreshold(log_odds, near);
+  result_.new_place = fabmap::LearnNewPlaceThreshold(log_odds, near, evaluation.new_place_rule,
+                                                     evaluation.new_place_near_recall);
   result_.new_place_sessions = sessions.size();
   result_.new_place_folds = folds;
   return Status::Ok();
@@ -337,6 +338,10 @@ Status EvaluationSession::WriteOutputs() {
     c["folds"] = result_.new_place_folds;
     c["near_nodes"] = t.near;
     c["far_nodes"] = t.far;
+    c["rule"] = fabmap::ToString(evaluation.new_place_rule);
+    if (evaluation.new_place_rule == fabmap::NewPlaceRule::kNearRecall) {
+      c["near_recall"] = evaluation.new_place_near_recall;
+    }
     c["calibrated"] = t.calibrated;
     c["log_odds_threshold"] = t.log_odds;
     c["near_accepted"] = t.near_accepted;

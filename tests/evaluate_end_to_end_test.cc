@@ -148,6 +148,36 @@ TEST(EvaluateEndToEndTest, MicrosoftWalksWifiOnly) {
   fs::remove_all(again);
 }
 
+// UJIIndoorLoc with map and queries from different users and phones (the shipped by-user
+// config): 39 % of the queries are more than 10 m from every map row on their floor, and the
+// arg-max answered 29 % of those on another floor (12.2 % floor mistakes overall). The
+// threshold learnt to accept 95 % of held-out near rows must keep that promise on the queries
+// (near ones rejected at most 5 %), bring floor mistakes to issue 12's 5 %, and stay within 5 %
+// of k-NN's share within 5 m in the same run (the Youden's J rule lost 5.5 points to it).
+TEST(EvaluateEndToEndTest, UjiByUserLearntThresholdRejectsUnmappedPlacesOnly) {
+  const fs::path data = fs::path(RATSLAM_SHARED_DATA_DIR) / "ujiindoorloc" / "trainingData.csv";
+  if (!fs::exists(data)) GTEST_SKIP() << "missing " << data;
+  const fs::path out = Scratch("evaluate_uji_by_user");
+  const std::string command =
+      std::string(RATSLAM_BINARY) + " evaluate --quiet --config " + RATSLAM_SOURCE_DIR +
+      "/configs/ujiindoorloc-wifi-by-user.toml --map " + data.string() + " --query " +
+      data.string() + " --out " + out.string() + " > /dev/null";
+  ASSERT_EQ(std::system(command.c_str()), 0) << command;
+  std::ifstream in(out / "evaluation.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  const nlohmann::json& calibration = j["new_place_calibration"];
+  ASSERT_TRUE(calibration["calibrated"].get<bool>());
+  EXPECT_EQ(calibration["rule"], "near_recall");
+  EXPECT_GE(calibration["near_accepted"].get<double>(), 0.95);
+  const nlohmann::json& by_distance = j["by_map_distance"];
+  EXPECT_LE(by_distance["near"]["rejection_rate"].get<double>(), 0.05);
+  EXPECT_GE(by_distance["far"]["rejection_rate"].get<double>(), 0.9);
+  EXPECT_LE(j["floor_mistake_rate"].get<double>(), 0.05);
+  EXPECT_GE(j["correct_within_m"]["5"].get<double>(),
+            0.95 * j["baselines"]["knn"]["correct_within_m"]["5"].get<double>());
+  fs::remove_all(out);
+}
+
 // UJIIndoorLoc rows are single captures with no travel between them. The Wi-Fi tree must learn
 // from (nearly) every map row: spacing by travel once left 1 of 7,974, every word fell back to
 // its marginal and 8 exclusive words localised 9.8 % of queries within 5 m (88.8 % rejected).

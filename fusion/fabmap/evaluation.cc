@@ -29,6 +29,22 @@ StatusOr<SplitUnit> SplitUnitFromString(const std::string& name) {
   return Status::Error("unknown split '" + name + "' (expected node, session or first_session)");
 }
 
+std::string ToString(NewPlaceRule rule) {
+  switch (rule) {
+    case NewPlaceRule::kNearRecall:
+      return "near_recall";
+    case NewPlaceRule::kYouden:
+      return "youden";
+  }
+  return "?";
+}
+
+StatusOr<NewPlaceRule> NewPlaceRuleFromString(const std::string& name) {
+  if (name == "near_recall") return NewPlaceRule::kNearRecall;
+  if (name == "youden") return NewPlaceRule::kYouden;
+  return Status::Error("unknown new_place_rule '" + name + "' (expected near_recall or youden)");
+}
+
 bool EvaluationOptions::IsValid(std::string* error) const {
   if (!schema::CheckFields(*this, error)) return false;
   if (far_place_m < near_place_m) {
@@ -38,8 +54,52 @@ bool EvaluationOptions::IsValid(std::string* error) const {
   return true;
 }
 
-NewPlaceThreshold LearnNewPlaceThreshold(const std::vector<double>& log_odds,
-                                         const std::vector<bool>& near) {
+namespace {
+
+// The highest threshold (-inf or a midpoint between distinct scores) at which at most
+// `allowed` of the ascending `scores` are rejected (score <= t).
+double HighestThresholdRejectingAtMost(const std::vector<double>& scores, size_t allowed) {
+  size_t j = std::min(allowed, scores.size());
+  while (j > 0 && j < scores.size() && scores[j - 1] == scores[j]) --j;  // never split a tie
+  if (j == 0) return -std::numeric_limits<double>::infinity();
+  if (j == scores.size() || !std::isfinite(scores[j - 1]) || !std::isfinite(scores[j])) {
+    return scores[j - 1];
+  }
+  return scores[j - 1] + 0.5 * (scores[j] - scores[j - 1]);
+}
+
+NewPlaceThreshold NearRecallThreshold(const std::vector<double>& log_odds,
+                                      const std::vector<bool>& near, double near_recall) {
+  NewPlaceThreshold result;
+  std::vector<double> near_scores, far_scores;
+  for (size_t i = 0; i < log_odds.size() && i < near.size(); ++i) {
+    const double v =
+        std::isnan(log_odds[i]) ? -std::numeric_limits<double>::infinity() : log_odds[i];
+    (near[i] ? near_scores : far_scores).push_back(v);
+  }
+  result.near = near_scores.size();
+  result.far = far_scores.size();
+  if (near_scores.empty() || !(near_recall > 0.0)) return result;
+  std::sort(near_scores.begin(), near_scores.end());
+  const double n = static_cast<double>(near_scores.size());
+  // The 1e-9 keeps (1 - 0.95) * 20 = 1 from rounding down to 0.
+  const auto allowed =
+      static_cast<size_t>(std::floor((1.0 - std::min(near_recall, 1.0)) * n + 1e-9));
+  const double t = HighestThresholdRejectingAtMost(near_scores, allowed);
+  result.log_odds = t;
+  const auto accepted =
+      std::count_if(near_scores.begin(), near_scores.end(), [t](double v) { return v > t; });
+  const auto rejected =
+      std::count_if(far_scores.begin(), far_scores.end(), [t](double v) { return !(v > t); });
+  result.near_accepted = static_cast<double>(accepted) / n;
+  result.far_rejected =
+      far_scores.empty() ? 0.0 : static_cast<double>(rejected) / static_cast<double>(result.far);
+  result.calibrated = true;
+  return result;
+}
+
+NewPlaceThreshold YoudenThreshold(const std::vector<double>& log_odds,
+                                  const std::vector<bool>& near) {
   NewPlaceThreshold result;
   std::vector<std::pair<double, bool>> scored;
   for (size_t i = 0; i < log_odds.size() && i < near.size(); ++i) {
@@ -87,6 +147,15 @@ NewPlaceThreshold LearnNewPlaceThreshold(const std::vector<double>& log_odds,
   result.far_rejected = static_cast<double>(best_far) / static_cast<double>(result.far);
   result.calibrated = true;
   return result;
+}
+
+}  // namespace
+
+NewPlaceThreshold LearnNewPlaceThreshold(const std::vector<double>& log_odds,
+                                         const std::vector<bool>& near, NewPlaceRule rule,
+                                         double near_recall) {
+  return rule == NewPlaceRule::kYouden ? YoudenThreshold(log_odds, near)
+                                       : NearRecallThreshold(log_odds, near, near_recall);
 }
 
 MapDistanceReport ByMapDistance(const EvaluationMetrics& metrics,

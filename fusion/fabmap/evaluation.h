@@ -33,6 +33,16 @@ enum class SplitUnit { kNode, kSession, kFirstSession };
 std::string ToString(SplitUnit unit);
 StatusOr<SplitUnit> SplitUnitFromString(const std::string& name);
 
+// How calibrate_new_place picks its log-odds threshold from the held-out map nodes.
+// kNearRecall: the highest threshold that still accepts `new_place_near_recall` of the near
+// nodes (far ones are only reported). kYouden: the threshold with the best Youden's J over near
+// and far nodes. Far nodes of a map are few and unlike far queries (they lie where the other
+// walks did not go, often beside a mapped place on another floor), so a rule that needs only the
+// near ones transfers better: see the README's new-place table.
+enum class NewPlaceRule { kNearRecall, kYouden };
+std::string ToString(NewPlaceRule rule);
+StatusOr<NewPlaceRule> NewPlaceRuleFromString(const std::string& name);
+
 struct EvaluationOptions {
   SplitUnit split =
       SplitUnit::kNode;          // when map and query are one data set: split by node or session
@@ -43,6 +53,8 @@ struct EvaluationOptions {
   double far_place_m = 10.0;           // no map place on the query's floor this close: "far"
   bool calibrate_new_place = false;    // learn the new-place threshold from held-out map sessions
   int calibration_folds = 4;           // map sessions held out in this many interleaved groups
+  NewPlaceRule new_place_rule = NewPlaceRule::kNearRecall;  // how the threshold is chosen
+  double new_place_near_recall = 0.95;  // kNearRecall: share of near held-out nodes accepted
 
   bool IsValid(std::string* error) const;
   template <typename Visitor>
@@ -71,22 +83,34 @@ struct EvaluationOptions {
       "learn the new-place decision from the map: its sessions are held out in groups "
       "(calibration_folds), each localised against a map of the others, and a query is answered "
       "with its best mapped place only when that place's log odds against the new place exceed "
-      "the threshold that best separates held-out nodes near the rest of the map from those far "
-      "from it (needs two map sessions)",
+      "a threshold learnt from the held-out nodes near the rest of the map and far from it "
+      "(new_place_rule; needs two map sessions)",
       schema::Any());
     v("calibration_folds", calibration_folds,
       "calibrate_new_place: map session k (in order of id) is held out with fold k mod this; "
       "more folds cost more localiser builds (at most one per session)",
       schema::Unit("").Within(2, 1000));
+    v("new_place_rule", new_place_rule,
+      "calibrate_new_place: near_recall (the highest threshold that accepts "
+      "new_place_near_recall of the near held-out nodes) or youden (the best Youden's J over "
+      "near and far held-out nodes)",
+      schema::Any());
+    v("new_place_near_recall", new_place_near_recall,
+      "new_place_rule = near_recall: share of the held-out nodes near the rest of the map that "
+      "the threshold accepts",
+      schema::Unit("").Above(0).AtMost(1));
   }
 };
 
 // The new-place threshold learnt from labelled scores: `log_odds[i]` is a held-out node's best
 // mapped place's log odds against the new place, `near[i]` whether that node was near the rest
-// of the map (true) or far from it (false). The threshold t maximises Youden's J, the share of
-// near nodes accepted (log odds > t) plus the share of far ones rejected (<= t), minus 1. The
-// candidates are "accept every finite score" and the midpoints between consecutive distinct
-// scores; ties go to the lowest t (accept more). NaN counts as -inf (no mapped place).
+// of the map (true) or far from it (false). A node is accepted when its log odds exceed t. The
+// candidates are "accept every finite score" (t = -inf) and the midpoints between consecutive
+// distinct scores. NaN counts as -inf (no mapped place, never accepted).
+// kYouden: t maximises Youden's J, the share of near nodes accepted plus the share of far ones
+// rejected (<= t), minus 1; ties go to the lowest t (accept more); needs both kinds of node.
+// kNearRecall: the highest candidate that rejects at most floor((1 - near_recall) n) of the n
+// near nodes (a tie is never split, so fewer may be rejected); needs near nodes only.
 struct NewPlaceThreshold {
   double log_odds = 0.0;  // t; 0 without both kinds of node (FABMAP's own arg-max rule)
   size_t near = 0, far = 0;
@@ -94,7 +118,8 @@ struct NewPlaceThreshold {
   bool calibrated = false;
 };
 NewPlaceThreshold LearnNewPlaceThreshold(const std::vector<double>& log_odds,
-                                         const std::vector<bool>& near);
+                                         const std::vector<bool>& near, NewPlaceRule rule,
+                                         double near_recall);
 
 // The places of one data set divided into map and queries by `options.split`: interleaved by
 // node or by session (InterleavedSplit with map_fraction), or the first session as the map.

@@ -181,8 +181,8 @@ TEST(MapDistanceTest, GroupsByNearestPlace) {
 TEST(NewPlaceThresholdTest, SeparableScoresGetTheMidpoint) {
   // Near nodes score 5, 6, 7; far ones 1, 2, 3: any t in [3, 5) separates them; the sweep takes
   // the first maximum, past the score 3, at the midpoint 4.
-  const NewPlaceThreshold t =
-      LearnNewPlaceThreshold({5, 1, 6, 2, 7, 3}, {true, false, true, false, true, false});
+  const NewPlaceThreshold t = LearnNewPlaceThreshold(
+      {5, 1, 6, 2, 7, 3}, {true, false, true, false, true, false}, NewPlaceRule::kYouden, 0.95);
   ASSERT_TRUE(t.calibrated);
   EXPECT_DOUBLE_EQ(t.log_odds, 4.0);
   EXPECT_EQ(t.near, 3u);
@@ -198,9 +198,9 @@ TEST(NewPlaceThresholdTest, OverlappingScoresMaximiseYoudensJ) {
   // and 4: 3/4 + 4/5 - 1 = 0.55; between 4 and 6: 3/4 + 1 - 1 = 0.75 (the best); higher t
   // accepts fewer near nodes at no gain.
   const double inf = std::numeric_limits<double>::infinity();
-  const NewPlaceThreshold t =
-      LearnNewPlaceThreshold({2, 6, 7, 9, 1, 3, 4, -inf, std::nan("")},
-                             {true, true, true, true, false, false, false, false, false});
+  const NewPlaceThreshold t = LearnNewPlaceThreshold(
+      {2, 6, 7, 9, 1, 3, 4, -inf, std::nan("")},
+      {true, true, true, true, false, false, false, false, false}, NewPlaceRule::kYouden, 0.95);
   ASSERT_TRUE(t.calibrated);
   EXPECT_DOUBLE_EQ(t.log_odds, 5.0);
   EXPECT_DOUBLE_EQ(t.near_accepted, 0.75);
@@ -216,13 +216,62 @@ TEST(MapDistanceTest, FarMustNotBeNearerThanNear) {
   EXPECT_NE(error.find("far_place_m"), std::string::npos) << error;
 }
 
-TEST(NewPlaceThresholdTest, OneKindOfNodeOnlyIsNotCalibrated) {
-  const NewPlaceThreshold t = LearnNewPlaceThreshold({5, 6}, {true, true});
+TEST(NewPlaceThresholdTest, YoudenNeedsBothKindsOfNode) {
+  const NewPlaceThreshold t =
+      LearnNewPlaceThreshold({5, 6}, {true, true}, NewPlaceRule::kYouden, 0.95);
   EXPECT_FALSE(t.calibrated);
   EXPECT_EQ(t.log_odds, 0.0);
   EXPECT_EQ(t.near, 2u);
   EXPECT_EQ(t.far, 0u);
-  EXPECT_FALSE(LearnNewPlaceThreshold({}, {}).calibrated);
+  EXPECT_FALSE(LearnNewPlaceThreshold({}, {}, NewPlaceRule::kYouden, 0.95).calibrated);
+}
+
+TEST(NewPlaceThresholdTest, NearRecallRejectsTheLowestShareOfNearNodes) {
+  // Near nodes score 20, 19, ..., 1 (shuffled in with far ones at 0.5, 3 and 30). Recall 0.95
+  // of 20 allows floor(0.05 x 20) = 1 rejection: t halfway between 1 and 2. Far nodes are only
+  // reported: 0.5 rejected, 3 and 30 accepted.
+  std::vector<double> scores = {0.5, 3, 30};
+  std::vector<bool> near = {false, false, false};
+  for (int v = 20; v >= 1; --v) {
+    scores.push_back(v);
+    near.push_back(true);
+  }
+  const NewPlaceThreshold t = LearnNewPlaceThreshold(scores, near, NewPlaceRule::kNearRecall, 0.95);
+  ASSERT_TRUE(t.calibrated);
+  EXPECT_DOUBLE_EQ(t.log_odds, 1.5);
+  EXPECT_EQ(t.near, 20u);
+  EXPECT_EQ(t.far, 3u);
+  EXPECT_DOUBLE_EQ(t.near_accepted, 0.95);
+  EXPECT_DOUBLE_EQ(t.far_rejected, 1.0 / 3.0);
+  // Recall 0.8 allows 4 rejections (t = 4.5); 0.79 still 4 (floor of 4.2); 1 none (t = -inf).
+  EXPECT_DOUBLE_EQ(LearnNewPlaceThreshold(scores, near, NewPlaceRule::kNearRecall, 0.8).log_odds,
+                   4.5);
+  EXPECT_DOUBLE_EQ(LearnNewPlaceThreshold(scores, near, NewPlaceRule::kNearRecall, 0.79).log_odds,
+                   4.5);
+  EXPECT_EQ(LearnNewPlaceThreshold(scores, near, NewPlaceRule::kNearRecall, 1.0).log_odds,
+            -std::numeric_limits<double>::infinity());
+}
+
+TEST(NewPlaceThresholdTest, NearRecallNeverSplitsATieAndNeedsNoFarNodes) {
+  const double inf = std::numeric_limits<double>::infinity();
+  // Near 1, 1, 2, 3: recall 0.75 allows one rejection, but the two 1s stand or fall together, so
+  // none is rejected: t = -inf. No far node: still calibrated, far_rejected 0.
+  NewPlaceThreshold t = LearnNewPlaceThreshold({2, 1, 3, 1}, {true, true, true, true},
+                                               NewPlaceRule::kNearRecall, 0.75);
+  ASSERT_TRUE(t.calibrated);
+  EXPECT_EQ(t.log_odds, -inf);
+  EXPECT_DOUBLE_EQ(t.near_accepted, 1.0);
+  EXPECT_EQ(t.far, 0u);
+  EXPECT_DOUBLE_EQ(t.far_rejected, 0.0);
+  // Near NaN (no mapped place: -inf), 5, 6, 7: the one rejection allowed is the NaN, which is
+  // rejected at every threshold; t stays -inf, 3 of 4 accepted.
+  t = LearnNewPlaceThreshold({std::nan(""), 5, 6, 7}, {true, true, true, true},
+                             NewPlaceRule::kNearRecall, 0.75);
+  EXPECT_EQ(t.log_odds, -inf);
+  EXPECT_DOUBLE_EQ(t.near_accepted, 0.75);
+  // Only far nodes: nothing to learn from.
+  EXPECT_FALSE(
+      LearnNewPlaceThreshold({1, 2}, {false, false}, NewPlaceRule::kNearRecall, 0.95).calibrated);
 }
 
 }  // namespace

@@ -42,6 +42,9 @@ struct TomlCodec<fabmap::WifiEncoding>
 template <>
 struct TomlCodec<fabmap::SplitUnit> : EnumCodec<fabmap::SplitUnit, fabmap::SplitUnitFromString> {};
 template <>
+struct TomlCodec<fabmap::NewPlaceRule>
+    : EnumCodec<fabmap::NewPlaceRule, fabmap::NewPlaceRuleFromString> {};
+template <>
 struct TomlCodec<WifiLearning> : EnumCodec<WifiLearning, WifiLearningFromString> {};
 template <>
 struct TomlCodec<RelaxationScheme> : EnumCodec<RelaxationScheme, RelaxationSchemeFromString> {};
@@ -283,6 +286,8 @@ constexpr AddedKey kKeysAddedAfter[] = {
     {7, "evaluation.far_place_m"},
     {7, "evaluation.calibrate_new_place"},
     {7, "evaluation.calibration_folds"},
+    {7, "evaluation.new_place_rule"},
+    {7, "evaluation.new_place_near_recall"},
 };
 
 // Whole sections added after a map format version: older maps resume only with every key at its
