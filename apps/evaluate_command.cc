@@ -1,4 +1,5 @@
 // `ratslam evaluate`: the fusion paper's localisation benchmark (sections 5.2-5.3) with FABMAP.
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -55,7 +56,19 @@ int EvaluateCommand(const Arguments& parsed) {
                   100 * x.rejection_rate, 100 * x.floor_mistake_rate);
     return name + rates;
   };
-  std::vector<LocalisationCurve> curves = {{label(fabmap::ToString(mode), m), m.errors_m}};
+  // FABMAP's own curve says how it decided "new place": its arg-max, or the learnt threshold.
+  std::string decision = ", arg-max";
+  if (r.new_place.calibrated) {
+    const fabmap::EvaluationOptions& e = options.pipeline.evaluation;
+    const double t = r.new_place.log_odds;
+    decision = std::isfinite(t) ? ", learnt threshold " + ShortestNumber(std::round(t)) + " nats"
+                                : std::string(", learnt threshold: any mapped place");
+    decision += e.new_place_rule == fabmap::NewPlaceRule::kNearRecall
+                    ? " (near recall " + ShortestNumber(e.new_place_near_recall) + ")"
+                    : " (Youden's J)";
+  }
+  std::vector<LocalisationCurve> curves = {
+      {label("FABMAP " + fabmap::ToString(mode) + decision, m), m.errors_m}};
   for (const auto& [name, b] : r.baselines) {
     curves.push_back({label("baseline " + name, b), b.errors_m});
   }
