@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
 # The new-place decision on queries near the map and far from it (issue 12, item 6), as a
 # Markdown table: Wi-Fi-only FABMAP with its own arg-max and with the threshold learnt from the
-# map's sessions ([evaluation] calibrate_new_place) by each new_place_rule, beside the k-NN and eq. 6 fingerprint
-# baselines of the same run, on the Microsoft walks (split by walk) and on UJIIndoorLoc split by
-# user and phone. "near": a map place on the query's floor within 5 m; "far": none within 10 m.
+# map's sessions ([evaluation] calibrate_new_place) by each new_place_rule, beside the k-NN and
+# eq. 6 fingerprint baselines of the same run, on the Microsoft walks (split by walk) and on
+# UJIIndoorLoc split by user and phone (no pair on both sides) and by node. "near": a map place
+# on the query's floor within 5 m; "far": none within 10 m.
 # Percentages of all queries, or of the group.
-# Usage: scripts/new_place_table.sh [DATA_DIR] [OUT_DIR]   (about 40 s)
+# Usage: scripts/new_place_table.sh [DATA_DIR] [OUT_DIR]   (about 50 s)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 data=${1:-../shared/data}
@@ -49,3 +50,4 @@ PY
 run "Microsoft site 1" configs/msft-ilc20-wifi.toml "$data/msft-ilc20-site1" ""
 run "UJIIndoorLoc by user" configs/ujiindoorloc-wifi-by-user.toml \
   "$data/ujiindoorloc/trainingData.csv" ""
+run "UJIIndoorLoc by node" configs/ujiindoorloc-wifi.toml "$data/ujiindoorloc/trainingData.csv" ""

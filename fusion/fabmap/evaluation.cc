@@ -190,17 +190,16 @@ MapDistanceReport ByMapDistance(const EvaluationMetrics& metrics,
 
 SplitNodes SplitEvaluationNodes(const std::vector<EvaluationNode>& nodes,
                                 const EvaluationOptions& options) {
-  std::vector<int> sessions;
-  for (const auto& n : nodes) {
-    if (sessions.empty() || sessions.back() != n.session) sessions.push_back(n.session);
-  }
+  // Sessions by id, in the order of their first node: a session whose nodes interleave in time
+  // with another's (UJIIndoorLoc's users and phones took turns) stays whole on one side.
+  std::map<int, size_t> index_of;
+  for (const auto& n : nodes) index_of.emplace(n.session, index_of.size());
   const bool by_session = options.split == SplitUnit::kSession;
   const std::vector<bool> split =
-      InterleavedSplit(by_session ? sessions.size() : nodes.size(), options.map_fraction);
+      InterleavedSplit(by_session ? index_of.size() : nodes.size(), options.map_fraction);
   SplitNodes out;
-  size_t session_index = 0;
   for (size_t i = 0; i < nodes.size(); ++i) {
-    if (i > 0 && nodes[i].session != nodes[i - 1].session) ++session_index;
+    const size_t session_index = index_of.at(nodes[i].session);
     const bool in_map = options.split == SplitUnit::kFirstSession ? session_index == 0
                         : by_session                              ? split[session_index]
                                                                   : split[i];

@@ -34,11 +34,10 @@ std::string ToString(SplitUnit unit);
 StatusOr<SplitUnit> SplitUnitFromString(const std::string& name);
 
 // How calibrate_new_place picks its log-odds threshold from the held-out map nodes.
-// kNearRecall: the highest threshold that still accepts `new_place_near_recall` of the near
-// nodes (far ones are only reported). kYouden: the threshold with the best Youden's J over near
-// and far nodes. Far nodes of a map are few and unlike far queries (they lie where the other
-// walks did not go, often beside a mapped place on another floor), so a rule that needs only the
-// near ones transfers better: see the README's new-place table.
+// kYouden: the threshold with the best Youden's J over near and far nodes. kNearRecall: the
+// highest threshold that still accepts `new_place_near_recall` of the near nodes (far ones are
+// only reported): it needs no far nodes, and keeps its promise where map and queries are alike
+// (the same users), but accepts more far queries where they differ (README, new-place table).
 enum class NewPlaceRule { kNearRecall, kYouden };
 std::string ToString(NewPlaceRule rule);
 StatusOr<NewPlaceRule> NewPlaceRuleFromString(const std::string& name);
@@ -53,7 +52,7 @@ struct EvaluationOptions {
   double far_place_m = 10.0;           // no map place on the query's floor this close: "far"
   bool calibrate_new_place = false;    // learn the new-place threshold from held-out map sessions
   int calibration_folds = 4;           // map sessions held out in this many interleaved groups
-  NewPlaceRule new_place_rule = NewPlaceRule::kNearRecall;  // how the threshold is chosen
+  NewPlaceRule new_place_rule = NewPlaceRule::kYouden;  // how the threshold is chosen
   double new_place_near_recall = 0.95;  // kNearRecall: share of near held-out nodes accepted
 
   bool IsValid(std::string* error) const;
@@ -91,9 +90,9 @@ struct EvaluationOptions {
       "more folds cost more localiser builds (at most one per session)",
       schema::Unit("").Within(2, 1000));
     v("new_place_rule", new_place_rule,
-      "calibrate_new_place: near_recall (the highest threshold that accepts "
-      "new_place_near_recall of the near held-out nodes) or youden (the best Youden's J over "
-      "near and far held-out nodes)",
+      "calibrate_new_place: youden (the best Youden's J over near and far held-out nodes) or "
+      "near_recall (the highest threshold that accepts new_place_near_recall of the near "
+      "held-out nodes)",
       schema::Any());
     v("new_place_near_recall", new_place_near_recall,
       "new_place_rule = near_recall: share of the held-out nodes near the rest of the map that "
@@ -123,6 +122,8 @@ NewPlaceThreshold LearnNewPlaceThreshold(const std::vector<double>& log_odds,
 
 // The places of one data set divided into map and queries by `options.split`: interleaved by
 // node or by session (InterleavedSplit with map_fraction), or the first session as the map.
+// Sessions are told apart by id and ordered by their first node: every node of a session goes to
+// the same side, however its nodes interleave in time with other sessions'.
 struct SplitNodes {
   std::vector<EvaluationNode> map, queries;
 };

@@ -119,6 +119,28 @@ TEST(EvaluationTest, SplitBySessionAndFirstSession) {
   EXPECT_FALSE(SplitUnitFromString("nodes").ok());
 }
 
+// Sessions that take turns in time (UJIIndoorLoc's users and phones did) stay whole: the split
+// is over session ids in the order of their first node, not over runs of nodes.
+TEST(EvaluationTest, SplitBySessionKeepsInterleavedSessionsWhole) {
+  std::vector<EvaluationNode> nodes;
+  for (int session : {7, 3, 7, 3, 9, 7, 5, 3, 9, 5, 8}) {  // first seen: 7, 3, 9, 5, 8
+    nodes.push_back(At(0, 0, 0));
+    nodes.back().session = session;
+  }
+  EvaluationOptions options;
+  options.split = SplitUnit::kSession;
+  options.map_fraction = 0.4;  // the 3rd and 5th of five (indices 2 and 4): sessions 9 and 8
+  const SplitNodes split = SplitEvaluationNodes(nodes, options);
+  ASSERT_EQ(split.map.size(), 3u);  // 9 twice, 8 once
+  for (const auto& n : split.map) EXPECT_TRUE(n.session == 9 || n.session == 8) << n.session;
+  ASSERT_EQ(split.queries.size(), 8u);
+  for (const auto& n : split.queries) EXPECT_TRUE(n.session != 9 && n.session != 8) << n.session;
+  options.split = SplitUnit::kFirstSession;  // session 7, all three of its nodes
+  const SplitNodes first = SplitEvaluationNodes(nodes, options);
+  ASSERT_EQ(first.map.size(), 3u);
+  for (const auto& n : first.map) EXPECT_EQ(n.session, 7);
+}
+
 // Hand-worked: five queries, best-place posteriors 0.9, 0.8, 0.8, 0.3 and none; errors 1, 30, 4,
 // 3 m; the last query has no map place on its floor. Equal posteriors are accepted together.
 TEST(PrecisionRecallTest, HandWorkedCurve) {
