@@ -730,18 +730,54 @@ StatusOr<TaskOutcome> ReadOutcome(const std::string& dir, int index) {
   return o;
 }
 
-// A run left behind by a killed sweep runner: its process group is still alive and its command
-// line names this folder. Ended before the folder is reused.
+// Processes other than this one with `folder` as one of their arguments (a run's --out).
+std::vector<pid_t> ProcessesNaming(const std::string& folder) {
+  std::vector<pid_t> found;
+  std::error_code ec;
+  for (fs::directory_iterator it("/proc", ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    pid_t pid = 0;
+    const auto [rest, error] = std::from_chars(name.data(), name.data() + name.size(), pid);
+    if (error != std::errc() || rest != name.data() + name.size() || pid <= 1 || pid == getpid()) {
+      continue;
+    }
+    std::ifstream cmdline(it->path() / "cmdline", std::ios::binary);
+    for (std::string arg; std::getline(cmdline, arg, '\0');) {
+      if (arg == folder) {
+        found.push_back(pid);
+        break;
+      }
+    }
+  }
+  return found;
+}
+
+// Whether `pid` is a process that has not ended (a zombie has: it waits only to be reaped).
+bool Alive(pid_t pid) {
+  if (kill(pid, 0) != 0) return false;
+  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+  std::string line;
+  std::getline(stat, line);
+  const size_t paren = line.rfind(')');  // "pid (name) state ...": the name may hold spaces
+  return paren == std::string::npos || paren + 2 >= line.size() || line[paren + 2] != 'Z';
+}
+
+// A run left behind by a killed sweep runner is still writing into its folder: ended before the
+// folder is reused. It is found by its command line, which names the folder, not by the pid file
+// the runner writes after starting it: a runner killed between the two leaves no pid file, and
+// the orphan would otherwise write its outputs into the next attempt's folder (seen in CI: the
+// next attempt refused to overwrite them).
 void EndOrphan(const std::string& folder) {
-  std::ifstream in(folder + "/pid");
-  pid_t pid = 0;
-  if (!(in >> pid) || pid <= 1) return;
-  std::ifstream cmdline("/proc/" + std::to_string(pid) + "/cmdline");
-  const std::string command((std::istreambuf_iterator<char>(cmdline)), {});
-  if (command.find(folder) == std::string::npos) return;  // gone, or the pid was reused
-  kill(-pid, SIGKILL);
-  for (int i = 0; i < 500 && kill(pid, 0) == 0; ++i) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  if (!fs::exists(folder)) return;  // never started
+  const std::vector<pid_t> orphans = ProcessesNaming(folder);
+  for (pid_t pid : orphans) {
+    kill(-pid, SIGKILL);  // its process group (runs start in their own)
+    kill(pid, SIGKILL);
+  }
+  for (pid_t pid : orphans) {
+    for (int i = 0; i < 500 && Alive(pid); ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
   }
 }
 
@@ -794,8 +830,8 @@ StatusOr<Running> Start(const Plan& plan, const std::string& dir, int index,
   posix_spawn_file_actions_destroy(&actions);
   posix_spawnattr_destroy(&attributes);
   if (rc != 0) return Status::Error(program + ": cannot start: " + std::strerror(rc));
-  // Who writes into the folder, so that a sweep resumed after its runner was killed can end the
-  // run that was left behind instead of racing it.
+  // Who writes into the folder (for people; EndOrphan finds a left-behind run by its command
+  // line, which also covers a runner killed before this line).
   std::ofstream(folder + "/pid") << r.pid << "\n";
   return r;
 }

@@ -536,6 +536,55 @@ TEST(SweepRunTest, EvaluateSweepsReadTheBenchmarksMetrics) {
   EXPECT_TRUE(fs::exists(fs::path(dir) / "runs" / "00000" / "evaluation.json"));
 }
 
+// A runner killed between starting a run and writing its `pid` file leaves a run that no file
+// names (CI once caught the kill in that window: the orphan's outputs landed in the next
+// attempt's folder, which refused to overwrite them). The resumed sweep must still end it: here
+// an orphan that has the run folder among its arguments, in its own process group, and no pid
+// file.
+TEST(SweepRunTest, AnOrphanWithoutAPidFileIsEndedBeforeItsFolderIsReused) {
+  SquareWalk("a", 0.0);
+  const std::string path = SweepFile("orphan.toml", R"(
+[[datasets]]
+data = ["data/a"]
+[parameters]
+"wifi.match_threshold" = [0.3]
+)");
+  const std::string dir = (Scratch().path() / "sweep-orphan").string();
+  ASSERT_TRUE(WritePlan(*MakePlan(*LoadSweepFile(path)), dir).ok());
+  const std::string folder = (fs::path(dir) / "runs" / "00000").string();
+  fs::create_directories(folder);
+  ASSERT_FALSE(fs::exists(folder + "/pid"));
+  std::string shell = "/bin/sh", c = "-c", loop = "while :; do sleep 1; done", arg0 = folder;
+  char* argv[] = {shell.data(), c.data(), loop.data(), arg0.data(), nullptr};
+  posix_spawnattr_t attributes;
+  posix_spawnattr_init(&attributes);
+  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETPGROUP);
+  posix_spawnattr_setpgroup(&attributes, 0);
+  pid_t orphan = -1;
+  ASSERT_EQ(posix_spawn(&orphan, shell.c_str(), nullptr, &attributes, argv, environ), 0);
+  posix_spawnattr_destroy(&attributes);
+  struct EndAnyway {  // a failing check must not leave the loop running (it would hold ctest's
+    pid_t pid;        // output open)
+    ~EndAnyway() {
+      kill(-pid, SIGKILL);
+      waitpid(pid, nullptr, WNOHANG);
+    }
+  } end_anyway{orphan};
+  usleep(100000);  // let it start
+  int status = 0;
+  ASSERT_EQ(waitpid(orphan, &status, WNOHANG), 0) << "the orphan ended by itself";
+  RunOptions options;
+  options.program = FakeProgram((Scratch().path() / "orphan.log").string());
+  StatusOr<RunReport> report = RunSweep(dir, options);
+  ASSERT_TRUE(report.ok()) << report.status().message();
+  EXPECT_EQ(report->done, 1);
+  ASSERT_EQ(waitpid(orphan, &status, WNOHANG), orphan) << "the orphan still runs";
+  EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL);
+  const StatusOr<std::vector<TaskOutcome>> outcomes = ReadOutcomes(dir);
+  ASSERT_TRUE(outcomes.ok());
+  EXPECT_EQ((*outcomes)[0].status, "ok") << (*outcomes)[0].error;
+}
+
 // The runner itself killed (SIGKILL, no chance to clean up) half-way: the same command resumes,
 // repeats no run that had ended, and ends any run the dead runner left behind.
 TEST(SweepRunTest, AKilledRunnerResumesWithoutRepeatingOrLosingRuns) {
