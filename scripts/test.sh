@@ -5,6 +5,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
+repeat=()
 if [[ "${SANITIZE:-0}" == 1 ]]; then
   export BUILD_DIR=build-sanitize
   export LSAN_OPTIONS="suppressions=$PWD/tests/lsan.supp:print_suppressions=0"
@@ -15,10 +16,16 @@ if [[ "${SANITIZE:-0}" == 1 ]]; then
   # Mesa's shader disk cache runs its own thread ("disk$0"), which is still exiting at exit too
   # (the same tracer crash, seen in a CI run on `evaluate`): no disk cache under sanitizers.
   export MESA_SHADER_CACHE_DISABLE=true
+  # The tracer crash still comes back now and then under load (CI, 2026-12-03: `evaluate` in
+  # SimulatedScenarios.ApartmentEarlyFusionIsNoWorseThanVision; the same test passed 3 of 3
+  # times alone). A failing test runs once more: a sanitizer report from our own code is
+  # deterministic and fails both times, the tracer's crash does not.
+  repeat=(--repeat until-pass:2)
   bash scripts/build.sh -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRATSLAM_SANITIZE=ON \
     -DRATSLAM_BUILD_TESTS=ON -DRATSLAM_BUILD_BENCHMARKS=OFF
 else
   export BUILD_DIR=build
   bash scripts/build.sh -DRATSLAM_BUILD_TESTS=ON -DRATSLAM_BUILD_BENCHMARKS=ON
 fi
-ctest --test-dir "$BUILD_DIR" --no-tests=error --output-on-failure --parallel "$(nproc)" --timeout 600
+ctest --test-dir "$BUILD_DIR" --no-tests=error --output-on-failure --parallel "$(nproc)" --timeout 600 \
+  "${repeat[@]}"
