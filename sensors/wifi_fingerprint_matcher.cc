@@ -124,10 +124,9 @@ void WifiFingerprintMatcher::Scan(const Fingerprint& query, Finish&& finish) con
         if (!dense && acc.common == 0) touched_.push_back(slot);
         ++acc.common;
         const double d = list.s - p->rssi_dbm;
-        acc.hit += d * d;
         if constexpr (kOffsetInvariant) diff_[slot] += d;
-        acc.extra_common += list.extra;
-        acc.miss_common += p->penalty2;
+        acc.hit += d * d;
+        acc.penalty_common += list.extra + p->penalty2;
       }
       list.next = list.stop;
     }
@@ -141,8 +140,7 @@ void WifiFingerprintMatcher::Scan(const Fingerprint& query, Finish&& finish) con
         c.hit = std::max(0.0, c.hit - diff_[slot] * diff_[slot] / c.h);
         diff_[slot] = 0.0;
       }
-      c.extra = std::max(0.0, extra_total - acc.extra_common);
-      c.miss = std::max(0.0, miss_penalty_total_[c.id] - acc.miss_common);
+      c.penalty = std::max(0.0, (extra_total + miss_penalty_total_[c.id]) - acc.penalty_common);
       finish(c);
       acc = Accumulator();
     };
@@ -158,7 +156,7 @@ void WifiFingerprintMatcher::Scan(const Fingerprint& query, Finish&& finish) con
 
 double WifiFingerprintMatcher::Exponent(const Candidate& c) const {
   const double two_sigma2 = 2.0 * options_.kernel_variance_dbm2;
-  return -c.hit / (two_sigma2 * c.h) - c.extra / two_sigma2 - c.miss / two_sigma2;
+  return -c.hit / (two_sigma2 * c.h) - c.penalty / two_sigma2;
 }
 
 double WifiFingerprintMatcher::CandidateWeight(const Candidate& c, double exponent,
@@ -200,7 +198,7 @@ WifiMatch WifiFingerprintMatcher::Best(const Fingerprint& query,
     if (allowed && !(*allowed)[c.id]) return;
     // The penalties alone (hit >= 0) bound x from above: most candidates stop here, before the
     // divisions. The margin covers the reciprocal's rounding.
-    if (!(-(c.extra + c.miss) * inv_two_sigma2 >= skip_below - 1e-9)) return;
+    if (!(-c.penalty * inv_two_sigma2 >= skip_below - 1e-9)) return;
     const double x = Exponent(c);
     if (!(x >= skip_below)) return;
     const uint32_t id = c.id;
