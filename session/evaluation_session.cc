@@ -289,12 +289,29 @@ Status EvaluationSession::Localise() {
         kDistancesM);
   }
   result_.baselines.clear();
+  result_.floor_accuracy.clear();
+  result_.queries_on_mapped_floors = fabmap::ShareOnMappedFloors(result_.map, result_.queries);
+  {
+    std::vector<std::optional<int>> floors(result_.queries.size());
+    for (size_t i = 0; i < floors.size(); ++i) {
+      if (result_.best_mapped_place[i] >= 0) {
+        floors[i] = result_.map[static_cast<size_t>(result_.best_mapped_place[i])].floor;
+      }
+    }
+    result_.floor_accuracy.emplace_back("fabmap_best_mapped_place",
+                                        fabmap::FloorAccuracy(result_.queries, floors));
+  }
   const bool map_has_wifi = std::any_of(result_.map.begin(), result_.map.end(),
                                         [](const fabmap::EvaluationNode& n) { return n.wifi; });
   if (map_has_wifi) {
-    result_.baselines.emplace_back(
-        "knn", fabmap::ComputeMetrics(result_.queries, KnnEstimates(result_.map, result_.queries),
-                                      kDistancesM));
+    const std::vector<fabmap::Estimate> knn = KnnEstimates(result_.map, result_.queries);
+    std::vector<std::optional<int>> floors(knn.size());
+    for (size_t i = 0; i < knn.size(); ++i) {
+      if (knn[i].located) floors[i] = knn[i].floor;
+    }
+    result_.floor_accuracy.emplace_back("knn", fabmap::FloorAccuracy(result_.queries, floors));
+    result_.baselines.emplace_back("knn",
+                                   fabmap::ComputeMetrics(result_.queries, knn, kDistancesM));
     const WifiMatcherOptions& wifi = options_.pipeline.sensors.wifi;
     result_.baselines.emplace_back(
         "fingerprint", fabmap::ComputeMetrics(
@@ -350,6 +367,11 @@ Status EvaluationSession::WriteOutputs() {
   j["baselines"] = nlohmann::ordered_json::object();
   for (const auto& [name, b] : result_.baselines) {
     AddRates(b, nearest, evaluation, &j["baselines"][name]);
+  }
+  {
+    nlohmann::ordered_json& f = j["floor_classification"];
+    f["queries_on_mapped_floors"] = result_.queries_on_mapped_floors;
+    for (const auto& [name, accuracy] : result_.floor_accuracy) f[name] = accuracy;
   }
   j["wifi_words"] = result_.wifi_words;
   j["wifi_map_scans"] = result_.wifi_map_scans;

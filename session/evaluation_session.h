@@ -54,6 +54,11 @@ struct EvaluationResult {
   // The Wi-Fi baselines on the same map and queries (evaluation_baselines.h), by name ("knn",
   // "fingerprint"); empty when the map has no scan.
   std::vector<std::pair<std::string, fabmap::EvaluationMetrics>> baselines;
+  // Floor classification (evaluation.json's floor_classification): the share of queries on a
+  // floor the map holds, and by method (FABMAP's best mapped place, accepted or not; k-NN) the
+  // share given their floor.
+  double queries_on_mapped_floors = 0.0;
+  std::vector<std::pair<std::string, double>> floor_accuracy;
   // With [evaluation] calibrate_new_place: the threshold learnt, the map's sessions and the folds
   // they were held out in (Localise then answers with the threshold).
   fabmap::NewPlaceThreshold new_place;

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <set>
 #include <system_error>
 
 namespace ratslam::fabmap {
@@ -301,6 +302,24 @@ std::vector<double> NearestPlaceWithin(const std::vector<EvaluationNode>& map,
   }
   for (double& w : within) w /= static_cast<double>(queries.size());
   return within;
+}
+
+double ShareOnMappedFloors(const std::vector<EvaluationNode>& map,
+                           const std::vector<EvaluationNode>& queries) {
+  if (queries.empty()) return 0.0;
+  std::set<int> floors;
+  for (const EvaluationNode& n : map) floors.insert(n.floor);
+  size_t on = 0;
+  for (const EvaluationNode& q : queries) on += floors.count(q.floor);
+  return static_cast<double>(on) / static_cast<double>(queries.size());
+}
+
+double FloorAccuracy(const std::vector<EvaluationNode>& queries,
+                     const std::vector<std::optional<int>>& floors) {
+  if (queries.empty() || floors.size() != queries.size()) return 0.0;
+  size_t right = 0;
+  for (size_t i = 0; i < queries.size(); ++i) right += floors[i] == queries[i].floor;
+  return static_cast<double>(right) / static_cast<double>(queries.size());
 }
 
 std::vector<PrecisionRecallPoint> PrecisionRecallCurve(const std::vector<double>& best_probability,

@@ -156,6 +156,15 @@ std::vector<double> NearestPlaceWithin(const std::vector<EvaluationNode>& map,
                                        const std::vector<EvaluationNode>& queries,
                                        const std::vector<double>& distances_m);
 
+// The share of queries whose floor holds at least one map place: no localiser that answers with
+// a map place's floor can classify more floors right (a split whose map skipped floors lowers it).
+double ShareOnMappedFloors(const std::vector<EvaluationNode>& map,
+                           const std::vector<EvaluationNode>& queries);
+// The share of queries whose floor is `floors[i]` (none: no answer, never right); the floor
+// classification of a localiser apart from where on the floor. Sizes must agree (else 0).
+double FloorAccuracy(const std::vector<EvaluationNode>& queries,
+                     const std::vector<std::optional<int>>& floors);
+
 // A localiser's answer to a query as a position: a map place's, or any position (k-NN averages
 // its neighbours), or none (a rejection).
 struct Estimate {

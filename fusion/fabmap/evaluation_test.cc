@@ -77,6 +77,21 @@ TEST(EvaluationTest, NearestPlaceWithinAgreesWithBruteForce) {
   EXPECT_LT(got[3], 1.0);     // floor 2 has no map place
 }
 
+// Floors 0 and 1 hold map places, floor 2 none: a third of these queries is out of reach.
+TEST(EvaluationTest, FloorClassificationOnAHandBuiltCase) {
+  const std::vector<EvaluationNode> map = {At(0, 0, 0), At(5, 0, 1), At(9, 9, 1)};
+  const std::vector<EvaluationNode> queries = {At(1, 1, 0), At(2, 2, 1), At(3, 3, 2),
+                                               At(4, 4, 0), At(5, 5, 1), At(6, 6, 2)};
+  EXPECT_DOUBLE_EQ(ShareOnMappedFloors(map, queries), 4.0 / 6.0);
+  EXPECT_DOUBLE_EQ(ShareOnMappedFloors(map, {}), 0.0);
+  EXPECT_DOUBLE_EQ(ShareOnMappedFloors({}, queries), 0.0);
+  // Right, wrong, wrong (an unmapped floor), no answer, right, right (a floor a map place
+  // cannot name, but a classifier may).
+  const std::vector<std::optional<int>> floors = {0, 0, 1, std::nullopt, 1, 2};
+  EXPECT_DOUBLE_EQ(FloorAccuracy(queries, floors), 3.0 / 6.0);
+  EXPECT_DOUBLE_EQ(FloorAccuracy(queries, {0, 1}), 0.0);  // sizes disagree
+}
+
 TEST(EvaluationTest, InterleavedSplitKeepsTheFraction) {
   const auto split = InterleavedSplit(10, 0.4);
   int in_map = 0;
