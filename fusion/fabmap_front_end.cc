@@ -209,6 +209,14 @@ class FabmapFrontEnd : public FrontEnd {
     return Status::Ok();
   }
 
+  // Whether the best place (-1: none) is recognised, by the rule of [fabmap_front_end].
+  bool Enough(int64_t best, double probability, double log_odds) const {
+    if (best < 0) return false;
+    return settings_.front_end.decide_by_log_odds
+               ? log_odds >= settings_.front_end.match_log_odds
+               : probability >= settings_.front_end.match_probability;
+  }
+
   StatusOr<std::optional<FrameDecision>> Decide(double time_s, fabmap::Query q) {
     if (!localiser_) {  // online, before the first model: every frame is a new place
       floors_.AddTemplate();
@@ -227,8 +235,10 @@ class FabmapFrontEnd : public FrontEnd {
     d.source = fabmap::UsesVision(mode()) ? DecisionSource::kCamera : DecisionSource::kWifi;
     const int64_t n = static_cast<int64_t>(places_.size());
     const double enough = settings_.front_end.match_probability;
-    int64_t best = r.best_place;
-    double best_probability = r.best_probability;
+    const bool by_log_odds = settings_.front_end.decide_by_log_odds;
+    int64_t best = by_log_odds ? r.best_mapped_place : r.best_place;
+    double best_probability = by_log_odds ? r.best_mapped_probability : r.best_probability;
+    double best_log_odds = r.best_mapped_log_odds;
     if (floors_.active()) {
       // The floor rule (front_end.h): the most probable place the barometer allows. The
       // posterior is per place except in the sequential modes (per candidate): there a
@@ -249,6 +259,8 @@ class FabmapFrontEnd : public FrontEnd {
       }
       const std::vector<uint8_t> agrees = floors_.BeginFrame(static_cast<uint32_t>(n));
       if (best >= 0 && !agrees[best]) {
+        const bool was_enough = by_log_odds ? best_log_odds >= settings_.front_end.match_log_odds
+                                            : best_probability >= enough;
         best = -1;
         best_probability = 0.0;
         for (size_t p = 0; per_place && p < agrees.size(); ++p) {
@@ -257,12 +269,16 @@ class FabmapFrontEnd : public FrontEnd {
             best_probability = r.place_probability[p];
           }
         }
-        if (r.best_probability >= enough && !(best >= 0 && best_probability >= enough)) {
-          floors_.CountRefused();
-        }
+        // The allowed place's log odds: the best mapped place's, moved by their posteriors'
+        // ratio (-inf where either posterior underflowed).
+        const double mapped = r.best_mapped_probability;
+        best_log_odds = best >= 0 && best_probability > 0.0 && mapped > 0.0
+                            ? r.best_mapped_log_odds + std::log(best_probability / mapped)
+                            : -std::numeric_limits<double>::infinity();
+        if (was_enough && !Enough(best, best_probability, best_log_odds)) floors_.CountRefused();
       }
     }
-    if (best >= 0 && best_probability >= enough) {
+    if (Enough(best, best_probability, best_log_odds)) {
       const bool old_enough =
           OldEnough(n, best, time_s, created_time_s_[best], settings_.front_end.recency_templates,
                     settings_.front_end.recency_s, settled_);

@@ -5,12 +5,6 @@
 // kClassicCamera: the OpenRatSLAM camera matcher (sensors/classic_camera_matcher.h).
 // kFused: the Wi-Fi RatSLAM paper's front end (section III): 12x9 camera templates (eq. 7),
 // Wi-Fi fingerprints (eqs. 3-6) and a compass (eq. 2), combined by the b_out rule (eqs. 8-12):
-// kFabmap: FABMAP (fusion/fabmap) decides: a place it recognises with at least
-// match_probability is the active view; otherwise (the new place wins) the observation becomes a
-// new place and template. Any FABMAP mode works (vision, wifi, early, late, sequential). The
-// Wi-Fi words, tree and virtual samples come from an exploration of the data set's own scans
-// (the fusion paper's section 3: Wi-Fi vocabularies exist only after exploring), spaced by
-// odometry travel and time; the visual model is loaded from [visual_model] file or trained.
 // the best match per sensor counts only if it reaches the sensor's threshold and is not among
 // the last k templates (k in templates and/or seconds); the camera is preferred when it matches,
 // else Wi-Fi, else a new joint template (camera view + newest Wi-Fi scan + heading) is stored.
@@ -21,6 +15,16 @@
 // templates); only both sensors below threshold make a new template.
 // Wi-Fi is evaluated at the camera rate with the newest scan; scans older than max_wifi_age_s
 // count as absent. Any sensor can be switched off (Wi-Fi only, camera only, fused).
+// kFabmap: FABMAP (fusion/fabmap) decides: a place it recognises with at least
+// match_probability is the active view; otherwise (the new place wins) the observation becomes a
+// new place and template. With decide_by_log_odds the best mapped place is the active view when
+// its log odds against the new place reach match_log_odds (the log of the two posteriors' ratio,
+// from the likelihoods, so finite where the posteriors saturate at 0 and 1): the rule whose
+// threshold `ratslam evaluate` learns ([evaluation] calibrate_new_place). Any FABMAP mode works
+// (vision, wifi, early, late, sequential). The Wi-Fi words, tree and virtual samples come from an
+// exploration of the data set's own scans (the fusion paper's section 3: Wi-Fi vocabularies exist
+// only after exploring), spaced by odometry travel and time; the visual model is loaded from
+// [visual_model] file or trained.
 // Floors ([barometer] use_barometer with a pressure stream; fused and FABMAP front ends): each
 // session's barometer gives levels (sensors/barometer.h); a template stores its session and
 // level, or "unknown" when made on the stairs (in transit). A session is on its first level
@@ -34,7 +38,8 @@
 // moves the session's offset. A query or template of unknown floor matches nothing that has a
 // floor, so a scan taken on the stairs becomes a new template. Sessions without barometer
 // readings are unconstrained, as before. FABMAP: the best place the barometer allows must still
-// reach match_probability; its votes use the posterior of places as the score.
+// pass the decision rule (match_probability, or match_log_odds with decide_by_log_odds); its
+// votes use the posterior of places as the score and match_probability as the threshold.
 // kDescriptors: per-image descriptors computed elsewhere (fusion/descriptor_table.h) matched by
 // cosine similarity with min_similarity and the same recency rule; pixels are never loaded.
 // kCustom: a front end of your own (see "Writing a front end" below FrontEnd).
@@ -194,7 +199,9 @@ struct FabmapFrontEndOptions {
   double recency_s = 10.0;         // nor one made less than this long ago
   double max_wifi_age_s = 5.0;     // an older newest scan counts as absent at an image frame
   WifiLearning wifi_learning = WifiLearning::kWholeDataSet;  // see WifiLearning
-  int online_first_scans = 20;  // kOnline: scans before the first Wi-Fi model
+  int online_first_scans = 20;      // kOnline: scans before the first Wi-Fi model
+  bool decide_by_log_odds = false;  // the best place's log odds, not its posterior, decide
+  double match_log_odds = 0.0;      // with decide_by_log_odds: least log odds of the best place
 
   bool IsValid(std::string* error) const;
   template <typename Visitor>
@@ -216,6 +223,14 @@ struct FabmapFrontEndOptions {
     v("online_first_scans", online_first_scans,
       "online: scans before the first Wi-Fi model (every frame is a new place until then)",
       schema::Unit("scans").AtLeast(1));
+    v("decide_by_log_odds", decide_by_log_odds,
+      "the best mapped place becomes active when its log odds against the new place reach "
+      "match_log_odds (instead of its posterior reaching match_probability)",
+      schema::Any());
+    v("match_log_odds", match_log_odds,
+      "decide_by_log_odds: least log(p(best place) / p(new place)), nats; 0 is the arg-max, "
+      "negative values accept places the new place beats",
+      schema::Unit("nats").Within(-1000, 1000));
   }
 };
 

@@ -196,6 +196,63 @@ FrontEndSettings FabmapWifiSettings() {
   return settings;
 }
 
+// The corridor walked twice (scans and odometry every 2 s), the second lap noisier.
+Dataset CorridorTwoLaps() {
+  Dataset data;
+  for (int lap = 0; lap < 2; ++lap) {
+    for (int i = 0; i < 40; ++i) {
+      const double t = lap * 100.0 + i * 2.0;
+      data.wifi.push_back(CorridorScan(t, 2.0 * i, lap == 0 ? 1.0 : 2.0));
+      data.odometry.push_back({t, 1.0, 0.0});
+    }
+  }
+  return data;
+}
+
+// Pressure at 10 Hz up to `until_s`, from *next_s on: the second lap one floor (3.5 m) up, the
+// climb between 82 and 96 s.
+void FeedPressureOneFloorUp(FrontEnd* f, double until_s, double* next_s) {
+  for (; *next_s <= until_s; *next_s += 0.1) {
+    const double h = *next_s < 82.0 ? 0.0 : std::min(3.5, 3.5 * (*next_s - 82.0) / 14.0);
+    EXPECT_TRUE(f->OnPressure(*next_s, 1000.0 * std::exp(-h / 8434.5)).ok());
+  }
+}
+
+// The two laps through a FABMAP front end (pressure fed when the barometer is on): its
+// templates, and the frames of one lap that re-activated (not merely re-used as recent) a
+// template made on the other.
+struct TwoLapRun {
+  std::unique_ptr<FrontEnd> front_end;
+  size_t templates = 0;
+  int cross_lap = 0;
+};
+TwoLapRun RunTwoLaps(const FrontEndSettings& settings) {
+  const Dataset data = CorridorTwoLaps();
+  TwoLapRun run;
+  auto resources = PrepareFabmapResources(settings, data, std::nullopt);
+  EXPECT_TRUE(resources.ok());
+  if (!resources.ok()) return run;
+  run.front_end = CreateFrontEnd(settings, *resources);
+  std::vector<int> lap_of_template;
+  double next_pressure = 0.0;
+  for (size_t i = 0; i < data.wifi.size(); ++i) {
+    if (settings.barometer.use_barometer) {
+      FeedPressureOneFloorUp(run.front_end.get(), data.wifi[i].time_s, &next_pressure);
+    }
+    const auto d = run.front_end->OnWifi(data.wifi[i]);
+    EXPECT_TRUE(d.ok() && d->has_value());
+    if (!d.ok() || !d->has_value()) continue;
+    const int lap = i < 40 ? 0 : 1;
+    if ((*d)->view.is_new) {
+      lap_of_template.push_back(lap);
+    } else if (!(*d)->recent) {
+      run.cross_lap += lap_of_template[(*d)->view.template_id] != lap;
+    }
+  }
+  run.templates = lap_of_template.size();
+  return run;
+}
+
 TEST(FabmapFrontEndTest, SecondLapRecognisesTheFirstLapsPlaces) {
   FrontEndSettings settings = FabmapWifiSettings();
   Dataset data;
@@ -245,6 +302,33 @@ TEST(FabmapFrontEndTest, SecondLapRecognisesTheFirstLapsPlaces) {
   EXPECT_THROW(CreateFrontEnd(settings, FrontEndResources{}), std::invalid_argument);
 }
 
+// decide_by_log_odds: the threshold on the best mapped place's log odds against the new place
+// orders the decisions: the higher it is, the more frames become new places (+1000: every
+// frame; -1000: only the first, whose map is empty). The floor rule still binds: with the
+// barometer and a threshold that accepts anything, the second lap one floor up never matches
+// the first lap's places.
+TEST(FabmapFrontEndTest, LogOddsThresholdOrdersDecisionsAndKeepsFloors) {
+  auto run = [](double threshold, bool barometer) {
+    FrontEndSettings settings = FabmapWifiSettings();
+    settings.fabmap.front_end.decide_by_log_odds = true;
+    settings.fabmap.front_end.match_log_odds = threshold;
+    settings.barometer.use_barometer = barometer;
+    return RunTwoLaps(settings);
+  };
+  EXPECT_EQ(run(1000.0, false).templates, 80u);
+  EXPECT_EQ(run(-1000.0, false).templates, 1u);
+  size_t previous = 80;
+  for (double t : {40.0, 20.0, 0.0, -20.0, -40.0}) {
+    const size_t templates = run(t, false).templates;
+    EXPECT_LE(templates, previous) << t;
+    previous = templates;
+  }
+  EXPECT_LT(previous, run(40.0, false).templates);  // the thresholds made a difference
+  // Without the barometer the second lap re-uses the first's places; with it, never.
+  EXPECT_GE(run(-1000.0, false).cross_lap, 30);
+  EXPECT_EQ(run(-1000.0, true).cross_lap, 0);
+}
+
 // The FABMAP front end under the floor rule: a second lap of the same corridor one floor up, with
 // the same Wi-Fi (aliased floors). Without the barometer it re-uses the first lap's places; with
 // it, none; the floors survive a state round trip.
@@ -252,35 +336,12 @@ TEST(FabmapFrontEndTest, BarometerKeepsPlacesOnTheirFloor) {
   auto run = [](bool barometer, std::string* state) {
     FrontEndSettings settings = FabmapWifiSettings();
     settings.barometer.use_barometer = barometer;
-    Dataset data;
-    for (int lap = 0; lap < 2; ++lap) {
-      for (int i = 0; i < 40; ++i) {
-        const double t = lap * 100.0 + i * 2.0;
-        data.wifi.push_back(CorridorScan(t, 2.0 * i, lap == 0 ? 1.0 : 2.0));
-        data.odometry.push_back({t, 1.0, 0.0});
-      }
-    }
+    TwoLapRun r = RunTwoLaps(settings);
+    if (!r.front_end) return -1;
+    const std::unique_ptr<FrontEnd>& f = r.front_end;
+    const int cross_floor = r.cross_lap;
+    const Dataset data = CorridorTwoLaps();
     auto resources = PrepareFabmapResources(settings, data, std::nullopt);
-    EXPECT_TRUE(resources.ok());
-    std::unique_ptr<FrontEnd> f = CreateFrontEnd(settings, *resources);
-    std::vector<int> lap_of_template;
-    int cross_floor = 0;
-    double next_pressure = 0.0;
-    for (size_t i = 0; i < data.wifi.size(); ++i) {
-      for (; next_pressure <= data.wifi[i].time_s; next_pressure += 0.1) {
-        const double h =
-            next_pressure < 82.0 ? 0.0 : std::min(3.5, 3.5 * (next_pressure - 82.0) / 14.0);
-        EXPECT_TRUE(f->OnPressure(next_pressure, 1000.0 * std::exp(-h / 8434.5)).ok());
-      }
-      const auto d = f->OnWifi(data.wifi[i]);
-      EXPECT_TRUE(d.ok() && d->has_value());
-      const int lap = i < 40 ? 0 : 1;
-      if ((*d)->view.is_new) {
-        lap_of_template.push_back(lap);
-      } else if (!(*d)->recent) {
-        cross_floor += lap_of_template[(*d)->view.template_id] != lap;
-      }
-    }
     if (state) *state = f->EncodeState();
     if (barometer) {
       std::unique_ptr<FrontEnd> g = CreateFrontEnd(settings, *resources);

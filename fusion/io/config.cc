@@ -288,6 +288,8 @@ constexpr AddedKey kKeysAddedAfter[] = {
     {7, "evaluation.calibration_folds"},
     {7, "evaluation.new_place_rule"},
     {7, "evaluation.new_place_near_recall"},
+    {7, "fabmap_front_end.decide_by_log_odds"},
+    {7, "fabmap_front_end.match_log_odds"},
 };
 
 // Whole sections added after a map format version: older maps resume only with every key at its
