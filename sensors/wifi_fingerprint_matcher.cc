@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <numeric>
 #include <stdexcept>
 #include <utility>
 
@@ -73,8 +74,9 @@ double WifiFingerprintMatcher::Weight(const Fingerprint& q, const Fingerprint& j
          (common + e + m);
 }
 
-template <bool kOffsetInvariant, typename Finish>
-void WifiFingerprintMatcher::Scan(const Fingerprint& query, Finish&& finish) const {
+template <bool kOffsetInvariant, typename Finish, typename Budget>
+void WifiFingerprintMatcher::Scan(const Fingerprint& query, Finish&& finish,
+                                  Budget&& budget) const {
   const uint32_t n = size();
   // The query's indexed APs, with their penalty and a cursor into their posting list.
   lists_.clear();
@@ -99,6 +101,9 @@ void WifiFingerprintMatcher::Scan(const Fingerprint& query, Finish&& finish) con
   const uint32_t block = total * 4 >= n ? kBlock : std::max<uint32_t>(n, 1);
   if (acc_.size() < block) acc_.resize(block);
   if (kOffsetInvariant && diff_.size() < block) diff_.resize(block, 0.0);
+  // The lists by the query AP's penalty, largest first, for the pruning below (sorted when
+  // first needed: a scan in one block, or with no budget, never prunes).
+  by_penalty_.clear();
   for (uint32_t base = 0; base < n && total > 0; base += block) {
     const uint32_t limit = base + block;
     const uint32_t slots = std::min(block, n - base);
@@ -117,18 +122,64 @@ void WifiFingerprintMatcher::Scan(const Fingerprint& query, Finish&& finish) con
     // the other way round.
     const bool dense = count * 4 >= slots;
     touched_.clear();
-    for (ListCursor& list : lists_) {
-      for (const Posting* p = list.next; p != list.stop; ++p) {
-        const uint32_t slot = p->fingerprint - base;
-        Accumulator& acc = acc_[slot];
-        if (!dense && acc.common == 0) touched_.push_back(slot);
-        ++acc.common;
-        const double d = list.s - p->rssi_dbm;
-        if constexpr (kOffsetInvariant) diff_[slot] += d;
-        acc.hit += d * d;
-        acc.penalty_common += list.extra + p->penalty2;
+    auto add = [&](const ListCursor& list, const Posting& p, uint32_t slot) {
+      Accumulator& acc = acc_[slot];
+      ++acc.common;
+      const double d = list.s - p.rssi_dbm;
+      if constexpr (kOffsetInvariant) diff_[slot] += d;
+      acc.hit += d * d;
+      acc.penalty_common += list.extra + p.penalty2;
+    };
+    // Pruning (max-score): a fingerprint missing every one of the query's k most penalised APs
+    // has a penalty of at least the sum of their P^2 (eq. 4). Once that sum exceeds the budget
+    // (the largest penalty a fingerprint may have and still win, from the best so far), only the
+    // fingerprints on those k "essential" lists are scored; the others are left out, exactly.
+    // Their sums still run over all the query's lists in order, so scored fingerprints get the
+    // same weight to the bit.
+    const double allowed = budget();
+    if (by_penalty_.empty() && allowed < std::numeric_limits<double>::infinity()) {
+      by_penalty_.resize(lists_.size());
+      std::iota(by_penalty_.begin(), by_penalty_.end(), uint32_t{0});
+      std::stable_sort(by_penalty_.begin(), by_penalty_.end(), [this](uint32_t a, uint32_t b) {
+        return lists_[a].extra > lists_[b].extra;
+      });
+    }
+    size_t essential = 0;
+    double essential_sum = 0.0;
+    while (essential < by_penalty_.size() && !(essential_sum > allowed)) {
+      essential_sum += lists_[by_penalty_[essential++]].extra;
+    }
+    if (essential_sum > allowed && essential < lists_.size()) {
+      if (marked_.size() < block) marked_.resize(block, 0);
+      for (size_t k = 0; k < essential; ++k) {
+        const ListCursor& list = lists_[by_penalty_[k]];
+        for (const Posting* p = list.next; p != list.stop; ++p) {
+          const uint32_t slot = p->fingerprint - base;
+          if (!dense && !marked_[slot]) touched_.push_back(slot);
+          marked_[slot] = 1;
+        }
       }
-      list.next = list.stop;
+      for (ListCursor& list : lists_) {
+        for (const Posting* p = list.next; p != list.stop; ++p) {
+          const uint32_t slot = p->fingerprint - base;
+          if (marked_[slot]) add(list, *p, slot);
+        }
+        list.next = list.stop;
+      }
+      if (dense) {
+        std::fill(marked_.begin(), marked_.begin() + slots, uint8_t{0});
+      } else {
+        for (uint32_t slot : touched_) marked_[slot] = 0;
+      }
+    } else {
+      for (ListCursor& list : lists_) {
+        for (const Posting* p = list.next; p != list.stop; ++p) {
+          const uint32_t slot = p->fingerprint - base;
+          if (!dense && acc_[slot].common == 0) touched_.push_back(slot);
+          add(list, *p, slot);
+        }
+        list.next = list.stop;
+      }
     }
     auto complete = [&](uint32_t slot) {
       Accumulator& acc = acc_[slot];
@@ -172,10 +223,11 @@ void WifiFingerprintMatcher::ForEachCandidate(const Fingerprint& query, Visit&& 
   auto finish = [&](const Candidate& c) {
     visit(c.id, CandidateWeight(c, Exponent(c), query_size));
   };
+  const auto unbounded = [] { return std::numeric_limits<double>::infinity(); };
   if (options_.offset_invariant) {
-    Scan<true>(query, finish);
+    Scan<true>(query, finish, unbounded);
   } else {
-    Scan<false>(query, finish);
+    Scan<false>(query, finish, unbounded);
   }
 }
 
@@ -211,10 +263,14 @@ WifiMatch WifiFingerprintMatcher::Best(const Fingerprint& query,
       if (w > 0.0) skip_below = std::log(w) - 1e-9;
     }
   };
+  // The budget of the pruning: a candidate is scored in full only if -penalty / (2 sigma^2) >=
+  // skip_below - 1e-9 (above), so one whose penalty exceeds this cannot win. The relative margin
+  // covers the rounding of the penalty's sums.
+  const auto budget = [&] { return (1e-9 - skip_below) / inv_two_sigma2 * (1.0 + 1e-9) + 1e-9; };
   if (options_.offset_invariant) {
-    Scan<true>(query, finish);
+    Scan<true>(query, finish, budget);
   } else {
-    Scan<false>(query, finish);
+    Scan<false>(query, finish, budget);
   }
   return best;
 }

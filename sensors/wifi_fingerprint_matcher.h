@@ -22,7 +22,9 @@
 //
 // Fingerprints are indexed by BSSID: a query touches only the stored fingerprints that share an
 // AP with it; the per-fingerprint totals of penalties are precomputed, so extra and missing APs
-// cost nothing beyond the shared ones.
+// cost nothing beyond the shared ones. Best, once it has met a good match, scores only the
+// fingerprints holding one of the query's most penalised APs (max-score pruning: any other has
+// an eq. 4 penalty that already rules it out), with the same answer as the exhaustive scan.
 #ifndef RATSLAM_SENSORS_WIFI_FINGERPRINT_MATCHER_H_
 #define RATSLAM_SENSORS_WIFI_FINGERPRINT_MATCHER_H_
 
@@ -151,8 +153,10 @@ class WifiFingerprintMatcher {
   };
   // Visits every stored fingerprint sharing an AP with the query, block by block of ids:
   // finish(candidate). Compiled once per hit term so the plain one pays nothing for the other.
-  template <bool kOffsetInvariant, typename Finish>
-  void Scan(const Fingerprint& query, Finish&& finish) const;
+  // budget(): the largest penalty (sum of eqs. 4-5) a fingerprint may have and still matter
+  // (infinity: every one does); asked once per block, so it may fall as the scan goes on.
+  template <bool kOffsetInvariant, typename Finish, typename Budget>
+  void Scan(const Fingerprint& query, Finish&& finish, Budget&& budget) const;
   // The exponent of eq. 6: the log of w_hit^(1/H) w_extra w_miss.
   double Exponent(const Candidate& c) const;
   // w of eq. 6 from that exponent: exp(x) H / (H + E + M).
@@ -172,8 +176,10 @@ class WifiFingerprintMatcher {
   // the query's posting lists.
   static constexpr uint32_t kBlock = 512;
   mutable std::vector<Accumulator> acc_;
-  mutable std::vector<double> diff_;       // sum of d (offset_invariant)
-  mutable std::vector<uint32_t> touched_;  // of a sparse block
+  mutable std::vector<double> diff_;          // sum of d (offset_invariant)
+  mutable std::vector<uint32_t> touched_;     // of a sparse block
+  mutable std::vector<uint8_t> marked_;       // on an essential list (zero outside a scan)
+  mutable std::vector<uint32_t> by_penalty_;  // indices into lists_, largest penalty first
   struct ListCursor {
     const Posting* next;
     const Posting* stop;  // the first posting past the block being scanned

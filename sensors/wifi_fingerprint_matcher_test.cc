@@ -193,11 +193,13 @@ TEST(WifiFingerprintMatcherTest, FollowRevisitAddsNewAndDropsGoneApsAndKeepsTheI
   EXPECT_GT(m.Weights(scan)[1], w_before);
 }
 
-// Best, which skips the exp of fingerprints whose penalties alone rule them out and scans the
-// index in blocks of ids, returns exactly the exhaustive argmax of the weights (largest weight,
-// ties to the lower id): against the pairwise formula on every stored fingerprint, in one building
-// (every fingerprint shares APs: the blocked scan) and on a campus (few do), with and without the
-// offset-invariant hit term, over more fingerprints than one block.
+// Best, which skips the exp of fingerprints whose penalties alone rule them out, scans the index
+// in blocks of ids and, once a good match is known, scores only fingerprints holding one of the
+// query's most penalised APs (the pruning that revisits trigger), returns exactly the exhaustive
+// argmax of the weights (largest weight, ties to the lower id): against the pairwise formula on
+// every stored fingerprint, in one building (every fingerprint shares APs: the blocked scan) and on
+// a campus (few do), with and without the offset-invariant hit term, over more fingerprints than
+// one block.
 TEST(WifiFingerprintMatcherTest, BestIsTheExhaustiveArgmax) {
   for (const int universe : {60, 5000}) {
     for (const bool offset_invariant : {false, true}) {
@@ -223,7 +225,13 @@ TEST(WifiFingerprintMatcherTest, BestIsTheExhaustiveArgmax) {
       // Exact duplicates of stored fingerprints: ties, which must go to the first copy.
       for (int i = 0; i < 20; ++i) m.Add(stored[static_cast<size_t>(i * 37)]);
       for (int k = 0; k < 60; ++k) {
-        const Fingerprint q = k % 3 == 0 ? stored[static_cast<size_t>(k * 37 % 740)] : scan();
+        // Copies of stored fingerprints, noisy revisits (3 dB, one AP lost) and new places.
+        Fingerprint q = k % 3 == 2 ? scan() : stored[static_cast<size_t>(k * 37 % 1500)];
+        if (k % 3 == 1) {
+          for (float& rssi : q.rssi_dbm) rssi += static_cast<float>(rng.Gaussian(0, 3));
+          q.ap_ids.erase(q.ap_ids.begin());
+          q.rssi_dbm.erase(q.rssi_dbm.begin());
+        }
         int32_t expected_id = -1;
         double expected = 0.0;
         for (uint32_t i = 0; i < m.size(); ++i) {
@@ -241,6 +249,42 @@ TEST(WifiFingerprintMatcherTest, BestIsTheExhaustiveArgmax) {
       }
     }
   }
+}
+
+// The pruning's edge: the winner lacks the query's most penalised AP. A (id 0, the first block of
+// ids) holds every query AP at 6 dB off: w = exp(-36 / 40) = 0.41. B (id 600, the second block)
+// holds the ten weak APs exactly but not x (-40 dBm, P^2 = 25): w = exp(-25 / 40) 10 / 11 = 0.49.
+// After the first block the budget is 40 ln(1 / 0.41) = 36 of penalty, so x alone (25) does not
+// rule out B; the essential lists are x and five weak APs, and B is on those. Filler fingerprints
+// (a weak query AP and a strong AP of their own) make the index scan in blocks.
+TEST(WifiFingerprintMatcherTest, PruningKeepsAWinnerThatLacksTheStrongestAp) {
+  WifiFingerprintMatcher m{WifiMatcherOptions()};
+  Readings query = {{"x", -40}}, a, b;
+  for (int k = 0; k < 10; ++k) {
+    std::string ap = "a";  // (not "a" + ...: GCC 12's -Wrestrict false positive)
+    ap += std::to_string(k);
+    query.push_back({ap, -75});
+    a.push_back({ap, -81});
+    b.push_back({ap, -75});
+  }
+  a.push_back({"x", -46});
+  m.Add(m.MakeFingerprint(a));
+  for (int i = 1; i < 700; ++i) {
+    if (i == 600) {
+      m.Add(m.MakeFingerprint(b));
+    } else {
+      std::string own = "own";
+      own += std::to_string(i);
+      m.Add(m.MakeFingerprint({{"a0", -99}, {own, -40}}));
+    }
+  }
+  const Fingerprint q = m.MakeFingerprint(query);
+  const std::vector<double> w = m.Weights(q);
+  EXPECT_NEAR(w[0], std::exp(-0.9), 1e-12);
+  EXPECT_NEAR(w[600], std::exp(-25.0 / 40.0) * 10.0 / 11.0, 1e-12);
+  const WifiMatch best = m.Best(q);
+  EXPECT_EQ(best.id, 600);
+  EXPECT_EQ(best.weight, w[600]);
 }
 
 }  // namespace
