@@ -259,8 +259,7 @@ class FabmapFrontEnd : public FrontEnd {
       }
       const std::vector<uint8_t> agrees = floors_.BeginFrame(static_cast<uint32_t>(n));
       if (best >= 0 && !agrees[best]) {
-        const bool was_enough = by_log_odds ? best_log_odds >= settings_.front_end.match_log_odds
-                                            : best_probability >= enough;
+        const bool was_enough = Enough(best, best_probability, best_log_odds);
         best = -1;
         best_probability = 0.0;
         for (size_t p = 0; per_place && p < agrees.size(); ++p) {
