@@ -4,10 +4,13 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <string>
+#include <unordered_map>
 
 #include "common/byte_buffer.h"
 #include "fusion/floor_rule.h"
 #include "fusion/front_end_internal.h"
+#include "fusion/rssi_offset.h"
 
 namespace ratslam {
 namespace front_end_internal {
@@ -17,7 +20,11 @@ class FabmapFrontEnd : public FrontEnd {
  public:
   FabmapFrontEnd(const FabmapSettings& settings, const FloorOptions& floors,
                  std::shared_ptr<const FabmapResources> resources)
-      : settings_(settings), resources_(std::move(resources)), floors_(floors) {
+      : settings_(settings),
+        resources_(std::move(resources)),
+        offset_(settings.front_end.rssi_offset_min_common_aps,
+                settings.front_end.rssi_offset_min_estimates),
+        floors_(floors) {
     if (!resources_ || (!online() && !resources_->empty_localiser)) {
       throw std::invalid_argument("the FABMAP front end needs PrepareFabmapResources' models");
     }
@@ -40,12 +47,18 @@ class FabmapFrontEnd : public FrontEnd {
   StatusOr<std::optional<FrameDecision>> OnWifi(const WifiScan& scan) override {
     if (!fabmap::UsesWifi(mode())) return std::optional<FrameDecision>();
     newest_scan_ = scan.readings;
+    if (settings_.front_end.online_rssi_offset) {
+      Fingerprint f = Intern(newest_scan_);
+      offset_.Calibrate(reference_, &f);
+      const double offset = offset_.CurrentOffset();
+      for (WifiReading& r : newest_scan_) r.rssi_dbm -= offset;
+    }
     newest_scan_time_s_ = scan.time_s;
     ++scans_seen_;
     if (online() && scans_seen_ >= NextRelearn()) RATSLAM_RETURN_IF_ERROR(Relearn(scans_seen_));
     if (fabmap::UsesVision(mode())) return std::optional<FrameDecision>();  // images are frames
     fabmap::Query q;
-    q.wifi = scan.readings;
+    q.wifi = newest_scan_;
     return Decide(scan.time_s, std::move(q));
   }
 
@@ -53,7 +66,14 @@ class FabmapFrontEnd : public FrontEnd {
   Status OnPressure(double time_s, double pressure_hpa) override {
     return floors_.OnPressure(time_s, pressure_hpa);
   }
-  void OnSessionStart(double start_s) override { floors_.OnSessionStart(start_s); }
+  void OnSessionStart(double start_s) override {
+    floors_.OnSessionStart(start_s);
+    if (settings_.front_end.online_rssi_offset) offset_.OnSessionStart(start_s, size());
+  }
+  std::vector<double> RssiOffsetsDb() const override {
+    if (!settings_.front_end.online_rssi_offset) return {};
+    return offset_.OffsetsDb();
+  }
   std::optional<FloorReport> floor_report() const override { return floors_.Report(); }
   std::optional<int> TemplateFloor(uint32_t id) const override { return floors_.TemplateFloor(id); }
   std::optional<double> CompassHeading() const override { return std::nullopt; }
@@ -95,6 +115,7 @@ class FabmapFrontEnd : public FrontEnd {
       w.Pod(learned_from_);
       w.Pod(relearnt_);
     }
+    if (settings_.front_end.online_rssi_offset) offset_.Encode(&w);  // likewise
     floors_.Encode(&w);
     return std::move(w.bytes());
   }
@@ -128,8 +149,10 @@ class FabmapFrontEnd : public FrontEnd {
     std::vector<WifiReading> newest;
     uint64_t scans_seen = 0, learned_from = 0, relearnt = 0;
     FloorRule floors = floors_;
+    RssiOffsetTracker offset = offset_;
     ok = ok && r.Optional(&newest_time) && readings(&newest) &&
          (!online() || (r.Pod(&scans_seen) && r.Pod(&learned_from) && r.Pod(&relearnt))) &&
+         (!settings_.front_end.online_rssi_offset || offset.Decode(&r, count)) &&
          floors.Decode(&r, count) && (r.AtEnd() || r.Fail("trailing bytes"));
     if (!ok) return Status::Error(r.error());
     if (online() &&
@@ -153,6 +176,8 @@ class FabmapFrontEnd : public FrontEnd {
     newest_scan_time_s_ = newest_time;
     newest_scan_ = std::move(newest);
     floors_ = std::move(floors);
+    offset_ = std::move(offset);
+    for (const fabmap::Query& place : places_) reference_.push_back(Reference(place));
     scans_seen_ = scans_seen;
     relearnt_ = relearnt;
     if (online()) {
@@ -179,6 +204,7 @@ class FabmapFrontEnd : public FrontEnd {
         online() ? nullptr : std::make_unique<fabmap::Localiser>(*resources_->empty_localiser);
     places_.clear();
     created_time_s_.clear();
+    reference_.clear();
     scans_seen_ = learned_from_ = relearnt_ = 0;
   }
 
@@ -209,6 +235,40 @@ class FabmapFrontEnd : public FrontEnd {
     return Status::Ok();
   }
 
+  // A scan as a fingerprint over this front end's own AP ids (for the RSSI offset estimate):
+  // sorted by id, a repeated AP's readings averaged.
+  Fingerprint Intern(const std::vector<WifiReading>& readings) {
+    std::vector<std::pair<uint32_t, double>> by_id;
+    by_id.reserve(readings.size());
+    for (const WifiReading& r : readings) {
+      if (!std::isfinite(r.rssi_dbm)) continue;
+      const auto [it, added] = ap_ids_.try_emplace(r.bssid, static_cast<uint32_t>(ap_ids_.size()));
+      by_id.emplace_back(it->second, r.rssi_dbm);
+    }
+    std::sort(by_id.begin(), by_id.end());
+    Fingerprint f;
+    for (size_t i = 0; i < by_id.size();) {
+      size_t j = i;
+      double sum = 0.0;
+      for (; j < by_id.size() && by_id[j].first == by_id[i].first; ++j) sum += by_id[j].second;
+      f.ap_ids.push_back(by_id[i].first);
+      f.rssi_dbm.push_back(static_cast<float>(sum / static_cast<double>(j - i)));
+      i = j;
+    }
+    return f;
+  }
+  Fingerprint Reference(const fabmap::Query& place) {
+    return settings_.front_end.online_rssi_offset && place.wifi ? Intern(*place.wifi)
+                                                                : Fingerprint();
+  }
+  void AddPlace(fabmap::Query q, double time_s) {
+    floors_.AddTemplate();
+    if (settings_.front_end.online_rssi_offset) offset_.AddTemplate();
+    reference_.push_back(Reference(q));
+    places_.push_back(std::move(q));
+    created_time_s_.push_back(time_s);
+  }
+
   // Whether the best place (-1: none) is recognised, by the rule of [fabmap_front_end].
   bool Enough(int64_t best, double probability, double log_odds) const {
     if (best < 0) return false;
@@ -219,9 +279,7 @@ class FabmapFrontEnd : public FrontEnd {
 
   StatusOr<std::optional<FrameDecision>> Decide(double time_s, fabmap::Query q) {
     if (!localiser_) {  // online, before the first model: every frame is a new place
-      floors_.AddTemplate();
-      places_.push_back(std::move(q));
-      created_time_s_.push_back(time_s);
+      AddPlace(std::move(q), time_s);
       FrameDecision d;
       d.view.time_s = time_s;
       d.view.template_id = static_cast<uint32_t>(places_.size() - 1);
@@ -288,9 +346,7 @@ class FabmapFrontEnd : public FrontEnd {
       return std::optional<FrameDecision>(d);
     }
     RATSLAM_RETURN_IF_ERROR(localiser_->AddPlace(q));
-    floors_.AddTemplate();
-    places_.push_back(std::move(q));
-    created_time_s_.push_back(time_s);
+    AddPlace(std::move(q), time_s);
     d.view.template_id = static_cast<uint32_t>(n);
     d.view.is_new = true;
     d.source = DecisionSource::kNew;
@@ -308,7 +364,12 @@ class FabmapFrontEnd : public FrontEnd {
   uint64_t scans_seen_ = 0;    // Wi-Fi scans received
   uint64_t learned_from_ = 0;  // online: scans behind the current model (0: none yet)
   uint64_t relearnt_ = 0;      // online: models built so far
-  FloorRule floors_;           // [barometer] use_barometer: see fusion/floor_rule.h
+  // [fabmap_front_end] online_rssi_offset (fusion/rssi_offset.h): the estimator, and per place
+  // its scan over ap_ids_ (empty without the option or without Wi-Fi).
+  RssiOffsetTracker offset_;
+  std::vector<Fingerprint> reference_;
+  std::unordered_map<std::string, uint32_t> ap_ids_;
+  FloorRule floors_;  // [barometer] use_barometer: see fusion/floor_rule.h
 };
 
 }  // namespace

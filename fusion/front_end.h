@@ -202,6 +202,11 @@ struct FabmapFrontEndOptions {
   int online_first_scans = 20;      // kOnline: scans before the first Wi-Fi model
   bool decide_by_log_odds = false;  // the best place's log odds, not its posterior, decide
   double match_log_odds = 0.0;      // with decide_by_log_odds: least log odds of the best place
+  // Per-device RSSI offset, estimated online as in [fused] (fusion/rssi_offset.h) and removed
+  // from a later session's scans before they become Wi-Fi words and places.
+  bool online_rssi_offset = false;
+  int rssi_offset_min_common_aps = 5;
+  int rssi_offset_min_estimates = 10;
 
   bool IsValid(std::string* error) const;
   template <typename Visitor>
@@ -231,6 +236,17 @@ struct FabmapFrontEndOptions {
       "decide_by_log_odds: least log(p(best place) / p(new place)), nats; 0 is the arg-max, "
       "negative values accept places the new place beats",
       schema::Unit("nats").Within(-1000, 1000));
+    v("online_rssi_offset", online_rssi_offset,
+      "estimate each later session's RSSI offset to the earlier sessions' places online and "
+      "remove it from its scans before they become Wi-Fi words (phones that read several dB "
+      "apart)",
+      schema::Any());
+    v("rssi_offset_min_common_aps", rssi_offset_min_common_aps,
+      "APs a scan must share with an earlier session's place to estimate the offset",
+      schema::Unit("APs").AtLeast(1));
+    v("rssi_offset_min_estimates", rssi_offset_min_estimates,
+      "offset estimates of a session before its median is applied",
+      schema::Unit("scans").AtLeast(1));
   }
 };
 

@@ -436,6 +436,81 @@ TEST(FusedFrontEndTest, OnlineRssiOffsetBridgesTwoPhones) {
   EXPECT_FALSE(CreateFrontEnd(settings)->DecodeState(state).ok());
 }
 
+// The FABMAP front end with the same two phones: the second walk reads 15 dB lower, about two of
+// the eight RSSI bins, so its scans are other words. With the online offset (estimated from the
+// scans against the first walk's places, no ground truth) the second walk's scans become the
+// first walk's words again and re-visit its places; the estimate is part of the state.
+TEST(FabmapFrontEndTest, OnlineRssiOffsetBridgesTwoPhones) {
+  constexpr double kShiftDb = -15.0;
+  Dataset data;
+  std::vector<double> x_of_scan;
+  for (int session = 0; session < 2; ++session) {
+    for (int i = 0; i < 40; ++i) {
+      const double t = 1000.0 * session + 2.0 * i;
+      WifiScan scan = CorridorScan(t, 2.0 * i, 1.0);
+      for (WifiReading& r : scan.readings) r.rssi_dbm += kShiftDb * session;
+      data.wifi.push_back(scan);
+      data.odometry.push_back({t, 1.0, 0.0});
+      x_of_scan.push_back(2.0 * i);
+    }
+  }
+  struct Walk {
+    int matches = 0, close = 0;
+    std::vector<double> offsets;
+    std::string state;
+  };
+  auto walk = [&](bool online) {
+    FrontEndSettings settings = FabmapWifiSettings();
+    settings.fabmap.front_end.online_rssi_offset = online;
+    const auto resources = PrepareFabmapResources(settings, data, std::nullopt);
+    EXPECT_TRUE(resources.ok());
+    std::unique_ptr<FrontEnd> f = CreateFrontEnd(settings, *resources);
+    Walk w;
+    std::vector<double> x_of_template;
+    size_t first_walk_templates = 0;
+    for (size_t i = 0; i < data.wifi.size(); ++i) {
+      if (i == 40) first_walk_templates = x_of_template.size();
+      f->OnSessionStart(i < 40 ? 0.0 : 1000.0);
+      const auto d = f->OnWifi(data.wifi[i]);
+      EXPECT_TRUE(d.ok() && d->has_value());
+      if (!d.ok() || !d->has_value()) continue;
+      const FrameDecision& decision = **d;
+      if (decision.view.is_new) {
+        x_of_template.push_back(x_of_scan[i]);
+      } else if (i >= 40 && decision.view.template_id < first_walk_templates) {
+        ++w.matches;
+        w.close += std::abs(x_of_template[decision.view.template_id] - x_of_scan[i]) <= 6.0;
+      }
+    }
+    w.offsets = f->RssiOffsetsDb();
+    w.state = f->EncodeState();
+    return w;
+  };
+  const Walk plain = walk(false);
+  EXPECT_TRUE(plain.offsets.empty());
+  const Walk online = walk(true);
+  ASSERT_EQ(online.offsets.size(), 2u);
+  EXPECT_EQ(online.offsets[0], 0.0);
+  EXPECT_NEAR(online.offsets[1], kShiftDb, 1.0);  // the noise is +-1 dB per AP
+  // Chance of a match within 6 m on the 78 m corridor is ~15 %.
+  EXPECT_GE(online.matches, 20) << "plain: " << plain.matches;
+  EXPECT_GE(online.close, online.matches * 9 / 10);
+  EXPECT_GE(online.close, 2 * plain.close + 10) << "plain: " << plain.close;
+
+  // A restored front end holds the same estimates and writes the same state.
+  FrontEndSettings settings = FabmapWifiSettings();
+  settings.fabmap.front_end.online_rssi_offset = true;
+  const auto resources = PrepareFabmapResources(settings, data, std::nullopt);
+  ASSERT_TRUE(resources.ok());
+  std::unique_ptr<FrontEnd> restored = CreateFrontEnd(settings, *resources);
+  ASSERT_TRUE(restored->DecodeState(online.state).ok());
+  EXPECT_EQ(restored->RssiOffsetsDb(), online.offsets);
+  EXPECT_EQ(restored->EncodeState(), online.state);
+  std::string truncated = online.state;
+  truncated.pop_back();
+  EXPECT_FALSE(restored->DecodeState(truncated).ok());
+}
+
 // Access points replaced one by one over months: in session s (0 to 6) the APs ap0 .. ap(s-1) of
 // the corridor are gone and new ones new0 .. new(s-1) hang 4 m further along, with the same
 // propagation. Each session walks the corridor once. Returns the share of the last session's

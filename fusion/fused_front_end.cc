@@ -2,14 +2,13 @@
 // compass combined by the b_out rule (eqs. 8-12). See front_end.h.
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <stdexcept>
 
 #include "common/byte_buffer.h"
 #include "common/circular.h"
-#include "common/median.h"
 #include "fusion/floor_rule.h"
 #include "fusion/front_end_internal.h"
+#include "fusion/rssi_offset.h"
 
 namespace ratslam {
 namespace front_end_internal {
@@ -19,7 +18,11 @@ class FusedFrontEnd : public FrontEnd {
  public:
   FusedFrontEnd(const FusedOptions& options, const KernelCameraOptions& camera,
                 const WifiMatcherOptions& wifi, const FloorOptions& floors)
-      : options_(options), camera_(camera), wifi_(wifi), floors_(floors) {}
+      : options_(options),
+        camera_(camera),
+        wifi_(wifi),
+        offset_(options.rssi_offset_min_common_aps, options.rssi_offset_min_estimates),
+        floors_(floors) {}
 
   StatusOr<std::optional<FrameDecision>> OnImage(double time_s, const GrayImage& image) override {
     if (!options_.use_camera) return std::optional<FrameDecision>();
@@ -38,7 +41,7 @@ class FusedFrontEnd : public FrontEnd {
     readings.reserve(scan.readings.size());
     for (const WifiReading& r : scan.readings) readings.emplace_back(r.bssid, r.rssi_dbm);
     newest_scan_ = wifi_.MakeFingerprint(readings);
-    if (options_.online_rssi_offset) RemoveRssiOffset(&newest_scan_);
+    if (options_.online_rssi_offset) offset_.Calibrate(wifi_.state().fingerprints, &newest_scan_);
     newest_scan_time_s_ = scan.time_s;
     newest_scan_followed_ = false;
     // One floor vote per scan (a scan re-used by several camera frames votes once).
@@ -73,11 +76,7 @@ class FusedFrontEnd : public FrontEnd {
 
   void OnSessionStart(double start_s) override {
     floors_.OnSessionStart(start_s);
-    if (!options_.online_rssi_offset || (session_start_s_ && *session_start_s_ == start_s)) return;
-    if (session_start_s_) offsets_db_.push_back(CurrentOffset());
-    session_start_s_ = start_s;
-    templates_before_session_ = size();
-    offset_estimates_db_.clear();
+    if (options_.online_rssi_offset) offset_.OnSessionStart(start_s, size());
   }
   std::optional<std::pair<uint64_t, uint64_t>> RevisitApUpdates() const override {
     if (options_.revisit_update_weight > 0) return std::pair(aps_added_, aps_dropped_);
@@ -85,9 +84,7 @@ class FusedFrontEnd : public FrontEnd {
   }
   std::vector<double> RssiOffsetsDb() const override {
     if (!options_.online_rssi_offset) return {};
-    std::vector<double> all = offsets_db_;
-    all.push_back(CurrentOffset());
-    return all;
+    return offset_.OffsetsDb();
   }
 
   std::string EncodeState() const override {
@@ -109,13 +106,8 @@ class FusedFrontEnd : public FrontEnd {
     w.PodVector(newest_scan_.rssi_dbm);
     w.Optional(newest_scan_time_s_);
     w.Optional(heading_rad_);
-    if (options_.online_rssi_offset) {  // without it, states keep the format of earlier releases
-      w.Optional(session_start_s_);
-      w.Pod(templates_before_session_);
-      w.PodVector(offset_estimates_db_);
-      w.PodVector(offsets_db_);
-      w.PodVector(calibrated_);
-    }
+    // Without the option, states keep the format of earlier releases.
+    if (options_.online_rssi_offset) offset_.Encode(&w);
     if (options_.revisit_update_weight > 0) {  // likewise
       w.Pod(static_cast<uint8_t>(newest_scan_followed_));
       w.Pod(aps_added_);
@@ -158,13 +150,8 @@ class FusedFrontEnd : public FrontEnd {
           r.Optional(&newest_time) && r.Optional(&heading))) {
       return Status::Error(r.error());
     }
-    std::optional<double> session_start;
-    uint32_t before_session = 0;
-    std::vector<double> estimates, offsets;
-    std::vector<uint8_t> calibrated;
-    if (options_.online_rssi_offset &&
-        !(r.Optional(&session_start) && r.Pod(&before_session) && r.PodVector(&estimates) &&
-          r.PodVector(&offsets) && r.PodVector(&calibrated))) {
+    RssiOffsetTracker offset = offset_;
+    if (options_.online_rssi_offset && !offset.Decode(&r, created.size())) {
       return Status::Error(r.error());
     }
     uint8_t followed = 0;
@@ -180,13 +167,6 @@ class FusedFrontEnd : public FrontEnd {
     if (camera.size() != created.size() || ws.fingerprints.size() != created.size() ||
         headings.size() != created.size()) {
       return Status::Error("fused front-end state: sensor template counts differ");
-    }
-    if (options_.online_rssi_offset && calibrated.size() != created.size()) {
-      return Status::Error("fused front-end state: RSSI calibration flags do not fit");
-    }
-    if (before_session > created.size() || !FiniteOrAbsent(session_start) ||
-        !AllFinite(estimates) || !AllFinite(offsets)) {
-      return Status::Error("fused front-end state: RSSI offset estimates do not fit");
     }
     if (!AllFinite(created) || !std::all_of(headings.begin(), headings.end(), FiniteOrAbsent) ||
         !FiniteOrAbsent(newest_time) || !FiniteOrAbsent(heading) || !AllFinite(newest.rssi_dbm) ||
@@ -209,11 +189,7 @@ class FusedFrontEnd : public FrontEnd {
     newest_scan_ = std::move(newest);
     newest_scan_time_s_ = newest_time;
     heading_rad_ = heading;
-    session_start_s_ = session_start;
-    templates_before_session_ = before_session;
-    offset_estimates_db_ = std::move(estimates);
-    offsets_db_ = std::move(offsets);
-    calibrated_ = std::move(calibrated);
+    offset_ = std::move(offset);
     newest_scan_followed_ = followed != 0;
     aps_added_ = added;
     aps_dropped_ = dropped;
@@ -223,55 +199,6 @@ class FusedFrontEnd : public FrontEnd {
 
  private:
   enum class Verdict { kNovel, kFamiliarRecent, kMatch };
-
-  // Whether this session's scans are in the first session's units: the first session defines
-  // them; a later one once its offset is known. Only such templates give estimates.
-  bool InReferenceUnits() const {
-    return offsets_db_.empty() ||
-           offset_estimates_db_.size() >= static_cast<size_t>(options_.rssi_offset_min_estimates);
-  }
-  double CurrentOffset() const {
-    return offset_estimates_db_.size() >= static_cast<size_t>(options_.rssi_offset_min_estimates)
-               ? Median(offset_estimates_db_)
-               : 0.0;
-  }
-
-  // One estimate from this scan (against the earlier sessions' templates), then the session's
-  // offset, once known, removed from the scan.
-  void RemoveRssiOffset(Fingerprint* scan) {
-    const std::vector<Fingerprint>& stored = wifi_.state().fingerprints;
-    double best_spread = std::numeric_limits<double>::infinity(), best_median = 0.0;
-    std::vector<double> d;
-    for (uint32_t t = 0; t < templates_before_session_ && t < stored.size(); ++t) {
-      if (!calibrated_[t]) continue;
-      const Fingerprint& f = stored[t];
-      d.clear();
-      for (size_t a = 0, b = 0; a < scan->ap_ids.size() && b < f.ap_ids.size();) {
-        if (scan->ap_ids[a] < f.ap_ids[b]) {
-          ++a;
-        } else if (f.ap_ids[b] < scan->ap_ids[a]) {
-          ++b;
-        } else {
-          d.push_back(static_cast<double>(scan->rssi_dbm[a++]) - f.rssi_dbm[b++]);
-        }
-      }
-      if (d.size() < static_cast<size_t>(options_.rssi_offset_min_common_aps)) continue;
-      double mean = 0.0;
-      for (double x : d) mean += x;
-      mean /= static_cast<double>(d.size());
-      double spread = 0.0;
-      for (double x : d) spread += (x - mean) * (x - mean);
-      spread /= static_cast<double>(d.size());
-      if (spread < best_spread) {  // ties: the older template
-        best_spread = spread;
-        best_median = Median(d);
-      }
-    }
-    if (std::isfinite(best_spread)) offset_estimates_db_.push_back(best_median);
-    const double offset = CurrentOffset();
-    if (offset == 0.0) return;
-    for (float& rssi : scan->rssi_dbm) rssi = static_cast<float>(rssi - offset);
-  }
 
   // Eqs. 10-11: a sensor's best match counts when it reaches the threshold and is not recent.
   Verdict Judge(int32_t best, double score, double threshold, double time_s) const {
@@ -357,7 +284,7 @@ class FusedFrontEnd : public FrontEnd {
     wifi_.Add(scan ? *scan : Fingerprint());
     created_time_s_.push_back(time_s);
     headings_.push_back(options_.use_compass ? heading_rad_ : std::nullopt);
-    if (options_.online_rssi_offset) calibrated_.push_back(InReferenceUnits());
+    if (options_.online_rssi_offset) offset_.AddTemplate();
     floors_.AddTemplate();
     d.view.template_id = n;
     d.view.is_new = true;
@@ -376,14 +303,8 @@ class FusedFrontEnd : public FrontEnd {
   bool newest_scan_followed_ = false;  // the newest scan updated a template (revisit_update_weight)
   uint64_t aps_added_ = 0, aps_dropped_ = 0;  // by revisit_update_weight, so far
   std::optional<double> heading_rad_;
-  // Online RSSI offset: where the current session began, the templates stored before it, this
-  // session's estimates and the offsets of the sessions before it.
-  std::optional<double> session_start_s_;
-  uint32_t templates_before_session_ = 0;
-  std::vector<double> offset_estimates_db_;
-  std::vector<double> offsets_db_;
-  std::vector<uint8_t> calibrated_;  // by template: stored in the reference units (see above)
-  FloorRule floors_;                 // [barometer] use_barometer: see fusion/floor_rule.h
+  RssiOffsetTracker offset_;  // [fused] online_rssi_offset: see fusion/rssi_offset.h
+  FloorRule floors_;          // [barometer] use_barometer: see fusion/floor_rule.h
 };
 
 }  // namespace

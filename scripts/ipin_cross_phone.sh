@@ -4,7 +4,9 @@
 # multi-session run with a config, with the same config plus [wifi] offset_invariant = true, and
 # with [fused] online_rssi_offset = true (the second phone's offset estimated online), and prints
 # per route: template matches between the two phones' sessions, the share of them
-# within 5 m and 10 m of where the matched template was stored, and map ATE.
+# within 5 m and 10 m of where the matched template was stored, and map ATE. With a FABMAP front-end
+# config (a [fabmap_front_end] section) the variants are the config and the config plus
+# [fabmap_front_end] online_rssi_offset = true (offset invariance is an eq. 6 option).
 # Usage: scripts/ipin_cross_phone.sh [config] [out dir]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -13,23 +15,34 @@ out=${2:-out/ipin-cross-phone}
 data=../shared/data/ipin2023-t3
 bin=./build/apps/ratslam
 mkdir -p "$out"
-grep -q '^\[wifi\]' "$config" || { echo "$config has no [wifi] section" >&2; exit 1; }
-sed 's/^\[wifi\]$/[wifi]\noffset_invariant = true/' "$config" > "$out/invariant.toml"
-grep -q '^\[fused\]' "$config" || { echo "$config has no [fused] section" >&2; exit 1; }
-sed 's/^\[fused\]$/[fused]\nonline_rssi_offset = true/' "$config" > "$out/online.toml"
-echo "| route | cross-phone matches | <=5 m | <=10 m | map ATE m | offset-invariant: matches | <=5 m | <=10 m | map ATE m | online offset: matches | <=5 m | <=10 m | map ATE m | offsets dB |"
-echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+variants=(plain invariant online)
+if grep -q '^\[fabmap_front_end\]' "$config"; then
+  variants=(plain online)
+  sed 's/^\[fabmap_front_end\]$/[fabmap_front_end]\nonline_rssi_offset = true/' "$config" \
+    > "$out/online.toml"
+  echo "| route | cross-phone matches | <=5 m | <=10 m | map ATE m | online offset: matches | <=5 m | <=10 m | map ATE m | offsets dB |"
+  echo "|---|---|---|---|---|---|---|---|---|---|"
+else
+  grep -q '^\[wifi\]' "$config" || { echo "$config has no [wifi] section" >&2; exit 1; }
+  sed 's/^\[wifi\]$/[wifi]\noffset_invariant = true/' "$config" > "$out/invariant.toml"
+  grep -q '^\[fused\]' "$config" || { echo "$config has no [fused] section" >&2; exit 1; }
+  sed 's/^\[fused\]$/[fused]\nonline_rssi_offset = true/' "$config" > "$out/online.toml"
+  echo "| route | cross-phone matches | <=5 m | <=10 m | map ATE m | offset-invariant: matches | <=5 m | <=10 m | map ATE m | online offset: matches | <=5 m | <=10 m | map ATE m | offsets dB |"
+  echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+fi
 for route in 01 02 03 21 22 23; do
   args=()
   for rep in 01 02 03 04; do args+=(--data "$data/IPIN2023_T3_TrainingTrial${route}_repetition${rep}.txt"); done
   "$bin" import --overwrite "${args[@]}" --out "$out/data-$route" > /dev/null 2>&1
-  "$bin" replay --quiet --overwrite --config "$config" --data "$out/data-$route" --out "$out/plain-$route" > /dev/null
-  "$bin" replay --quiet --overwrite --config "$out/invariant.toml" --data "$out/data-$route" \
-    --out "$out/invariant-$route" > /dev/null
-  "$bin" replay --quiet --overwrite --config "$out/online.toml" --data "$out/data-$route" \
-    --out "$out/online-$route" > /dev/null
-  /usr/bin/python3 - "$out/data-$route" "$out/plain-$route" "$out/invariant-$route" \
-    "$out/online-$route" "$route" <<'PY'
+  runs=()
+  for v in "${variants[@]}"; do
+    c="$out/$v.toml"
+    [ "$v" = plain ] && c="$config"
+    "$bin" replay --quiet --overwrite --config "$c" --data "$out/data-$route" --out "$out/$v-$route" \
+      > /dev/null
+    runs+=("$out/$v-$route")
+  done
+  /usr/bin/python3 - "$out/data-$route" "${runs[@]}" "$route" <<'PY'
 import bisect, csv, json, math, re, sys
 data = sys.argv[1]
 starts = [float(x) for x in re.search(r"session_start_times_s = \[(.*)\]",
@@ -49,7 +62,7 @@ def truth(t):
     f = (t - a[0]) / (b[0] - a[0])
     return (a[1] + f * (b[1] - a[1]), a[2] + f * (b[2] - a[2]))
 cells = []
-for run in sys.argv[2:5]:
+for run in sys.argv[2:-1]:
     created, distances = {}, []
     for r in csv.DictReader(open(run + "/frames.csv")):
         t, tid = float(r["time_s"]), int(r["template_id"])
@@ -66,8 +79,8 @@ for run in sys.argv[2:5]:
     rate = lambda d: f"{sum(x <= d for x in distances) / n:.2f}" if n else "-"
     summary = json.load(open(run + "/summary.json"))
     cells += [str(n), rate(5), rate(10), f"{summary['map_ate_m']:.2f}"]
-offsets = json.load(open(sys.argv[4] + "/summary.json")).get("wifi_rssi_offsets_db", [])
+offsets = json.load(open(sys.argv[-2] + "/summary.json")).get("wifi_rssi_offsets_db", [])
 cells.append(" / ".join(f"{x:.1f}" for x in offsets[1:]))
-print(f"| {sys.argv[5]} | " + " | ".join(cells) + " |")
+print(f"| {sys.argv[-1]} | " + " | ".join(cells) + " |")
 PY
 done

@@ -290,6 +290,9 @@ constexpr AddedKey kKeysAddedAfter[] = {
     {7, "evaluation.new_place_near_recall"},
     {7, "fabmap_front_end.decide_by_log_odds"},
     {7, "fabmap_front_end.match_log_odds"},
+    {7, "fabmap_front_end.online_rssi_offset"},
+    {7, "fabmap_front_end.rssi_offset_min_common_aps"},
+    {7, "fabmap_front_end.rssi_offset_min_estimates"},
 };
 
 // Whole sections added after a map format version: older maps resume only with every key at its

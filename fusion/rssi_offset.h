@@ -1,0 +1,61 @@
+// A phone's RSSI offset to the map, estimated online per session (issue 12, item 4): phones read
+// the same place several dB apart, a difference that Wi-Fi kernels and RSSI bins both turn into
+// "another place". Shared by the fused and the FABMAP front ends.
+//
+// Each scan of a later session is compared with the templates of the earlier sessions that are in
+// the reference units (the first session's, or a later one's once its offset was known); the
+// template whose RSSI differences to the scan spread least (a constant offset costs nothing
+// there) gives one estimate, the median difference. Once a session has min_estimates estimates,
+// their median is its offset and is removed from its scans, in matching and in the templates it
+// stores. No ground truth, no per-phone constant.
+#ifndef RATSLAM_FUSION_RSSI_OFFSET_H_
+#define RATSLAM_FUSION_RSSI_OFFSET_H_
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "common/byte_buffer.h"
+#include "sensors/wifi_fingerprint_matcher.h"
+
+namespace ratslam {
+
+class RssiOffsetTracker {
+ public:
+  RssiOffsetTracker(int min_common_aps, int min_estimates)
+      : min_common_aps_(min_common_aps), min_estimates_(min_estimates) {}
+
+  // Called at every frame with its session's start; a new start begins a session whose earlier
+  // sessions hold the first `templates` templates.
+  void OnSessionStart(double start_s, uint32_t templates);
+  // One estimate from `scan` against `stored` (by template id; only the earlier sessions'
+  // calibrated templates are read), then the scan in reference units.
+  void Calibrate(const std::vector<Fingerprint>& stored, Fingerprint* scan);
+  // A template was stored from this session's (calibrated) scan.
+  void AddTemplate() { calibrated_.push_back(InReferenceUnits() ? 1 : 0); }
+
+  // The current session's offset (0 until it is known).
+  double CurrentOffset() const;
+  // Per session so far, the first's (0) included.
+  std::vector<double> OffsetsDb() const;
+
+  // The state in the byte layout the fused front end has written since the option existed.
+  void Encode(ByteWriter* w) const;
+  // Checks sizes against `templates` and that every number is finite; false with r's error set.
+  bool Decode(ByteReader* r, size_t templates);
+
+ private:
+  bool InReferenceUnits() const;
+
+  int min_common_aps_;
+  int min_estimates_;
+  std::optional<double> session_start_s_;
+  uint32_t templates_before_session_ = 0;
+  std::vector<double> estimates_db_;  // the current session's
+  std::vector<double> offsets_db_;    // the earlier sessions'
+  std::vector<uint8_t> calibrated_;   // by template: stored in the reference units
+};
+
+}  // namespace ratslam
+
+#endif  // RATSLAM_FUSION_RSSI_OFFSET_H_
