@@ -108,6 +108,7 @@ struct Setup {
     fabmap_wifi.sensors.fabmap.localiser.localiser.mode = fabmap::FabmapMode::kWifi;
     fabmap_wifi.sensors.fabmap.localiser.virtual_wifi.use_exploration_scans = true;
     fabmap_wifi.sensors.barometer.use_barometer = true;
+    fabmap_wifi.sensors.fabmap.front_end.online_rssi_offset = true;  // its estimates: state
     // Wi-Fi sequence loop closure alone (its poses, loops and links in the saved state).
     PipelineOptions sequence;
     sequence.sensors.front_end.kind = FrontEndKind::kNone;
