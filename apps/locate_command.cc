@@ -435,6 +435,7 @@ int LocateCommand(const Arguments& parsed) {
   j["resamplings"] = filter.resamplings();
   j["walls"] = map->walls().size();
   j["wall_crossings"] = filter.wall_crossings();
+  if (options->particle_filter.online_rssi_offset) j["rssi_offset_db"] = filter.rssi_offset_db();
   if (map->truth_from_map()) {
     j["errors_after_map_alignment"] = true;  // the map is a run's: scored in the truth's frame
     j["map_to_truth_rmse_m"] = map->truth_from_map()->rmse_m;

@@ -10,7 +10,7 @@
 #include "common/byte_buffer.h"
 #include "fusion/floor_rule.h"
 #include "fusion/front_end_internal.h"
-#include "fusion/rssi_offset.h"
+#include "sensors/rssi_offset.h"
 
 namespace ratslam {
 namespace front_end_internal {
@@ -364,7 +364,7 @@ class FabmapFrontEnd : public FrontEnd {
   uint64_t scans_seen_ = 0;    // Wi-Fi scans received
   uint64_t learned_from_ = 0;  // online: scans behind the current model (0: none yet)
   uint64_t relearnt_ = 0;      // online: models built so far
-  // [fabmap_front_end] online_rssi_offset (fusion/rssi_offset.h): the estimator, and per place
+  // [fabmap_front_end] online_rssi_offset (sensors/rssi_offset.h): the estimator, and per place
   // its scan over ap_ids_ (empty without the option or without Wi-Fi).
   RssiOffsetTracker offset_;
   std::vector<Fingerprint> reference_;

@@ -202,7 +202,7 @@ struct FabmapFrontEndOptions {
   int online_first_scans = 20;      // kOnline: scans before the first Wi-Fi model
   bool decide_by_log_odds = false;  // the best place's log odds, not its posterior, decide
   double match_log_odds = 0.0;      // with decide_by_log_odds: least log odds of the best place
-  // Per-device RSSI offset, estimated online as in [fused] (fusion/rssi_offset.h) and removed
+  // Per-device RSSI offset, estimated online as in [fused] (sensors/rssi_offset.h) and removed
   // from a later session's scans before they become Wi-Fi words and places.
   bool online_rssi_offset = false;
   int rssi_offset_min_common_aps = 5;

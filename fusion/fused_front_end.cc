@@ -8,7 +8,7 @@
 #include "common/circular.h"
 #include "fusion/floor_rule.h"
 #include "fusion/front_end_internal.h"
-#include "fusion/rssi_offset.h"
+#include "sensors/rssi_offset.h"
 
 namespace ratslam {
 namespace front_end_internal {
@@ -303,7 +303,7 @@ class FusedFrontEnd : public FrontEnd {
   bool newest_scan_followed_ = false;  // the newest scan updated a template (revisit_update_weight)
   uint64_t aps_added_ = 0, aps_dropped_ = 0;  // by revisit_update_weight, so far
   std::optional<double> heading_rad_;
-  RssiOffsetTracker offset_;  // [fused] online_rssi_offset: see fusion/rssi_offset.h
+  RssiOffsetTracker offset_;  // [fused] online_rssi_offset: see sensors/rssi_offset.h
   FloorRule floors_;          // [barometer] use_barometer: see fusion/floor_rule.h
 };
 

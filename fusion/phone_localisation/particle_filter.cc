@@ -139,10 +139,28 @@ bool OnSegment(const Point2& p, const Point2& q, const Point2& r) {  // q on p-r
          q.y <= std::max(p.y, r.y);
 }
 int Sign(double v) { return (v > 0) - (v < 0); }
+
+// (AP index, RSSI) sorted by AP as a Fingerprint: a repeated AP's readings averaged.
+Fingerprint ToFingerprint(const std::vector<std::pair<int64_t, double>>& sorted) {
+  Fingerprint f;
+  for (size_t i = 0; i < sorted.size();) {
+    size_t j = i;
+    double sum = 0.0;
+    for (; j < sorted.size() && sorted[j].first == sorted[i].first; ++j) sum += sorted[j].second;
+    f.ap_ids.push_back(static_cast<uint32_t>(sorted[i].first));
+    f.rssi_dbm.push_back(static_cast<float>(sum / static_cast<double>(j - i)));
+    i = j;
+  }
+  return f;
+}
 }  // namespace
 
 ParticleFilter::ParticleFilter(const WifiGpMap& map, const ParticleFilterOptions& options)
-    : map_(map), options_(Validated(options)), random_(options.seed), floors_(map.floors()) {
+    : map_(map),
+      options_(Validated(options)),
+      random_(options.seed),
+      floors_(map.floors()),
+      offset_(options.rssi_offset_min_common_aps, options.rssi_offset_min_estimates) {
   for (uint32_t k = 0; k < map_.walls().size(); ++k) {
     const WallSegment& w = map_.walls()[k];
     const int x0 = WallCell(std::min(w.a.x, w.b.x)), x1 = WallCell(std::max(w.a.x, w.b.x));
@@ -163,6 +181,14 @@ ParticleFilter::ParticleFilter(const WifiGpMap& map, const ParticleFilterOptions
     }
     std::sort(f.begin(), f.end());
     fingerprints_.push_back(std::move(f));
+  }
+  if (options_.online_rssi_offset) {
+    offset_.OnSessionStart(0.0, 0);  // the map's scans: the reference units
+    for (const auto& f : fingerprints_) {
+      offset_references_.push_back(ToFingerprint(f));
+      offset_.AddTemplate();
+    }
+    offset_.OnSessionStart(1.0, static_cast<uint32_t>(offset_references_.size()));  // the phone
   }
 }
 
@@ -345,6 +371,14 @@ size_t ParticleFilter::Update(const std::vector<std::pair<std::string, double>>&
     if (ap >= 0 && std::isfinite(rssi)) known.emplace_back(ap, rssi);
   }
   if (known.empty() || particles_.empty()) return known.size();
+  if (options_.online_rssi_offset) {
+    std::vector<std::pair<int64_t, double>> sorted = known;
+    std::sort(sorted.begin(), sorted.end());
+    Fingerprint scan = ToFingerprint(sorted);
+    offset_.Calibrate(offset_references_, &scan);
+    const double offset = offset_.CurrentOffset();
+    for (auto& reading : known) reading.second -= offset;
+  }
   // Floor changes: before weighting, a particle moves to another floor the map knows (same x, y)
   // with probability floor_change_per_scan, so a phone that took the stairs is found again.
   if (options_.floor_change_per_scan > 0.0 && floors_.size() > 1) {

@@ -25,6 +25,12 @@
 //    short walk in a large map, or a filter stuck in a wrong mode, is found again. (Augmented
 //    MCL's adaptive share, 1 - fast/slow of two running averages of the scans' fit, was tried:
 //    mean error over the twelve IPIN rows 2.49 m against 2.05 m for the fixed share.)
+//  - Phones read the same place several dB apart (the map's phone and the located one). With
+//    online_rssi_offset the located phone's offset to the map's training scans is estimated from
+//    its own scans, with no position (sensors/rssi_offset.h: the training scan whose RSSI
+//    differences to a scan spread least gives the median difference as one estimate; after
+//    rssi_offset_min_estimates of them their median is removed from every later scan, before
+//    sensor resetting and weighting).
 // Floors: at each scan a particle moves to another floor the map knows (same x, y) with a small
 // probability, so the filter follows a phone up the stairs without a stairs model; the scan's
 // weight then decides.
@@ -44,6 +50,7 @@
 #include "common/schema.h"
 #include "common/status.h"
 #include "fusion/phone_localisation/wifi_gp_map.h"
+#include "sensors/rssi_offset.h"
 
 namespace ratslam {
 
@@ -72,6 +79,9 @@ struct ParticleFilterOptions {
   ScanLikelihood likelihood = ScanLikelihood::kSum;  // see ScanLikelihood
   int candidates = 12;                               // k of the k-means candidates (section IV-C.2)
   uint64_t seed = 1;                                 // the filter's random generator
+  bool online_rssi_offset = false;                   // see the header comment
+  int rssi_offset_min_common_aps = 5;  // APs a scan shares with a training scan for an estimate
+  int rssi_offset_min_estimates = 10;  // estimates before the offset is removed
 
   bool IsValid(std::string* error) const;
 
@@ -121,6 +131,16 @@ struct ParticleFilterOptions {
     v("candidates", candidates, "k of the k-means candidate locations (the paper's 12)",
       schema::Unit("").AtLeast(1));
     v("seed", seed, "seed of the filter's random generator", schema::Any());
+    v("online_rssi_offset", online_rssi_offset,
+      "estimate the phone's RSSI offset to the map's training scans from its own scans and "
+      "remove it (phones that read several dB apart)",
+      schema::Any());
+    v("rssi_offset_min_common_aps", rssi_offset_min_common_aps,
+      "APs a scan must share with a training scan to estimate the offset",
+      schema::Unit("APs").AtLeast(1));
+    v("rssi_offset_min_estimates", rssi_offset_min_estimates,
+      "offset estimates before their median is removed from the scans",
+      schema::Unit("scans").AtLeast(1));
   }
 };
 
@@ -162,6 +182,9 @@ class ParticleFilter {
   double EffectiveSampleSize() const;
   const std::vector<Particle>& particles() const { return particles_; }
   uint64_t resamplings() const { return resamplings_; }
+  // online_rssi_offset: the offset removed from the scans now (0 until it is known; dBm, the
+  // phone's reading minus the map's).
+  double rssi_offset_db() const { return offset_.CurrentOffset(); }
 
   // The weight eq. 13-14 (or the product) gives one particle at `p` on `floor` (for tests).
   double Likelihood(const Point2& p, int floor,
@@ -194,6 +217,10 @@ class ParticleFilter {
   bool reseeded_ = false;  // whether a scan has reseeded since Initialise
   // The training scans as (AP index, RSSI) sorted by AP, for sensor resetting.
   std::vector<std::vector<std::pair<int64_t, double>>> fingerprints_;
+  // online_rssi_offset: the estimator (the map is its first session, the phone its second) and
+  // the training scans in its terms.
+  RssiOffsetTracker offset_;
+  std::vector<Fingerprint> offset_references_;
 };
 
 // Whether segments p1-p2 and q1-q2 intersect (touching counts).

@@ -1,5 +1,5 @@
 // See rssi_offset.h.
-#include "fusion/rssi_offset.h"
+#include "sensors/rssi_offset.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,6 +1,6 @@
 // A phone's RSSI offset to the map, estimated online per session (issue 12, item 4): phones read
 // the same place several dB apart, a difference that Wi-Fi kernels and RSSI bins both turn into
-// "another place". Shared by the fused and the FABMAP front ends.
+// "another place". Shared by the fused and FABMAP front ends and the phone particle filter.
 //
 // Each scan of a later session is compared with the templates of the earlier sessions that are in
 // the reference units (the first session's, or a later one's once its offset was known); the
@@ -8,8 +8,8 @@
 // there) gives one estimate, the median difference. Once a session has min_estimates estimates,
 // their median is its offset and is removed from its scans, in matching and in the templates it
 // stores. No ground truth, no per-phone constant.
-#ifndef RATSLAM_FUSION_RSSI_OFFSET_H_
-#define RATSLAM_FUSION_RSSI_OFFSET_H_
+#ifndef RATSLAM_SENSORS_RSSI_OFFSET_H_
+#define RATSLAM_SENSORS_RSSI_OFFSET_H_
 
 #include <cstdint>
 #include <optional>
@@ -58,4 +58,4 @@ class RssiOffsetTracker {
 
 }  // namespace ratslam
 
-#endif  // RATSLAM_FUSION_RSSI_OFFSET_H_
+#endif  // RATSLAM_SENSORS_RSSI_OFFSET_H_
