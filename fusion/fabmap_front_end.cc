@@ -245,17 +245,7 @@ class FabmapFrontEnd : public FrontEnd {
       const auto [it, added] = ap_ids_.try_emplace(r.bssid, static_cast<uint32_t>(ap_ids_.size()));
       by_id.emplace_back(it->second, r.rssi_dbm);
     }
-    std::sort(by_id.begin(), by_id.end());
-    Fingerprint f;
-    for (size_t i = 0; i < by_id.size();) {
-      size_t j = i;
-      double sum = 0.0;
-      for (; j < by_id.size() && by_id[j].first == by_id[i].first; ++j) sum += by_id[j].second;
-      f.ap_ids.push_back(by_id[i].first);
-      f.rssi_dbm.push_back(static_cast<float>(sum / static_cast<double>(j - i)));
-      i = j;
-    }
-    return f;
+    return FingerprintOf(std::move(by_id));
   }
   Fingerprint Reference(const fabmap::Query& place) {
     return settings_.front_end.online_rssi_offset && place.wifi ? Intern(*place.wifi)

@@ -9,6 +9,22 @@
 
 namespace ratslam {
 
+Fingerprint FingerprintOf(std::vector<std::pair<uint32_t, double>> readings) {
+  std::sort(readings.begin(), readings.end());
+  Fingerprint f;
+  for (size_t i = 0; i < readings.size();) {
+    size_t j = i;
+    double sum = 0.0;
+    for (; j < readings.size() && readings[j].first == readings[i].first; ++j) {
+      sum += readings[j].second;
+    }
+    f.ap_ids.push_back(readings[i].first);
+    f.rssi_dbm.push_back(static_cast<float>(sum / static_cast<double>(j - i)));
+    i = j;
+  }
+  return f;
+}
+
 void RssiOffsetTracker::OnSessionStart(double start_s, uint32_t templates) {
   if (session_start_s_ && *session_start_s_ == start_s) return;
   if (session_start_s_) offsets_db_.push_back(CurrentOffset());

@@ -13,12 +13,16 @@
 
 #include <cstdint>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "common/byte_buffer.h"
 #include "sensors/wifi_fingerprint_matcher.h"
 
 namespace ratslam {
+
+// Readings (AP id, RSSI) as a Fingerprint: sorted by AP, a repeated AP's readings averaged.
+Fingerprint FingerprintOf(std::vector<std::pair<uint32_t, double>> readings);
 
 class RssiOffsetTracker {
  public:

@@ -8,12 +8,14 @@
 #include <limits>
 #include <system_error>
 #include <tuple>
+#include <unordered_map>
 #include <utility>
 
 #include "fusion/io/visual_model_file.h"
 #include "sensors/dataset/dataset_loader.h"
 #include "sensors/dataset/uji_long_term.h"
 #include "sensors/dataset/ujiindoorloc.h"
+#include "sensors/rssi_offset.h"
 
 namespace ratslam {
 
@@ -205,6 +207,55 @@ StatusOr<std::vector<EvaluationNode>> LoadEvaluationNodes(
   auto d = LoadDataset(path, phone, bag, video);
   if (!d.ok()) return d.status();
   return DatasetNodes(*d, as_map, want_images, options);
+}
+
+std::vector<SessionRssiOffset> RemoveQueryRssiOffsets(
+    const std::vector<fabmap::EvaluationNode>& map, std::vector<fabmap::EvaluationNode>* queries,
+    int min_common_aps, int min_estimates) {
+  std::unordered_map<std::string, uint32_t> ap_ids;
+  auto fingerprint = [&](const std::vector<WifiReading>& readings) {
+    std::vector<std::pair<uint32_t, double>> by_id;
+    by_id.reserve(readings.size());
+    for (const WifiReading& r : readings) {
+      if (!std::isfinite(r.rssi_dbm)) continue;
+      const auto [it, added] = ap_ids.try_emplace(r.bssid, static_cast<uint32_t>(ap_ids.size()));
+      by_id.emplace_back(it->second, r.rssi_dbm);
+    }
+    return FingerprintOf(std::move(by_id));
+  };
+  std::vector<Fingerprint> references;
+  references.reserve(map.size());
+  for (const fabmap::EvaluationNode& n : map) {
+    references.push_back(n.wifi ? fingerprint(*n.wifi) : Fingerprint());
+  }
+  std::vector<int> order;  // sessions by first appearance
+  std::unordered_map<int, std::vector<size_t>> members;
+  for (size_t i = 0; i < queries->size(); ++i) {
+    auto [it, added] = members.try_emplace((*queries)[i].session);
+    if (added) order.push_back((*queries)[i].session);
+    it->second.push_back(i);
+  }
+  std::vector<SessionRssiOffset> offsets;
+  for (int session : order) {
+    std::vector<size_t>& nodes = members.at(session);
+    std::stable_sort(nodes.begin(), nodes.end(), [&](size_t a, size_t b) {
+      return (*queries)[a].time_s < (*queries)[b].time_s;
+    });
+    RssiOffsetTracker tracker(min_common_aps, min_estimates);
+    tracker.OnSessionStart(0.0, 0);  // the map: the reference units
+    for (size_t k = 0; k < references.size(); ++k) tracker.AddTemplate();
+    tracker.OnSessionStart(1.0, static_cast<uint32_t>(references.size()));
+    for (size_t i : nodes) {
+      std::optional<std::vector<WifiReading>>& wifi = (*queries)[i].wifi;
+      if (!wifi || wifi->empty()) continue;
+      Fingerprint scan = fingerprint(*wifi);
+      tracker.Calibrate(references, &scan);
+      const double offset = tracker.CurrentOffset();
+      for (WifiReading& r : *wifi) r.rssi_dbm -= offset;
+    }
+    offsets.push_back({session, tracker.CurrentOffset()});
+  }
+  return offsets;
 }
 
 }  // namespace ratslam

@@ -24,6 +24,21 @@ StatusOr<std::vector<fabmap::EvaluationNode>> LoadEvaluationNodes(
     const fabmap::EvaluationOptions& options, const PhoneLogOptions& phone,
     const BagTopics& bag = {}, const VideoOptions& video = {});
 
+// A query session's RSSI offset to the map (the phone's reading minus the map's, dB).
+struct SessionRssiOffset {
+  int session = 0;
+  double offset_db = 0.0;  // 0: never known (fewer than min_estimates estimates)
+};
+
+// [evaluation] online_rssi_offset: each query session (in order of first appearance), walked in
+// time order, estimates its offset to the map nodes' scans from its own scans as a phone would
+// online (sensors/rssi_offset.h: the map is the reference session), and once min_estimates
+// estimates exist their median is removed from its later scans. No position is used. Every
+// method (FABMAP, k-NN, fingerprint) then sees the corrected scans.
+std::vector<SessionRssiOffset> RemoveQueryRssiOffsets(
+    const std::vector<fabmap::EvaluationNode>& map, std::vector<fabmap::EvaluationNode>* queries,
+    int min_common_aps, int min_estimates);
+
 }  // namespace ratslam
 
 #endif  // RATSLAM_SESSION_EVALUATION_NODES_H_

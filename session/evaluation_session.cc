@@ -114,6 +114,11 @@ Status EvaluationSession::Load() {
                          std::to_string(result_.map.size()) + ", queries " +
                          std::to_string(result_.queries.size()) + ")");
   }
+  if (evaluation.online_rssi_offset) {
+    result_.query_rssi_offsets =
+        RemoveQueryRssiOffsets(result_.map, &result_.queries, evaluation.rssi_offset_min_common_aps,
+                               evaluation.rssi_offset_min_estimates);
+  }
   return Status::Ok();
 }
 
@@ -376,6 +381,13 @@ Status EvaluationSession::WriteOutputs() {
   j["wifi_words"] = result_.wifi_words;
   j["wifi_map_scans"] = result_.wifi_map_scans;
   j["wifi_tree_scans"] = result_.wifi_tree_scans;
+  if (options_.pipeline.evaluation.online_rssi_offset) {
+    nlohmann::ordered_json& offsets = j["query_rssi_offsets_db"];
+    offsets = nlohmann::ordered_json::array();
+    for (const SessionRssiOffset& o : result_.query_rssi_offsets) {
+      offsets.push_back({{"session", o.session}, {"offset_db", o.offset_db}});
+    }
+  }
   j["visual_words"] = result_.visual_words;
   j["query_time_ms"] = result_.query_time_ms;
   result_.wall_time_s = clock_->Seconds() - started_s_;

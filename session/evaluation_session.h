@@ -24,6 +24,7 @@
 #include "fusion/fabmap/visual_model.h"
 #include "fusion/replay_pipeline.h"
 #include "sensors/dataset/image_loader.h"
+#include "session/evaluation_nodes.h"
 
 namespace ratslam {
 
@@ -51,6 +52,8 @@ struct EvaluationResult {
   size_t wifi_words = 0, visual_words = 0;
   size_t wifi_map_scans = 0;   // map scans that define the Wi-Fi words
   size_t wifi_tree_scans = 0;  // of them, those that learnt the Wi-Fi Chow-Liu tree
+  // With [evaluation] online_rssi_offset: per query session, the offset removed from its scans.
+  std::vector<SessionRssiOffset> query_rssi_offsets;
   // The Wi-Fi baselines on the same map and queries (evaluation_baselines.h), by name ("knn",
   // "fingerprint"); empty when the map has no scan.
   std::vector<std::pair<std::string, fabmap::EvaluationMetrics>> baselines;

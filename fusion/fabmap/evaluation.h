@@ -54,6 +54,9 @@ struct EvaluationOptions {
   int calibration_folds = 4;           // map sessions held out in this many interleaved groups
   NewPlaceRule new_place_rule = NewPlaceRule::kYouden;  // how the threshold is chosen
   double new_place_near_recall = 0.95;  // kNearRecall: share of near held-out nodes accepted
+  bool online_rssi_offset = false;      // remove each query session's RSSI offset, online
+  int rssi_offset_min_common_aps = 5;   // APs a query shares with a map scan for an estimate
+  int rssi_offset_min_estimates = 10;   // estimates before a session's offset is removed
 
   bool IsValid(std::string* error) const;
   template <typename Visitor>
@@ -98,6 +101,17 @@ struct EvaluationOptions {
       "new_place_rule = near_recall: share of the held-out nodes near the rest of the map that "
       "the threshold accepts",
       schema::Unit("").Above(0).AtMost(1));
+    v("online_rssi_offset", online_rssi_offset,
+      "estimate each query session's RSSI offset to the map's scans from its own scans, in time "
+      "order as a phone would online, and remove it once known (every method sees the "
+      "corrected scans; phones that read several dB apart)",
+      schema::Any());
+    v("rssi_offset_min_common_aps", rssi_offset_min_common_aps,
+      "APs a query scan must share with a map scan to estimate the offset",
+      schema::Unit("APs").AtLeast(1));
+    v("rssi_offset_min_estimates", rssi_offset_min_estimates,
+      "offset estimates of a query session before its median is removed",
+      schema::Unit("scans").AtLeast(1));
   }
 };
 

@@ -140,18 +140,12 @@ bool OnSegment(const Point2& p, const Point2& q, const Point2& r) {  // q on p-r
 }
 int Sign(double v) { return (v > 0) - (v < 0); }
 
-// (AP index, RSSI) sorted by AP as a Fingerprint: a repeated AP's readings averaged.
-Fingerprint ToFingerprint(const std::vector<std::pair<int64_t, double>>& sorted) {
-  Fingerprint f;
-  for (size_t i = 0; i < sorted.size();) {
-    size_t j = i;
-    double sum = 0.0;
-    for (; j < sorted.size() && sorted[j].first == sorted[i].first; ++j) sum += sorted[j].second;
-    f.ap_ids.push_back(static_cast<uint32_t>(sorted[i].first));
-    f.rssi_dbm.push_back(static_cast<float>(sum / static_cast<double>(j - i)));
-    i = j;
-  }
-  return f;
+// (AP index, RSSI) readings as a Fingerprint.
+Fingerprint ToFingerprint(const std::vector<std::pair<int64_t, double>>& readings) {
+  std::vector<std::pair<uint32_t, double>> by_id;
+  by_id.reserve(readings.size());
+  for (const auto& [ap, rssi] : readings) by_id.emplace_back(static_cast<uint32_t>(ap), rssi);
+  return FingerprintOf(std::move(by_id));
 }
 }  // namespace
 
@@ -372,9 +366,7 @@ size_t ParticleFilter::Update(const std::vector<std::pair<std::string, double>>&
   }
   if (known.empty() || particles_.empty()) return known.size();
   if (options_.online_rssi_offset) {
-    std::vector<std::pair<int64_t, double>> sorted = known;
-    std::sort(sorted.begin(), sorted.end());
-    Fingerprint scan = ToFingerprint(sorted);
+    Fingerprint scan = ToFingerprint(known);
     offset_.Calibrate(offset_references_, &scan);
     const double offset = offset_.CurrentOffset();
     for (auto& reading : known) reading.second -= offset;
