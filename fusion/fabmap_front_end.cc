@@ -238,14 +238,7 @@ class FabmapFrontEnd : public FrontEnd {
   // A scan as a fingerprint over this front end's own AP ids (for the RSSI offset estimate):
   // sorted by id, a repeated AP's readings averaged.
   Fingerprint Intern(const std::vector<WifiReading>& readings) {
-    std::vector<std::pair<uint32_t, double>> by_id;
-    by_id.reserve(readings.size());
-    for (const WifiReading& r : readings) {
-      if (!std::isfinite(r.rssi_dbm)) continue;
-      const auto [it, added] = ap_ids_.try_emplace(r.bssid, static_cast<uint32_t>(ap_ids_.size()));
-      by_id.emplace_back(it->second, r.rssi_dbm);
-    }
-    return FingerprintOf(std::move(by_id));
+    return InternedFingerprint(readings, &ap_ids_);
   }
   Fingerprint Reference(const fabmap::Query& place) {
     return settings_.front_end.online_rssi_offset && place.wifi ? Intern(*place.wifi)

@@ -11,8 +11,11 @@
 #ifndef RATSLAM_SENSORS_RSSI_OFFSET_H_
 #define RATSLAM_SENSORS_RSSI_OFFSET_H_
 
+#include <cmath>
 #include <cstdint>
 #include <optional>
+#include <string>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -23,6 +26,20 @@ namespace ratslam {
 
 // Readings (AP id, RSSI) as a Fingerprint: sorted by AP, a repeated AP's readings averaged.
 Fingerprint FingerprintOf(std::vector<std::pair<uint32_t, double>> readings);
+
+// A scan (objects with `bssid` and `rssi_dbm`, e.g. WifiReading) as a Fingerprint over the AP ids
+// in `ids` (a BSSID not in it gets the next id); readings that are not finite are dropped.
+template <typename Readings>
+Fingerprint InternedFingerprint(const Readings& readings,
+                                std::unordered_map<std::string, uint32_t>* ids) {
+  std::vector<std::pair<uint32_t, double>> by_id;
+  for (const auto& r : readings) {
+    if (!std::isfinite(r.rssi_dbm)) continue;
+    const auto it = ids->try_emplace(r.bssid, static_cast<uint32_t>(ids->size())).first;
+    by_id.emplace_back(it->second, r.rssi_dbm);
+  }
+  return FingerprintOf(std::move(by_id));
+}
 
 class RssiOffsetTracker {
  public:

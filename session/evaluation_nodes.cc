@@ -214,14 +214,7 @@ std::vector<SessionRssiOffset> RemoveQueryRssiOffsets(
     int min_common_aps, int min_estimates) {
   std::unordered_map<std::string, uint32_t> ap_ids;
   auto fingerprint = [&](const std::vector<WifiReading>& readings) {
-    std::vector<std::pair<uint32_t, double>> by_id;
-    by_id.reserve(readings.size());
-    for (const WifiReading& r : readings) {
-      if (!std::isfinite(r.rssi_dbm)) continue;
-      const auto [it, added] = ap_ids.try_emplace(r.bssid, static_cast<uint32_t>(ap_ids.size()));
-      by_id.emplace_back(it->second, r.rssi_dbm);
-    }
-    return FingerprintOf(std::move(by_id));
+    return InternedFingerprint(readings, &ap_ids);
   };
   std::vector<Fingerprint> references;
   references.reserve(map.size());
