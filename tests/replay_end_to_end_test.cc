@@ -554,24 +554,26 @@ class SimulatedSaveResumeTest : public ::testing::Test {
     delete root_;
     root_ = nullptr;
   }
-  static std::string Args(const std::string& config, const fs::path& out) {
-    return "replay --quiet --config " + config + " --data " + (root_->path() / "data").string() +
-           " --out " + out.string();
+  static std::string Args(const std::string& config, const fs::path& out,
+                          const fs::path& data = {}) {
+    return "replay --quiet --config " + config + " --data " +
+           (data.empty() ? root_->path() / "data" : data).string() + " --out " + out.string();
   }
   // Runs whole, then in two halves split at `until_s`; the halves must equal the whole.
-  static void ExpectResumeEqualsWhole(const std::string& config, double until_s) {
+  static void ExpectResumeEqualsWhole(const std::string& config, double until_s,
+                                      const fs::path& data = {}) {
     const fs::path& dir = root_->path();
     const std::string stem = fs::path(config).stem().string();
     const fs::path whole = dir / (stem + "_whole"), part = dir / (stem + "_part"),
                    rest = dir / (stem + "_rest"), map = dir / (stem + ".map");
-    ASSERT_EQ(RunRatslam(Args(config, whole), dir).exit_code, 0);
-    ASSERT_EQ(RunRatslam(Args(config, part) + " --until " + std::to_string(until_s) +
+    ASSERT_EQ(RunRatslam(Args(config, whole, data), dir).exit_code, 0);
+    ASSERT_EQ(RunRatslam(Args(config, part, data) + " --until " + std::to_string(until_s) +
                              " --save-map " + map.string(),
                          dir)
                   .exit_code,
               0);
     EXPECT_EQ(Summary(part)["finished"], false);
-    const Result r = RunRatslam(Args(config, rest) + " --load-map " + map.string(), dir);
+    const Result r = RunRatslam(Args(config, rest, data) + " --load-map " + map.string(), dir);
     ASSERT_EQ(r.exit_code, 0) << r.err;
     ExpectSameRun(whole, rest);
     // Matches before and after the split, so the front end's restored places were used.
@@ -623,6 +625,42 @@ TEST_F(SimulatedSaveResumeTest, FabmapFrontEnd) {
                            "[virtual_wifi]\nuse_exploration_scans = true\n"
                            "[pose_cells]\ncell_size_m = 2.0\n";
   ExpectResumeEqualsWhole(config.string(), 250.0);
+}
+
+// The same with the online RSSI offset, on a copy of the data whose second session (from 178 s)
+// reads 6 dB lower, as another phone would: the split (250 s) falls after that session's offset
+// became known (3 estimates), so the restored estimates and the places' fingerprints (their APs
+// numbered afresh on load) must carry the rest of the run identically.
+TEST_F(SimulatedSaveResumeTest, FabmapFrontEndWithOnlineRssiOffset) {
+  const fs::path data = root_->path() / "data-second-phone";
+  fs::copy(root_->path() / "data", data, fs::copy_options::recursive);
+  {
+    std::ifstream in(data / "wifi.csv");
+    std::stringstream out;
+    std::string line;
+    std::getline(in, line);
+    ASSERT_EQ(line, "time_s,bssid,rssi_dbm");
+    out << line << "\n";
+    while (std::getline(in, line)) {
+      const size_t a = line.find(','), b = line.rfind(',');
+      const double t = std::stod(line.substr(0, a)), rssi = std::stod(line.substr(b + 1));
+      out << line.substr(0, b + 1) << (t >= 177.8 ? rssi - 6.0 : rssi) << "\n";
+    }
+    in.close();
+    std::ofstream(data / "wifi.csv") << out.str();
+  }
+  const fs::path config = root_->path() / "fabmap-wifi-offset.toml";
+  std::ofstream(config) << "[front_end]\nkind = \"fabmap\"\n[fabmap]\nmode = \"wifi\"\n"
+                           "[fabmap_front_end]\nmatch_probability = 0.5\nrecency_s = 40.0\n"
+                           "online_rssi_offset = true\nrssi_offset_min_estimates = 3\n"
+                           "[wifi_words]\nbins = 4\nencoding = \"incremental\"\n"
+                           "[virtual_wifi]\nuse_exploration_scans = true\n"
+                           "[pose_cells]\ncell_size_m = 2.0\n";
+  ExpectResumeEqualsWhole(config.string(), 250.0, data);
+  const nlohmann::json part = Summary(root_->path() / "fabmap-wifi-offset_part");
+  ASSERT_TRUE(part.contains("wifi_rssi_offsets_db")) << part.dump();
+  ASSERT_EQ(part["wifi_rssi_offsets_db"].size(), 2u);  // both sessions began before the split
+  EXPECT_NEAR(part["wifi_rssi_offsets_db"][1].get<double>(), -6.0, 1.0);  // known by then
 }
 
 TEST_F(ReplayEndToEndTest, ResumeWithAnotherConfigIsRefused) {
