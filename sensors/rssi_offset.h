@@ -1,6 +1,7 @@
 // A phone's RSSI offset to the map, estimated online per session (issue 12, item 4): phones read
 // the same place several dB apart, a difference that Wi-Fi kernels and RSSI bins both turn into
-// "another place". Shared by the fused and FABMAP front ends and the phone particle filter.
+// "another place". Shared by the fused and FABMAP front ends, the phone particle filter and
+// evaluate (per query session).
 //
 // Each scan of a later session is compared with the templates of the earlier sessions that are in
 // the reference units (the first session's, or a later one's once its offset was known); the
