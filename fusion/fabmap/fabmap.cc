@@ -2,8 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
+#include <ranges>
 #include <utility>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace ratslam::fabmap {
 
@@ -153,6 +159,7 @@ void FabmapModel::Index(PlaceIndex* index, Observation observation) const {
     index->postings[q].push_back(place);
     offset += seen_[q][0][0] - unseen_[q][0][0];
   }
+  index->total_words += observation.size();
   index->seen_offset.push_back(offset);
   index->observations.push_back(std::move(observation));
 }
@@ -172,20 +179,45 @@ FabmapModel::Active FabmapModel::ActiveWords(const Observation& z) const {
   };
   auto set = [](std::vector<uint64_t>& bits, WordId q) { bits[q >> 6] |= uint64_t{1} << (q & 63); };
   for (WordId q : z) set(in_query, q);
-  Active active;
-  active.words.reserve(z.size() * 2);
+  struct Word {
+    WordId q;
+    uint8_t z, z_parent;
+    double delta;
+  };
+  std::vector<Word> found;
+  found.reserve(z.size() * 2);
   auto add = [&](WordId q) {
     if (test(seen, q)) return;
     set(seen, q);
     const WordId p = tree_.parent[q];
-    active.words.push_back(q);
-    active.z.push_back(static_cast<uint8_t>(test(in_query, q)));
-    active.z_parent.push_back(
-        static_cast<uint8_t>(p != ChowLiuTree::kNoParent && test(in_query, p)));
+    const int zq = static_cast<int>(test(in_query, q));
+    const int zp = static_cast<int>(p != ChowLiuTree::kNoParent && test(in_query, p));
+    const double delta =
+        (seen_[q][zq][zp] - unseen_[q][zq][zp]) - (seen_[q][0][0] - unseen_[q][0][0]);
+    found.push_back({q, static_cast<uint8_t>(zq), static_cast<uint8_t>(zp), delta});
   };
   for (WordId q : z) {
     add(q);
     for (uint32_t c = child_begin_[q]; c < child_begin_[q + 1]; ++c) add(children_[c]);
+  }
+  // A stable partition, without branches: positive deltas first, each group in found's order.
+  const size_t k = found.size();
+  Active active;
+  active.words.resize(k);
+  active.z.resize(k);
+  active.z_parent.resize(k);
+  active.delta.resize(k);
+  for (const Word& w : found) active.positive += w.delta > 0.0;
+  size_t next_positive = 0, next_other = active.positive;
+  for (const Word& w : found) {
+    const bool positive = w.delta > 0.0;
+    const size_t i = positive ? next_positive : next_other;
+    next_positive += positive;
+    next_other += !positive;
+    active.words[i] = w.q;
+    active.z[i] = w.z;
+    active.z_parent[i] = w.z_parent;
+    active.delta[i] = w.delta;
   }
   return active;
 }
@@ -199,6 +231,17 @@ double FabmapModel::UnseenLogLikelihood(const Active& active) const {
   return sum;
 }
 
+void FabmapModel::Scatter(const PlaceIndex& index, const Active& active, size_t begin, size_t end,
+                          double* score) {
+  for (size_t i = begin; i < end; ++i) {
+    const double delta = active.delta[i];
+    const std::vector<uint32_t>& places = index.postings[active.words[i]];
+    const uint32_t* place = places.data();
+#pragma GCC unroll 4
+    for (size_t k = 0, m = places.size(); k < m; ++k) score[place[k]] += delta;
+  }
+}
+
 void FabmapModel::IndexLogLikelihoods(const PlaceIndex& index, const Active& active,
                                       std::vector<double>* out) const {
   const double unseen = UnseenLogLikelihood(active);
@@ -207,16 +250,7 @@ void FabmapModel::IndexLogLikelihoods(const PlaceIndex& index, const Active& act
   double* score = out->data();
   const double* offset = index.seen_offset.data();
   for (size_t i = 0; i < n; ++i) score[i] = unseen + offset[i];
-  for (size_t i = 0; i < active.words.size(); ++i) {
-    const WordId q = active.words[i];
-    const int zq = active.z[i], zp = active.z_parent[i];
-    const double delta =
-        (seen_[q][zq][zp] - unseen_[q][zq][zp]) - (seen_[q][0][0] - unseen_[q][0][0]);
-    const std::vector<uint32_t>& places = index.postings[q];
-    const uint32_t* place = places.data();
-#pragma GCC unroll 4
-    for (size_t k = 0, m = places.size(); k < m; ++k) score[place[k]] += delta;
-  }
+  Scatter(index, active, 0, active.words.size(), score);
 }
 
 void FabmapModel::LogLikelihoods(const Observation& z, std::vector<double>* log_likelihood) const {
@@ -254,46 +288,120 @@ double FabmapModel::UnknownLogLikelihood(const Active& active) const {
   return sum;
 }
 
-LocalisationResult FabmapModel::Normalise(std::vector<double> log_likelihood,
-                                          double unknown_log_likelihood) const {
-  LocalisationResult result;
-  const size_t n = log_likelihood.size();
-  const double log_new = std::log(options_.p_new_place) + unknown_log_likelihood;
-  const double log_place_prior =
-      n > 0 ? std::log((1.0 - options_.p_new_place) / static_cast<double>(n)) : 0.0;
-  double* p = log_likelihood.data();
-  size_t best = 0;
-  for (size_t i = 1; i < n; ++i) {
-    if (p[i] > p[best]) best = i;
-  }
-  const double best_log_likelihood = n > 0 ? p[best] : 0.0;
-  const double top = n > 0 ? std::max(log_new, best_log_likelihood + log_place_prior) : log_new;
-  const double new_weight = std::exp(log_new - top);
-  double total = new_weight;
-  // A place e^-40 (4e-18) below the best changes no sum in double precision: it costs no exp
-  // and its probability is reported as 0. The others are few: they alone are rescaled below.
-  constexpr double kUnderflow = -40.0;
-  std::vector<uint32_t> kept;  // local: Localise stays safe to call from several threads
-  for (size_t i = 0; i < n; ++i) {
-    const double relative = p[i] + log_place_prior - top;
-    if (relative < kUnderflow) {
-      p[i] = 0.0;
-    } else {
-      p[i] = std::exp(relative);
-      total += p[i];
-      kept.push_back(static_cast<uint32_t>(i));
+namespace {
+
+// A place e^-40 (4e-18) below the best changes no sum in double precision: it costs no exp and
+// its probability is reported as 0.
+constexpr double kUnderflow = -40.0;
+// Localise rules a place out this far beyond the underflow: far more than any rounding of the
+// sums here (below 1e-9 nats), so a ruled-out place would have been reported as 0 for certain.
+constexpr double kRuleOutMargin = 1.0;
+
+// The first index of the largest of s[0..n) (n > 0; no NaN): the maximum by blocks, two lanes
+// at a time, then the first block holding it is searched.
+size_t ArgMax(const double* s, size_t n) {
+  constexpr size_t kBlock = 512;
+  double best = s[0];
+  size_t best_block = 0;
+  for (size_t b = 0; b < n; b += kBlock) {
+    const size_t end = std::min(n, b + kBlock);
+    size_t i = b;
+    double m = s[b];
+#if defined(__SSE2__)
+    __m128d m0 = _mm_set1_pd(m), m1 = m0;
+    for (; i + 4 <= end; i += 4) {
+      m0 = _mm_max_pd(m0, _mm_loadu_pd(s + i));
+      m1 = _mm_max_pd(m1, _mm_loadu_pd(s + i + 2));
+    }
+    m0 = _mm_max_pd(m0, m1);
+    m = std::max(_mm_cvtsd_f64(m0), _mm_cvtsd_f64(_mm_unpackhi_pd(m0, m0)));
+#endif
+    for (; i < end; ++i) m = std::max(m, s[i]);
+    if (m > best) {
+      best = m;
+      best_block = b;
     }
   }
+  size_t i = best_block;
+  while (s[i] != best) ++i;
+  return i;
+}
+
+// Appends to `ids` the indices of s[0..n) at or above `threshold`; stops (returning false) when
+// a `limit`+1-th would be added.
+bool AtOrAbove(const double* s, size_t n, double threshold, size_t limit,
+               std::vector<uint32_t>* ids) {
+  size_t i = 0;
+#if defined(__SSE2__)
+  const __m128d t = _mm_set1_pd(threshold);
+  for (; i + 4 <= n; i += 4) {
+    const __m128d a = _mm_cmpge_pd(_mm_loadu_pd(s + i), t);
+    const __m128d b = _mm_cmpge_pd(_mm_loadu_pd(s + i + 2), t);
+    if (_mm_movemask_pd(_mm_or_pd(a, b)) == 0) continue;
+    for (size_t k = i; k < i + 4; ++k) {
+      if (!(s[k] >= threshold)) continue;
+      if (ids->size() == limit) return false;
+      ids->push_back(static_cast<uint32_t>(k));
+    }
+  }
+#endif
+  for (; i < n; ++i) {
+    if (!(s[i] >= threshold)) continue;
+    if (ids->size() == limit) return false;
+    ids->push_back(static_cast<uint32_t>(i));
+  }
+  return true;
+}
+
+}  // namespace
+
+namespace {
+
+// Normalise over the places `ids` lists (ascending; every other place's probability is 0).
+// With `others_zero`, the entries of places not in `ids` are 0 already.
+template <typename Ids>
+LocalisationResult NormaliseOver(std::vector<double> log_likelihood, const Ids& ids,
+                                 bool others_zero, double p_new_place,
+                                 double unknown_log_likelihood) {
+  LocalisationResult result;
+  const size_t n = log_likelihood.size();
+  const double log_new = std::log(p_new_place) + unknown_log_likelihood;
+  const double log_place_prior =
+      n > 0 ? std::log((1.0 - p_new_place) / static_cast<double>(n)) : 0.0;
+  double* p = log_likelihood.data();
+  const bool any = std::begin(ids) != std::end(ids);
+  uint32_t best = any ? static_cast<uint32_t>(*std::begin(ids)) : 0;
+  for (const auto i : ids) {
+    if (p[i] > p[best]) best = static_cast<uint32_t>(i);
+  }
+  const double best_log_likelihood = any ? p[best] : 0.0;
+  const double top = any ? std::max(log_new, best_log_likelihood + log_place_prior) : log_new;
+  const double new_weight = std::exp(log_new - top);
+  double total = new_weight;
+  // The places above the underflow are few: they alone are rescaled below.
+  std::vector<std::pair<uint32_t, double>> kept;  // local: Localise stays thread safe
+  for (const auto i : ids) {
+    const double relative = p[i] + log_place_prior - top;
+    if (relative >= kUnderflow) {
+      kept.emplace_back(static_cast<uint32_t>(i), std::exp(relative));
+      total += kept.back().second;
+    }
+  }
+  if (others_zero) {
+    for (const auto i : ids) p[i] = 0.0;
+  } else {
+    std::fill(log_likelihood.begin(), log_likelihood.end(), 0.0);
+  }
   const double inverse = 1.0 / total;
-  for (uint32_t i : kept) p[i] *= inverse;
+  for (const auto& [i, weight] : kept) p[i] = weight * inverse;
   result.new_place_probability = new_weight * inverse;
   result.best_probability = result.new_place_probability;
-  if (n > 0) {
+  if (any) {
     result.best_mapped_place = static_cast<int64_t>(best);
     result.best_mapped_probability = p[best];
     result.best_mapped_log_odds = best_log_likelihood + log_place_prior - log_new;
   }
-  if (n > 0 && p[best] > result.best_probability) {  // a tie goes to the new place
+  if (any && p[best] > result.best_probability) {  // a tie goes to the new place
     result.best_probability = p[best];
     result.best_place = static_cast<int64_t>(best);
   }
@@ -301,12 +409,88 @@ LocalisationResult FabmapModel::Normalise(std::vector<double> log_likelihood,
   return result;
 }
 
-LocalisationResult FabmapModel::Localise(const Observation& z) const {
+}  // namespace
+
+LocalisationResult FabmapModel::Normalise(std::vector<double> log_likelihood,
+                                          double unknown_log_likelihood) const {
+  const auto all = std::views::iota(size_t{0}, log_likelihood.size());
+  return NormaliseOver(std::move(log_likelihood), all, false, options_.p_new_place,
+                       unknown_log_likelihood);
+}
+
+LocalisationResult FabmapModel::NormaliseAmong(std::vector<double> log_likelihood,
+                                               const std::vector<uint32_t>& candidates,
+                                               double unknown_log_likelihood) const {
+  return NormaliseOver(std::move(log_likelihood), candidates, true, options_.p_new_place,
+                       unknown_log_likelihood);
+}
+
+LocalisationResult FabmapModel::LocaliseExhaustive(const Observation& z) const {
   const Active active = ActiveWords(z);
   std::vector<double> log_likelihood;
   IndexLogLikelihoods(mapped_, active, &log_likelihood);
   const double unknown = UnknownLogLikelihood(active);
   return Normalise(std::move(log_likelihood), unknown);
+}
+
+LocalisationResult FabmapModel::Localise(const Observation& z) const {
+  // See the header: the positive words for every place, then the rest only for the places that
+  // can still have a posterior above the underflow or be the best.
+  const Active active = ActiveWords(z);
+  const double unknown = UnknownLogLikelihood(active);
+  const size_t n = mapped_.observations.size();
+  const size_t m = active.words.size();
+  std::vector<double> log_likelihood(n);
+  double* score = log_likelihood.data();
+  const double unseen = UnseenLogLikelihood(active);
+  for (size_t i = 0; i < n; ++i) score[i] = unseen + mapped_.seen_offset[i];
+  Scatter(mapped_, active, 0, active.positive, score);
+  size_t remaining_postings = 0;
+  for (size_t i = active.positive; i < m; ++i) {
+    remaining_postings += mapped_.postings[active.words[i]].size();
+  }
+  // Completing a place walks its own words and the remaining active ones; that must cost well
+  // under the postings it saves.
+  const double walk = static_cast<double>(m - active.positive) +
+                      (n > 0 ? static_cast<double>(mapped_.total_words) / n : 0.0) + 1.0;
+  const size_t max_candidates = static_cast<size_t>(0.5 * remaining_postings / walk);
+  if (n == 0 || max_candidates == 0) {
+    Scatter(mapped_, active, active.positive, m, score);
+    return Normalise(std::move(log_likelihood), unknown);
+  }
+  // Bit set of one place's words, cleared after each use.
+  std::vector<uint64_t> bits((vocabulary_size() + 63) / 64, 0);
+  auto complete = [&](uint32_t place) {
+    const Observation& words = mapped_.observations[place];
+    for (WordId q : words) bits[q >> 6] |= uint64_t{1} << (q & 63);
+    double sum = score[place];
+    for (size_t i = active.positive; i < m; ++i) {
+      const WordId q = active.words[i];
+      if ((bits[q >> 6] >> (q & 63)) & 1) sum += active.delta[i];
+    }
+    for (WordId q : words) bits[q >> 6] = 0;
+    return sum;
+  };
+  // Every remaining delta is <= 0, so a partial sum is an upper bound of the place's final sum,
+  // and the final sum of the place with the best partial one a lower bound of the best final.
+  const double best_lower = complete(static_cast<uint32_t>(ArgMax(score, n)));
+  const double log_place_prior = std::log((1.0 - options_.p_new_place) / static_cast<double>(n));
+  const double new_place = std::log(options_.p_new_place) + unknown - log_place_prior;
+  const double threshold =
+      std::min(best_lower, std::max(best_lower, new_place) + kUnderflow - kRuleOutMargin) -
+      kRuleOutMargin;
+  std::vector<uint32_t> candidates;
+  if (!AtOrAbove(score, n, threshold, max_candidates, &candidates)) {
+    Scatter(mapped_, active, active.positive, m, score);
+    return Normalise(std::move(log_likelihood), unknown);
+  }
+  std::vector<double> final_sum(candidates.size());
+  for (size_t k = 0; k < candidates.size(); ++k) final_sum[k] = complete(candidates[k]);
+  std::fill(log_likelihood.begin(), log_likelihood.end(), 0.0);
+  for (size_t k = 0; k < candidates.size(); ++k) score[candidates[k]] = final_sum[k];
+  LocalisationResult result = NormaliseAmong(std::move(log_likelihood), candidates, unknown);
+  result.places_ruled_out = static_cast<uint32_t>(n - candidates.size());
+  return result;
 }
 
 LocalisationResult FabmapModel::LocaliseAmong(const Observation& z,

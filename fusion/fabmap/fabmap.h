@@ -15,6 +15,20 @@
 // query. An inverted index over words visits only places that saw an active word. The dense
 // FABMAP 1.0 sum over all words is kept as DenseLogLikelihood, the test oracle.
 //
+// Localise rules most places out before their last words, exactly. A place's log-likelihood is a
+// start value plus one delta per active word it saw; the active words are summed in a fixed order,
+// those whose delta is positive first. After the positive ones, every place's partial sum bounds
+// its final one from above, and the final sum of the place with the best partial sum (its last
+// words added) bounds the best final one from below. A place whose partial sum is below that
+// bound cannot be the best, and one more than 41 nats below it (and below the new place) has a
+// posterior that Normalise would report as 0 anyway (e^-40 below the best). So only the places
+// above both limits get their last words, by a walk over their own words rather than over the
+// posting lists, and the others' probabilities are 0. When too many places are left for that to
+// pay (near copies of one place, or a flat posterior), the scatter simply goes on. Either way
+// every number is the one the exhaustive sum gives, to the bit (LocaliseExhaustive is the test
+// oracle). This is FAB-MAP 2.0's bail-out with a bound that always holds instead of a
+// probabilistic one.
+//
 // Normalisation (eq. 3): p(L_i|Z) = p(Z|L_i) p(L_i) / (sum_m p(Z|L_m) p(L_m) + p_new p(Z|L_u)),
 // p(L_m) = (1 - p_new) / n_M. The unknown-world likelihood p(Z|L_u) comes from
 //   - kSampled: the mean of p(Z|L_u) over unknown-world sample observations (the paper's eq. 3);
@@ -98,6 +112,9 @@ struct LocalisationResult {
   // log-likelihoods so that it stays finite where both posteriors saturate (0 and 1): the margin
   // by which the best mapped place beat (> 0) or lost to the new place. -inf with no place.
   double best_mapped_log_odds = -std::numeric_limits<double>::infinity();
+  // Places ruled out (probability exactly 0) before their last words were summed: a measure of
+  // the work Localise saved, not of the answer (which is the exhaustive one).
+  uint32_t places_ruled_out = 0;
 };
 
 class FabmapModel {
@@ -125,6 +142,9 @@ class FabmapModel {
 
   // The posterior over mapped places and the new place (eq. 3, uniform priors, eq. 5 arg-max).
   LocalisationResult Localise(const Observation& z) const;
+  // The same with every place's log-likelihood summed in full (the test oracle of Localise's
+  // bound: equal to the bit, but for places_ruled_out).
+  LocalisationResult LocaliseExhaustive(const Observation& z) const;
   // The same over a subset of places (normalised over them plus the new place); the result's
   // place_probability follows `candidates`' order, best_place is a place id.
   LocalisationResult LocaliseAmong(const Observation& z,
@@ -137,24 +157,37 @@ class FabmapModel {
     std::vector<Observation> observations;
     std::vector<std::vector<uint32_t>> postings;  // word -> places that saw it
     std::vector<double> seen_offset;  // per place: sum over its words of the all-zero delta
+    size_t total_words = 0;           // over all places
   };
 
   FabmapModel() = default;
   void Index(PlaceIndex* index, Observation observation) const;
-  // Query bits of the active words: the query's words and their children.
+  // Query bits of the active words (the query's words and their children) and the change each
+  // makes to the log-likelihood of a place that saw it; the words with a positive change come
+  // first (`positive` of them), which is the order every sum over them follows.
   struct Active {
     std::vector<WordId> words;
     std::vector<uint8_t> z, z_parent;
+    std::vector<double> delta;
+    size_t positive = 0;
   };
   Active ActiveWords(const Observation& z) const;
   double UnseenLogLikelihood(const Active& active) const;
   double UnknownLogLikelihood(const Active& active) const;
   void IndexLogLikelihoods(const PlaceIndex& index, const Active& active,
                            std::vector<double>* out) const;
+  // Adds active words [begin, end) to every place that saw them.
+  static void Scatter(const PlaceIndex& index, const Active& active, size_t begin, size_t end,
+                      double* score);
   // Turns per-place log-likelihoods into the posterior, in place: the vector becomes the result's
   // place_probability (no second allocation; only places above the underflow are rescaled).
   LocalisationResult Normalise(std::vector<double> log_likelihood,
                                double unknown_log_likelihood) const;
+  // The same when only `candidates` (ascending) can have a non-zero posterior; the others'
+  // entries in `log_likelihood` must be 0 already.
+  LocalisationResult NormaliseAmong(std::vector<double> log_likelihood,
+                                    const std::vector<uint32_t>& candidates,
+                                    double unknown_log_likelihood) const;
 
   ChowLiuTree tree_;
   FabmapOptions options_;

@@ -198,6 +198,57 @@ TEST(FabmapTest, NewPlaceStaysCalibratedAtTenThousandPlaces) {
   RecordProperty("sampled_new_called_new", sampled_new_called_new);
 }
 
+// Localise rules places out before their last words (fabmap.h); every number must still be the
+// exhaustive one, to the bit: on revisits (one place stands out), new places (the new place wins
+// and every place is ruled out), a map of near copies (too many places survive the bound, so the
+// scatter goes on), both unknown-world estimates and the openFABMAP detector.
+TEST(FabmapTest, RulingPlacesOutChangesNoNumber) {
+  const World w = MakeWorld(2000, 100, 12);
+  for (const UnknownWorld unknown : {UnknownWorld::kMeanField, UnknownWorld::kSampled}) {
+    for (const double p_detect : {0.8, 0.39}) {
+      FabmapModel model = MakeModel(w, unknown, p_detect);
+      Random random(13);
+      std::vector<Observation> places;
+      for (int i = 0; i < 3000; ++i) {
+        places.push_back(w.words.SamplePlace(&random));
+        // A run of 200 observations of one place: near copies that all survive the bound.
+        const Observation& truth = i >= 1000 && i < 1200 ? places[1000] : places.back();
+        ASSERT_TRUE(model.AddPlace(w.words.Observe(truth, &random)).ok());
+      }
+      uint64_t ruled_out = 0;
+      int queries = 0;
+      auto check = [&](const Observation& z) -> uint32_t {
+        const LocalisationResult fast = model.Localise(z);
+        const LocalisationResult slow = model.LocaliseExhaustive(z);
+        EXPECT_EQ(fast.best_place, slow.best_place);
+        EXPECT_EQ(fast.best_probability, slow.best_probability);
+        EXPECT_EQ(fast.new_place_probability, slow.new_place_probability);
+        EXPECT_EQ(fast.best_mapped_place, slow.best_mapped_place);
+        EXPECT_EQ(fast.best_mapped_probability, slow.best_mapped_probability);
+        EXPECT_EQ(fast.best_mapped_log_odds, slow.best_mapped_log_odds);
+        EXPECT_TRUE(fast.place_probability == slow.place_probability);
+        EXPECT_EQ(slow.places_ruled_out, 0u);
+        ruled_out += fast.places_ruled_out;
+        ++queries;
+        return fast.places_ruled_out;
+      };
+      int revisits_mostly_ruled_out = 0, copies_none_ruled_out = 0;
+      for (int i = 0; i < 30; ++i) {
+        check(w.words.Observe(w.words.SamplePlace(&random), &random));  // a new place
+        revisits_mostly_ruled_out += check(w.words.Observe(places[random.NextU64() % 1000],
+                                                           &random)) > model.places() * 9 / 10;
+        copies_none_ruled_out += check(w.words.Observe(places[1000], &random)) == 0;
+        ASSERT_FALSE(HasFailure());
+      }
+      check({});  // nothing observed
+      // The bound did its work on revisits, and the near copies took the other path.
+      EXPECT_GE(revisits_mostly_ruled_out, 25) << ToString(unknown) << " " << p_detect;
+      EXPECT_GE(copies_none_ruled_out, 25) << ToString(unknown) << " " << p_detect;
+      RecordProperty("mean_ruled_out_" + ToString(unknown), static_cast<int>(ruled_out / queries));
+    }
+  }
+}
+
 TEST(FabmapTest, LocaliseAmongCandidates) {
   const World w = MakeWorld(500, 40, 9);
   FabmapModel model = MakeModel(w);
