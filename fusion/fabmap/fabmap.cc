@@ -311,7 +311,7 @@ constexpr double kUnderflow = -40.0;
 // sums here (below 1e-9 nats), so a ruled-out place would have been reported as 0 for certain.
 constexpr double kRuleOutMargin = 1.0;
 
-// The first index of the largest of s[0..n) (n > 0; no NaN): the maximum by blocks, two lanes
+// The first index of the largest of s[0..n) (n > 0): the maximum by blocks, two lanes
 // at a time, then the first block holding it is searched.
 size_t ArgMax(const double* s, size_t n) {
   constexpr size_t kBlock = 512;
@@ -336,9 +336,12 @@ size_t ArgMax(const double* s, size_t n) {
       best_block = b;
     }
   }
-  size_t i = best_block;
-  while (s[i] != best) ++i;
-  return i;
+  // Bounded: a NaN (which no sum here should make) must not run the search off the block.
+  const size_t end = std::min(n, best_block + kBlock);
+  for (size_t i = best_block; i < end; ++i) {
+    if (s[i] == best) return i;
+  }
+  return best_block;
 }
 
 // Appends to `ids` the indices of s[0..n) at or above `threshold`; stops (returning false) when
@@ -494,7 +497,7 @@ LocalisationResult FabmapModel::Localise(const Observation& z) const {
       std::min(best_lower, std::max(best_lower, new_place) + kUnderflow - kRuleOutMargin) -
       kRuleOutMargin;
   std::vector<uint32_t> candidates;
-  if (!AtOrAbove(score, n, threshold, max_candidates, &candidates)) {
+  if (std::isnan(threshold) || !AtOrAbove(score, n, threshold, max_candidates, &candidates)) {
     Scatter(mapped_, active, active.positive, m, score);
     return Normalise(std::move(log_likelihood), unknown);
   }
