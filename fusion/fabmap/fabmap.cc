@@ -4,7 +4,6 @@
 #include <cmath>
 #include <iterator>
 #include <limits>
-#include <ranges>
 #include <utility>
 
 #if defined(__SSE2__)
@@ -235,12 +234,20 @@ void FabmapModel::Scatter(const PlaceIndex& index, const Active& active, size_t 
                           double* score) {
   // The lists lie far apart in memory: the next one's head is fetched while this one is read,
   // and each list a few cache lines ahead of the reading (measured: 10-20 % of the scatter).
+  // Prefetch addresses are computed as integers: they may lie past a list's end (harmless for a
+  // prefetch, undefined as pointer arithmetic).
   constexpr size_t kLine = 64 / sizeof(uint32_t), kAhead = 4 * kLine;
+  auto prefetch = [](const uint32_t* base, size_t offset) {
+    __builtin_prefetch(reinterpret_cast<const void*>(reinterpret_cast<uintptr_t>(base) +
+                                                     offset * sizeof(uint32_t)));
+  };
   for (size_t i = begin; i < end; ++i) {
     if (i + 1 < end) {
-      const uint32_t* next = index.postings[active.words[i + 1]].data();
-      __builtin_prefetch(next);
-      __builtin_prefetch(next + kLine);
+      const std::vector<uint32_t>& next = index.postings[active.words[i + 1]];
+      if (!next.empty()) {
+        prefetch(next.data(), 0);
+        prefetch(next.data(), kLine);
+      }
     }
     const double delta = active.delta[i];
     const std::vector<uint32_t>& places = index.postings[active.words[i]];
@@ -248,7 +255,7 @@ void FabmapModel::Scatter(const PlaceIndex& index, const Active& active, size_t 
     const size_t m = places.size();
     size_t k = 0;
     for (; k + kLine <= m; k += kLine) {
-      __builtin_prefetch(place + k + kAhead);
+      prefetch(place, k + kAhead);
 #pragma GCC unroll 16
       for (size_t j = k; j < k + kLine; ++j) score[place[j]] += delta;
     }
@@ -375,6 +382,23 @@ bool AtOrAbove(const double* s, size_t n, double threshold, size_t limit,
 namespace {
 
 // Normalise over the places `ids` lists (ascending; every other place's probability is 0).
+// Every place id below `n`, as a range (clang 14, which builds the fuzzers, cannot use
+// std::views::iota with this libstdc++).
+struct AllPlaces {
+  struct Iterator {
+    size_t i;
+    size_t operator*() const { return i; }
+    Iterator& operator++() {
+      ++i;
+      return *this;
+    }
+    bool operator==(const Iterator&) const = default;
+  };
+  size_t n;
+  Iterator begin() const { return {0}; }
+  Iterator end() const { return {n}; }
+};
+
 // With `others_zero`, the entries of places not in `ids` are 0 already.
 template <typename Ids>
 LocalisationResult NormaliseOver(std::vector<double> log_likelihood, const Ids& ids,
@@ -430,7 +454,7 @@ LocalisationResult NormaliseOver(std::vector<double> log_likelihood, const Ids& 
 
 LocalisationResult FabmapModel::Normalise(std::vector<double> log_likelihood,
                                           double unknown_log_likelihood) const {
-  const auto all = std::views::iota(size_t{0}, log_likelihood.size());
+  const AllPlaces all{log_likelihood.size()};
   return NormaliseOver(std::move(log_likelihood), all, false, options_.p_new_place,
                        unknown_log_likelihood);
 }
