@@ -264,14 +264,14 @@ void FabmapModel::Scatter(const PlaceIndex& index, const Active& active, size_t 
 }
 
 void FabmapModel::IndexLogLikelihoods(const PlaceIndex& index, const Active& active,
-                                      std::vector<double>* out) const {
+                                      std::vector<double>* out, size_t words_end) const {
   const double unseen = UnseenLogLikelihood(active);
   const size_t n = index.observations.size();
   out->resize(n);
   double* score = out->data();
   const double* offset = index.seen_offset.data();
   for (size_t i = 0; i < n; ++i) score[i] = unseen + offset[i];
-  Scatter(index, active, 0, active.words.size(), score);
+  Scatter(index, active, 0, std::min(words_end, active.words.size()), score);
 }
 
 void FabmapModel::LogLikelihoods(const Observation& z, std::vector<double>* log_likelihood) const {
@@ -377,11 +377,6 @@ bool AtOrAbove(const double* s, size_t n, double threshold, size_t limit,
   return true;
 }
 
-}  // namespace
-
-namespace {
-
-// Normalise over the places `ids` lists (ascending; every other place's probability is 0).
 // Every place id below `n`, as a range (clang 14, which builds the fuzzers, cannot use
 // std::views::iota with this libstdc++).
 struct AllPlaces {
@@ -399,7 +394,8 @@ struct AllPlaces {
   Iterator end() const { return {n}; }
 };
 
-// With `others_zero`, the entries of places not in `ids` are 0 already.
+// Normalise over the places `ids` lists (ascending; every other place's probability is 0). With
+// `others_zero`, the entries of places not in `ids` are 0 already.
 template <typename Ids>
 LocalisationResult NormaliseOver(std::vector<double> log_likelihood, const Ids& ids,
                                  bool others_zero, double p_new_place,
@@ -481,11 +477,9 @@ LocalisationResult FabmapModel::Localise(const Observation& z) const {
   const double unknown = UnknownLogLikelihood(active);
   const size_t n = mapped_.observations.size();
   const size_t m = active.words.size();
-  std::vector<double> log_likelihood(n);
+  std::vector<double> log_likelihood;
+  IndexLogLikelihoods(mapped_, active, &log_likelihood, active.positive);
   double* score = log_likelihood.data();
-  const double unseen = UnseenLogLikelihood(active);
-  for (size_t i = 0; i < n; ++i) score[i] = unseen + mapped_.seen_offset[i];
-  Scatter(mapped_, active, 0, active.positive, score);
   size_t remaining_postings = 0;
   for (size_t i = active.positive; i < m; ++i) {
     remaining_postings += mapped_.postings[active.words[i]].size();

@@ -174,8 +174,10 @@ class FabmapModel {
   Active ActiveWords(const Observation& z) const;
   double UnseenLogLikelihood(const Active& active) const;
   double UnknownLogLikelihood(const Active& active) const;
-  void IndexLogLikelihoods(const PlaceIndex& index, const Active& active,
-                           std::vector<double>* out) const;
+  // Per place of `index`, the log-likelihood with the active words before `words_end` summed
+  // (all of them by default).
+  void IndexLogLikelihoods(const PlaceIndex& index, const Active& active, std::vector<double>* out,
+                           size_t words_end = std::numeric_limits<size_t>::max()) const;
   // Adds active words [begin, end) to every place that saw them.
   static void Scatter(const PlaceIndex& index, const Active& active, size_t begin, size_t end,
                       double* score);
