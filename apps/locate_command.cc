@@ -15,6 +15,7 @@
 
 #include "apps/cli.h"
 #include "apps/progress.h"
+#include "common/file_util.h"
 #include "common/number_text.h"
 #include "common/output_folder.h"
 #include "fusion/io/config.h"
@@ -185,7 +186,7 @@ StatusOr<std::vector<WallSegment>> WallsOfData(const std::vector<std::string>& p
   std::vector<WallSegment> walls;
   for (const std::string& path : paths) {
     const fs::path world = fs::path(path) / "world.toml";
-    if (!fs::is_directory(path) || !fs::exists(world)) continue;
+    if (!IsDirectory(path) || !PathExists(world)) continue;
     StatusOr<sim::World> w = sim::LoadWorldFile(world.string());
     if (!w.ok()) return w.status();
     for (const sim::Wall& wall : w->walls) {
@@ -489,7 +490,7 @@ int LocateCommand(const Arguments& parsed) {
 
 StatusOr<RobotMap> LoadRobotMap(const std::string& path) {
   RobotMap m;
-  if (fs::is_directory(path)) {
+  if (IsDirectory(path)) {
     StatusOr<RunFolder> run = ReadRunFolder(path);
     if (!run.ok()) return run.status();
     m.experiences = std::move(run->experiences);

@@ -13,6 +13,21 @@
 #include <system_error>
 
 namespace ratslam {
+
+bool PathExists(const std::filesystem::path& path) noexcept {
+  std::error_code ec;
+  return std::filesystem::exists(path, ec);
+}
+
+bool IsDirectory(const std::filesystem::path& path) noexcept {
+  std::error_code ec;
+  return std::filesystem::is_directory(path, ec);
+}
+
+bool IsRegularFile(const std::filesystem::path& path) noexcept {
+  std::error_code ec;
+  return std::filesystem::is_regular_file(path, ec);
+}
 namespace {
 
 std::string TempPath(const std::string& path) { return path + ".tmp" + std::to_string(::getpid()); }

@@ -2,6 +2,7 @@
 #ifndef RATSLAM_COMMON_FILE_UTIL_H_
 #define RATSLAM_COMMON_FILE_UTIL_H_
 
+#include <filesystem>
 #include <string>
 #include <utility>
 #include <vector>
@@ -9,6 +10,13 @@
 #include "common/status.h"
 
 namespace ratslam {
+
+// std::filesystem's questions without its exceptions: a path the system refuses to look up (a
+// path longer than PATH_MAX, a file used as a folder, no permission) is simply
+// not there. User-given paths go through these, never through the throwing overloads.
+bool PathExists(const std::filesystem::path& path) noexcept;
+bool IsDirectory(const std::filesystem::path& path) noexcept;
+bool IsRegularFile(const std::filesystem::path& path) noexcept;
 
 // Writes `contents` to a temporary file beside `path` (`path.tmp<pid>`), flushes it to disk and
 // renames it over `path`: the file is either the old one or the complete new one. Temporary

@@ -133,7 +133,7 @@ Status WritePng(const RgbaImage& image, const std::string& path) {
 }
 
 StatusOr<RgbaImage> ReadPng(const std::string& path) {
-  if (!std::filesystem::exists(path)) return Status::Error(path + ": file missing");
+  if (!PathExists(path)) return Status::Error(path + ": file missing");
   cv::Mat bgra = cv::imread(path, cv::IMREAD_UNCHANGED);
   if (bgra.empty()) return Status::Error(path + ": cannot read image");
   cv::Mat rgba;

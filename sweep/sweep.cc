@@ -212,7 +212,7 @@ StatusOr<std::vector<std::string>> Expand(const std::string& pattern, const fs::
                                           const std::string& where) {
   const std::string full = fs::path(pattern).is_absolute() ? pattern : (base / pattern).string();
   if (full.find_first_of("*?[") == std::string::npos) {
-    if (!fs::exists(full)) return Status::Error(where + ": no such data set: " + full);
+    if (!PathExists(full)) return Status::Error(where + ": no such data set: " + full);
     return std::vector<std::string>{fs::absolute(full).lexically_normal().string()};
   }
   glob_t g{};
@@ -632,7 +632,7 @@ Status WritePlan(const Plan& plan, const std::string& dir) {
   if (ec) return Status::Error(dir + ": cannot create folder: " + ec.message());
   const std::string text = PlanToJson(plan).dump(1) + "\n";
   const fs::path plan_path = fs::path(dir) / "plan.json";
-  if (fs::exists(plan_path)) {
+  if (PathExists(plan_path)) {
     StatusOr<std::string> existing = ReadRegularFile(plan_path.string(), "plan", size_t{1} << 30);
     if (!existing.ok()) return existing.status();
     if (*existing == text) return Status::Ok();  // re-planning the same sweep changes nothing
@@ -710,7 +710,7 @@ StatusOr<TaskOutcome> ReadOutcome(const std::string& dir, int index) {
   o.index = index;
   o.status = "pending";
   const std::string path = RunFolder(dir, index) + "/status.json";
-  if (!fs::exists(path)) return o;
+  if (!PathExists(path)) return o;
   StatusOr<std::string> text = ReadRegularFile(path, "run status", 1 << 20);
   if (!text.ok()) return text.status();
   try {
@@ -768,7 +768,7 @@ bool Alive(pid_t pid) {
 // the orphan would otherwise write its outputs into the next attempt's folder (seen in CI: the
 // next attempt refused to overwrite them).
 void EndOrphan(const std::string& folder) {
-  if (!fs::exists(folder)) return;  // never started
+  if (!PathExists(folder)) return;  // never started
   const std::vector<pid_t> orphans = ProcessesNaming(folder);
   for (pid_t pid : orphans) {
     kill(-pid, SIGKILL);  // its process group (runs start in their own)
@@ -1290,7 +1290,7 @@ StatusOr<CollectReport> Collect(const std::string& dir) {
   const SweepSpec& spec = plan->spec;
   CollectReport report;
   // After a finished successive halving, a task that never ran belongs to an eliminated point.
-  const bool halving_done = fs::exists(fs::path(dir) / "search.json");
+  const bool halving_done = PathExists(fs::path(dir) / "search.json");
   std::string csv = "index,point,dataset,status,exit_code,wall_s";
   for (const Parameter& p : spec.parameters) {
     csv += ',';

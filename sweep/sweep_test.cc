@@ -216,6 +216,23 @@ TEST(SweepPlanTest, BadKeysAndValuesNameTheSweepFileLine) {
       << relation;
 }
 
+// A data path the system refuses to look up (a path longer than PATH_MAX, a file used as a
+// folder) is a missing data set, not an exception (found by sweep_file_fuzzer).
+TEST(SweepPlanTest, DataPathsTheSystemCannotLookUpAreMissingDataSets) {
+  Write("plain_file", "not a folder\n");
+  const std::string prefix = (Scratch().path() / "bad.toml").string() + ":";
+  for (const std::string& data : {"data/" + std::string(5000, 'x'), std::string("plain_file/a")}) {
+    const std::string path = SweepFile("bad.toml", "[[datasets]]\ndata = [\"" + data +
+                                                       "\"]\n[parameters]\n\"fused.recency_s\" = "
+                                                       "[1.0]\n");
+    StatusOr<SweepSpec> spec = LoadSweepFile(path);
+    ASSERT_FALSE(spec.ok()) << data;
+    EXPECT_EQ(spec.status().message().rfind(prefix, 0), 0u) << spec.status().message();
+    EXPECT_NE(spec.status().message().find("no such data set"), std::string::npos)
+        << spec.status().message();
+  }
+}
+
 // A fake worker: crashes for data set "crash", hangs for "hang", and runs the real program
 // otherwise; every start is appended to a log so that repeats can be counted.
 std::string FakeProgram(const std::string& log) {

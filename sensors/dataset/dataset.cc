@@ -193,8 +193,8 @@ std::string Dataset::ImagePath(const ImageRow& row) const {
 
 StatusOr<Dataset> ReadDataset(const std::string& folder) {
   const std::string manifest_path = (fs::path(folder) / "manifest.toml").string();
-  if (!fs::is_directory(folder)) return Status::Error(folder + ": not a data-set folder");
-  if (!fs::exists(manifest_path)) return Status::Error(manifest_path + ": missing manifest");
+  if (!IsDirectory(folder)) return Status::Error(folder + ": not a data-set folder");
+  if (!PathExists(manifest_path)) return Status::Error(manifest_path + ": missing manifest");
   StatusOr<std::string> manifest_text = ReadRegularFile(manifest_path, "manifest", 1 << 20);
   if (!manifest_text.ok()) return manifest_text.status();
   StatusOr<toml::table> parsed = schema::ParseToml(*manifest_text, manifest_path);

@@ -18,8 +18,8 @@ namespace ratslam {
 namespace fs = std::filesystem;
 
 StatusOr<DatasetFormat> DetectDatasetFormat(const std::string& path) {
-  if (fs::is_directory(path)) {
-    if (fs::exists(fs::path(path) / "manifest.toml")) return DatasetFormat::kReplayFolder;
+  if (IsDirectory(path)) {
+    if (PathExists(fs::path(path) / "manifest.toml")) return DatasetFormat::kReplayFolder;
     return Status::Error(path + ": a folder without manifest.toml is not a replay data set");
   }
   std::ifstream in(path);
@@ -165,12 +165,12 @@ Status CopyImagesInto(Dataset* dataset, const std::string& folder,
     std::string bytes, extension;
     std::string bag;
     uint64_t message = 0;
-    if (!fs::exists(source) && ParseBagImageReference(source, &bag, &message)) {
+    if (!PathExists(source) && ParseBagImageReference(source, &bag, &message)) {
       StatusOr<EncodedImage> encoded = bags.Encoded(source);
       if (!encoded.ok()) return encoded.status();
       bytes.assign(encoded->bytes.begin(), encoded->bytes.end());
       extension = encoded->extension;
-    } else if (!fs::exists(source) && ParseVideoFrameReference(source, &bag, &message)) {
+    } else if (!PathExists(source) && ParseVideoFrameReference(source, &bag, &message)) {
       // A video frame, decoded (to grey, as replays see it) and stored losslessly.
       StatusOr<GrayImage> frame = videos.Load(source);
       if (!frame.ok()) return frame.status();

@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 
+#include "common/file_util.h"
 #include "sensors/dataset/rosbag.h"
 #include "sensors/dataset/video.h"
 
@@ -15,7 +16,7 @@ FileImageLoader::~FileImageLoader() = default;
 StatusOr<GrayImage> FileImageLoader::Load(const std::string& path) {
   std::string bag;
   uint64_t message = 0;
-  if (!std::filesystem::exists(path)) {  // then maybe a bag's message or a video's frame
+  if (!PathExists(path)) {  // then maybe a bag's message or a video's frame
     if (ParseBagImageReference(path, &bag, &message)) return bags_->Load(path);
     if (ParseVideoFrameReference(path, &bag, &message)) return videos_->Load(path);
     return Status::Error(path + ": image file missing");

@@ -23,6 +23,7 @@
 #include <opencv2/imgproc.hpp>
 #include <set>
 
+#include "common/file_util.h"
 #include "sensors/dataset/opencv_gray.h"
 #include "sensors/dataset/rosbag_check.h"
 
@@ -255,7 +256,7 @@ bool RosbagSupported() { return true; }
 StatusOr<Dataset> ReadRosbag(const std::string& path, const BagTopics& topics) {
   std::string error;
   if (!topics.IsValid(&error)) return Status::Error(error);
-  if (!fs::is_regular_file(path)) return Status::Error(path + ": not a file");
+  if (!IsRegularFile(path)) return Status::Error(path + ": not a file");
   if (!LooksLikeRosbag(path)) {
     return Status::Error(path + ": not a ROS 1 bag (it does not start with #ROSBAG V2.0)");
   }

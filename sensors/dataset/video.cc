@@ -13,6 +13,7 @@
 #include <opencv2/videoio.hpp>
 #include <vector>
 
+#include "common/file_util.h"
 #include "sensors/dataset/opencv_gray.h"
 #include "sensors/dataset/rosbag.h"
 
@@ -138,7 +139,7 @@ bool ParseVideoFrameReference(const std::string& path, std::string* video, uint6
 StatusOr<Dataset> ReadVideo(const std::string& path, const VideoOptions& options) {
   std::string error;
   if (!options.IsValid(&error)) return Status::Error("video." + error);
-  if (!fs::is_regular_file(path)) return Status::Error(path + ": not a file");
+  if (!IsRegularFile(path)) return Status::Error(path + ": not a file");
   cv::VideoCapture capture;
   try {
     OpenFile(capture, path);
@@ -166,7 +167,7 @@ StatusOr<Dataset> ReadVideo(const std::string& path, const VideoOptions& options
   std::string log = options.odometry_log;
   if (log.empty()) {
     const fs::path beside = fs::path(path).replace_extension(".txt");
-    if (fs::is_regular_file(beside)) log = beside.string();
+    if (IsRegularFile(beside)) log = beside.string();
   }
   std::vector<LogRow> rows;
   if (!log.empty()) {
