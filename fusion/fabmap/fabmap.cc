@@ -318,39 +318,6 @@ constexpr double kUnderflow = -40.0;
 // sums here (below 1e-9 nats), so a ruled-out place would have been reported as 0 for certain.
 constexpr double kRuleOutMargin = 1.0;
 
-// The first index of the largest of s[0..n) (n > 0): the maximum by blocks, two lanes
-// at a time, then the first block holding it is searched.
-size_t ArgMax(const double* s, size_t n) {
-  constexpr size_t kBlock = 512;
-  double best = s[0];
-  size_t best_block = 0;
-  for (size_t b = 0; b < n; b += kBlock) {
-    const size_t end = std::min(n, b + kBlock);
-    size_t i = b;
-    double m = s[b];
-#if defined(__SSE2__)
-    __m128d m0 = _mm_set1_pd(m), m1 = m0;
-    for (; i + 4 <= end; i += 4) {
-      m0 = _mm_max_pd(m0, _mm_loadu_pd(s + i));
-      m1 = _mm_max_pd(m1, _mm_loadu_pd(s + i + 2));
-    }
-    m0 = _mm_max_pd(m0, m1);
-    m = std::max(_mm_cvtsd_f64(m0), _mm_cvtsd_f64(_mm_unpackhi_pd(m0, m0)));
-#endif
-    for (; i < end; ++i) m = std::max(m, s[i]);
-    if (m > best) {
-      best = m;
-      best_block = b;
-    }
-  }
-  // Bounded: a NaN (which no sum here should make) must not run the search off the block.
-  const size_t end = std::min(n, best_block + kBlock);
-  for (size_t i = best_block; i < end; ++i) {
-    if (s[i] == best) return i;
-  }
-  return best_block;
-}
-
 // Appends to `ids` the indices of s[0..n) at or above `threshold`; stops (returning false) when
 // a `limit`+1-th would be added.
 bool AtOrAbove(const double* s, size_t n, double threshold, size_t limit,
@@ -375,6 +342,66 @@ bool AtOrAbove(const double* s, size_t n, double threshold, size_t limit,
     ids->push_back(static_cast<uint32_t>(i));
   }
   return true;
+}
+
+// The places of s[0..n) (n > 0) that may still matter: those at or above a threshold that rises
+// as the scan goes. `bound(i)` gives a lower bound of the best final sum from place i (its
+// completed sum), `threshold_for(lower)` the threshold that lower bound allows. Each new
+// largest s[i] (a record; the first is place 0) is completed, so by the end the threshold is at
+// least the one the arg max's completed sum gives. Every threshold lies below the record
+// (threshold_for(lower) < lower <= s[record]), so a block below the threshold holds no record.
+// Usually one pass; when an early, low threshold lets more than 2 `limit` places in, the rest is
+// scanned for records only and the places are collected again under the final threshold.
+// Returns false when a bound is NaN or more than `limit` places are at or above the final
+// threshold. `ids` ascends.
+template <typename Bound, typename ThresholdFor>
+bool Contenders(const double* s, size_t n, const Bound& bound, const ThresholdFor& threshold_for,
+                size_t limit, std::vector<uint32_t>* ids) {
+  double record = s[0];
+  double lower = bound(0);
+  double threshold = threshold_for(lower);
+  bool nan = std::isnan(threshold);
+  auto new_record = [&](size_t k) {
+    record = s[k];
+    const double b = bound(k);
+    nan = nan || std::isnan(b);
+    if (b > lower) {
+      lower = b;
+      threshold = threshold_for(lower);
+    }
+  };
+  size_t i = 0;
+  bool collecting = true;
+  auto visit = [&](size_t k) {
+    if (s[k] > record) new_record(k);
+    if (!(s[k] >= threshold)) return;
+    ids->push_back(static_cast<uint32_t>(k));
+    if (ids->size() <= 2 * limit) return;
+    std::erase_if(*ids, [&](uint32_t j) { return !(s[j] >= threshold); });
+    collecting = ids->size() <= 2 * limit;
+  };
+#if defined(__SSE2__)
+  for (; collecting && !nan && i + 4 <= n; i += 4) {
+    const __m128d t = _mm_set1_pd(threshold);
+    const __m128d a = _mm_cmpge_pd(_mm_loadu_pd(s + i), t);
+    const __m128d b = _mm_cmpge_pd(_mm_loadu_pd(s + i + 2), t);
+    if (_mm_movemask_pd(_mm_or_pd(a, b)) == 0) continue;
+    for (size_t k = i; k < i + 4; ++k) visit(k);
+  }
+#endif
+  for (; collecting && !nan && i < n; ++i) visit(i);
+  if (nan) return false;
+  if (collecting) {
+    std::erase_if(*ids, [&](uint32_t j) { return !(s[j] >= threshold); });
+    return ids->size() <= limit;
+  }
+  // Too many places under an early threshold: the records of the rest, then collect again.
+  for (; i < n; ++i) {
+    if (s[i] > record) new_record(i);
+  }
+  if (nan) return false;
+  ids->clear();
+  return AtOrAbove(s, n, threshold, limit, ids);
 }
 
 // Every place id below `n`, as a range (clang 14, which builds the fuzzers, cannot use
@@ -480,6 +507,10 @@ LocalisationResult FabmapModel::Localise(const Observation& z) const {
   std::vector<double> log_likelihood;
   IndexLogLikelihoods(mapped_, active, &log_likelihood, active.positive);
   double* score = log_likelihood.data();
+  auto scatter_the_rest = [&] {
+    Scatter(mapped_, active, active.positive, m, score);
+    return Normalise(std::move(log_likelihood), unknown);
+  };
   size_t remaining_postings = 0;
   for (size_t i = active.positive; i < m; ++i) {
     remaining_postings += mapped_.postings[active.words[i]].size();
@@ -489,10 +520,7 @@ LocalisationResult FabmapModel::Localise(const Observation& z) const {
   const double walk = static_cast<double>(m - active.positive) +
                       (n > 0 ? static_cast<double>(mapped_.total_words) / n : 0.0) + 1.0;
   const size_t max_candidates = static_cast<size_t>(0.5 * remaining_postings / walk);
-  if (n == 0 || max_candidates == 0) {
-    Scatter(mapped_, active, active.positive, m, score);
-    return Normalise(std::move(log_likelihood), unknown);
-  }
+  if (n == 0 || max_candidates == 0) return scatter_the_rest();
   // Bit set of one place's words, cleared after each use.
   std::vector<uint64_t> bits((vocabulary_size() + 63) / 64, 0);
   auto complete = [&](uint32_t place) {
@@ -507,17 +535,17 @@ LocalisationResult FabmapModel::Localise(const Observation& z) const {
     return sum;
   };
   // Every remaining delta is <= 0, so a partial sum is an upper bound of the place's final sum,
-  // and the final sum of the place with the best partial one a lower bound of the best final.
-  const double best_lower = complete(static_cast<uint32_t>(ArgMax(score, n)));
+  // and any place's final sum a lower bound of the best final sum.
   const double log_place_prior = std::log((1.0 - options_.p_new_place) / static_cast<double>(n));
   const double new_place = std::log(options_.p_new_place) + unknown - log_place_prior;
-  const double threshold =
-      std::min(best_lower, std::max(best_lower, new_place) + kUnderflow - kRuleOutMargin) -
-      kRuleOutMargin;
+  auto threshold_for = [&](double best_lower) {
+    return std::min(best_lower, std::max(best_lower, new_place) + kUnderflow - kRuleOutMargin) -
+           kRuleOutMargin;
+  };
+  auto bound = [&](size_t place) { return complete(static_cast<uint32_t>(place)); };
   std::vector<uint32_t> candidates;
-  if (std::isnan(threshold) || !AtOrAbove(score, n, threshold, max_candidates, &candidates)) {
-    Scatter(mapped_, active, active.positive, m, score);
-    return Normalise(std::move(log_likelihood), unknown);
+  if (!Contenders(score, n, bound, threshold_for, max_candidates, &candidates)) {
+    return scatter_the_rest();
   }
   std::vector<double> final_sum(candidates.size());
   for (size_t k = 0; k < candidates.size(); ++k) final_sum[k] = complete(candidates[k]);
