@@ -249,6 +249,41 @@ TEST(FabmapTest, RulingPlacesOutChangesNoNumber) {
   }
 }
 
+// The index keeps places in blocks of 2^16 (a posting is a 16-bit number within its block):
+// places past the first block get the dense oracle's likelihood, a revisit of one is found, and
+// Localise still equals the exhaustive sum across blocks.
+TEST(FabmapTest, PlacesPastTheFirstIndexBlockAreScoredLikeTheOthers) {
+  const World w = MakeWorld(400, 12, 21);
+  FabmapModel model = MakeModel(w);
+  Random random(22);
+  std::vector<Observation> places;
+  const uint32_t n = (1u << 16) + 5000;
+  for (uint32_t i = 0; i < n; ++i) {
+    places.push_back(w.words.SamplePlace(&random));
+    ASSERT_TRUE(model.AddPlace(w.words.Observe(places.back(), &random)).ok());
+  }
+  std::vector<double> sparse;
+  for (uint32_t target : {3u, 65535u, 65536u, 65537u, n - 1}) {
+    const Observation z = w.words.Observe(places[target], &random);
+    model.LogLikelihoods(z, &sparse);
+    ASSERT_EQ(sparse.size(), n);
+    for (uint32_t place : {0u, 65535u, 65536u, n - 1, target}) {
+      const double dense = model.DenseLogLikelihood(z, place);
+      EXPECT_NEAR(sparse[place], dense, 1e-9 * std::abs(dense) + 1e-9) << place;
+    }
+    const LocalisationResult fast = model.Localise(z);
+    const LocalisationResult slow = model.LocaliseExhaustive(z);
+    EXPECT_EQ(fast.best_mapped_place, slow.best_mapped_place);
+    EXPECT_EQ(fast.best_mapped_log_odds, slow.best_mapped_log_odds);
+    EXPECT_TRUE(fast.place_probability == slow.place_probability);
+    // 12 words of 400 do not single a place out of 70k, but the place seen must be among the
+    // likeliest: its log-likelihood is above that of 99 % of the places.
+    size_t above = 0;
+    for (double s : sparse) above += s > sparse[target];
+    EXPECT_LT(above, n / 100) << target;
+  }
+}
+
 TEST(FabmapTest, LocaliseAmongCandidates) {
   const World w = MakeWorld(500, 40, 9);
   FabmapModel model = MakeModel(w);
