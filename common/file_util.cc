@@ -28,6 +28,7 @@ bool IsRegularFile(const std::filesystem::path& path) noexcept {
   std::error_code ec;
   return std::filesystem::is_regular_file(path, ec);
 }
+
 namespace {
 
 std::string TempPath(const std::string& path) { return path + ".tmp" + std::to_string(::getpid()); }

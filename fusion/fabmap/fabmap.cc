@@ -382,6 +382,7 @@ bool Contenders(const double* s, size_t n, const Bound& bound, const ThresholdFo
       threshold = threshold_for(lower);
     }
   };
+  auto below_threshold = [&](uint32_t j) { return !(s[j] >= threshold); };
   size_t i = 0;
   bool collecting = true;
   auto visit = [&](size_t k) {
@@ -389,7 +390,7 @@ bool Contenders(const double* s, size_t n, const Bound& bound, const ThresholdFo
     if (!(s[k] >= threshold)) return;
     ids->push_back(static_cast<uint32_t>(k));
     if (ids->size() <= 2 * limit) return;
-    std::erase_if(*ids, [&](uint32_t j) { return !(s[j] >= threshold); });
+    std::erase_if(*ids, below_threshold);
     collecting = ids->size() <= 2 * limit;
   };
 #if defined(__SSE2__)
@@ -404,7 +405,7 @@ bool Contenders(const double* s, size_t n, const Bound& bound, const ThresholdFo
   for (; collecting && !nan && i < n; ++i) visit(i);
   if (nan) return false;
   if (collecting) {
-    std::erase_if(*ids, [&](uint32_t j) { return !(s[j] >= threshold); });
+    std::erase_if(*ids, below_threshold);
     return ids->size() <= limit;
   }
   // Too many places under an early threshold: the records of the rest, then collect again.
