@@ -68,6 +68,27 @@ BENCHMARK(BM_WifiBestRevisit)
     ->Args({10000, 20000, 7000})
     ->Unit(benchmark::kMicrosecond);
 
+// What the front ends ask (eqs. 9 and 12): the best match only if it reaches t_wifi (0.25), so
+// the pruning has its budget from the start. A new place (above) and the revisit of id 7000.
+void BM_WifiBestAtThreshold(benchmark::State& state) {
+  Setup s = Make(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  Fingerprint q = s.query;
+  if (state.range(2) >= 0) {
+    Random rng(11);
+    q = s.stored[static_cast<size_t>(state.range(2))];
+    for (float& rssi : q.rssi_dbm) rssi += static_cast<float>(rng.Gaussian(0, 3));
+    q.ap_ids.pop_back();
+    q.rssi_dbm.pop_back();
+  }
+  const double t = s.matcher.options().match_threshold;
+  for (auto _ : state) benchmark::DoNotOptimize(s.matcher.Best(q, nullptr, t));
+}
+BENCHMARK(BM_WifiBestAtThreshold)
+    ->Args({10000, 230, -1})
+    ->Args({10000, 20000, -1})
+    ->Args({10000, 230, 7000})
+    ->Unit(benchmark::kMicrosecond);
+
 void BM_WifiBestPairwiseBaseline(benchmark::State& state) {
   Setup s = Make(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
   for (auto _ : state) {

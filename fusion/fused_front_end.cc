@@ -225,7 +225,8 @@ class FusedFrontEnd : public FrontEnd {
       camera_verdict = Judge(best.id, best.similarity, camera_.options().match_threshold, time_s);
     }
     if (scan && !scan->empty()) {
-      const WifiMatch best = wifi_.Best(*scan, allowed);  // eq. 9
+      // Eq. 9; a best below t_wifi would be novel anyway, so the matcher may prune by it.
+      const WifiMatch best = wifi_.Best(*scan, allowed, wifi_.options().match_threshold);
       wifi_best = best.id;
       wifi_best_weight = best.weight;
       wifi_verdict = Judge(best.id, best.weight, wifi_.options().match_threshold, time_s);
@@ -235,8 +236,8 @@ class FusedFrontEnd : public FrontEnd {
       // template.
       const bool camera_would =
           view && camera_.Best(*view).similarity >= camera_.options().match_threshold;
-      const bool wifi_would =
-          scan && !scan->empty() && wifi_.Best(*scan).weight >= wifi_.options().match_threshold;
+      const bool wifi_would = scan && !scan->empty() &&
+                              wifi_.Best(*scan, nullptr, wifi_.options().match_threshold).id >= 0;
       if (camera_would || wifi_would) floors_.CountRefused();
     }
     FrameDecision d;

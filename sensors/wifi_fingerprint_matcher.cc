@@ -238,12 +238,16 @@ std::vector<double> WifiFingerprintMatcher::Weights(const Fingerprint& query) co
 }
 
 WifiMatch WifiFingerprintMatcher::Best(const Fingerprint& query,
-                                       const std::vector<uint8_t>* allowed) const {
+                                       const std::vector<uint8_t>* allowed,
+                                       double min_weight) const {
   WifiMatch best;
   // w = exp(x) * H / (H + E + M) <= exp(x): a fingerprint whose exponent x is below log(best)
-  // cannot win, and its exp is skipped. The margin of 1e-9 covers the rounding of exp, of the
-  // log and of the product (each within a few ulps), so the answer is the exhaustive one.
-  double skip_below = -std::numeric_limits<double>::infinity();
+  // (or log(min_weight)) cannot win, and its exp is skipped. The margin of 1e-9 covers the
+  // rounding of exp, of the log and of the product (each within a few ulps), so the answer is
+  // the exhaustive one.
+  const bool floor = min_weight > 0.0;  // false for NaN too
+  double skip_below =
+      floor ? std::log(min_weight) - 1e-9 : -std::numeric_limits<double>::infinity();
   const size_t query_size = CountedSize(query);
   const double inv_two_sigma2 = 1.0 / (2.0 * options_.kernel_variance_dbm2);
   auto finish = [&](const Candidate& c) {
@@ -255,6 +259,7 @@ WifiMatch WifiFingerprintMatcher::Best(const Fingerprint& query,
     if (!(x >= skip_below)) return;
     const uint32_t id = c.id;
     const double w = CandidateWeight(c, x, query_size);
+    if (floor && !(w >= min_weight)) return;
     // Ties go to the older template, independent of the order the index visits them in.
     if (w > best.weight ||
         (w == best.weight && best.id >= 0 && id < static_cast<uint32_t>(best.id))) {

@@ -104,8 +104,11 @@ class WifiFingerprintMatcher {
   // Weights against every stored fingerprint, by id (0 where no AP is shared).
   std::vector<double> Weights(const Fingerprint& query) const;
   // The stored fingerprint with the largest weight (eq. 9); with `allowed` (one flag per stored
-  // fingerprint), the largest among those whose flag is set.
-  WifiMatch Best(const Fingerprint& query, const std::vector<uint8_t>* allowed = nullptr) const;
+  // fingerprint), the largest among those whose flag is set. With `min_weight` > 0, the largest
+  // only if it is at least `min_weight` ({-1, 0} otherwise): what a caller holding t_wifi needs,
+  // and faster, since the pruning below has its budget from the first block on.
+  WifiMatch Best(const Fingerprint& query, const std::vector<uint8_t>* allowed = nullptr,
+                 double min_weight = 0.0) const;
 
   // Stores a fingerprint (possibly empty: a template with no Wi-Fi); returns its id.
   uint32_t Add(const Fingerprint& fingerprint);

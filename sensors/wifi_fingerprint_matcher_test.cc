@@ -246,6 +246,18 @@ TEST(WifiFingerprintMatcherTest, BestIsTheExhaustiveArgmax) {
         ASSERT_NEAR(best.weight, expected, 1e-12);
         // The indexed weights agree with Best to the bit.
         ASSERT_EQ(best.weight, m.Weights(q)[static_cast<size_t>(best.id)]);
+        // With a floor (the pruning's budget from the start): the same answer when the best
+        // reaches it, at t_wifi and exactly at the best weight, and nothing just above it.
+        const WifiMatch at_t = m.Best(q, nullptr, options.match_threshold);
+        if (expected >= options.match_threshold) {
+          ASSERT_EQ(at_t.id, best.id) << "universe " << universe << " query " << k;
+          ASSERT_EQ(at_t.weight, best.weight);
+        } else {
+          ASSERT_EQ(at_t.id, -1) << "universe " << universe << " query " << k;
+          ASSERT_EQ(at_t.weight, 0.0);
+        }
+        ASSERT_EQ(m.Best(q, nullptr, best.weight).id, best.id);
+        ASSERT_EQ(m.Best(q, nullptr, std::nextafter(best.weight, 2.0)).id, -1);
       }
     }
   }
@@ -285,6 +297,11 @@ TEST(WifiFingerprintMatcherTest, PruningKeepsAWinnerThatLacksTheStrongestAp) {
   const WifiMatch best = m.Best(q);
   EXPECT_EQ(best.id, 600);
   EXPECT_EQ(best.weight, w[600]);
+  // A floor of 0.45 gives the pruning a budget of 40 ln(1 / 0.45) = 31.9 from the first block:
+  // x (25) alone still does not rule B out. Above B's weight nothing is left.
+  EXPECT_EQ(m.Best(q, nullptr, 0.45).id, 600);
+  EXPECT_EQ(m.Best(q, nullptr, 0.45).weight, w[600]);
+  EXPECT_EQ(m.Best(q, nullptr, 0.5).id, -1);
 }
 
 }  // namespace

@@ -161,8 +161,9 @@ std::vector<Estimate> FingerprintEstimates(const std::vector<EvaluationNode>& ma
   }
   for (size_t q = 0; q < queries.size(); ++q) {
     if (!queries[q].wifi || nodes.empty()) continue;
-    const WifiMatch best = matcher.Best(matcher.MakeFingerprint(pairs(*queries[q].wifi)));
-    if (best.id < 0 || best.weight < options.match_threshold) continue;
+    const WifiMatch best = matcher.Best(matcher.MakeFingerprint(pairs(*queries[q].wifi)), nullptr,
+                                        options.match_threshold);
+    if (best.id < 0) continue;
     const EvaluationNode& n = map[nodes[best.id]];
     out[q] = {true, n.x_m, n.y_m, n.floor};
   }
