@@ -24,7 +24,9 @@
 // AP with it; the per-fingerprint totals of penalties are precomputed, so extra and missing APs
 // cost nothing beyond the shared ones. Best, once it has met a good match, scores only the
 // fingerprints holding one of the query's most penalised APs (max-score pruning: any other has
-// an eq. 4 penalty that already rules it out), with the same answer as the exhaustive scan.
+// an eq. 4 penalty that already rules it out), with the same answer as the exhaustive scan. A
+// caller that only acts on a match of at least t_wifi (the front ends) passes it as a floor, and
+// the pruning then starts with the first block of ids instead of after the first good match.
 #ifndef RATSLAM_SENSORS_WIFI_FINGERPRINT_MATCHER_H_
 #define RATSLAM_SENSORS_WIFI_FINGERPRINT_MATCHER_H_
 
