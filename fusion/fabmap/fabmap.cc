@@ -356,6 +356,27 @@ bool AtOrAbove(const double* s, size_t n, double threshold, size_t limit,
   return true;
 }
 
+// The index of the first largest of s[0..n) (n > 0): one pass keeping each block's maximum,
+// then a search of the winning block (0 when every entry is NaN).
+size_t ArgMax(const double* s, size_t n) {
+  constexpr size_t kBlock = 64;
+  double best = -std::numeric_limits<double>::infinity();
+  size_t best_block = 0;
+  for (size_t b = 0; b < n; b += kBlock) {
+    const size_t e = std::min(n, b + kBlock);
+    double m = best;
+    for (size_t i = b; i < e; ++i) m = std::max(m, s[i]);
+    if (m > best) {
+      best = m;
+      best_block = b;
+    }
+  }
+  for (size_t i = best_block; i < std::min(n, best_block + kBlock); ++i) {
+    if (s[i] == best) return i;
+  }
+  return 0;
+}
+
 // The places of s[0..n) (n > 0) that may still matter: those at or above a threshold that rises
 // as the scan goes. `bound(i)` gives a lower bound of the best final sum from place i (its
 // completed sum), `threshold_for(lower)` the threshold that lower bound allows. Each new
@@ -567,6 +588,133 @@ LocalisationResult FabmapModel::Localise(const Observation& z) const {
   LocalisationResult result = NormaliseAmong(std::move(log_likelihood), candidates, unknown);
   result.places_ruled_out = static_cast<uint32_t>(n - candidates.size());
   return result;
+}
+
+double BennettUpperBound(const std::vector<double>& delta, const std::vector<double>& p,
+                         double probability) {
+  double mean = 0.0, variance = 0.0, largest = 0.0, all = 0.0;
+  for (size_t i = 0; i < delta.size(); ++i) {
+    mean += delta[i] * p[i];
+    variance += delta[i] * delta[i] * p[i] * (1.0 - p[i]);
+    largest = std::max(largest, delta[i]);
+    all += delta[i];
+  }
+  if (!(variance > 0.0) || !(largest > 0.0)) return mean;  // nothing is random
+  // h(u) >= log(1 / probability) a^2 / v, h increasing on u >= 0: bisection, keeping the upper
+  // end (a larger u only lowers the bound on the probability).
+  const double target = -std::log(probability) * largest * largest / variance;
+  auto h = [](double u) { return (1.0 + u) * std::log1p(u) - u; };
+  double lo = 0.0, hi = 1.0;
+  while (h(hi) < target) hi *= 2.0;
+  for (int i = 0; i < 200 && hi - lo > 1e-12 * hi; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (h(mid) < target ? lo : hi) = mid;
+  }
+  // S never exceeds the sum of all the deltas.
+  return std::min(all, mean + hi * variance / largest);
+}
+
+PlaceAbove FabmapModel::BestAbove(const Observation& z, double min_log_odds,
+                                  double bail_out_probability) const {
+  PlaceAbove answer;
+  const size_t n = mapped_.observations.size();
+  if (n == 0) return answer;
+  if (!(bail_out_probability > 0.0)) {
+    const LocalisationResult r = Localise(z);
+    if (r.best_mapped_place >= 0 && r.best_mapped_log_odds >= min_log_odds) {
+      answer.place = r.best_mapped_place;
+      answer.log_odds = r.best_mapped_log_odds;
+    }
+    return answer;
+  }
+  const Active active = ActiveWords(z);
+  const size_t m = active.words.size();
+  const size_t positive = active.positive;
+  // As Normalise computes the log odds; a place reaches the floor when its log-likelihood does.
+  const double log_new = std::log(options_.p_new_place) + UnknownLogLikelihood(active);
+  const double log_place_prior = std::log((1.0 - options_.p_new_place) / static_cast<double>(n));
+  const double floor = min_log_odds + log_new - log_place_prior;
+  auto settle = [&](int64_t place, double log_likelihood) {
+    const double log_odds = log_likelihood + log_place_prior - log_new;
+    if (place >= 0 && log_odds >= min_log_odds) {
+      answer.place = place;
+      answer.log_odds = log_odds;
+    }
+    return answer;
+  };
+  std::vector<double> log_likelihood;
+  IndexLogLikelihoods(mapped_, active, &log_likelihood, 0);
+  double* score = log_likelihood.data();
+  std::vector<size_t> postings_from(m + 1, 0);
+  for (size_t i = m; i-- > 0;) {
+    postings_from[i] = postings_from[i + 1] + mapped_.word_places[active.words[i]];
+  }
+  const double positive_postings = static_cast<double>(postings_from[0] - postings_from[positive]);
+  const double words_per_place = static_cast<double>(mapped_.total_words) / n;
+  std::vector<uint64_t> bits((vocabulary_size() + 63) / 64, 0);
+  std::vector<uint32_t> candidates;
+  std::vector<double> delta, share;
+  size_t summed = 0;
+  // Check points by the share of the raising postings summed. From half on, a place seen again
+  // leads the others or is close enough not to be dropped (README, design notes: checking at a
+  // quarter changed answers on dense synthetic vocabularies; from half on none of 7,200).
+  for (const double fraction : {0.5, 0.75}) {
+    size_t k = summed;
+    while (k < positive && static_cast<double>(postings_from[0] - postings_from[k]) <
+                               fraction * positive_postings) {
+      ++k;
+    }
+    if (k == summed || k >= positive) continue;
+    Scatter(mapped_, active, summed, k, score);
+    summed = k;
+    // Completing a place walks its own words and the remaining active ones; that must cost well
+    // under the postings it saves.
+    const double walk = static_cast<double>(m - k) + words_per_place + 1.0;
+    const auto max_candidates = static_cast<size_t>(0.5 * postings_from[k] / walk);
+    if (max_candidates == 0) break;
+    delta.assign(active.delta.begin() + k, active.delta.begin() + positive);
+    share.clear();
+    for (size_t i = k; i < positive; ++i) {
+      share.push_back(static_cast<double>(mapped_.word_places[active.words[i]]) / n);
+    }
+    const double gain = BennettUpperBound(delta, share, bail_out_probability);
+    auto complete = [&](uint32_t place) {
+      const Observation& words = mapped_.observations[place];
+      for (WordId q : words) bits[q >> 6] |= uint64_t{1} << (q & 63);
+      double sum = score[place];
+      for (size_t i = k; i < m; ++i) {
+        const WordId q = active.words[i];
+        if ((bits[q >> 6] >> (q & 63)) & 1) sum += active.delta[i];
+      }
+      for (WordId q : words) bits[q >> 6] = 0;
+      return sum;
+    };
+    // The bound is about places unlike the query; the place seen again is not one of them, and
+    // it usually leads by now: its final sum is summed here, so the others must be able to beat
+    // it (or the floor, whichever is higher) to stay.
+    const auto leader = static_cast<int64_t>(ArgMax(score, n));
+    const double leader_sum = complete(static_cast<uint32_t>(leader));
+    candidates.clear();
+    if (!AtOrAbove(score, n, std::max(floor, leader_sum) - gain - kRuleOutMargin, max_candidates,
+                   &candidates)) {
+      continue;
+    }
+    answer.bailed_out = true;
+    int64_t best = leader;
+    double best_sum = leader_sum;
+    for (const uint32_t place : candidates) {
+      const double sum = complete(place);
+      // Ties go to the first place, as in Localise.
+      if (sum > best_sum || (sum == best_sum && place < best)) {
+        best = place;
+        best_sum = sum;
+      }
+    }
+    return settle(best, best_sum);
+  }
+  Scatter(mapped_, active, summed, m, score);
+  const size_t best = ArgMax(score, n);
+  return settle(static_cast<int64_t>(best), score[best]);
 }
 
 LocalisationResult FabmapModel::LocaliseAmong(const Observation& z,
