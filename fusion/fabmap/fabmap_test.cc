@@ -44,6 +44,13 @@ FabmapModel MakeModel(const World& w, UnknownWorld unknown = UnknownWorld::kMean
   return *std::move(model);
 }
 
+// Adds `n` places of the world, each seen once.
+void AddRandomPlaces(const World& w, int n, Random* random, FabmapModel* model) {
+  for (int i = 0; i < n; ++i) {
+    ASSERT_TRUE(model->AddPlace(w.words.Observe(w.words.SamplePlace(random), random)).ok());
+  }
+}
+
 TEST(FabmapTest, SparseLikelihoodEqualsDenseOracle) {
   const World w = MakeWorld(300, 30, 1);
   for (double p_absent : {0.0, 0.05}) {
@@ -156,9 +163,7 @@ TEST(FabmapTest, AllNewObservationIsRejected) {
   const World w = MakeWorld(1000, 50, 3);
   FabmapModel model = MakeModel(w);
   Random random(6);
-  for (int i = 0; i < 300; ++i) {
-    ASSERT_TRUE(model.AddPlace(w.words.Observe(w.words.SamplePlace(&random), &random)).ok());
-  }
+  AddRandomPlaces(w, 300, &random, &model);
   int rejected = 0;
   for (int i = 0; i < 100; ++i) {
     const LocalisationResult r =
@@ -373,9 +378,7 @@ TEST(FabmapTest, BestAboveKeepsAPlaceThatOvertakesTheLeaderLate) {
   const World w = MakeWorld(2000, 100, 51);
   FabmapModel model = MakeModel(w);
   Random random(52);
-  for (int i = 0; i < 3000; ++i) {
-    ASSERT_TRUE(model.AddPlace(w.words.Observe(w.words.SamplePlace(&random), &random)).ok());
-  }
+  AddRandomPlaces(w, 3000, &random, &model);
   const Observation z = w.words.Observe(w.words.SamplePlace(&random), &random);
   ASSERT_GT(z.size(), 60u);
   const Observation a(z.begin(), z.begin() + z.size() / 2);
