@@ -3,7 +3,6 @@
 // measured in the same run.
 #include <benchmark/benchmark.h>
 
-#include <cmath>
 #include <map>
 #include <memory>
 #include <utility>
@@ -75,9 +74,14 @@ BENCHMARK(BM_FabmapQuery)
     ->ArgsProduct({{1000, 10000, 100000}, {1000, 10000}})
     ->Unit(benchmark::kMicrosecond);
 
-// 64 of the places Model drew, drawn again with its seed, each observed afresh.
-std::vector<Observation> RevisitQueries(uint32_t places, uint32_t vocabulary) {
+// A mapped place seen again (a second observation of it): one place stands out, so Localise
+// rules the others out early.
+void BM_FabmapRevisit(benchmark::State& state) {
+  const uint32_t places = static_cast<uint32_t>(state.range(0));
+  const uint32_t vocabulary = static_cast<uint32_t>(state.range(1));
+  FabmapModel& model = Model(places, vocabulary);
   const SyntheticWordWorld w = World(vocabulary);
+  // The places Model drew, drawn again with its seed, each observed afresh.
   std::vector<Observation> queries;
   Random random(2), fresh(5);
   for (uint32_t i = 0; i < places && queries.size() < 64; ++i) {
@@ -85,44 +89,10 @@ std::vector<Observation> RevisitQueries(uint32_t places, uint32_t vocabulary) {
     (void)w.Observe(place, &random);
     if (i % (places / 64) == 0) queries.push_back(w.Observe(place, &fresh));
   }
-  return queries;
-}
-
-// A mapped place seen again (a second observation of it): one place stands out, so Localise
-// rules the others out early.
-void BM_FabmapRevisit(benchmark::State& state) {
-  const uint32_t places = static_cast<uint32_t>(state.range(0));
-  const uint32_t vocabulary = static_cast<uint32_t>(state.range(1));
-  FabmapModel& model = Model(places, vocabulary);
-  TimeQueries(state, model, RevisitQueries(places, vocabulary));
+  TimeQueries(state, model, queries);
 }
 BENCHMARK(BM_FabmapRevisit)
     ->ArgsProduct({{1000, 10000, 100000}, {10000}})
-    ->Unit(benchmark::kMicrosecond);
-
-// What a front end deciding by log odds asks: the best mapped place if it beats the new place
-// (log odds >= 0). Third argument: new places (0) or revisits (1); fourth: the bail-out
-// probability as 10^-k (0: exact, Localise thresholded). Counter: the share decided early.
-void BM_FabmapBestAbove(benchmark::State& state) {
-  const uint32_t places = static_cast<uint32_t>(state.range(0));
-  const uint32_t vocabulary = static_cast<uint32_t>(state.range(1));
-  FabmapModel& model = Model(places, vocabulary);
-  const std::vector<Observation> queries = state.range(2) == 0
-                                               ? Observations(World(vocabulary), 64, 3)
-                                               : RevisitQueries(places, vocabulary);
-  const double probability =
-      state.range(3) == 0 ? 0.0 : std::pow(10.0, -static_cast<double>(state.range(3)));
-  size_t i = 0;
-  double bailed = 0.0;
-  for (auto _ : state) {
-    const PlaceAbove r = model.BestAbove(queries[i++ % queries.size()], 0.0, probability);
-    bailed += r.bailed_out;
-    benchmark::DoNotOptimize(r);
-  }
-  state.counters["bailed_out"] = bailed / static_cast<double>(state.iterations());
-}
-BENCHMARK(BM_FabmapBestAbove)
-    ->ArgsProduct({{1000, 10000, 100000}, {10000}, {0, 1}, {0, 6, 9}})
     ->Unit(benchmark::kMicrosecond);
 
 // Baseline: the dense FABMAP 1.0 sum over every word for every place (1k places only).

@@ -117,22 +117,6 @@ struct LocalisationResult {
   uint32_t places_ruled_out = 0;
 };
 
-// The answer to "which mapped place, if any, beats the new place by at least a margin": what a
-// front end deciding by log odds needs, without the posterior.
-struct PlaceAbove {
-  int64_t place = -1;  // the best mapped place if its log odds reach the floor, else -1
-  double log_odds = -std::numeric_limits<double>::infinity();  // its log odds (as in Localise)
-  bool bailed_out = false;  // decided before the last words by the probabilistic bound
-};
-
-// Bennett's inequality for a sum S of independent terms delta_i X_i, X_i ~ Bernoulli(p_i),
-// 0 < delta_i <= a: P(S - E[S] >= t) <= exp(-(v / a^2) h(a t / v)), v = sum delta_i^2 p_i (1 -
-// p_i), h(u) = (1 + u) ln(1 + u) - u. Returns E[S] + t for the t where that bound is
-// `probability` (in (0, 1)): a value S exceeds with at most that probability. Used by
-// BestAbove, as FAB-MAP 2.0 (Cummins and Newman 2011) bounds the words still to come.
-double BennettUpperBound(const std::vector<double>& delta, const std::vector<double>& p,
-                         double probability);
-
 class FabmapModel {
  public:
   // `blocks` must cover words 0..tree.size()-1 in order; `unknown_world_samples` are
@@ -161,16 +145,6 @@ class FabmapModel {
   // The same with every place's log-likelihood summed in full (the test oracle of Localise's
   // bound: equal to the bit, but for places_ruled_out).
   LocalisationResult LocaliseExhaustive(const Observation& z) const;
-  // The best mapped place if its log odds against the new place (best_mapped_log_odds of
-  // Localise) are at least `min_log_odds`. With `bail_out_probability` = 0 the answer is
-  // Localise's, exactly. Above 0 (FAB-MAP 2.0's bail-out): at a quarter, half and three quarters
-  // of the likelihood-raising postings, a place whose partial sum plus what the remaining words
-  // add with probability above `bail_out_probability` (BennettUpperBound, each word present
-  // with its share of the mapped places) stays below the floor is dropped; when few are left,
-  // those are summed in full and the rest never are. Approximate: a place whose words come late
-  // and together (not like a random place's) can be missed; the exact path stays the default.
-  PlaceAbove BestAbove(const Observation& z, double min_log_odds,
-                       double bail_out_probability = 0.0) const;
   // The same over a subset of places (normalised over them plus the new place); the result's
   // place_probability follows `candidates`' order, best_place is a place id.
   LocalisationResult LocaliseAmong(const Observation& z,

@@ -44,13 +44,6 @@ FabmapModel MakeModel(const World& w, UnknownWorld unknown = UnknownWorld::kMean
   return *std::move(model);
 }
 
-// Adds `n` places of the world, each seen once.
-void AddRandomPlaces(const World& w, int n, Random* random, FabmapModel* model) {
-  for (int i = 0; i < n; ++i) {
-    ASSERT_TRUE(model->AddPlace(w.words.Observe(w.words.SamplePlace(random), random)).ok());
-  }
-}
-
 TEST(FabmapTest, SparseLikelihoodEqualsDenseOracle) {
   const World w = MakeWorld(300, 30, 1);
   for (double p_absent : {0.0, 0.05}) {
@@ -163,7 +156,9 @@ TEST(FabmapTest, AllNewObservationIsRejected) {
   const World w = MakeWorld(1000, 50, 3);
   FabmapModel model = MakeModel(w);
   Random random(6);
-  AddRandomPlaces(w, 300, &random, &model);
+  for (int i = 0; i < 300; ++i) {
+    ASSERT_TRUE(model.AddPlace(w.words.Observe(w.words.SamplePlace(&random), &random)).ok());
+  }
   int rejected = 0;
   for (int i = 0; i < 100; ++i) {
     const LocalisationResult r =
@@ -287,110 +282,6 @@ TEST(FabmapTest, PlacesPastTheFirstIndexBlockAreScoredLikeTheOthers) {
     for (double s : sparse) above += s > sparse[target];
     EXPECT_LT(above, n / 100) << target;
   }
-}
-
-// Bennett's bound against the exact tail of a sum of weighted Bernoulli terms (by enumerating
-// every outcome): the value it returns is exceeded with at most the probability asked, and it is
-// not vacuous (below the sum of all the weights where that tail is small but not zero).
-TEST(FabmapTest, BennettUpperBoundHoldsAgainstTheExactTail) {
-  Random random(31);
-  for (int trial = 0; trial < 40; ++trial) {
-    const int terms = 4 + trial % 11;
-    std::vector<double> delta, p;
-    for (int i = 0; i < terms; ++i) {
-      delta.push_back(0.5 + 3.0 * random.Uniform());
-      p.push_back(0.02 + 0.5 * random.Uniform());
-    }
-    for (const double probability : {0.1, 1e-3, 1e-6}) {
-      const double bound = BennettUpperBound(delta, p, probability);
-      double tail = 0.0, all = 0.0;
-      for (int i = 0; i < terms; ++i) all += delta[i];
-      for (uint32_t outcome = 0; outcome < (1u << terms); ++outcome) {
-        double sum = 0.0, likelihood = 1.0;
-        for (int i = 0; i < terms; ++i) {
-          const bool present = (outcome >> i) & 1;
-          sum += present ? delta[i] : 0.0;
-          likelihood *= present ? p[i] : 1.0 - p[i];
-        }
-        if (sum > bound) tail += likelihood;
-      }
-      EXPECT_LE(tail, probability) << "trial " << trial << " probability " << probability;
-      EXPECT_LE(bound, all);
-    }
-  }
-  // A hand-checked case: ten terms of 1 with p = 0.1 (mean 1, variance 0.9, a = 1). At 1e-3,
-  // h(u) = ln(1000) / 0.9 = 7.675 gives u = 6.03 (7.03 ln 7.03 - 6.03 = 7.68) and the bound is
-  // 1 + 0.9 u = 6.4, where the exact binomial tail allows 5 (P(S > 5) = 1.5e-4, P(S > 4) = 1.6e-3).
-  const double bound =
-      BennettUpperBound(std::vector<double>(10, 1.0), std::vector<double>(10, 0.1), 1e-3);
-  EXPECT_GT(bound, 6.0);
-  EXPECT_LT(bound, 7.0);
-}
-
-// BestAbove without the bail-out is Localise thresholded, to the bit; with it (1e-6), it gives
-// the same answer on revisits and new places of synthetic worlds, sparse (100 of 2,000 words per
-// place) and dense (60 of 300: each word in about a fifth of the places), deciding most of them
-// before the last words.
-TEST(FabmapTest, BestAboveAgreesWithLocalise) {
-  for (const auto& [vocabulary, words] : {std::pair(2000u, 100.0), std::pair(300u, 60.0)}) {
-    const World w = MakeWorld(vocabulary, words, 41);
-    FabmapModel model = MakeModel(w);
-    Random random(42);
-    std::vector<Observation> places;
-    for (int i = 0; i < 5000; ++i) {
-      places.push_back(w.words.SamplePlace(&random));
-      ASSERT_TRUE(model.AddPlace(w.words.Observe(places.back(), &random)).ok());
-    }
-    int bailed = 0, found = 0, queries = 0;
-    for (int i = 0; i < 40; ++i) {
-      const Observation z = i % 2 == 0 ? w.words.Observe(places[random.NextU64() % 5000], &random)
-                                       : w.words.Observe(w.words.SamplePlace(&random), &random);
-      const LocalisationResult exact = model.LocaliseExhaustive(z);
-      for (const double floor : {-5.0, 0.0, 20.0}) {
-        const bool above = exact.best_mapped_place >= 0 && exact.best_mapped_log_odds >= floor;
-        const PlaceAbove plain = model.BestAbove(z, floor);
-        EXPECT_EQ(plain.place, above ? exact.best_mapped_place : -1);
-        if (above) {
-          EXPECT_EQ(plain.log_odds, exact.best_mapped_log_odds);
-        }
-        EXPECT_FALSE(plain.bailed_out);
-        const PlaceAbove fast = model.BestAbove(z, floor, 1e-6);
-        EXPECT_EQ(fast.place, plain.place) << "query " << i << " floor " << floor;
-        if (above) {
-          EXPECT_EQ(fast.log_odds, exact.best_mapped_log_odds);
-        }
-        bailed += fast.bailed_out;
-        found += fast.place >= 0;
-        ++queries;
-      }
-      ASSERT_FALSE(HasFailure()) << "vocabulary " << vocabulary;
-    }
-    EXPECT_GT(found, queries / 4);  // the revisits
-    EXPECT_GT(bailed, queries * 3 / 4) << "vocabulary " << vocabulary;
-  }
-}
-
-// The bail-out's margin at work: A saw the first half of the query's words and nothing else; B
-// the same but for the first five, and the whole second half. Halfway, A leads B by five words'
-// worth (about 20 nats) and A is complete; B overtakes it with the second half. Bennett's margin
-// (what a place like the mapped ones might still add) keeps B; without it B would be dropped.
-TEST(FabmapTest, BestAboveKeepsAPlaceThatOvertakesTheLeaderLate) {
-  const World w = MakeWorld(2000, 100, 51);
-  FabmapModel model = MakeModel(w);
-  Random random(52);
-  AddRandomPlaces(w, 3000, &random, &model);
-  const Observation z = w.words.Observe(w.words.SamplePlace(&random), &random);
-  ASSERT_GT(z.size(), 60u);
-  const Observation a(z.begin(), z.begin() + z.size() / 2);
-  const Observation b(z.begin() + 5, z.end());
-  const auto id_a = model.AddPlace(a), id_b = model.AddPlace(b);
-  ASSERT_TRUE(id_a.ok() && id_b.ok());
-  const LocalisationResult exact = model.LocaliseExhaustive(z);
-  ASSERT_EQ(exact.best_mapped_place, *id_b);
-  const PlaceAbove fast = model.BestAbove(z, 0.0, 1e-6);
-  EXPECT_TRUE(fast.bailed_out);
-  EXPECT_EQ(fast.place, *id_b);
-  EXPECT_EQ(fast.log_odds, exact.best_mapped_log_odds);
 }
 
 TEST(FabmapTest, LocaliseAmongCandidates) {
