@@ -24,10 +24,13 @@
 // posterior that Normalise would report as 0 anyway (e^-40 below the best). So only the places
 // above both limits get their last words, by a walk over their own words rather than over the
 // posting lists, and the others' probabilities are 0. When too many places are left for that to
-// pay (near copies of one place, or a flat posterior), the scatter simply goes on. Either way
-// every number is the one the exhaustive sum gives, to the bit (LocaliseExhaustive is the test
-// oracle). This is FAB-MAP 2.0's bail-out with a bound that always holds instead of a
-// probabilistic one.
+// pay (near copies of one place, or a flat posterior), the scatter simply goes on. The same test
+// is tried once earlier, after half of the positive words, with the sum of the positive deltas
+// still to come added to every partial sum as its bound: a revisited place has pulled far enough
+// ahead by then (revisits at 100k places: 0.55-0.61 of the time), and for a new place the test
+// fails after a few hundred places (2 % more instructions). Either way every number is the one
+// the exhaustive sum gives, to the bit (LocaliseExhaustive is the test oracle). This is FAB-MAP
+// 2.0's bail-out with a bound that always holds instead of a probabilistic one.
 //
 // Normalisation (eq. 3): p(L_i|Z) = p(Z|L_i) p(L_i) / (sum_m p(Z|L_m) p(L_m) + p_new p(Z|L_u)),
 // p(L_m) = (1 - p_new) / n_M. The unknown-world likelihood p(Z|L_u) comes from
@@ -115,6 +118,9 @@ struct LocalisationResult {
   // Places ruled out (probability exactly 0) before their last words were summed: a measure of
   // the work Localise saved, not of the answer (which is the exhaustive one).
   uint32_t places_ruled_out = 0;
+  // How many of the query's active words were summed for every place before the others were
+  // ruled out (all of them when none were): the same kind of measure.
+  uint32_t words_summed_for_every_place = 0;
 };
 
 class FabmapModel {

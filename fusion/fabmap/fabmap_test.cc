@@ -216,7 +216,7 @@ TEST(FabmapTest, RulingPlacesOutChangesNoNumber) {
         ASSERT_TRUE(model.AddPlace(w.words.Observe(truth, &random)).ok());
       }
       uint64_t ruled_out = 0;
-      int queries = 0;
+      int queries = 0, early = 0;
       auto check = [&](const Observation& z) -> uint32_t {
         const LocalisationResult fast = model.Localise(z);
         const LocalisationResult slow = model.LocaliseExhaustive(z);
@@ -228,21 +228,27 @@ TEST(FabmapTest, RulingPlacesOutChangesNoNumber) {
         EXPECT_EQ(fast.best_mapped_log_odds, slow.best_mapped_log_odds);
         EXPECT_TRUE(fast.place_probability == slow.place_probability);
         EXPECT_EQ(slow.places_ruled_out, 0u);
+        EXPECT_LE(fast.words_summed_for_every_place, slow.words_summed_for_every_place);
         ruled_out += fast.places_ruled_out;
         ++queries;
+        early += fast.words_summed_for_every_place < slow.words_summed_for_every_place / 2;
         return fast.places_ruled_out;
       };
-      int revisits_mostly_ruled_out = 0, copies_none_ruled_out = 0;
+      int revisits_mostly_ruled_out = 0, copies_none_ruled_out = 0, revisits_early = 0;
       for (int i = 0; i < 30; ++i) {
         check(w.words.Observe(w.words.SamplePlace(&random), &random));  // a new place
+        const int before = early;
         revisits_mostly_ruled_out += check(w.words.Observe(places[random.NextU64() % 1000],
                                                            &random)) > model.places() * 9 / 10;
+        revisits_early += early - before;
         copies_none_ruled_out += check(w.words.Observe(places[1000], &random)) == 0;
         ASSERT_FALSE(HasFailure());
       }
       check({});  // nothing observed
-      // The bound did its work on revisits, and the near copies took the other path.
+      // The bound did its work on revisits, most of them after the first eighth of the words
+      // that raise a likelihood, and the near copies took the other path.
       EXPECT_GE(revisits_mostly_ruled_out, 25) << ToString(unknown) << " " << p_detect;
+      EXPECT_GE(revisits_early, 20) << ToString(unknown) << " " << p_detect;
       EXPECT_GE(copies_none_ruled_out, 25) << ToString(unknown) << " " << p_detect;
       RecordProperty("mean_ruled_out_" + ToString(unknown), static_cast<int>(ruled_out / queries));
     }
