@@ -26,11 +26,13 @@
 // posting lists, and the others' probabilities are 0. When too many places are left for that to
 // pay (near copies of one place, or a flat posterior), the scatter simply goes on. The same test
 // is tried once earlier, after half of the positive words, with the sum of the positive deltas
-// still to come added to every partial sum as its bound: a revisited place has pulled far enough
-// ahead by then (revisits at 100k places: 0.55-0.61 of the time), and for a new place the test
-// fails after a few hundred places (2 % more instructions). Either way every number is the one
-// the exhaustive sum gives, to the bit (LocaliseExhaustive is the test oracle). This is FAB-MAP
-// 2.0's bail-out with a bound that always holds instead of a probabilistic one.
+// still to come added to every partial sum as its bound: a revisited place of the synthetic
+// benchmark has pulled far enough ahead by then (revisits at 100k places: 0.55-0.61 of the time;
+// on real Wi-Fi words, where consecutive scans are near copies, it decides 15 % of UJIIndoorLoc
+// queries and no Microsoft ones), and for a new place the test fails after a few hundred places
+// (2 % more instructions). Either way every number is the one the exhaustive sum gives, to the
+// bit (LocaliseExhaustive is the test oracle). This is FAB-MAP 2.0's bail-out with a bound that
+// always holds instead of a probabilistic one.
 //
 // Normalisation (eq. 3): p(L_i|Z) = p(Z|L_i) p(L_i) / (sum_m p(Z|L_m) p(L_m) + p_new p(Z|L_u)),
 // p(L_m) = (1 - p_new) / n_M. The unknown-world likelihood p(Z|L_u) comes from

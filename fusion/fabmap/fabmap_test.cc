@@ -245,8 +245,8 @@ TEST(FabmapTest, RulingPlacesOutChangesNoNumber) {
         ASSERT_FALSE(HasFailure());
       }
       check({});  // nothing observed
-      // The bound did its work on revisits, most of them after the first eighth of the words
-      // that raise a likelihood, and the near copies took the other path.
+      // The bound did its work on revisits, most of them before half of the active words were
+      // summed for every place, and the near copies took the other path.
       EXPECT_GE(revisits_mostly_ruled_out, 25) << ToString(unknown) << " " << p_detect;
       EXPECT_GE(revisits_early, 20) << ToString(unknown) << " " << p_detect;
       EXPECT_GE(copies_none_ruled_out, 25) << ToString(unknown) << " " << p_detect;
