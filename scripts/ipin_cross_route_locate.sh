@@ -34,7 +34,7 @@ map_of() {  # output map, routes...: a map from repetitions 01 and 02 of the rou
   "$bin" wifi-map "${a[@]}" --out "$map" > /dev/null
 }
 locate_row() {  # map, route, repetition, output folder, label
-  "$bin" locate --quiet --wifi-map "$1" --data "$(log "$2" "$3")" --out "$4"
+  "$bin" locate --quiet --overwrite --wifi-map "$1" --data "$(log "$2" "$3")" --out "$4"
   row "$4/summary.json" "$5"
 }
 echo "| located (map) | scans with truth | filter mean / median / p90 m | 3-NN mean / median / p90 m |"

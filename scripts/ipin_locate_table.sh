@@ -23,18 +23,18 @@ echo "|---|---|---|---|---|---|---|---|---|"
 for route in 01 02 03 21 22 23; do
   log() { echo "$data/IPIN2023_T3_TrainingTrial${route}_repetition$1.txt"; }
   "$bin" wifi-map --data "$(log 01)" --data "$(log 02)" --out "$out/route$route.wifimap" > /dev/null
-  "$bin" replay --quiet --config configs/ipin2023-wifi-compass.toml --data "$(log 01)" \
+  "$bin" replay --quiet --overwrite --config configs/ipin2023-wifi-compass.toml --data "$(log 01)" \
     --data "$(log 02)" --out "$out/route$route-run" > /dev/null
   "$bin" wifi-map --run "$out/route$route-run" --data "$(log 01)" --data "$(log 02)" \
     --out "$out/route$route-run.wifimap" > /dev/null
   for rep in 03 04; do
-    "$bin" locate --quiet --wifi-map "$out/route$route.wifimap" --data "$(log $rep)" \
+    "$bin" locate --quiet --overwrite --wifi-map "$out/route$route.wifimap" --data "$(log $rep)" \
       --out "$out/route$route-rep$rep-sum"
-    "$bin" locate --quiet --config "$out/product.toml" --wifi-map "$out/route$route.wifimap" \
+    "$bin" locate --quiet --overwrite --config "$out/product.toml" --wifi-map "$out/route$route.wifimap" \
       --data "$(log $rep)" --out "$out/route$route-rep$rep-product"
-    "$bin" locate --quiet --wifi-map "$out/route$route-run.wifimap" --data "$(log $rep)" \
+    "$bin" locate --quiet --overwrite --wifi-map "$out/route$route-run.wifimap" --data "$(log $rep)" \
       --out "$out/route$route-rep$rep-run"
-    "$bin" locate --quiet --config "$out/online.toml" --wifi-map "$out/route$route.wifimap" \
+    "$bin" locate --quiet --overwrite --config "$out/online.toml" --wifi-map "$out/route$route.wifimap" \
       --data "$(log $rep)" --out "$out/route$route-rep$rep-online"
     /usr/bin/python3 - "$out/route$route-rep$rep-sum/summary.json" \
       "$out/route$route-rep$rep-product/summary.json" "$out/route$route-rep$rep-run/summary.json" \

@@ -19,7 +19,7 @@ for route in 01 02 03 21 22 23 51; do
       args=(); for rep in 01 02 03 04; do f=$data/IPIN2023_T3_TrainingTrial${route}_repetition${rep}.txt; [[ -f $f ]] && args+=(--data $f); [[ ${#args[@]} -ge $((2*n)) ]] && break; done
       line="$route $mode $n"
       for when in frames time; do
-        "$bin" replay --quiet --config $when-$mode.toml "${args[@]}" --out $when-$route-$mode-$n >/dev/null 2>&1 && line+=" | "$(get $when-$route-$mode-$n)
+        "$bin" replay --quiet --overwrite --config $when-$mode.toml "${args[@]}" --out $when-$route-$mode-$n >/dev/null 2>&1 && line+=" | "$(get $when-$route-$mode-$n)
       done
       echo "$line"
     done

@@ -20,7 +20,7 @@ sed 's/^enabled = true/enabled = false/' configs/ipin2023-wifi-sequence-alone.to
 row() {  # name mode config args...
   local name=$1 mode=$2 config=$3; shift 3
   local dir="$out/$name-${mode//[+ ]/-}"
-  "$bin" replay --quiet --config "$config" "$@" --out "$dir" > /dev/null
+  "$bin" replay --quiet --overwrite --config "$config" "$@" --out "$dir" > /dev/null
   /usr/bin/python3 - "$dir/summary.json" "$name" "$mode" <<'PY'
 import json, sys
 j = json.load(open(sys.argv[1])); w = j.get("wifi_sequence")

@@ -12,7 +12,7 @@ mkdir -p "$out"
 row() {  # name mode args...
   local name=$1 mode=$2; shift 2
   local dir="$out/$name-$mode"
-  "$bin" replay --quiet --config "configs/ipin2023-$mode.toml" "$@" --out "$dir" > /dev/null
+  "$bin" replay --quiet --overwrite --config "configs/ipin2023-$mode.toml" "$@" --out "$dir" > /dev/null
   python3 - "$dir/summary.json" "$name" "$mode" <<'PY'
 import json, sys
 j = json.load(open(sys.argv[1])); r = j.get("match_rate_within_m", {})

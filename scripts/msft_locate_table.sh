@@ -22,7 +22,7 @@ echo "| floor | walk | scans (with truth) | filter mean / median / p90 m (wrong 
 echo "|---|---|---|---|---|"
 for f in "${floors[@]}"; do
   w=$(ls "$data/$f/path_data_files" | sort | head -1)
-  "$bin" locate --quiet --wifi-map "$out/site1.wifimap" --data "$data/$f/path_data_files/$w" \
+  "$bin" locate --quiet --overwrite --wifi-map "$out/site1.wifimap" --data "$data/$f/path_data_files/$w" \
     --out "$out/$f"
   /usr/bin/python3 - "$out/$f/summary.json" "$f" "$w" <<'PY'
 import json, sys

@@ -24,7 +24,7 @@ for world in office apartment circular aliased_floors day_night; do
   done
   "$bin" wifi-map --data "$out/$world-1" --out "$out/$world.wifimap" > "$out/$world-wifimap.json"
   for c in sum sum-nowalls product product-nowalls; do
-    "$bin" locate --quiet --config "$out/$c.toml" --wifi-map "$out/$world.wifimap" \
+    "$bin" locate --quiet --overwrite --config "$out/$c.toml" --wifi-map "$out/$world.wifimap" \
       --data "$out/$world-2" --out "$out/$world-$c"
   done
   /usr/bin/python3 - "$out" "$world" <<'PY'
