@@ -627,28 +627,33 @@ TEST_F(SimulatedSaveResumeTest, FabmapFrontEnd) {
   ExpectResumeEqualsWhole(config.string(), 250.0);
 }
 
-// The same with the online RSSI offset, on a copy of the data whose second session (from 178 s)
-// reads 6 dB lower, as another phone would: the split (250 s) falls after that session's offset
-// became known (3 estimates), so the restored estimates and the places' fingerprints (their APs
-// numbered afresh on load) must carry the rest of the run identically.
-TEST_F(SimulatedSaveResumeTest, FabmapFrontEndWithOnlineRssiOffset) {
-  const fs::path data = root_->path() / "data-second-phone";
-  fs::copy(root_->path() / "data", data, fs::copy_options::recursive);
-  {
-    std::ifstream in(data / "wifi.csv");
-    std::stringstream out;
-    std::string line;
-    std::getline(in, line);
-    ASSERT_EQ(line, "time_s,bssid,rssi_dbm");
-    out << line << "\n";
-    while (std::getline(in, line)) {
-      const size_t a = line.find(','), b = line.rfind(',');
-      const double t = std::stod(line.substr(0, a)), rssi = std::stod(line.substr(b + 1));
-      out << line.substr(0, b + 1) << (t >= 177.8 ? rssi - 6.0 : rssi) << "\n";
-    }
-    in.close();
-    std::ofstream(data / "wifi.csv") << out.str();
+// A copy of the simulated data whose second session (from 178 s) reads 6 dB lower, as another
+// phone would (made once).
+fs::path SecondPhoneData(const fs::path& root) {
+  const fs::path data = root / "data-second-phone";
+  if (fs::exists(data)) return data;
+  fs::copy(root / "data", data, fs::copy_options::recursive);
+  std::ifstream in(data / "wifi.csv");
+  std::stringstream out;
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "time_s,bssid,rssi_dbm");
+  out << line << "\n";
+  while (std::getline(in, line)) {
+    const size_t a = line.find(','), b = line.rfind(',');
+    const double t = std::stod(line.substr(0, a)), rssi = std::stod(line.substr(b + 1));
+    out << line.substr(0, b + 1) << (t >= 177.8 ? rssi - 6.0 : rssi) << "\n";
   }
+  in.close();
+  std::ofstream(data / "wifi.csv") << out.str();
+  return data;
+}
+
+// With the online RSSI offset on the second-phone data: the split (250 s) falls after the second
+// session's offset became known, so the restored estimates (and, for FABMAP, the places'
+// fingerprints, their APs numbered afresh on load) must carry the rest of the run identically.
+TEST_F(SimulatedSaveResumeTest, FabmapFrontEndWithOnlineRssiOffset) {
+  const fs::path data = SecondPhoneData(root_->path());
   const fs::path config = root_->path() / "fabmap-wifi-offset.toml";
   std::ofstream(config) << "[front_end]\nkind = \"fabmap\"\n[fabmap]\nmode = \"wifi\"\n"
                            "[fabmap_front_end]\nmatch_probability = 0.5\nrecency_s = 40.0\n"
@@ -661,6 +666,25 @@ TEST_F(SimulatedSaveResumeTest, FabmapFrontEndWithOnlineRssiOffset) {
   ASSERT_TRUE(part.contains("wifi_rssi_offsets_db")) << part.dump();
   ASSERT_EQ(part["wifi_rssi_offsets_db"].size(), 2u);  // both sessions began before the split
   EXPECT_NEAR(part["wifi_rssi_offsets_db"][1].get<double>(), -6.0, 1.0);  // known by then
+}
+
+TEST_F(SimulatedSaveResumeTest, FusedFrontEndWithOnlineRssiOffset) {
+  const fs::path data = SecondPhoneData(root_->path());
+  const fs::path config = root_->path() / "demo-offset.toml";
+  std::ifstream shipped(fs::path(RATSLAM_SOURCE_DIR) / "configs" / "demo.toml");
+  std::stringstream text;
+  text << shipped.rdbuf();
+  std::string toml = text.str();
+  const std::string fused = "[fused]\n";
+  ASSERT_NE(toml.find(fused), std::string::npos);
+  toml.insert(toml.find(fused) + fused.size(),
+              "online_rssi_offset = true\nrssi_offset_min_estimates = 3\n");
+  std::ofstream(config) << toml;
+  ExpectResumeEqualsWhole(config.string(), 250.0, data);
+  const nlohmann::json part = Summary(root_->path() / "demo-offset_part");
+  ASSERT_TRUE(part.contains("wifi_rssi_offsets_db")) << part.dump();
+  ASSERT_EQ(part["wifi_rssi_offsets_db"].size(), 2u);
+  EXPECT_NEAR(part["wifi_rssi_offsets_db"][1].get<double>(), -6.0, 1.0);
 }
 
 TEST_F(ReplayEndToEndTest, ResumeWithAnotherConfigIsRefused) {
