@@ -53,13 +53,19 @@ BENCHMARK(BM_WifiBestIndexed)
 // missed, the common query of a run (a new place is the one above). Best prunes fingerprints
 // that lack the query's strongest APs once it has met a good match: from the block of ids
 // holding k on (these synthetic places have random RSSI, so other places never score well).
-void BM_WifiBestRevisit(benchmark::State& state) {
-  Setup s = Make(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+// A revisit of stored fingerprint `id`: its readings with 3 dB noise, one AP missed.
+Fingerprint Revisit(const Setup& s, size_t id) {
   Random rng(11);
-  Fingerprint q = s.stored[static_cast<size_t>(state.range(2))];
+  Fingerprint q = s.stored[id];
   for (float& rssi : q.rssi_dbm) rssi += static_cast<float>(rng.Gaussian(0, 3));
   q.ap_ids.pop_back();
   q.rssi_dbm.pop_back();
+  return q;
+}
+
+void BM_WifiBestRevisit(benchmark::State& state) {
+  Setup s = Make(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  const Fingerprint q = Revisit(s, static_cast<size_t>(state.range(2)));
   for (auto _ : state) benchmark::DoNotOptimize(s.matcher.Best(q));
 }
 BENCHMARK(BM_WifiBestRevisit)
@@ -72,14 +78,8 @@ BENCHMARK(BM_WifiBestRevisit)
 // the pruning has its budget from the start. A new place (above) and the revisit of id 7000.
 void BM_WifiBestAtThreshold(benchmark::State& state) {
   Setup s = Make(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
-  Fingerprint q = s.query;
-  if (state.range(2) >= 0) {
-    Random rng(11);
-    q = s.stored[static_cast<size_t>(state.range(2))];
-    for (float& rssi : q.rssi_dbm) rssi += static_cast<float>(rng.Gaussian(0, 3));
-    q.ap_ids.pop_back();
-    q.rssi_dbm.pop_back();
-  }
+  const Fingerprint q =
+      state.range(2) >= 0 ? Revisit(s, static_cast<size_t>(state.range(2))) : s.query;
   const double t = s.matcher.options().match_threshold;
   for (auto _ : state) benchmark::DoNotOptimize(s.matcher.Best(q, nullptr, t));
 }
