@@ -24,6 +24,7 @@
 #include "common/median.h"
 #include "sensors/dataset/dataset_loader.h"
 #include "tests/documented_keys.h"
+#include "tests/run_ratslam.h"
 
 namespace ratslam {
 namespace {
@@ -387,15 +388,10 @@ TEST(IpinEndToEndTest, OnlineRssiOffsetFindsTheSecondPhonesOffset) {
           fs::temp_directory_path() / ("ratslam_ipin_offset_" + std::to_string(::getpid()));
       fs::create_directories(root);
       const fs::path config = root / "config.toml";
-      std::ifstream shipped(std::string(RATSLAM_SOURCE_DIR) +
-                            "/configs/ipin2023-wifi-compass.toml");
-      std::stringstream text;
-      text << shipped.rdbuf();
-      std::string toml = text.str();
-      const std::string fused = "[fused]\n";
-      ASSERT_NE(toml.find(fused), std::string::npos);
-      toml.insert(toml.find(fused) + fused.size(),
-                  std::string("online_rssi_offset = ") + (online ? "true" : "false") + "\n");
+      const std::string toml = e2e::WithLinesInSection(
+          e2e::Slurp(std::string(RATSLAM_SOURCE_DIR) + "/configs/ipin2023-wifi-compass.toml"),
+          "fused", std::string("online_rssi_offset = ") + (online ? "true" : "false") + "\n");
+      ASSERT_FALSE(toml.empty());
       std::ofstream(config) << toml;
       const fs::path out = root / (std::string(trial) + (online ? "_on" : "_off"));
       std::string command = std::string(RATSLAM_BINARY) + " replay --quiet --overwrite --config " +

@@ -524,10 +524,9 @@ TEST_F(ReplayEndToEndTest, FormatFiveMapResumesWithWifiSequenceOffOnly) {
 // without it); the error names the key.
 TEST_F(ReplayEndToEndTest, MapFromThePreviousReleaseRefusesAKeyItCouldNotHaveUsed) {
   const fs::path config = root_ / "synthetic-online.toml";
-  std::string text = Slurp(config_);
-  const std::string header = "[fabmap_front_end]\n";
-  ASSERT_NE(text.find(header), std::string::npos);
-  text.insert(text.find(header) + header.size(), "wifi_learning = \"online\"\n");
+  const std::string text =
+      e2e::WithLinesInSection(Slurp(config_), "fabmap_front_end", "wifi_learning = \"online\"\n");
+  ASSERT_FALSE(text.empty());
   std::ofstream(config) << text;
   const std::string fixture =
       (fs::path(RATSLAM_SOURCE_DIR) / "tests" / "data" / "map-v2-synthetic.map").string();
@@ -671,14 +670,10 @@ TEST_F(SimulatedSaveResumeTest, FabmapFrontEndWithOnlineRssiOffset) {
 TEST_F(SimulatedSaveResumeTest, FusedFrontEndWithOnlineRssiOffset) {
   const fs::path data = SecondPhoneData(root_->path());
   const fs::path config = root_->path() / "demo-offset.toml";
-  std::ifstream shipped(fs::path(RATSLAM_SOURCE_DIR) / "configs" / "demo.toml");
-  std::stringstream text;
-  text << shipped.rdbuf();
-  std::string toml = text.str();
-  const std::string fused = "[fused]\n";
-  ASSERT_NE(toml.find(fused), std::string::npos);
-  toml.insert(toml.find(fused) + fused.size(),
-              "online_rssi_offset = true\nrssi_offset_min_estimates = 3\n");
+  const std::string toml = e2e::WithLinesInSection(
+      Slurp(fs::path(RATSLAM_SOURCE_DIR) / "configs" / "demo.toml"), "fused",
+      "online_rssi_offset = true\nrssi_offset_min_estimates = 3\n");
+  ASSERT_FALSE(toml.empty());
   std::ofstream(config) << toml;
   ExpectResumeEqualsWhole(config.string(), 250.0, data);
   const nlohmann::json part = Summary(root_->path() / "demo-offset_part");

@@ -21,6 +21,15 @@ inline std::string Slurp(const std::filesystem::path& path) {
   return s.str();
 }
 
+// `toml` with `lines` added right after its "[section]" header line; empty when there is none.
+inline std::string WithLinesInSection(std::string toml, const std::string& section,
+                                      const std::string& lines) {
+  const std::string header = "[" + section + "]\n";
+  const size_t at = toml.find(header);
+  if (at == std::string::npos) return {};
+  return toml.insert(at + header.size(), lines);
+}
+
 struct Result {
   int exit_code;
   std::string err;  // what it printed on stderr
