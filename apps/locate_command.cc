@@ -239,7 +239,7 @@ Status SamplesFromRun(const std::string& run_folder, const std::vector<std::stri
     frame_of->set_compass_to_map_rad(std::atan2(sum_sin, sum_cos));
   std::vector<Point2> on_map, on_truth;
   for (const GroundTruthRow& p : *trajectory) {
-    const auto truth = InterpolateGroundTruth(data->ground_truth, p.time_s);
+    const auto truth = GroundTruthAt(*data, p.time_s);
     if (!truth) continue;
     on_map.push_back({p.x_m, p.y_m});
     on_truth.push_back({truth->x_m, truth->y_m});
@@ -281,7 +281,7 @@ int WifiMapCommand(const Arguments& parsed) {
     for (const Dataset& d : data.value()) {
       for (const WifiScan& scan : d.wifi) {
         ++scans;
-        const auto truth = InterpolateGroundTruth(d.ground_truth, scan.time_s);
+        const auto truth = GroundTruthAt(d, scan.time_s);
         if (!truth || scan.readings.empty()) continue;
         samples.push_back({{truth->x_m, truth->y_m}, truth->floor, Readings(scan)});
       }
@@ -397,7 +397,7 @@ int LocateCommand(const Arguments& parsed) {
         }
         errors << ShortestNumber(scan.time_s) << ',' << ShortestNumber(est.x_m) << ','
                << ShortestNumber(est.y_m) << ',' << est.floor << ',' << known;
-        const auto truth = InterpolateGroundTruth(d.ground_truth, scan.time_s);
+        const auto truth = GroundTruthAt(d, scan.time_s);
         if (truth) {
           // A map made from a run is in the run's frame and has one floor: its estimates are
           // scored after its alignment onto the truth, on position alone.
@@ -566,7 +566,7 @@ int CallCommand(const Arguments& parsed) {
   j["last_scan_s"] = last_scan_s;
   j["robot_experience"] = *robot->current;
   j["estimate"] = {{"x_m", estimate.x_m}, {"y_m", estimate.y_m}, {"floor", estimate.floor}};
-  const auto truth = InterpolateGroundTruth(d.ground_truth, last_scan_s);
+  const auto truth = GroundTruthAt(d, last_scan_s);
   std::optional<Point2> truth_on_map;
   if (truth) {
     truth_on_map = TruthToMap(map, {truth->x_m, truth->y_m});

@@ -1,7 +1,10 @@
 #!/usr/bin/env bash
-# Runs Wi-Fi RatSLAM on every IPIN 2023 Track 3 training log (single walks and all repetitions of
-# each route as one multi-session run), with and without the compass, and prints a Markdown
-# table. PDR-only is the dead-reckoning error of the same runs (odometry_ate_m).
+# The README's IPIN table: Wi-Fi RatSLAM on the IPIN 2023 Track 3 training logs (the four
+# repetitions of each route as one multi-session run, Wi-Fi alone and with the compass; two single
+# walks; route 51 with and without the barometer), with the shipped configs and, for comparison,
+# as they were before 2026-12-02: OpenRatSLAM's frame memory ([local_view] memory line removed)
+# and then also the calibration gesture counted as steps ([pdr] min_orientation_steadiness = 0).
+# PDR-only is the dead-reckoning error of the same runs (odometry_ate_m).
 # Usage: scripts/ipin_table.sh [DATA_DIR] [OUT_DIR]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -9,29 +12,62 @@ data=${1:-../shared/data/ipin2023-t3}
 out=${2:-out/ipin-table}
 bin=./build/apps/ratslam
 mkdir -p "$out"
-row() {  # name mode args...
-  local name=$1 mode=$2; shift 2
-  local dir="$out/$name-$mode"
-  "$bin" replay --quiet --overwrite --config "configs/ipin2023-$mode.toml" "$@" --out "$dir" > /dev/null
-  python3 - "$dir/summary.json" "$name" "$mode" <<'PY'
+for mode in wifi wifi-compass; do
+  sed 's/^use_barometer = true$/use_barometer = false/' "configs/ipin2023-$mode.toml" \
+    > "$out/nobaro-$mode.toml"
+done
+old_configs() {  # config name: the config with frame memory, and also with the gesture counted
+  sed '/^memory = /d' "$1" > "$out/$2-frames.toml"
+  printf '\n[pdr]\nmin_orientation_steadiness = 0\n' | cat "$out/$2-frames.toml" - \
+    > "$out/$2-gesture.toml"
+}
+run() {  # config dir args...
+  local config=$1 dir=$2; shift 2
+  "$bin" replay --quiet --overwrite --config "$config" "$@" --out "$dir" > /dev/null
+}
+row() {  # name mode label past(yes/no: the history columns) args...
+  local name=$1 mode=$2 label=$3 past=$4 shipped=configs/ipin2023-$2.toml; shift 4
+  [ "$name" = "${name%nobaro}" ] || shipped=$out/nobaro-$mode.toml
+  run "$shipped" "$out/$name-$mode" "$@"
+  local dirs=("$out/$name-$mode")
+  if [ "$past" = yes ]; then
+    old_configs "$shipped" "$name-$mode"
+    run "$out/$name-$mode-frames.toml" "$out/$name-$mode-frames" "$@"
+    run "$out/$name-$mode-gesture.toml" "$out/$name-$mode-gesture" "$@"
+    dirs+=("$out/$name-$mode-frames" "$out/$name-$mode-gesture")
+  fi
+  /usr/bin/python3 - "$label" "$mode" "${dirs[@]}" <<'PY'
 import json, sys
-j = json.load(open(sys.argv[1])); r = j.get("match_rate_within_m", {})
+label, mode, dirs = sys.argv[1], sys.argv[2], sys.argv[3:]
+s = [json.load(open(d + "/summary.json")) for d in dirs]
 f = lambda v: f"{v:.2f}"
-print(f"| {sys.argv[2]} | {sys.argv[3]} | {j['frames']} | {j['templates']} | {j['matches']} | "
-      f"{f(r.get('2',0))} | {f(r.get('5',0))} | {f(r.get('10',0))} | {f(r.get('20',0))} | "
-      f"{j['floor_mistakes']} | {f(j['map_ate_m'])} | {f(j['odometry_ate_m'])} |")
+j = s[0]
+matches = str(j["matches"])
+if j.get("floor_unverified_matches"): matches += f" ({j['floor_unverified_matches']} unverified)"
+cells = [label, "Wi-Fi + compass" if mode == "wifi-compass" else "Wi-Fi", matches,
+         str(j["view_injections"]), f(j.get("match_rate_within_m", {}).get("5", 0)),
+         str(j["floor_mistakes"]), f(j["map_ate_m"]), f(j["odometry_ate_m"])]
+if len(s) == 3:
+    cells += [f(s[1]["map_ate_m"]), str(s[1]["view_injections"]), f(s[2]["map_ate_m"]),
+              f(s[2]["odometry_ate_m"])]
+else:
+    cells += ["-"] * 4
+print("| " + " | ".join(cells) + " |")
 PY
 }
-echo "| run | mode | frames | templates | matches | <=2 m | <=5 m | <=10 m | <=20 m | floor mistakes | map ATE m | PDR-only ATE m |"
+echo "| run | mode | matches | injections | <=5 m | floor mistakes | map ATE m | PDR-only ATE m | map ATE, frame memory | injections, frame memory | map ATE, frame memory and gesture counted | PDR-only, gesture counted |"
 echo "|---|---|---|---|---|---|---|---|---|---|---|---|"
 for route in 01 02 03 21 22 23; do
+  args=()
+  for rep in 01 02 03 04; do args+=(--data "$data/IPIN2023_T3_TrainingTrial${route}_repetition${rep}.txt"); done
   for mode in wifi wifi-compass; do
-    row "route$route-rep01" "$mode" --data "$data/IPIN2023_T3_TrainingTrial${route}_repetition01.txt"
-    args=()
-    for rep in 01 02 03 04; do args+=(--data "$data/IPIN2023_T3_TrainingTrial${route}_repetition${rep}.txt"); done
-    row "route$route-all4" "$mode" "${args[@]}"
+    row "route$route-all4" "$mode" "route$route all4" yes "${args[@]}"
   done
 done
-for mode in wifi wifi-compass; do
-  row "route51-rep02" "$mode" --data "$data/IPIN2023_T3_TrainingTrial51_repetition02.txt"
+for route in 01 02; do
+  row "route$route-rep01" wifi-compass "route$route rep01" yes \
+    --data "$data/IPIN2023_T3_TrainingTrial${route}_repetition01.txt"
 done
+route51=(--data "$data/IPIN2023_T3_TrainingTrial51_repetition02.txt")
+row route51-rep02 wifi-compass "route51 rep02 (3 floors), barometer" no "${route51[@]}"
+row route51-rep02-nobaro wifi-compass "route51 rep02 (3 floors), no barometer" yes "${route51[@]}"

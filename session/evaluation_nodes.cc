@@ -124,7 +124,7 @@ std::vector<EvaluationNode> DatasetNodes(const Dataset& d, bool as_map, bool wan
     return s;
   };
   auto add = [&](double t, std::string image, std::optional<std::vector<WifiReading>> wifi) {
-    const auto truth = InterpolateGroundTruth(d.ground_truth, t);
+    const auto truth = GroundTruthAt(d, t);
     if (!truth) return;
     EvaluationNode n;
     n.x_m = truth->x_m;

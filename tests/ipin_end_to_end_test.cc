@@ -54,7 +54,7 @@ TEST(IpinEndToEndTest, WifiRatslamClosesOutAndBackLoops) {
   ASSERT_TRUE(d.ok());
   std::vector<GroundTruthRow> at_scans;
   for (const WifiScan& scan : d->wifi) {
-    if (auto gt = InterpolateGroundTruth(d->ground_truth, scan.time_s)) at_scans.push_back(*gt);
+    if (auto gt = GroundTruthAt(*d, scan.time_s)) at_scans.push_back(*gt);
   }
   size_t pairs = 0, near = 0;
   for (size_t i = 0; i < at_scans.size(); ++i) {
@@ -347,7 +347,7 @@ TEST(IpinEndToEndTest, OnlineRssiOffsetFindsTheSecondPhonesOffset) {
     };
     std::vector<Located> scans;
     for (const WifiScan& scan : d->wifi) {
-      if (auto gt = InterpolateGroundTruth(d->ground_truth, scan.time_s)) {
+      if (auto gt = GroundTruthAt(*d, scan.time_s)) {
         scans.push_back({session_of(scan.time_s), *gt, &scan});
       }
     }

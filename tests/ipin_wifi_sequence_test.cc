@@ -104,7 +104,7 @@ TEST_P(IpinWifiSequenceTest, VerifiedSequencesCloseLoopsOnRealWalks) {
       continue;
     }
     const double t = loops->Number(r, "current_time_s").value();
-    const auto now = InterpolateGroundTruth(d->ground_truth, t);
+    const auto now = GroundTruthAt(*d, t);
     if (!now) continue;
     size_t session = 0;
     while (session + 1 < d->session_start_times_s.size() &&
@@ -115,7 +115,7 @@ TEST_P(IpinWifiSequenceTest, VerifiedSequencesCloseLoopsOnRealWalks) {
     size_t n = 0;
     for (const WifiScan& scan : d->wifi) {
       if (scan.time_s >= d->session_start_times_s[session]) break;
-      if (auto then = InterpolateGroundTruth(d->ground_truth, scan.time_s)) {
+      if (auto then = GroundTruthAt(*d, scan.time_s)) {
         sum += std::hypot(now->x_m - then->x_m, now->y_m - then->y_m);
         ++n;
       }

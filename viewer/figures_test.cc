@@ -17,6 +17,22 @@ TEST(NiceStepTest, PicksOneTwoFive) {
   EXPECT_DOUBLE_EQ(NiceStep(0.9, 5), 0.2);
 }
 
+// Two walks on floor -2, each starting a minute before its first ground-truth point (a phone's
+// calibration): experiences made in those minutes have no measured position but belong to the
+// walk's floor, not to a floor 0 the building may not have.
+TEST(ExperienceFloorsTest, ExperiencesWithoutTruthTakeTheNearestPointsFloor) {
+  Dataset d;
+  d.session_start_times_s = {0.0, 100.0};
+  d.ground_truth = {
+      {60.0, 0, 0, 0, -2}, {90.0, 5, 0, 0, -2}, {160.0, 0, 0, 0, -1}, {190.0, 5, 0, 0, -1}};
+  std::vector<Experience> ex(6);
+  const double times[] = {10.0, 70.0, 95.0, 130.0, 170.0, 250.0};
+  for (size_t i = 0; i < ex.size(); ++i) ex[i].time_s = times[i];
+  const std::vector<int> floors = ExperienceFloors(ex, d);
+  EXPECT_EQ(floors, (std::vector<int>{-2, -2, -2, -1, -1, -1}));
+  EXPECT_EQ(ExperienceFloors(ex, Dataset{}), std::vector<int>(6, 0));
+}
+
 TEST(SequentialColorTest, LightnessRisesMonotonically) {
   double previous = -1;
   for (int i = 0; i <= 100; ++i) {

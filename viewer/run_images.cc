@@ -15,7 +15,7 @@ std::vector<Point2> GroundTruthInMapFrame(const std::vector<Experience>& experie
                                           std::vector<int>* floors) {
   std::vector<Point2> map_points, truth_points, truth_path;
   for (const Experience& e : experiences) {
-    if (auto gt = InterpolateGroundTruth(dataset.ground_truth, e.time_s)) {
+    if (auto gt = GroundTruthAt(dataset, e.time_s)) {
       map_points.push_back({e.x_m, e.y_m});
       truth_points.push_back({gt->x_m, gt->y_m});
     }
@@ -48,9 +48,26 @@ std::vector<int> ExperienceFloors(const std::vector<Experience>& experiences,
                                   const Dataset& dataset) {
   std::vector<int> floors;
   floors.reserve(experiences.size());
+  const std::vector<GroundTruthRow>& rows = dataset.ground_truth;
   for (const Experience& e : experiences) {
-    const auto gt = InterpolateGroundTruth(dataset.ground_truth, e.time_s);
-    floors.push_back(gt ? gt->floor : 0);
+    if (const auto gt = GroundTruthAt(dataset, e.time_s)) {
+      floors.push_back(gt->floor);
+      continue;
+    }
+    // No measured position (before a walk's first point, e.g. a phone's calibration minute, or
+    // after its last): drawn on the floor of the ground-truth point nearest in time, not on a
+    // floor 0 the building may not have.
+    if (rows.empty()) {
+      floors.push_back(0);
+      continue;
+    }
+    auto after = std::lower_bound(rows.begin(), rows.end(), e.time_s,
+                                  [](const GroundTruthRow& r, double t) { return r.time_s < t; });
+    if (after == rows.end() ||
+        (after != rows.begin() && e.time_s - (after - 1)->time_s < after->time_s - e.time_s)) {
+      --after;
+    }
+    floors.push_back(after->floor);
   }
   return floors;
 }
@@ -185,7 +202,7 @@ Status WriteRunImages(SceneRenderer* renderer, const RunView& run, const Dataset
       map_options.title = "localisation on a saved map (" + dataset.name + ")";
       std::vector<Point2> localised, truth, path;
       for (const LocalisationRecord& r : *run.localisation) {
-        const auto gt = InterpolateGroundTruth(dataset.ground_truth, r.time_s);
+        const auto gt = GroundTruthAt(dataset, r.time_s);
         if (!gt) continue;
         path.push_back({gt->x_m, gt->y_m});
         if (r.lost) continue;

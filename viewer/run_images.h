@@ -21,7 +21,9 @@ std::vector<Point2> GroundTruthInMapFrame(const std::vector<Experience>& experie
                                           const Dataset& dataset, double until_time_s,
                                           std::vector<int>* floors = nullptr);
 
-// The floor of each experience: the ground truth's floor at its creation (0 without one).
+// The floor of each experience: the ground truth's floor at its creation; where there is none
+// (before a walk's first point, between two walks), the floor of the point nearest in time; 0
+// without ground truth.
 std::vector<int> ExperienceFloors(const std::vector<Experience>& experiences,
                                   const Dataset& dataset);
 

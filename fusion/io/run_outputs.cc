@@ -108,7 +108,7 @@ nlohmann::ordered_json SequenceSummary(const WifiSequenceLoopCloser& closer,
   if (dataset.ground_truth.empty()) return j;
   std::vector<std::optional<GroundTruthRow>> truth(closer.size());
   for (size_t i = 0; i < closer.size(); ++i) {
-    truth[i] = InterpolateGroundTruth(dataset.ground_truth, closer.pose(i).time_s);
+    truth[i] = GroundTruthAt(dataset, closer.pose(i).time_s);
   }
   auto metres = [&](uint32_t a, uint32_t b) {
     if (!truth[a] || !truth[b]) return std::numeric_limits<double>::quiet_NaN();
@@ -161,13 +161,14 @@ nlohmann::ordered_json SequenceSummary(const WifiSequenceLoopCloser& closer,
 
 std::vector<double> LocalisationErrors(const std::vector<LocalisationRecord>& records,
                                        const std::vector<GroundTruthRow>& ground_truth,
-                                       std::vector<Point2>* truth) {
+                                       std::vector<Point2>* truth,
+                                       const std::vector<double>& session_starts) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   std::vector<double> errors(records.size(), nan);
   std::vector<Point2> true_at(records.size(), {nan, nan});
   std::vector<Point2> estimate, paired_truth;
   for (size_t i = 0; i < records.size(); ++i) {
-    const auto gt = InterpolateGroundTruth(ground_truth, records[i].time_s);
+    const auto gt = InterpolateGroundTruth(ground_truth, records[i].time_s, session_starts);
     if (!gt) continue;
     true_at[i] = {gt->x_m, gt->y_m};
     if (records[i].lost) continue;
@@ -206,7 +207,7 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
     // (A localisation run's experiences were made on another data set's clock.)
     for (const Experience& e : map.experiences()) {
       if (pipeline.localising()) break;
-      if (auto gt = InterpolateGroundTruth(dataset.ground_truth, e.time_s)) {
+      if (auto gt = GroundTruthAt(dataset, e.time_s)) {
         estimate.push_back({e.x_m, e.y_m});
         truth.push_back({gt->x_m, gt->y_m});
       }
@@ -219,7 +220,7 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
     for (size_t i = 0; i < state.trajectory.size(); ++i) {
       const TrajectoryRecord& r = state.trajectory[i];
       if (!InTumFiles(state.trajectory, i)) continue;
-      if (auto gt = InterpolateGroundTruth(dataset.ground_truth, r.time_s)) {
+      if (auto gt = GroundTruthAt(dataset, r.time_s)) {
         double x, y, theta;
         RecordPose(map, r, &x, &y, &theta);
         corrected.push_back({x, y});
@@ -246,15 +247,15 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
       if (pipeline.localising()) break;    // templates stored on another data set's clock
       if (f.is_new || f.recent) continue;  // only matches that can close a loop
       const double created_s = slam.local_view().at(f.template_id).created_time_s;
-      const auto now = InterpolateGroundTruth(dataset.ground_truth, f.time_s);
-      const auto then = InterpolateGroundTruth(dataset.ground_truth, created_s);
+      const auto now = GroundTruthAt(dataset, f.time_s);
+      const auto then = GroundTruthAt(dataset, created_s);
       if (!now || !then) continue;
       ++s.evaluated_matches;
       // Floors are known only where the ground-truth points around a time agree. A match with
       // either end between points on different floors (on the stairs) cannot be judged: it is
       // counted as unverified and left out of the rates.
-      const std::optional<int> floor_now = KnownFloor(dataset.ground_truth, f.time_s);
-      const std::optional<int> floor_then = KnownFloor(dataset.ground_truth, created_s);
+      const std::optional<int> floor_now = KnownFloorAt(dataset, f.time_s);
+      const std::optional<int> floor_then = KnownFloorAt(dataset, created_s);
       if (!floor_now || !floor_then) {
         ++s.floor_unverified_matches;
         continue;
@@ -360,7 +361,8 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
     l["experiences_recognised"] = visited.size();
     l["unmapped_views"] = slam.localisation_counters().unmapped_views;
     if (!dataset.ground_truth.empty()) {
-      s.localisation_errors_m = LocalisationErrors(records, dataset.ground_truth);
+      s.localisation_errors_m =
+          LocalisationErrors(records, dataset.ground_truth, nullptr, dataset.session_start_times_s);
       std::vector<double> known;
       for (double e : s.localisation_errors_m) {
         if (!std::isnan(e)) known.push_back(e);
@@ -436,7 +438,7 @@ StatusOr<RunSummary> WriteRunOutputs(OutputFolder& folder, const ReplayPipeline&
     RecordPose(map, r, &x, &y, &theta);
     trajectory << TumLine(r.time_s, x, y, theta);
     odometry << TumLine(r.time_s, r.odometry_x_m, r.odometry_y_m, r.odometry_theta_rad);
-    if (auto gt = InterpolateGroundTruth(dataset.ground_truth, r.time_s)) {
+    if (auto gt = GroundTruthAt(dataset, r.time_s)) {
       ground_truth << TumLine(r.time_s, gt->x_m, gt->y_m, gt->theta_rad);
     }
   }
@@ -505,7 +507,8 @@ StatusOr<RunSummary> WriteRunOutputs(OutputFolder& folder, const ReplayPipeline&
   if (pipeline.localising()) {
     std::vector<Point2> truth;
     const std::vector<LocalisationRecord>& records = pipeline.localisation();
-    const std::vector<double> errors = LocalisationErrors(records, dataset.ground_truth, &truth);
+    const std::vector<double> errors =
+        LocalisationErrors(records, dataset.ground_truth, &truth, dataset.session_start_times_s);
     std::ostringstream localisation;
     localisation << kLocalisationColumns.Header();
     for (size_t i = 0; i < records.size(); ++i) {

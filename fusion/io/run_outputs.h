@@ -58,10 +58,12 @@ void RecordPose(const ExperienceMap& map, const TrajectoryRecord& record, double
 // not the ground truth's), and each error is the aligned position's distance from the truth. NaN
 // for a lost frame, a frame outside the ground truth, or when fewer than 10 frames can be aligned
 // (a fit to fewer would fit them almost exactly, whatever they are).
-// `truth` (optional) gets the true position, NaN where none.
+// `truth` (optional) gets the true position, NaN where none. With `session_starts` nothing is
+// interpolated between two sessions (GroundTruthAt).
 std::vector<double> LocalisationErrors(const std::vector<LocalisationRecord>& records,
                                        const std::vector<GroundTruthRow>& ground_truth,
-                                       std::vector<Point2>* truth = nullptr);
+                                       std::vector<Point2>* truth = nullptr,
+                                       const std::vector<double>& session_starts = {});
 
 RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, const RunInfo& info);
 

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <utility>
 
 #include "common/circular.h"
 #include "common/file_util.h"
@@ -399,16 +400,37 @@ std::vector<Event> MergeEvents(const Dataset& d) {
   return events;
 }
 
-std::optional<GroundTruthRow> InterpolateGroundTruth(const std::vector<GroundTruthRow>& rows,
-                                                     double time_s) {
+namespace {
+
+// The rows either side of `time_s`: {row, row} on a row (or at the first row), {a, b} between
+// two rows, nullopt outside the span or (with session starts) between two sessions.
+std::optional<std::pair<const GroundTruthRow*, const GroundTruthRow*>> Bracket(
+    const std::vector<GroundTruthRow>& rows, const std::vector<double>& session_starts,
+    double time_s) {
   if (rows.empty() || time_s < rows.front().time_s || time_s > rows.back().time_s) {
     return std::nullopt;
   }
   auto after = std::lower_bound(rows.begin(), rows.end(), time_s,
                                 [](const GroundTruthRow& r, double t) { return r.time_s < t; });
-  if (after->time_s == time_s || after == rows.begin()) return *after;
-  const GroundTruthRow& b = *after;
-  const GroundTruthRow& a = *(after - 1);
+  if (after->time_s == time_s || after == rows.begin()) return std::make_pair(&*after, &*after);
+  const GroundTruthRow* a = &*(after - 1);
+  const GroundTruthRow* b = &*after;
+  const auto session = [&](double t) {
+    return std::upper_bound(session_starts.begin(), session_starts.end(), t) -
+           session_starts.begin();
+  };
+  if (session(a->time_s) != session(b->time_s)) return std::nullopt;
+  return std::make_pair(a, b);
+}
+
+std::optional<GroundTruthRow> Interpolate(const std::vector<GroundTruthRow>& rows,
+                                          const std::vector<double>& session_starts,
+                                          double time_s) {
+  const auto ab = Bracket(rows, session_starts, time_s);
+  if (!ab) return std::nullopt;
+  const GroundTruthRow& a = *ab->first;
+  const GroundTruthRow& b = *ab->second;
+  if (&a == &b) return a;
   const double f = (time_s - a.time_s) / (b.time_s - a.time_s);
   GroundTruthRow r;
   r.time_s = time_s;
@@ -419,15 +441,32 @@ std::optional<GroundTruthRow> InterpolateGroundTruth(const std::vector<GroundTru
   return r;
 }
 
-std::optional<int> KnownFloor(const std::vector<GroundTruthRow>& rows, double time_s) {
-  if (rows.empty() || time_s < rows.front().time_s || time_s > rows.back().time_s) {
-    return std::nullopt;
-  }
-  auto after = std::lower_bound(rows.begin(), rows.end(), time_s,
-                                [](const GroundTruthRow& r, double t) { return r.time_s < t; });
-  if (after->time_s == time_s || after == rows.begin()) return after->floor;
-  if ((after - 1)->floor != after->floor) return std::nullopt;
-  return after->floor;
+std::optional<int> Floor(const std::vector<GroundTruthRow>& rows,
+                         const std::vector<double>& session_starts, double time_s) {
+  const auto ab = Bracket(rows, session_starts, time_s);
+  if (!ab || ab->first->floor != ab->second->floor) return std::nullopt;
+  return ab->second->floor;
+}
+
+}  // namespace
+
+std::optional<GroundTruthRow> InterpolateGroundTruth(const std::vector<GroundTruthRow>& rows,
+                                                     double time_s,
+                                                     const std::vector<double>& session_starts) {
+  return Interpolate(rows, session_starts, time_s);
+}
+
+std::optional<int> KnownFloor(const std::vector<GroundTruthRow>& rows, double time_s,
+                              const std::vector<double>& session_starts) {
+  return Floor(rows, session_starts, time_s);
+}
+
+std::optional<GroundTruthRow> GroundTruthAt(const Dataset& dataset, double time_s) {
+  return Interpolate(dataset.ground_truth, dataset.session_start_times_s, time_s);
+}
+
+std::optional<int> KnownFloorAt(const Dataset& dataset, double time_s) {
+  return Floor(dataset.ground_truth, dataset.session_start_times_s, time_s);
 }
 
 }  // namespace ratslam

@@ -96,13 +96,26 @@ struct Event {
 std::vector<Event> MergeEvents(const Dataset& dataset);
 
 // Ground-truth position at `time_s`, linearly interpolated; nullopt outside the covered span.
-std::optional<GroundTruthRow> InterpolateGroundTruth(const std::vector<GroundTruthRow>& rows,
-                                                     double time_s);
+// With `session_starts` (a data set's `session_start_times_s`), nothing is interpolated between
+// two rows of different sessions (see GroundTruthAt).
+std::optional<GroundTruthRow> InterpolateGroundTruth(
+    const std::vector<GroundTruthRow>& rows, double time_s,
+    const std::vector<double>& session_starts = {});
 
 // The floor at `time_s` when the ground-truth points either side of it agree (or one falls on it);
 // nullopt between two points on different floors (the walker changed floor somewhere between,
 // on the stairs) and outside the covered span.
-std::optional<int> KnownFloor(const std::vector<GroundTruthRow>& rows, double time_s);
+std::optional<int> KnownFloor(const std::vector<GroundTruthRow>& rows, double time_s,
+                              const std::vector<double>& session_starts = {});
+
+// These two for a data set that may join several sessions (walks recorded apart, laid on one
+// clock by `session_start_times_s`): nothing is interpolated between two rows of different
+// sessions, so the time from one session's last ground-truth point to the next one's first (the
+// end of one recording and the start of the next, e.g. a phone's calibration minute) has no
+// ground truth, as the time before the first session's first point has none. What is scored
+// (match distances, ATE, floors) is then what was measured.
+std::optional<GroundTruthRow> GroundTruthAt(const Dataset& dataset, double time_s);
+std::optional<int> KnownFloorAt(const Dataset& dataset, double time_s);
 
 }  // namespace ratslam
 

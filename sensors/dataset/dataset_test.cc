@@ -305,6 +305,42 @@ TEST(GroundTruthTest, InterpolatesAndRefusesOutsideSpan) {
   EXPECT_FALSE(InterpolateGroundTruth(rows, 2.5).has_value());
 }
 
+// Two walks on one clock: the first measured from 10 s to 20 s, the second (starting at 100 s,
+// a calibration minute before its first point) from 160 s. Between 20 s and 160 s nobody measured
+// where the walker was: no position and no floor, while the plain interpolation (no sessions)
+// draws a line from the first walk's end to the second's start.
+TEST(GroundTruthTest, NothingIsInterpolatedBetweenTwoSessions) {
+  Dataset d;
+  d.session_start_times_s = {0.0, 100.0};
+  d.ground_truth = {
+      {10.0, 0, 0, 0, 0}, {20.0, 10, 0, 0, 0}, {160.0, 0, 0, 0, 0}, {170.0, 0, 10, 0, 0}};
+  const auto in_first = GroundTruthAt(d, 15.0);
+  ASSERT_TRUE(in_first.has_value());
+  EXPECT_DOUBLE_EQ(in_first->x_m, 5.0);
+  const auto in_second = GroundTruthAt(d, 165.0);
+  ASSERT_TRUE(in_second.has_value());
+  EXPECT_DOUBLE_EQ(in_second->y_m, 5.0);
+  for (double t : {20.5, 99.0, 100.0, 130.0, 159.9}) {
+    EXPECT_FALSE(GroundTruthAt(d, t).has_value()) << t;
+    EXPECT_FALSE(KnownFloorAt(d, t).has_value()) << t;
+  }
+  EXPECT_FALSE(GroundTruthAt(d, 5.0).has_value());  // before the first walk's first point
+  // On the points themselves, and within a walk, the floor is known.
+  ASSERT_TRUE(GroundTruthAt(d, 20.0).has_value());
+  EXPECT_DOUBLE_EQ(GroundTruthAt(d, 20.0)->x_m, 10.0);
+  EXPECT_EQ(GroundTruthAt(d, 160.0)->y_m, 0.0);
+  EXPECT_EQ(KnownFloorAt(d, 165.0), 0);
+  // Without sessions the same rows are one walk: (10, 0) at 20 s to (0, 0) at 160 s.
+  const auto joined = InterpolateGroundTruth(d.ground_truth, 90.0);
+  ASSERT_TRUE(joined.has_value());
+  EXPECT_DOUBLE_EQ(joined->x_m, 5.0);
+  // A single session (or none recorded) interpolates everywhere inside the span.
+  d.session_start_times_s = {0.0};
+  EXPECT_TRUE(GroundTruthAt(d, 90.0).has_value());
+  d.session_start_times_s.clear();
+  EXPECT_TRUE(GroundTruthAt(d, 90.0).has_value());
+}
+
 TEST(SyntheticDatasetTest, SameSeedSameBytesAndImagesRepeatAcrossLaps) {
   SyntheticOptions options;
   options.laps = 2;
