@@ -2,8 +2,9 @@
 # The README's IPIN table: Wi-Fi RatSLAM on the IPIN 2023 Track 3 training logs (the four
 # repetitions of each route as one multi-session run, Wi-Fi alone and with the compass; two single
 # walks; route 51 with and without the barometer), with the shipped configs and, for comparison,
-# as they were before 2026-12-02: OpenRatSLAM's frame memory ([local_view] memory line removed)
-# and then also the calibration gesture counted as steps ([pdr] min_orientation_steadiness = 0).
+# without the online RSSI offset ([fused] online_rssi_offset = false), and as they were before
+# 2026-12-02: also OpenRatSLAM's frame memory ([local_view] memory line removed) and then also
+# the calibration gesture counted as steps ([pdr] min_orientation_steadiness = 0).
 # PDR-only is the dead-reckoning error of the same runs (odometry_ate_m).
 # Usage: scripts/ipin_table.sh [DATA_DIR] [OUT_DIR]
 set -euo pipefail
@@ -16,8 +17,9 @@ for mode in wifi wifi-compass; do
   sed 's/^use_barometer = true$/use_barometer = false/' "configs/ipin2023-$mode.toml" \
     > "$out/nobaro-$mode.toml"
 done
-old_configs() {  # config name: the config with frame memory, and also with the gesture counted
-  sed '/^memory = /d' "$1" > "$out/$2-frames.toml"
+old_configs() {  # config name: without the offset, then frame memory, then the gesture counted
+  sed 's/^online_rssi_offset = true$/online_rssi_offset = false/' "$1" > "$out/$2-nooffset.toml"
+  sed '/^memory = /d' "$out/$2-nooffset.toml" > "$out/$2-frames.toml"
   printf '\n[pdr]\nmin_orientation_steadiness = 0\n' | cat "$out/$2-frames.toml" - \
     > "$out/$2-gesture.toml"
 }
@@ -32,9 +34,10 @@ row() {  # name mode label past(yes/no: the history columns) args...
   local dirs=("$out/$name-$mode")
   if [ "$past" = yes ]; then
     old_configs "$shipped" "$name-$mode"
+    run "$out/$name-$mode-nooffset.toml" "$out/$name-$mode-nooffset" "$@"
     run "$out/$name-$mode-frames.toml" "$out/$name-$mode-frames" "$@"
     run "$out/$name-$mode-gesture.toml" "$out/$name-$mode-gesture" "$@"
-    dirs+=("$out/$name-$mode-frames" "$out/$name-$mode-gesture")
+    dirs+=("$out/$name-$mode-nooffset" "$out/$name-$mode-frames" "$out/$name-$mode-gesture")
   fi
   /usr/bin/python3 - "$label" "$mode" "${dirs[@]}" <<'PY'
 import json, sys
@@ -47,16 +50,17 @@ if j.get("floor_unverified_matches"): matches += f" ({j['floor_unverified_matche
 cells = [label, "Wi-Fi + compass" if mode == "wifi-compass" else "Wi-Fi", matches,
          str(j["view_injections"]), f(j.get("match_rate_within_m", {}).get("5", 0)),
          str(j["floor_mistakes"]), f(j["map_ate_m"]), f(j["odometry_ate_m"])]
-if len(s) == 3:
-    cells += [f(s[1]["map_ate_m"]), str(s[1]["view_injections"]), f(s[2]["map_ate_m"]),
-              f(s[2]["odometry_ate_m"])]
+if len(s) == 4:
+    cells += [f(s[1].get("match_rate_within_m", {}).get("5", 0)), f(s[1]["map_ate_m"]),
+              f(s[2]["map_ate_m"]), str(s[2]["view_injections"]), f(s[3]["map_ate_m"]),
+              f(s[3]["odometry_ate_m"])]
 else:
-    cells += ["-"] * 4
+    cells += ["-"] * 6
 print("| " + " | ".join(cells) + " |")
 PY
 }
-echo "| run | mode | matches | injections | <=5 m | floor mistakes | map ATE m | PDR-only ATE m | map ATE, frame memory | injections, frame memory | map ATE, frame memory and gesture counted | PDR-only, gesture counted |"
-echo "|---|---|---|---|---|---|---|---|---|---|---|---|"
+echo "| run | mode | matches | injections | <=5 m | floor mistakes | map ATE m | PDR-only ATE m | <=5 m, no RSSI offset | map ATE, no RSSI offset | map ATE, frame memory | injections, frame memory | map ATE, frame memory and gesture counted | PDR-only, gesture counted |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 for route in 01 02 03 21 22 23; do
   args=()
   for rep in 01 02 03 04; do args+=(--data "$data/IPIN2023_T3_TrainingTrial${route}_repetition${rep}.txt"); done
