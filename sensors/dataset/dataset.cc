@@ -423,9 +423,11 @@ std::optional<std::pair<const GroundTruthRow*, const GroundTruthRow*>> Bracket(
   return std::make_pair(a, b);
 }
 
-std::optional<GroundTruthRow> Interpolate(const std::vector<GroundTruthRow>& rows,
-                                          const std::vector<double>& session_starts,
-                                          double time_s) {
+}  // namespace
+
+std::optional<GroundTruthRow> InterpolateGroundTruth(const std::vector<GroundTruthRow>& rows,
+                                                     double time_s,
+                                                     const std::vector<double>& session_starts) {
   const auto ab = Bracket(rows, session_starts, time_s);
   if (!ab) return std::nullopt;
   const GroundTruthRow& a = *ab->first;
@@ -441,32 +443,19 @@ std::optional<GroundTruthRow> Interpolate(const std::vector<GroundTruthRow>& row
   return r;
 }
 
-std::optional<int> Floor(const std::vector<GroundTruthRow>& rows,
-                         const std::vector<double>& session_starts, double time_s) {
+std::optional<int> KnownFloor(const std::vector<GroundTruthRow>& rows, double time_s,
+                              const std::vector<double>& session_starts) {
   const auto ab = Bracket(rows, session_starts, time_s);
   if (!ab || ab->first->floor != ab->second->floor) return std::nullopt;
   return ab->second->floor;
 }
 
-}  // namespace
-
-std::optional<GroundTruthRow> InterpolateGroundTruth(const std::vector<GroundTruthRow>& rows,
-                                                     double time_s,
-                                                     const std::vector<double>& session_starts) {
-  return Interpolate(rows, session_starts, time_s);
-}
-
-std::optional<int> KnownFloor(const std::vector<GroundTruthRow>& rows, double time_s,
-                              const std::vector<double>& session_starts) {
-  return Floor(rows, session_starts, time_s);
-}
-
 std::optional<GroundTruthRow> GroundTruthAt(const Dataset& dataset, double time_s) {
-  return Interpolate(dataset.ground_truth, dataset.session_start_times_s, time_s);
+  return InterpolateGroundTruth(dataset.ground_truth, time_s, dataset.session_start_times_s);
 }
 
 std::optional<int> KnownFloorAt(const Dataset& dataset, double time_s) {
-  return Floor(dataset.ground_truth, dataset.session_start_times_s, time_s);
+  return KnownFloor(dataset.ground_truth, time_s, dataset.session_start_times_s);
 }
 
 }  // namespace ratslam
