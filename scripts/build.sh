@@ -5,9 +5,10 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build_dir=${BUILD_DIR:-build}
+source scripts/ccache_env.sh
 generator=()
 command -v ninja >/dev/null && generator=(-G Ninja)
-cmake -S . -B "$build_dir" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release -DRATSLAM_WERROR=ON "$@"
+cmake -S . -B "$build_dir" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release -DRATSLAM_WERROR=ON "${ccache_args[@]}" "$@"
 target=()
 [[ -n "${BUILD_TARGET:-}" ]] && target=(--target "$BUILD_TARGET")
 cmake --build "$build_dir" --parallel "$(nproc)" "${target[@]}"

@@ -23,10 +23,11 @@ harnesses=(config_fuzzer ini_fuzzer map_file_fuzzer visual_model_fuzzer dataset_
            run_folder_fuzzer output_list_fuzzer rosbag_fuzzer video_log_fuzzer descriptor_fuzzer)
 if (($#)); then harnesses=("$@"); fi
 
+source scripts/ccache_env.sh
 generator=()
 command -v ninja >/dev/null && generator=(-G Ninja)
 CC=clang-14 CXX=clang++-14 cmake -S . -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DRATSLAM_FUZZ=ON -DRATSLAM_BUILD_TESTS=OFF -DRATSLAM_BUILD_BENCHMARKS=OFF -DRATSLAM_WERROR=ON >/dev/null
+  -DRATSLAM_FUZZ=ON -DRATSLAM_BUILD_TESTS=OFF -DRATSLAM_BUILD_BENCHMARKS=OFF -DRATSLAM_WERROR=ON "${ccache_args[@]}" >/dev/null
 targets=()
 for h in "${harnesses[@]}"; do targets+=("$h" "${h}_replay"); done
 cmake --build "$build" --parallel "$(nproc)" --target "${targets[@]}"

@@ -5,7 +5,7 @@
 set -euo pipefail
 
 packages=(
-  build-essential cmake ninja-build pkg-config git clang-format python3
+  build-essential cmake ninja-build ccache pkg-config git clang-format python3
   libboost-dev libboost-graph-dev libeigen3-dev
   libopencv-dev libosmesa6-dev libtomlplusplus-dev nlohmann-json3-dev libcli11-dev zlib1g-dev
   libcairo2-dev fonts-dejavu-core
