@@ -12,11 +12,21 @@
 #include <string>
 #include <vector>
 
+#include "common/checksum.h"
 #include "common/scratch_dir.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size);
 
 namespace ratslam::fuzz {
+
+// `bytes` with their last four bytes replaced by the CRC-32C of the rest (common/checksum.h): a
+// fuzzer's mutations then reach the decoder behind a file's checksum instead of stopping at it.
+inline std::string WithMatchingChecksum(std::string bytes) {
+  if (bytes.size() < 4) return bytes;
+  bytes.resize(bytes.size() - 4);
+  AppendChecksum(&bytes);
+  return bytes;
+}
 
 // Valid example inputs for this harness (the driver writes them with --seeds DIR).
 std::vector<std::string> FuzzSeeds();

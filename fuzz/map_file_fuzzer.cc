@@ -165,10 +165,11 @@ std::vector<std::string> FuzzSeeds() {
 
 }  // namespace ratslam::fuzz
 
-extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+namespace {
+
+int DecodeAndRun(const std::string& bytes) {
   using namespace ratslam;
-  StatusOr<MapFile> map =
-      DecodeMapFile(std::string(reinterpret_cast<const char*>(data), size), "fuzz.map");
+  StatusOr<MapFile> map = DecodeMapFile(bytes, "fuzz.map");
   if (!map.ok()) return 0;
   fuzz::Setup& setup = fuzz::Shared();
   for (size_t i = 0; i < setup.options.size(); ++i) {
@@ -183,5 +184,17 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const RunSummary summary = Summarise(*pipeline, setup.dataset, RunInfo{});
     if (summary.json.empty()) fuzz::InvariantFailed("empty summary");
   }
+  return 0;
+}
+
+}  // namespace
+
+// The input as it is (old formats have no checksum), and behind a matching checksum, so that
+// mutations reach the decoder (a flipped byte under the checksum is refused: map_file_test).
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  const std::string bytes(reinterpret_cast<const char*>(data), size);
+  const std::string checked = ratslam::fuzz::WithMatchingChecksum(bytes);
+  DecodeAndRun(bytes);
+  if (checked != bytes) DecodeAndRun(checked);
   return 0;
 }

@@ -49,10 +49,11 @@ std::vector<std::string> FuzzSeeds() {
 
 }  // namespace ratslam::fuzz
 
-extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+namespace {
+
+int DecodeAndUse(const std::string& bytes) {
   using namespace ratslam;
-  StatusOr<WifiGpMap> map =
-      WifiGpMap::Decode(std::string(reinterpret_cast<const char*>(data), size), "w.wifimap");
+  StatusOr<WifiGpMap> map = WifiGpMap::Decode(bytes, "w.wifimap");
   if (!map.ok()) {
     if (map.status().message().rfind("w.wifimap", 0) != 0) {
       fuzz::InvariantFailed("error does not name the file: " + map.status().message());
@@ -83,5 +84,18 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const LocationEstimate e = filter.Estimate();
   if (!std::isfinite(e.x_m) || !std::isfinite(e.y_m)) fuzz::InvariantFailed("estimate not finite");
   (void)filter.Candidates();
+  return 0;
+}
+
+}  // namespace
+
+// The input as it is (formats 1 and 2 have no checksum), and behind a matching checksum, so that
+// mutations reach the decoder (a flipped byte under the checksum is refused:
+// particle_filter_test).
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  const std::string bytes(reinterpret_cast<const char*>(data), size);
+  const std::string checked = ratslam::fuzz::WithMatchingChecksum(bytes);
+  DecodeAndUse(bytes);
+  if (checked != bytes) DecodeAndUse(checked);
   return 0;
 }

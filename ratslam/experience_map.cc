@@ -417,6 +417,21 @@ std::vector<uint32_t> ExperienceMap::ShortestPath(uint32_t from, uint32_t to) co
 Status ExperienceMap::SetState(State state) {
   // Every id and number is checked before anything is taken over: a restored map is untrusted
   // input, and a dangling id or a NaN would crash or poison the next action.
+  RATSLAM_RETURN_IF_ERROR(ValidateState(state));
+  const size_t n_links = state.links.size();
+  state_ = std::move(state);
+  link_cos_.resize(n_links);
+  link_sin_.resize(n_links);
+  in_region_.assign(n_links, 0);
+  for (uint32_t l : state_.relaxation_pending_links) in_region_[l] = 1;
+  for (size_t i = 0; i < n_links; ++i) {
+    link_cos_[i] = std::cos(state_.links[i].heading_rad);
+    link_sin_[i] = std::sin(state_.links[i].heading_rad);
+  }
+  return Status::Ok();
+}
+
+Status ExperienceMap::ValidateState(const State& state) {
   auto fail = [](const std::string& what) {
     return Status::Error("experience map state: " + what);
   };
@@ -457,15 +472,6 @@ Status ExperienceMap::SetState(State state) {
   if (!finite(state.offset.forward_m) || !finite(state.offset.left_m) ||
       !finite(state.offset.facing_rad) || !finite(state.offset_start_time_s)) {
     return fail("offset since the current experience is not finite");
-  }
-  state_ = std::move(state);
-  link_cos_.resize(n_links);
-  link_sin_.resize(n_links);
-  in_region_.assign(n_links, 0);
-  for (uint32_t l : state_.relaxation_pending_links) in_region_[l] = 1;
-  for (size_t i = 0; i < n_links; ++i) {
-    link_cos_[i] = std::cos(state_.links[i].heading_rad);
-    link_sin_[i] = std::sin(state_.links[i].heading_rad);
   }
   return Status::Ok();
 }

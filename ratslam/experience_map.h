@@ -217,6 +217,9 @@ class ExperienceMap {
   // Restores a state; fails, changing nothing, on an id that points nowhere (a link's ends, an
   // experience's links, the current experience) or a non-finite or out-of-range number.
   Status SetState(State state);
+  // The checks of SetState alone: every reader of a saved map (map_file.h) runs them, so a map
+  // that one command refuses is refused by all.
+  static Status ValidateState(const State& state);
 
  private:
   void AddLink(uint32_t from, uint32_t to, double time_s, std::optional<double> facing_override,

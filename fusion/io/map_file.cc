@@ -7,6 +7,7 @@
 #include <type_traits>
 
 #include "common/byte_buffer.h"
+#include "common/checksum.h"
 #include "common/file_util.h"
 #include "common/text_file.h"
 #include "fusion/io/state_schema.h"
@@ -24,6 +25,7 @@ std::string EncodeMapFile(const MapFile& map) {
   w.Pod(kMapFormatVersion);
   EncodeArchive archive(w, kMapFormatVersion);
   Describe(archive, const_cast<MapFile&>(map));  // the encoder only reads
+  AppendChecksum(&w.bytes());
   return std::move(w.bytes());
 }
 
@@ -32,19 +34,32 @@ StatusOr<MapFile> DecodeMapFile(const std::string& bytes, const std::string& sou
     return Status::Error(source + ": not a RatSLAM map file");
   }
   // The body is read in place: a copy would double the memory a large map needs.
-  ByteReader r(std::string_view(bytes).substr(sizeof kMagic), source + ": corrupt map file");
+  std::string_view file(bytes);
   uint32_t version = 0;
-  MapFile map;
-  if (!r.Pod(&version)) return Status::Error(r.error());
+  {
+    ByteReader header(file.substr(sizeof kMagic), source + ": corrupt map file");
+    if (!header.Pod(&version)) return Status::Error(header.error());
+  }
   if (version < kOldestMapFormatVersion || version > kMapFormatVersion) {
     return Status::Error(source + ": map file version " + std::to_string(version) +
                          " (this program reads " + std::to_string(kOldestMapFormatVersion) +
                          " to " + std::to_string(kMapFormatVersion) + ")");
   }
+  if (version >= kFirstChecksummedMapFormatVersion) {
+    StatusOr<std::string_view> body = StripChecksum(file, source);
+    if (!body.ok()) return body.status();
+    file = *body;
+  }
+  ByteReader r(file.substr(sizeof kMagic + sizeof version), source + ": corrupt map file");
+  MapFile map;
   DecodeArchive archive(r, version);
   if (!Describe(archive, map)) return Status::Error(r.error());
   map.format_version = version;
   if (!r.AtEnd()) return Status::Error(source + ": corrupt map file: trailing bytes");
+  // Every reader of a map gets one that a resume would accept: a dangling id crashed `route`.
+  if (Status valid = ExperienceMap::ValidateState(map.state.ratslam.experience_map); !valid.ok()) {
+    return Status::Error(source + ": corrupt map file: " + valid.message());
+  }
   return map;
 }
 

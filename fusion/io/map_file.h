@@ -1,7 +1,8 @@
 // Saving and resuming a replay: the whole pipeline state (pose cells, templates, experiences,
 // links, the data-set position and everything recorded so far) in one binary file, written
-// atomically (temporary file, flush to disk, rename). Loading checks every count against the
-// bytes present, so a truncated or corrupt file is an error, never a crash.
+// atomically (temporary file, flush to disk, rename). Loading checks the checksum, every count
+// against the bytes present and every id against what it refers to (ValidateState), so a
+// truncated or corrupt file is an error, never a crash or a different map.
 #ifndef RATSLAM_FUSION_IO_MAP_FILE_H_
 #define RATSLAM_FUSION_IO_MAP_FILE_H_
 
@@ -24,8 +25,10 @@ namespace ratslam {
 // and older resume with it off; fixture tests/data/map-v5-synthetic.map). Version 7 changes no
 // state: its configurations have the link noise keys experience_map.link_sigma_* (the
 // least_squares relaxation scheme and the g2o information), which older maps resume with at
-// their defaults.
-inline constexpr uint32_t kMapFormatVersion = 7;
+// their defaults. Version 8 changes no state: the file ends with a CRC-32C of every byte before
+// it (common/checksum.h), so a flipped byte is an error instead of a different map.
+inline constexpr uint32_t kMapFormatVersion = 8;
+inline constexpr uint32_t kFirstChecksummedMapFormatVersion = 8;
 inline constexpr uint32_t kOldestMapFormatVersion = 2;
 
 struct MapFile {

@@ -4,6 +4,7 @@
 
 #include <filesystem>
 
+#include "common/checksum.h"
 #include "common/scratch_dir.h"
 #include "fusion/io/state_schema.h"
 
@@ -62,12 +63,44 @@ TEST(MapFileTest, CorruptCountsAndTrailingBytesAreErrors) {
   // The first count after the header (pose-cell indices) set to an absurd value.
   const size_t count_at = 8 + 4 + 8 + 8 + std::string("sample").size();
   for (int i = 0; i < 8; ++i) huge[count_at + i] = '\xff';
+  // With a matching checksum, so that the count itself is what the reader meets.
+  huge.resize(huge.size() - 4);
+  AppendChecksum(&huge);
   StatusOr<MapFile> a = DecodeMapFile(huge, "m");
   ASSERT_FALSE(a.ok());
   EXPECT_NE(a.status().message().find("exceeds the file size"), std::string::npos)
       << a.status().message();
   EXPECT_FALSE(DecodeMapFile(bytes + "x", "m").ok());
   EXPECT_FALSE(DecodeMapFile("not a map", "m").ok());
+}
+
+TEST(MapFileTest, EverySingleByteChangeIsAnError) {
+  const std::string bytes = EncodeMapFile(SampleMap());
+  for (size_t i = 0; i < bytes.size(); i += 1 + i / 64) {
+    std::string flipped = bytes;
+    flipped[i] = static_cast<char>(flipped[i] ^ 0x64);
+    StatusOr<MapFile> map = DecodeMapFile(flipped, "m.map");
+    EXPECT_FALSE(map.ok()) << "byte " << i;
+  }
+  std::string flipped = bytes;
+  flipped[bytes.size() / 2] ^= 1;
+  StatusOr<MapFile> map = DecodeMapFile(flipped, "m.map");
+  ASSERT_FALSE(map.ok());
+  EXPECT_NE(map.status().message().find("m.map: checksum mismatch"), std::string::npos)
+      << map.status().message();
+}
+
+// A map whose checksum is right but whose graph is not (a link to an experience that does not
+// exist) is refused by the decoder itself, so no reader of maps (route, call, render) can meet it.
+TEST(MapFileTest, ADanglingLinkIsRefusedByEveryReader) {
+  MapFile map = SampleMap();
+  ASSERT_FALSE(map.state.ratslam.experience_map.links.empty());
+  map.state.ratslam.experience_map.links.back().to = 100;
+  StatusOr<MapFile> back = DecodeMapFile(EncodeMapFile(map), "m.map");
+  ASSERT_FALSE(back.ok());
+  EXPECT_NE(back.status().message().find("m.map: corrupt map file: experience map state: link"),
+            std::string::npos)
+      << back.status().message();
 }
 
 TEST(MapFileTest, SaveIsAtomicAndLoads) {

@@ -103,6 +103,25 @@ WifiGpMap TrainedMap(const Field& field) {
   return std::move(map.value());
 }
 
+// A cell far too small for the area is refused before anything is allocated, naming the key and
+// what it would take (1 cm cells, 12 m margins, 15 APs over this 40 m x 20 m floor: 4e8 cells).
+TEST(WifiGpMapTest, AGridThatWouldNotFitInMemoryIsRefusedUpFront) {
+  const Field field;
+  std::vector<WifiMapSample> samples;
+  for (double x = 0; x <= 40; x += 2.0) {
+    for (double y = 0; y <= 20; y += 4.0)
+      samples.push_back({{x, y}, 0, field.Scan({x, y}, nullptr)});
+  }
+  WifiGpOptions options;
+  options.cell_size_m = 0.01;
+  options.grid_margin_m = 12;
+  const StatusOr<WifiGpMap> map = WifiGpMap::Build(samples, options);
+  ASSERT_FALSE(map.ok());
+  EXPECT_NE(map.status().message().find("[wifi_map] cell_size_m = 0.01 m would need up to"),
+            std::string::npos)
+      << map.status().message();
+}
+
 TEST(WifiGpMapTest, PredictsTheFieldNearItsSamplesAndThePriorElsewhere) {
   const Field field;
   const WifiGpMap map = TrainedMap(field);
@@ -190,9 +209,26 @@ TEST(WifiGpMapTest, FileRoundTripAndBadFiles) {
   EXPECT_FALSE(WifiGpMap::Build({{{0, 0}, 0, {{"a", NAN}}}}, WifiGpOptions()).ok());
 }
 
-TEST(WifiGpMapTest, RunFrameRoundTripsAndFormatOneStillReads) {
+TEST(WifiGpMapTest, EverySingleByteChangeIsAnError) {
+  const std::string bytes = TrainedMap(Field()).Encode();
+  for (size_t i = 0; i < bytes.size(); i += 1 + i / 32) {
+    std::string flipped = bytes;
+    flipped[i] = static_cast<char>(flipped[i] ^ 0x21);
+    EXPECT_FALSE(WifiGpMap::Decode(flipped, "w.wifimap").ok()) << "byte " << i;
+  }
+  std::string flipped = bytes;
+  flipped[bytes.size() / 2] ^= 1;
+  const StatusOr<WifiGpMap> bad = WifiGpMap::Decode(flipped, "w.wifimap");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.status().message().find("w.wifimap: checksum mismatch"), std::string::npos)
+      << bad.status().message();
+}
+
+TEST(WifiGpMapTest, RunFrameRoundTripsAndFormatsOneAndTwoStillRead) {
   WifiGpMap map = TrainedMap(Field());
-  const std::string plain = map.Encode();
+  // Formats 1 and 2 had no checksum: the bodies below are format 3's without its trailer.
+  const std::string checked = map.Encode();
+  const std::string plain = checked.substr(0, checked.size() - 4);
   map.set_compass_to_map_rad(1.1);  // its lowest byte differs from 0.0's
   RigidAlignment2D a;
   a.rotation_rad = -0.5;
@@ -200,8 +236,9 @@ TEST(WifiGpMapTest, RunFrameRoundTripsAndFormatOneStillReads) {
   a.translation_y_m = -4.0;
   a.rmse_m = 1.5;
   map.set_truth_from_map(a);
-  const std::string framed = map.Encode();
-  StatusOr<WifiGpMap> back = WifiGpMap::Decode(framed, "w.wifimap");
+  const std::string framed_checked = map.Encode();
+  const std::string framed = framed_checked.substr(0, framed_checked.size() - 4);
+  StatusOr<WifiGpMap> back = WifiGpMap::Decode(framed_checked, "w.wifimap");
   ASSERT_TRUE(back.ok()) << back.status().message();
   EXPECT_EQ(back->compass_to_map_rad(), 1.1);
   ASSERT_TRUE(back->truth_from_map().has_value());
@@ -227,7 +264,14 @@ TEST(WifiGpMapTest, RunFrameRoundTripsAndFormatOneStillReads) {
   const size_t version_at = plain.find("RSWIFIGP") + 8;
   uint32_t version = 0;
   std::memcpy(&version, plain.data() + version_at, 4);
-  ASSERT_EQ(version, 2u);
+  ASSERT_EQ(version, 3u);
+  // Format 2 is format 3's body under version 2.
+  std::string v2 = plain;
+  version = 2;
+  std::memcpy(v2.data() + version_at, &version, 4);
+  StatusOr<WifiGpMap> two = WifiGpMap::Decode(v2, "v2.wifimap");
+  ASSERT_TRUE(two.ok()) << two.status().message();
+  EXPECT_EQ(two->stored_cells(), map.stored_cells());
   ASSERT_EQ(plain[85], 0);  // fit_hyperparameters false
   ASSERT_EQ(plain[86], 0);  // fit_length_scale false
   ASSERT_GT(first, 87u);

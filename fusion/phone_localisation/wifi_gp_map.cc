@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include "common/byte_buffer.h"
+#include "common/checksum.h"
 #include "common/text_file.h"
 
 namespace ratslam {
@@ -13,7 +15,14 @@ namespace {
 constexpr char kMagic[] = "RSWIFIGP";
 // 1: first; 2: adds the frame of maps made from a run (compass_to_map, truth_from_map), walls
 // and the options fit_hyperparameters and fit_length_scale.
-constexpr uint32_t kVersion = 2;
+// The most grid cells a Wi-Fi map may store: 2 GiB of grids, and each cell is a GP prediction to
+// compute (far beyond what any site needs at a useful cell size: 500 APs over 70 m x 70 m each at
+// 0.25 m are 4e7).
+constexpr double kMaxWifiMapCells = double{1 << 28};
+
+// Format 3 adds a CRC-32C trailer (common/checksum.h) to format 2.
+constexpr uint32_t kVersion = 3;
+constexpr uint32_t kFirstChecksummedVersion = 3;
 constexpr int kTileCells = 8;  // cells per tile side: one local GP per tile
 
 using Key = std::pair<int, int>;
@@ -213,6 +222,35 @@ StatusOr<WifiGpMap> WifiGpMap::Build(const std::vector<WifiMapSample>& samples,
   const double signal2 = o.signal_sigma_dbm * o.signal_sigma_dbm;
   const double reach = 4.0 * o.length_scale_m;  // kernel below e^-8 beyond
   const double cell = options.cell_size_m;
+  // Memory and time up front, from each grid's bounding box (heard bins plus the margin): a cell
+  // of 1 cm once started and ran the machine out of memory.
+  double total_cells = 0.0;
+  for (size_t ap = 0; ap < map.bssids_.size(); ++ap) {
+    for (const TrainingSet& set : sets[ap]) {
+      int min_x = std::numeric_limits<int>::max(), min_y = min_x;
+      int max_x = std::numeric_limits<int>::min(), max_y = max_x;
+      for (const Key& k : set.heard_bins) {
+        min_x = std::min(min_x, k.first);
+        min_y = std::min(min_y, k.second);
+        max_x = std::max(max_x, k.first);
+        max_y = std::max(max_y, k.second);
+      }
+      if (set.heard_bins.empty()) continue;
+      const double width_m = (max_x - min_x + 1) * options.bin_size_m + 2 * options.grid_margin_m;
+      const double height_m = (max_y - min_y + 1) * options.bin_size_m + 2 * options.grid_margin_m;
+      total_cells += std::ceil(width_m / cell + 1) * std::ceil(height_m / cell + 1);
+    }
+  }
+  if (total_cells > kMaxWifiMapCells) {
+    char text[320];
+    std::snprintf(text, sizeof text,
+                  "Wi-Fi map: [wifi_map] cell_size_m = %g m would need up to %.2g grid cells for "
+                  "%zu access points (%.1f GiB, each a prediction to compute; at most %.2g): use "
+                  "a larger cell_size_m or a smaller grid_margin_m",
+                  cell, total_cells, map.bssids_.size(), total_cells * 8 / (1 << 30),
+                  kMaxWifiMapCells);
+    return Status::Error(text);
+  }
   map.grids_.resize(map.bssids_.size());
   for (size_t ap = 0; ap < map.bssids_.size(); ++ap) {
     for (const TrainingSet& set : sets[ap]) {
@@ -437,11 +475,24 @@ std::string WifiGpMap::Encode() const {
       w.Pod(rssi);
     }
   }
+  AppendChecksum(&w.bytes());
   return std::move(w.bytes());
 }
 
 StatusOr<WifiGpMap> WifiGpMap::Decode(const std::string& bytes, const std::string& name) {
-  ByteReader r(bytes, name);
+  std::string_view file(bytes);
+  {
+    ByteReader header(file, name);
+    std::string magic;
+    uint32_t version = 0;
+    if (header.String(&magic) && magic == kMagic && header.Pod(&version) &&
+        version >= kFirstChecksummedVersion) {
+      StatusOr<std::string_view> body = StripChecksum(file, name);
+      if (!body.ok()) return body.status();
+      file = *body;
+    }
+  }
+  ByteReader r(file, name);
   auto fail = [&](const std::string& what) {
     return Status::Error(name + ": " + (r.error().empty() ? what : r.error()));
   };
@@ -449,7 +500,7 @@ StatusOr<WifiGpMap> WifiGpMap::Decode(const std::string& bytes, const std::strin
   uint32_t version = 0;
   if (!r.String(&magic) || magic != kMagic) return fail("not a Wi-Fi map file");
   if (!r.Pod(&version)) return fail("truncated");
-  if (version != kVersion && version != 1) {
+  if (version < 1 || version > kVersion) {
     return fail("Wi-Fi map format " + std::to_string(version) + " (this program reads 1 to " +
                 std::to_string(kVersion) + ")");
   }
