@@ -3,6 +3,7 @@
 #define RATSLAM_APPS_CLI_H_
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -14,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "common/provenance.h"
 #include "fusion/io/config.h"
 #include "ratslam/experience_map.h"
 #include "render/renderer.h"
@@ -36,13 +38,36 @@ struct Arguments {
   bool render = false;
   bool lenient = false;
   std::string command_line;  // as typed, for provenance
+  // Under an OutputGuard, --out is the guard's staging folder and this is the folder the user
+  // named, where the outputs appear at the end (see Shown).
+  std::string output_folder;
 
   // The value of `flag`, or "" when it was not given.
   std::string Value(const std::string& flag) const {
     auto it = values.find(flag);
     return it == values.end() ? std::string() : it->second;
   }
+  // `path` as the user knows it: a path below the staging folder is named below --out's folder.
+  std::string Shown(const std::string& path) const { return Provenance().Recorded(path); }
+  // The command line and start time, and where the run writes, for the outputs' `run` block.
+  RunProvenance Provenance() const {
+    RunProvenance p;
+    p.command_line = command_line;
+    p.started_utc = UtcNowIso8601();
+    if (!output_folder.empty()) {
+      p.staging_folder = Value("--out");
+      p.output_folder = output_folder;
+    }
+    return p;
+  }
 };
+
+// SIGINT and SIGTERM while a command that writes into --out runs (ratslam_main.cc installs the
+// handler). A command that stops cleanly calls StopCooperatively() and then polls StopFlag(); any
+// other command ends at once with exit 130, and its output folder is as it was (its files were
+// only staged).
+std::atomic<bool>& StopFlag();
+void StopCooperatively();
 
 // "ratslam CMD: ", the one prefix of every message a command prints (main sets it once the
 // command is known; usage errors use the same form).

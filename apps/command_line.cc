@@ -246,8 +246,9 @@ const std::vector<CommandSpec>& Commands() {
        "data sets with ground truth into the file W. With --run, positions come from that run's "
        "final map instead (give --data as the replay had it).",
        {Text("--data", "D", "data set; repeat for several", true, true),
-        Text("--out", "W", "Wi-Fi map file to write", true), kConfig,
-        Text("--run", "RUN_FOLDER", "take positions from this run's map"), kLenient},
+        Text("--out", "W", "Wi-Fi map file to write", true),
+        Flag("--overwrite", "replace the file W if it exists (refused without it)"), kConfig,
+        Text("--run", "RUN_FOLDER", "take positions from this run's map"), kLenient, kQuiet, kJson},
        {}},
       {"locate",
        "locate a phone in a Wi-Fi map with a particle filter",
@@ -437,7 +438,15 @@ struct Built {
 void AddOption(CLI::App* sub, const OptionSpec& spec) {
   const bool positional = spec.name[0] != '-';
   if (spec.kind == Kind::kFlag) {
-    sub->add_flag(spec.name, spec.help);
+    // A yes/no flag takes no value, or exactly true or false: CLI11 alone turned
+    // `--overwrite=no` and `--render=banana` on.
+    sub->add_flag(spec.name, spec.help)
+        ->check(CLI::Validator(
+            [](std::string& text) -> std::string {
+              if (text == "true" || text == "false") return "";
+              return "takes no value, or true or false; not '" + text + "'";
+            },
+            ""));
     return;
   }
   CLI::Option* option = nullptr;
@@ -538,6 +547,7 @@ ParsedCommand Collect(CLI::App* at, const std::string& path) {
     const CLI::Option* option = at->get_option(o.name);
     if (option->count() == 0) continue;
     if (o.kind == Kind::kFlag) {
+      if (option->results().back() == "false") continue;  // --flag=false: as if not given
       if (o.name == "--quiet") {
         parsed.args.quiet = true;
       } else if (o.name == "--render") {

@@ -95,6 +95,16 @@ TEST(CommandLineTest, NestedCommandsPositionalsAndOtherFlags) {
   EXPECT_EQ(o.command().args.values.count("--slurm"), 1u);
   EXPECT_EQ(o.command().args.values.count("--dry-run"), 0u);
   EXPECT_EQ(o.command().args.all.at("--sbatch-arg"), (std::vector<std::string>{"-A", "x"}));
+  // A yes/no flag with an explicit value: true is the flag, false is its absence.
+  const Outcome on = Parse("replay --data a --out o --overwrite=true --render=true --quiet=false");
+  ASSERT_EQ(on.code(), -1) << on.err;
+  EXPECT_EQ(on.command().args.values.count("--overwrite"), 1u);
+  EXPECT_TRUE(on.command().args.render);
+  EXPECT_FALSE(on.command().args.quiet);
+  const Outcome off = Parse("replay --data a --out o --overwrite=false --render=false");
+  ASSERT_EQ(off.code(), -1) << off.err;
+  EXPECT_EQ(off.command().args.values.count("--overwrite"), 0u);
+  EXPECT_FALSE(off.command().args.render);
   const Outcome p = Parse("print-config locate");
   ASSERT_EQ(p.code(), -1) << p.err;
   EXPECT_EQ(p.command().args.positional, std::vector<std::string>{"locate"});
@@ -130,6 +140,11 @@ TEST(CommandLineTest, UsageErrorsSayWhatIsWrong) {
       {"print-config other", "'other' is not one of locate"},
       {"sweep run", "DIR is required"},
       {"import-openratslam a.ini b.ini", "unexpected argument 'b.ini'"},
+      {"replay --data a --out o --overwrite=no", "takes no value, or true or false; not 'no'"},
+      {"replay --data a --out o --render=no", "not 'no'"},
+      {"replay --data a --out o --render=banana", "not 'banana'"},
+      {"replay --data a --out o --render=1", "not '1'"},
+      {"replay --data a --out o --quiet=yes", "not 'yes'"},
   };
   for (const auto& [line, expected] : cases) {
     const Outcome o = Parse(line);

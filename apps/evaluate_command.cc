@@ -26,7 +26,7 @@ int EvaluateCommand(const Arguments& parsed) {
   options.map_path = args->values.at("--map");
   options.query_path = args->values.at("--query");
   options.lenient = args->lenient;
-  options.provenance = {args->command_line, UtcNowIso8601()};
+  options.provenance = args->Provenance();
   const std::string out_path = args->values.at("--out");
   auto fail = [](const Status& s) {
     std::cerr << MessagePrefix() << s.message() << "\n";
@@ -36,15 +36,23 @@ int EvaluateCommand(const Arguments& parsed) {
   if (!out.ok()) return fail(out.status());
   ProgressPrinter progress(stderr, args->quiet);
   EvaluationSession session(options, out->get(), nullptr, &progress);
-  if (Status s = session.Load(); !s.ok()) return fail(s);
+  // Ctrl-C or SIGTERM stops it between steps, nothing written (exit 130).
+  session.set_stop_flag(&StopFlag());
+  StopCooperatively();
+  auto fail_or_stop = [&](const Status& s) {
+    if (!session.stopped()) return fail(s);
+    std::cerr << MessagePrefix() << "interrupted; no outputs written\n";
+    return kExitInterrupted;
+  };
+  if (Status s = session.Load(); !s.ok()) return fail_or_stop(s);
   const fabmap::FabmapMode mode = session.mode();
   if (!args->quiet) {
     std::fprintf(stderr, "%smode %s, %zu map nodes, %zu queries\n", MessagePrefix().c_str(),
                  fabmap::ToString(mode).c_str(), session.result().map.size(),
                  session.result().queries.size());
   }
-  if (Status s = session.Prepare(); !s.ok()) return fail(s);
-  if (Status s = session.Localise(); !s.ok()) return fail(s);
+  if (Status s = session.Prepare(); !s.ok()) return fail_or_stop(s);
+  if (Status s = session.Localise(); !s.ok()) return fail_or_stop(s);
   if (Status s = session.WriteOutputs(); !s.ok()) return fail(s);
   const EvaluationResult& r = session.result();
   const fabmap::EvaluationMetrics& m = r.metrics;

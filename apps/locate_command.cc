@@ -18,8 +18,10 @@
 #include "common/file_util.h"
 #include "common/number_text.h"
 #include "common/output_folder.h"
+#include "common/output_guard.h"
 #include "fusion/io/config.h"
 #include "fusion/io/map_file.h"
+#include "fusion/io/provenance_json.h"
 #include "fusion/io/run_reader.h"
 #include "fusion/phone_localisation/particle_filter.h"
 #include "fusion/phone_localisation/robot_call.h"
@@ -258,6 +260,12 @@ int WifiMapCommand(const Arguments& parsed) {
     std::cerr << MessagePrefix() << s.message() << "\n";
     return kExitError;
   };
+  // Refused before any work: a Wi-Fi map is not replaced without --overwrite.
+  if (Status s = CheckReplaceable(args->values.at("--out"), args->values.count("--overwrite") > 0,
+                                  "--out");
+      !s.ok()) {
+    return fail(s);
+  }
   const auto start = std::chrono::steady_clock::now();
   PhoneLogOptions phone;
   phone.lenient = args->lenient;
@@ -333,7 +341,15 @@ int WifiMapCommand(const Arguments& parsed) {
     if (map->truth_from_map()) j["map_to_truth_rmse_m"] = map->truth_from_map()->rmse_m;
   }
   j["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  std::cout << j.dump(2) << "\n";
+  j["run"] = RunObject(args->Provenance(), args->all.at("--data"), std::nullopt, 0);
+  char human[256];
+  std::snprintf(human, sizeof human,
+                "%swrote %s: %zu access points on %zu floor(s), %zu stored cells, from %zu "
+                "samples (%s)\n",
+                MessagePrefix().c_str(), out.string().c_str(), map->bssids().size(),
+                map->floors().size(), static_cast<size_t>(map->stored_cells()), samples.size(),
+                from_run ? "run trajectory" : "ground truth");
+  PrintOutcome(args->values.count("--json") > 0, args->quiet, j.dump(2) + "\n", human);
   return kExitOk;
 }
 
@@ -446,6 +462,8 @@ int LocateCommand(const Arguments& parsed) {
     for (auto& [key, value] : f.items()) j[key] = value;
     j["knn_baseline"] = ErrorSummary(knn_errors);
   }
+  j["run"] = RunObject(args->Provenance(),
+                       {args->values.at("--wifi-map"), args->values.at("--data")}, std::nullopt, 0);
   const std::string summary = j.dump(2) + "\n";
   StatusOr<std::unique_ptr<DiskFolder>> folder = DiskFolder::Open(args->values.at("--out"));
   if (!folder.ok()) return fail(folder.status());
@@ -482,7 +500,7 @@ int LocateCommand(const Arguments& parsed) {
     }
     human += "; " + f["wrong_floor"].dump() + " on the wrong floor";
   }
-  human += "\n" + MessagePrefix() + "outputs in " + args->values.at("--out") +
+  human += "\n" + MessagePrefix() + "outputs in " + args->Shown(args->values.at("--out")) +
            " (summary.json; --json prints it here)\n";
   PrintOutcome(args->values.count("--json") > 0, args->quiet, summary, human);
   return kExitOk;
@@ -680,6 +698,10 @@ int CallCommand(const Arguments& parsed) {
     return scene;
   };
 
+  j["run"] = RunObject(
+      args->Provenance(),
+      {args->values.at("--map"), args->values.at("--wifi-map"), args->values.at("--data")},
+      std::nullopt, 0);
   const std::string summary = j.dump(2) + "\n";
   StatusOr<std::unique_ptr<DiskFolder>> folder = DiskFolder::Open(args->values.at("--out"));
   if (!folder.ok()) return fail(folder.status());
@@ -697,7 +719,7 @@ int CallCommand(const Arguments& parsed) {
     human += "; estimate " + Metres(j["estimate_error_m"]) + " from the truth, nearest candidate " +
              Metres(j["nearest_candidate_error_m"]);
   }
-  human += "\n" + MessagePrefix() + "outputs in " + args->values.at("--out") +
+  human += "\n" + MessagePrefix() + "outputs in " + args->Shown(args->values.at("--out")) +
            " (call.json; --json prints it here)\n";
   PrintOutcome(args->values.count("--json") > 0, args->quiet, summary, human);
   return kExitOk;

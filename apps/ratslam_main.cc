@@ -1,5 +1,6 @@
 // The `ratslam` command line: replay a data set, run the demo, print or import configurations,
 // and write the built-in synthetic data set.
+#include <sys/prctl.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -22,11 +23,11 @@
 #include "apps/cli.h"
 #include "apps/command_line.h"
 #include "apps/demo_config.h"
-#include "apps/output_guard.h"
 #include "apps/progress.h"
 #include "apps/wifi_sequence_images.h"
 #include "common/file_util.h"
 #include "common/output_folder.h"
+#include "common/output_guard.h"
 #include "common/provenance.h"
 #include "common/version.h"
 #include "fusion/io/config.h"
@@ -43,6 +44,7 @@
 #include "sensors/dataset/visual_odometry_source.h"
 #include "session/replay_session.h"
 #include "sim/world.h"
+#include "sweep/sweep.h"
 #include "viewer/animation.h"
 #include "viewer/figures.h"
 #include "viewer/run_images.h"
@@ -53,8 +55,14 @@ namespace {
 namespace fs = std::filesystem;
 
 std::atomic<bool> g_stop_requested{false};
+std::atomic<bool> g_cooperative{false};
 
 extern "C" void OnSignal(int) { g_stop_requested.store(true); }
+
+// A command that does not poll the stop flag ends at once; a second signal ends any command.
+extern "C" void OnGuardedSignal(int) {
+  if (!g_cooperative.load() || g_stop_requested.exchange(true)) ::_exit(kExitInterrupted);
+}
 
 struct ReplayRequest {
   ReplaySessionOptions session;
@@ -123,6 +131,8 @@ int RunReplay(const ReplayRequest& request) {
   };
   StatusOr<std::unique_ptr<DiskFolder>> out = DiskFolder::Open(request.out);
   if (!out.ok()) return fail(out.status());
+  // Messages name the folder the outputs end up in, not the staging folder they are written to.
+  auto shown = [&](const std::string& path) { return request.session.provenance.Recorded(path); };
   ProgressPrinter progress(stderr, request.quiet);
   SessionEnvironment environment;
   environment.out = out->get();
@@ -175,7 +185,7 @@ int RunReplay(const ReplayRequest& request) {
     const bool video = animation->Close();
     std::cerr << MessagePrefix() << "wrote " << animation->frames() << " animation frames"
               << (video ? " and animation.avi" : " (no video writer available)") << " to "
-              << (fs::path(request.out) / "animation").string() << "\n";
+              << shown((fs::path(request.out) / "animation").string()) << "\n";
   }
   (void)session.WriteOutputs();
   (void)session.SaveMap();
@@ -184,7 +194,7 @@ int RunReplay(const ReplayRequest& request) {
   int exit_code = kExitOk;
   if (result.summary) {
     PrintOutcome(request.json, request.quiet, result.summary->json,
-                 HumanSummary(*result.summary, request.out));
+                 HumanSummary(*result.summary, shown(request.out)));
   }
   if (!result.outputs.ok()) exit_code = fail(result.outputs);
   if (!result.save.ok()) exit_code = fail(result.save);
@@ -206,24 +216,25 @@ int RunReplay(const ReplayRequest& request) {
   if (!result.replay.ok()) {
     std::cerr << MessagePrefix() << result.replay.message() << "\n";
     if (result.outputs.ok()) {
-      std::cerr << MessagePrefix() << "outputs up to the last complete event are in " << request.out
-                << "\n";
+      std::cerr << MessagePrefix() << "outputs up to the last complete event are in "
+                << shown(request.out) << "\n";
     }
     if (!result.saved_map.empty()) {
-      std::cerr << MessagePrefix() << "the state is saved in " << result.saved_map << "\n";
+      std::cerr << MessagePrefix() << "the state is saved in " << shown(result.saved_map) << "\n";
     }
     return kExitError;
   }
   if (exit_code != kExitOk) return exit_code;
   if (result.interrupted) {
-    std::cerr << MessagePrefix() << "interrupted; state saved in " << result.saved_map << "\n";
+    std::cerr << MessagePrefix() << "interrupted; state saved in " << shown(result.saved_map)
+              << "\n";
     return kExitInterrupted;
   }
   if (result.summary && result.summary->frames == 0) {
     std::cerr << MessagePrefix()
               << "the run processed no frame (no view for the front end to judge); "
                  "the outputs in "
-              << request.out << " hold dead reckoning only\n";
+              << shown(request.out) << " hold dead reckoning only\n";
     return kExitError;
   }
   return kExitOk;
@@ -236,7 +247,7 @@ int Replay(const Arguments& parsed) {
   if (!options) return kExitError;
   request.session.pipeline = *options;
   request.session.data = args->all.at("--data");
-  request.session.provenance = {args->command_line, UtcNowIso8601()};
+  request.session.provenance = args->Provenance();
   request.session.lenient = args->lenient;
   request.out = args->values.at("--out");
   request.session.save_map = args->Value("--save-map");
@@ -275,14 +286,15 @@ int Replay(const Arguments& parsed) {
 }
 
 int Synthesize(const SyntheticOptions& options, const std::string& folder,
-               const std::string& bag_path, const std::string& video_path) {
+               const std::string& shown_folder, const std::string& bag_path,
+               const std::string& video_path) {
   StatusOr<Dataset> d = WriteSyntheticDataset(options, folder);
   if (!d.ok()) {
     std::cerr << MessagePrefix() << d.status().message() << "\n";
     return kExitError;
   }
   std::cerr << MessagePrefix() << "wrote " << d->images.size() << " frames of '" << d->name
-            << "' to " << folder << "\n";
+            << "' to " << shown_folder << "\n";
   if (!bag_path.empty()) {
     // OpenRatSLAM's topic names under the root "synthetic" (what topic_root=synthetic implies).
     const BagTopics topics{"/synthetic/camera/image/compressed", "/synthetic/odom",
@@ -333,7 +345,7 @@ int Demo(const Arguments& parsed) {
   request.session.pipeline = DemoPipelineOptions();
   request.session.config_path = "(built-in demo configuration, as configs/demo.toml)";
   request.session.data = {data};
-  request.session.provenance = {args->command_line, UtcNowIso8601()};
+  request.session.provenance = args->Provenance();
   request.out = out;
   request.quiet = args->quiet;
   request.json = args->values.count("--json") > 0;
@@ -439,41 +451,75 @@ int SynthesizeCommand(const Arguments& parsed) {
     if (!start) return kExitUsage;
     options.start_m = *start;
   }
-  return Synthesize(options, args->values.at("--out"), args->Value("--bag"),
-                    args->Value("--video"));
+  return Synthesize(options, args->values.at("--out"), args->Shown(args->values.at("--out")),
+                    args->Value("--bag"), args->Value("--video"));
 }
 
 }  // namespace
+
+std::atomic<bool>& StopFlag() { return g_stop_requested; }
+void StopCooperatively() { g_cooperative.store(true); }
+
 }  // namespace ratslam
 
 namespace {
 
-// Runs a command that writes into the folder --out under an OutputGuard: a folder holding an
-// earlier run's outputs is refused without --overwrite, and the run's files are listed after it.
+// Runs a command that writes into the folder --out under an OutputGuard (common/output_guard.h):
+// the folder is locked, a folder holding an earlier run's outputs is refused without --overwrite,
+// the command writes into the guard's staging folder, and its outputs appear in --out together
+// when it ends (kept aside in incomplete-run/ when it fails).
 int RunGuarded(int (*handler)(const ratslam::Arguments&), const ratslam::Arguments& args) {
   using namespace ratslam;
   const std::string folder = args.Value("--out");
+  const bool overwrite = args.values.count("--overwrite") > 0;
   std::vector<std::string> inputs;
   for (const char* flag : {"--data", "--load-map", "--config", "--map", "--query", "--wifi-map"}) {
     if (auto it = args.all.find(flag); it != args.all.end()) {
       inputs.insert(inputs.end(), it->second.begin(), it->second.end());
     }
   }
-  StatusOr<OutputGuard> guard =
-      OutputGuard::Begin(folder, args.values.count("--overwrite") > 0, inputs);
-  if (!guard.ok()) {
-    std::cerr << MessagePrefix() << guard.status().message() << "\n";
+  auto fail = [](const Status& s) {
+    std::cerr << MessagePrefix() << s.message() << "\n";
     return kExitError;
+  };
+  const std::string save_map = args.Value("--save-map");
+  if (Status s = CheckReplaceable(save_map, overwrite, "--save-map"); !s.ok()) return fail(s);
+  StatusOr<OutputGuard> guard = OutputGuard::Begin(folder, overwrite, inputs, args.command_line);
+  if (!guard.ok()) return fail(guard.status());
+  Arguments staged = args;
+  staged.output_folder = folder;
+  staged.values["--out"] = guard->staging();
+  staged.all["--out"] = {guard->staging()};
+  if (!save_map.empty()) {
+    staged.values["--save-map"] = guard->Staged(save_map);
+    staged.all["--save-map"] = {staged.values["--save-map"]};
   }
-  const int code = handler(args);
-  StatusOr<std::vector<std::string>> removed = guard->Finish(code == kExitOk);
-  if (!removed.ok()) {
-    std::cerr << MessagePrefix()
-              << "the list of outputs was not written: " << removed.status().message() << "\n";
+  std::signal(SIGINT, OnGuardedSignal);
+  std::signal(SIGTERM, OnGuardedSignal);
+  const int code = handler(staged);
+  // Ends once the outputs are in place (a signal during the moves waits for them).
+  std::signal(SIGINT, SIG_IGN);
+  std::signal(SIGTERM, SIG_IGN);
+  // A run stopped by a data error after writing its summary (a replay keeps its outputs up to
+  // the last complete event, and its state to resume from) keeps them as an interrupted one does.
+  OutputGuard::Outcome outcome = OutputGuard::Outcome::kFailed;
+  if (code == kExitOk) {
+    outcome = OutputGuard::Outcome::kSucceeded;
+  } else if ((code == kExitInterrupted || code == kExitError) && guard->StagedSummary()) {
+    outcome = OutputGuard::Outcome::kInterrupted;
+  }
+  StatusOr<OutputGuard::Report> report = guard->Finish(outcome);
+  if (!report.ok()) {
+    std::cerr << MessagePrefix() << "the outputs were not moved into " << folder << ": "
+              << report.status().message() << "\n";
     return code == kExitOk ? kExitError : code;
   }
-  if (!removed->empty() && !args.quiet) {
-    std::cerr << MessagePrefix() << "--overwrite removed " << removed->size()
+  if (!report->incomplete.empty()) {
+    std::cerr << MessagePrefix() << "the unfinished run's files are in " << report->incomplete
+              << " (" << folder << " itself is as it was)\n";
+  }
+  if (!report->removed.empty() && !args.quiet) {
+    std::cerr << MessagePrefix() << "--overwrite removed " << report->removed.size()
               << " file(s) of the earlier run that this run did not write again\n";
   }
   return code;
@@ -518,9 +564,19 @@ int Dispatch(int argc, char** argv) {
 
 }  // namespace
 
+// A run started by `sweep run` ends with its runner (sweep.h, kEndWithParentVariable): SIGTERM
+// when the runner dies stops it as Ctrl-C would.
+void EndWithParent() {
+  const char* parent = std::getenv(ratslam::sweep::kEndWithParentVariable);
+  if (parent == nullptr) return;
+  ::prctl(PR_SET_PDEATHSIG, SIGTERM);
+  if (std::to_string(::getppid()) != parent) std::raise(SIGTERM);  // the runner died already
+}
+
 // Expected failures come back as Status; an exception here is a bug or an exhausted machine
 // (std::bad_alloc). Either way the program says so and exits non-zero instead of aborting.
 int main(int argc, char** argv) {
+  EndWithParent();
   try {
     return Dispatch(argc, argv);
   } catch (const std::bad_alloc&) {

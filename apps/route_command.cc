@@ -192,7 +192,7 @@ int RouteCommand(const Arguments& args) {
     if (Status s = WriteCommandFigure(args, folder.value()->Path("route.png"), build); !s.ok()) {
       return fail(s);
     }
-    human += MessagePrefix() + "outputs in " + args.values.at("--out") +
+    human += MessagePrefix() + "outputs in " + args.Shown(args.values.at("--out")) +
              " (route.json, route.csv, route.png)\n";
   }
   PrintOutcome(args.values.count("--json") > 0, args.quiet, json, human);

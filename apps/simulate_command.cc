@@ -82,8 +82,8 @@ int SimulateCommand(const Arguments& parsed) {
   }
   if (!args->quiet) {
     std::printf("simulated '%s' into %s: %zu images, %zu Wi-Fi scans, %.0f s\n",
-                world->name.c_str(), args->values.at("--out").c_str(), dataset.images.size(),
-                dataset.wifi.size(),
+                world->name.c_str(), args->Shown(args->values.at("--out")).c_str(),
+                dataset.images.size(), dataset.wifi.size(),
                 dataset.ground_truth.back().time_s - dataset.ground_truth.front().time_s);
   }
   return kExitOk;

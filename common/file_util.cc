@@ -66,10 +66,22 @@ void RemoveStaleTemps(const std::string& path) {
   }
 }
 
+// Creates `temp` exclusively, never through a link: whatever is already at that name (a file of a
+// process with a recycled pid, or a planted symbolic link to a file elsewhere) is removed, not
+// written through.
+int CreateExclusively(const std::string& temp) {
+  constexpr int kFlags = O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC;
+  int fd = ::open(temp.c_str(), kFlags, 0644);
+  if (fd < 0 && errno == EEXIST && ::unlink(temp.c_str()) == 0) {
+    fd = ::open(temp.c_str(), kFlags, 0644);
+  }
+  return fd;
+}
+
 // Writes (and, with `flush`, flushes to disk) `contents` to `temp`; on failure removes it and
 // names `temp`.
 Status WriteAndFlush(const std::string& temp, const std::string& contents, bool flush = true) {
-  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  const int fd = CreateExclusively(temp);
   if (fd < 0) return Status::Error(temp + ": cannot create: " + std::strerror(errno));
   size_t written = 0;
   while (written < contents.size()) {

@@ -18,7 +18,8 @@ bool PathExists(const std::filesystem::path& path) noexcept;
 bool IsDirectory(const std::filesystem::path& path) noexcept;
 bool IsRegularFile(const std::filesystem::path& path) noexcept;
 
-// Writes `contents` to a temporary file beside `path` (`path.tmp<pid>`), flushes it to disk and
+// Writes `contents` to a temporary file beside `path` (`path.tmp<pid>`, created exclusively and
+// never through a symbolic link), flushes it to disk and
 // renames it over `path`: the file is either the old one or the complete new one. Temporary
 // files that killed writers left in that folder (their process is gone) are removed the first
 // time this process writes there.

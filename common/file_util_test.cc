@@ -45,6 +45,22 @@ TEST(FileUtilTest, AFailedWriteOfSeveralFilesKeepsEveryEarlierFile) {
 
 // A writer killed mid-save leaves `name.tmp<pid>`; the next save removes it when that process is
 // gone, and leaves a live writer's file alone.
+TEST(FileUtilTest, APlantedLinkAtTheTemporaryNameIsNeverWrittenThrough) {
+  ScratchDir dir("ratslam_file_util");
+  fs::create_directories(dir / "out");
+  ASSERT_TRUE(WriteFileAtomically((dir / "outside.txt").string(), "precious").ok());
+  const std::string target = (dir / "out" / "summary.json").string();
+  // The name this process's temporary file will have, planted as a link to a file elsewhere.
+  fs::create_symlink(dir / "outside.txt", target + ".tmp" + std::to_string(::getpid()));
+  ASSERT_TRUE(WriteFileAtomically(target, "{}").ok());
+  EXPECT_EQ(Slurp(dir / "outside.txt"), "precious");
+  EXPECT_EQ(Slurp(target), "{}");
+  EXPECT_FALSE(fs::is_symlink(target));
+  fs::create_symlink(dir / "outside.txt", target + ".tmp" + std::to_string(::getpid()));
+  ASSERT_TRUE(WriteFileAtomically(target, "{}", /*flush_to_disk=*/false).ok());
+  EXPECT_EQ(Slurp(dir / "outside.txt"), "precious");
+}
+
 TEST(FileUtilTest, TemporaryFilesOfKilledWritersAreRemoved) {
   ScratchDir dir("ratslam_file_util");
   const pid_t child = ::fork();

@@ -6,6 +6,15 @@
 
 namespace ratslam {
 
+std::string RunProvenance::Recorded(const std::string& path) const {
+  if (staging_folder.empty() || path.compare(0, staging_folder.size(), staging_folder) != 0) {
+    return path;
+  }
+  const std::string rest = path.substr(staging_folder.size());
+  if (!rest.empty() && rest.front() != '/') return path;
+  return output_folder + rest;
+}
+
 std::vector<InputDescription> DescribeInputs(const std::vector<std::string>& paths) {
   namespace fs = std::filesystem;
   std::vector<InputDescription> out;

@@ -29,6 +29,14 @@ std::string ShellCommandLine(int argc, const char* const* argv);
 struct RunProvenance {
   std::string command_line;  // empty when the run did not come from a command line
   std::string started_utc;   // empty: unknown
+  // A run under an OutputGuard writes into a staging folder that becomes the output folder at
+  // its end: paths below `staging_folder` are recorded as below `output_folder` (a demo's data
+  // set, simulated into the staging folder, is named where it will be).
+  std::string staging_folder;
+  std::string output_folder;
+
+  // `path` as the run's outputs name it (see staging_folder).
+  std::string Recorded(const std::string& path) const;
 };
 
 }  // namespace ratslam

@@ -5,7 +5,7 @@
 #include <fstream>
 #include <string>
 
-#include "apps/output_guard.h"
+#include "common/output_guard.h"
 #include "fuzz/fuzz_support.h"
 
 namespace ratslam::fuzz {
@@ -40,8 +40,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       fuzz::InvariantFailed("refusal does not name the list: " + guard.status().message());
     }
   } else {
-    std::ofstream(folder / "summary.json") << "the new run's";  // the run rewrites one file
-    StatusOr<std::vector<std::string>> removed = guard->Finish(/*succeeded=*/true);
+    // The run rewrites one file.
+    std::ofstream(fs::path(guard->staging()) / "summary.json") << "the new run's";
+    StatusOr<OutputGuard::Report> removed = guard->Finish(OutputGuard::Outcome::kSucceeded);
     if (!removed.ok()) fuzz::InvariantFailed("Finish failed: " + removed.status().message());
   }
   if (!fs::exists(root / "outside.txt")) fuzz::InvariantFailed("removed a file outside the folder");

@@ -18,14 +18,16 @@
 #include <utility>
 #include <vector>
 
-#include "apps/output_guard.h"
 #include "common/geometry.h"
 #include "common/output_folder.h"
+#include "common/output_guard.h"
 #include "common/provenance.h"
+#include "common/version.h"
 #include "fusion/io/config.h"
 #include "fusion/io/map_file.h"
 #include "fusion/io/run_outputs.h"
 #include "fusion/replay_pipeline.h"
+#include "sensors/dataset/csv.h"
 #include "session/evaluation_session.h"
 #include "session/replay_session.h"
 
@@ -38,8 +40,27 @@ struct Error : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// Messages written for the command line name its flags; Python users pass keyword arguments.
+std::string InPythonTerms(std::string message) {
+  for (const auto& [flag, keyword] :
+       {std::pair<std::string, std::string>{"--overwrite", "overwrite=True"},
+        {"--save-map", "save_map"}}) {
+    for (size_t at = message.find(flag); at != std::string::npos;
+         at = message.find(flag, at + keyword.size())) {
+      message.replace(at, flag.size(), keyword);
+    }
+  }
+  return message;
+}
+
 void Check(const Status& status) {
-  if (!status.ok()) throw Error(status.message());
+  if (!status.ok()) throw Error(InPythonTerms(status.message()));
+}
+
+// The outcome of a run for its OutputGuard: see OutputGuard::Outcome.
+OutputGuard::Outcome OutcomeOf(bool ok, bool stopped_with_outputs) {
+  if (ok) return OutputGuard::Outcome::kSucceeded;
+  return stopped_with_outputs ? OutputGuard::Outcome::kInterrupted : OutputGuard::Outcome::kFailed;
 }
 template <typename T>
 T Take(StatusOr<T> value) {
@@ -213,7 +234,7 @@ class InterruptiblePython : public ProgressSink {
 
 // ratslam.replay: what `ratslam replay` does, into the folder `out`, returning the summary and
 // the run as columns.
-py::dict Replay(const std::vector<std::string>& data, const std::string& out,
+py::dict Replay(const std::vector<std::string>& data, std::string out,
                 const std::optional<Config>& config, const std::string& load_map,
                 const std::string& save_map, bool localise, double lost_after_m,
                 std::optional<double> until_s, bool overwrite) {
@@ -223,15 +244,19 @@ py::dict Replay(const std::vector<std::string>& data, const std::string& out,
   options.config_path = config ? "(from Python)" : "";
   options.data = data;
   options.load_map = load_map;
-  options.save_map = save_map;
   options.localise = localise;
   options.lost_after_m = lost_after_m;
-  if (until_s) options.until_s = *until_s;
-  options.provenance = {"python: ratslam.replay", UtcNowIso8601()};
+  if (until_s) {
+    if (!std::isfinite(*until_s)) throw Error("replay: until_s must be a finite number of seconds");
+    options.until_s = *until_s;
+  }
   std::vector<std::string> inputs = data;
   if (!load_map.empty()) inputs.push_back(load_map);
-  OutputGuard guard = Take(OutputGuard::Begin(out, overwrite, inputs));
-  std::unique_ptr<DiskFolder> folder = Take(DiskFolder::Open(out));
+  Check(CheckReplaceable(save_map, overwrite, "--save-map"));
+  OutputGuard guard = Take(OutputGuard::Begin(out, overwrite, inputs, "python: ratslam.replay"));
+  options.save_map = guard.Staged(save_map);
+  options.provenance = {"python: ratslam.replay", UtcNowIso8601(), guard.staging(), out};
+  std::unique_ptr<DiskFolder> folder = Take(DiskFolder::Open(guard.staging()));
   SessionEnvironment environment;
   environment.out = folder.get();
   InterruptiblePython interrupt;
@@ -242,8 +267,10 @@ py::dict Replay(const std::vector<std::string>& data, const std::string& out,
     py::gil_scoped_release release;
     return session.Run();
   }();
+  const OutputGuard::Report report = Take(guard.Finish(
+      OutcomeOf(result.ok() && result->ok(), result.ok() && result->summary.has_value())));
   Check(result.status());
-  (void)guard.Finish(result->ok());
+  if (!report.incomplete.empty()) out = report.incomplete;
   if (interrupt.stopped()) {
     PyErr_SetString(PyExc_KeyboardInterrupt,
                     ("ratslam.replay stopped; the outputs so far are in " + out).c_str());
@@ -298,9 +325,8 @@ class Session {
 
   void Odometry(double time_s, double forward_speed, double turn_rate) {
     Advance(time_s);
-    if (!std::isfinite(forward_speed) || !std::isfinite(turn_rate)) {
-      throw Error("odometry at t=" + std::to_string(time_s) + ": speeds must be finite");
-    }
+    Within(forward_speed, "odometry: forward_speed");
+    Within(turn_rate, "odometry: turn_rate");
     Check(pipeline_->FeedOdometry({time_s, forward_speed, turn_rate}));
   }
   void Image(double time_s, const py::array_t<uint8_t, py::array::c_style>& pixels) {
@@ -314,13 +340,23 @@ class Session {
     image.pixels.assign(pixels.data(), pixels.data() + pixels.size());
     Check(pipeline_->FeedImage(time_s, image).WithContext("image at t=" + std::to_string(time_s)));
   }
-  void Descriptor(double time_s,
-                  const py::array_t<float, py::array::c_style | py::array::forcecast>& values) {
-    if (values.ndim() != 1 || values.shape(0) < 1) {
+  void Descriptor(double time_s, const py::array& given) {
+    // Real numbers only: a complex array cast to float would silently lose its imaginary part.
+    const char kind = given.dtype().kind();
+    if (kind != 'f' && kind != 'i' && kind != 'u') {
+      throw Error("descriptor: expected real numbers, got an array of dtype " +
+                  std::string(py::str(given.dtype())));
+    }
+    const auto values =
+        py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(given);
+    if (!values || values.ndim() != 1 || values.shape(0) < 1) {
       throw Error("descriptor: expected a 1-D array of floats");
     }
     Advance(time_s);
     const std::vector<float> v(values.data(), values.data() + values.size());
+    for (float x : v) {
+      if (!std::isfinite(x)) throw Error("descriptor: values must be finite");
+    }
     Check(pipeline_->FeedDescriptor(time_s, v).WithContext("descriptor at t=" +
                                                            std::to_string(time_s)));
   }
@@ -329,21 +365,20 @@ class Session {
     WifiScan scan;
     scan.time_s = time_s;
     for (const auto& [bssid, rssi] : readings) {
-      if (bssid.empty() || !std::isfinite(rssi)) {
-        throw Error("wifi at t=" + std::to_string(time_s) +
-                    ": BSSIDs must be non-empty and RSSI finite");
-      }
+      if (bssid.empty()) throw Error("wifi at t=" + std::to_string(time_s) + ": empty BSSID");
+      Within(rssi, "wifi: RSSI of " + bssid);
       scan.readings.push_back({bssid, rssi});
     }
     Check(pipeline_->FeedWifi(scan).WithContext("wifi at t=" + std::to_string(time_s)));
   }
   void Compass(double time_s, double heading_rad) {
     Advance(time_s);
-    if (!std::isfinite(heading_rad)) throw Error("compass: the heading must be finite");
+    Within(heading_rad, "compass: heading_rad");
     pipeline_->FeedCompass({time_s, heading_rad});
   }
   void Pressure(double time_s, double pressure_hpa) {
     Advance(time_s);
+    Within(pressure_hpa, "pressure: pressure_hpa");
     Check(pipeline_->FeedPressure({time_s, pressure_hpa})
               .WithContext("pressure at t=" + std::to_string(time_s)));
   }
@@ -387,8 +422,16 @@ class Session {
   const ReplayPipeline& pipeline() const { return *pipeline_; }
 
  private:
+  // The bound every number of a data-set file meets (kMaxCsvMagnitude): what a file could not
+  // hold, a caller cannot feed either.
+  static void Within(double value, const std::string& what) {
+    if (!std::isfinite(value) || std::abs(value) > kMaxCsvMagnitude) {
+      throw Error(what + " must be a finite number of magnitude at most 1e12, got " +
+                  std::to_string(value));
+    }
+  }
   void Advance(double time_s) {
-    if (!std::isfinite(time_s)) throw Error("times must be finite");
+    Within(time_s, "time_s");
     if (last_time_s_ && time_s < *last_time_s_) {
       throw Error("time goes backwards: " + std::to_string(time_s) + " s after " +
                   std::to_string(*last_time_s_) + " s");
@@ -424,9 +467,10 @@ py::dict Evaluate(const std::string& map, const std::string& query, const std::s
   options.map_path = map;
   options.query_path = query;
   options.lenient = lenient;
-  options.provenance = {"python: ratslam.evaluate", UtcNowIso8601()};
-  OutputGuard guard = Take(OutputGuard::Begin(out, overwrite, {map, query}));
-  std::unique_ptr<DiskFolder> folder = Take(DiskFolder::Open(out));
+  OutputGuard guard =
+      Take(OutputGuard::Begin(out, overwrite, {map, query}, "python: ratslam.evaluate"));
+  options.provenance = {"python: ratslam.evaluate", UtcNowIso8601(), guard.staging(), out};
+  std::unique_ptr<DiskFolder> folder = Take(DiskFolder::Open(guard.staging()));
   InterruptiblePython interrupt;
   EvaluationSession session(std::move(options), folder.get(), nullptr, &interrupt);
   session.set_stop_flag(interrupt.flag());
@@ -434,7 +478,7 @@ py::dict Evaluate(const std::string& map, const std::string& query, const std::s
     py::gil_scoped_release release;
     return session.Run();
   }();
-  (void)guard.Finish(result.ok());
+  (void)Take(guard.Finish(OutcomeOf(result.ok(), false)));
   if (interrupt.stopped()) {
     PyErr_SetString(PyExc_KeyboardInterrupt, "ratslam.evaluate stopped before writing its outputs");
     throw py::error_already_set();
@@ -465,6 +509,7 @@ PYBIND11_MODULE(ratslam, m) {
       "RatSLAM: replays, localisation on saved maps and frame-by-frame sessions (see the README's "
       "Python section).";
   py::register_exception<Error>(m, "Error", PyExc_RuntimeError);
+  m.attr("__version__") = ratslam::RatslamVersion();
 
   py::class_<Config>(m, "Config", "A pipeline configuration (the TOML of `ratslam print-config`).")
       .def(py::init<>(), "The built-in defaults.")

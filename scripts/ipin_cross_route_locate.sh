@@ -31,7 +31,7 @@ map_of() {  # output map, routes...: a map from repetitions 01 and 02 of the rou
   local map=$1 a=() r
   shift
   for r in "$@"; do a+=(--data "$(log "$r" 01)" --data "$(log "$r" 02)"); done
-  "$bin" wifi-map "${a[@]}" --out "$map" > /dev/null
+  "$bin" wifi-map --overwrite "${a[@]}" --out "$map" > /dev/null
 }
 locate_row() {  # map, route, repetition, output folder, label
   "$bin" locate --quiet --overwrite --wifi-map "$1" --data "$(log "$2" "$3")" --out "$4"

@@ -22,10 +22,10 @@ echo "| route | phone log | scans with truth | sum (eq. 13) mean / median / p75 
 echo "|---|---|---|---|---|---|---|---|---|"
 for route in 01 02 03 21 22 23; do
   log() { echo "$data/IPIN2023_T3_TrainingTrial${route}_repetition$1.txt"; }
-  "$bin" wifi-map --data "$(log 01)" --data "$(log 02)" --out "$out/route$route.wifimap" > /dev/null
+  "$bin" wifi-map --overwrite --data "$(log 01)" --data "$(log 02)" --out "$out/route$route.wifimap" > /dev/null
   "$bin" replay --quiet --overwrite --config configs/ipin2023-wifi-compass.toml --data "$(log 01)" \
     --data "$(log 02)" --out "$out/route$route-run" > /dev/null
-  "$bin" wifi-map --run "$out/route$route-run" --data "$(log 01)" --data "$(log 02)" \
+  "$bin" wifi-map --overwrite --run "$out/route$route-run" --data "$(log 01)" --data "$(log 02)" \
     --out "$out/route$route-run.wifimap" > /dev/null
   for rep in 03 04; do
     "$bin" locate --quiet --overwrite --wifi-map "$out/route$route.wifimap" --data "$(log $rep)" \

@@ -17,7 +17,7 @@ for f in "${floors[@]}"; do
   mapfile -t walks < <(ls "$data/$f/path_data_files" | sort)
   for w in "${walks[@]:1}"; do map_args+=(--data "$data/$f/path_data_files/$w"); done
 done
-"$bin" wifi-map "${map_args[@]}" --out "$out/site1.wifimap" > "$out/site1-wifimap.json"
+"$bin" wifi-map --overwrite "${map_args[@]}" --out "$out/site1.wifimap" > "$out/site1-wifimap.json"
 echo "| floor | walk | scans (with truth) | filter mean / median / p90 m (wrong floor) | 3-NN mean / median / p90 m (wrong floor) |"
 echo "|---|---|---|---|---|"
 for f in "${floors[@]}"; do

@@ -22,7 +22,7 @@ for world in office apartment circular aliased_floors day_night; do
     [[ -d "$out/$world-$seed" ]] || "$bin" simulate --quiet --world "$world" --seed "$seed" \
       --out "$out/$world-$seed"
   done
-  "$bin" wifi-map --data "$out/$world-1" --out "$out/$world.wifimap" > "$out/$world-wifimap.json"
+  "$bin" wifi-map --overwrite --data "$out/$world-1" --out "$out/$world.wifimap" > "$out/$world-wifimap.json"
   for c in sum sum-nowalls product product-nowalls; do
     "$bin" locate --quiet --overwrite --config "$out/$c.toml" --wifi-map "$out/$world.wifimap" \
       --data "$out/$world-2" --out "$out/$world-$c"

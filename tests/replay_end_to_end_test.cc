@@ -1,5 +1,7 @@
 // Runs the `ratslam` program as a user would and checks its outputs.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -16,7 +18,9 @@
 
 #include "apps/demo_config.h"
 #include "common/geometry.h"
+#include "common/output_guard.h"
 #include "common/scratch_dir.h"
+#include "fusion/io/map_file.h"
 #include "render/image.h"
 #include "render/renderer.h"
 #include "sensors/dataset/csv.h"
@@ -117,6 +121,154 @@ TEST_F(ReplayEndToEndTest, AnEarlierRunsOutputsAreReplacedOnlyWithOverwrite) {
   EXPECT_EQ(Slurp(out / "my_notes.txt"), "kept");
   EXPECT_NE(Slurp(out / "summary.json"), first_summary);
   for (const char* name : kOutputs) EXPECT_TRUE(fs::exists(out / name)) << name;
+}
+
+// A yes/no flag with a value other than true or false is a usage error that touches nothing
+// (`--overwrite=no` once turned --overwrite on and replaced an earlier run).
+TEST_F(ReplayEndToEndTest, YesNoFlagsTakeOnlyTrueOrFalse) {
+  const fs::path out = root_ / "flags";
+  ASSERT_EQ(RunRatslam(ReplayArgs(out) + " --until 20", root_).exit_code, 0);
+  const std::string first = Slurp(out / "summary.json");
+  for (const char* flag : {"--overwrite=no", "--render=no", "--render=banana"}) {
+    const Result r = RunRatslam(ReplayArgs(out) + " --until 30 " + flag, root_);
+    EXPECT_EQ(r.exit_code, 2) << flag << "\n" << r.err;
+    EXPECT_EQ(Slurp(out / "summary.json"), first) << flag;
+  }
+  const Result off = RunRatslam(ReplayArgs(out) + " --until 30 --overwrite=false", root_);
+  EXPECT_EQ(off.exit_code, 1) << off.err;
+  EXPECT_NE(off.err.find("holds the outputs of an earlier run"), std::string::npos) << off.err;
+  EXPECT_EQ(Slurp(out / "summary.json"), first);
+}
+
+// While one run holds an output folder, a second run into it fails at once, names the first and
+// changes nothing; the first run's outputs then appear complete.
+TEST_F(ReplayEndToEndTest, ASecondRunIntoAFolderInUseFailsAtOnce) {
+  const fs::path out = root_ / "in_use";
+  StatusOr<OutputGuard> holder =
+      OutputGuard::Begin(out.string(), false, {}, "ratslam replay (the first run)");
+  ASSERT_TRUE(holder.ok()) << holder.status().message();
+  const Result second = RunRatslam(ReplayArgs(out) + " --until 20 --overwrite", root_, 120);
+  EXPECT_EQ(second.exit_code, 1) << second.err;
+  EXPECT_NE(second.err.find("is in use by another ratslam run (pid " + std::to_string(::getpid()) +
+                            ": ratslam replay (the first run))"),
+            std::string::npos)
+      << second.err;
+  EXPECT_FALSE(fs::exists(out / "summary.json"));
+  std::ofstream(fs::path(holder->staging()) / "summary.json") << "{}";
+  ASSERT_TRUE(holder->Finish(OutputGuard::Outcome::kSucceeded).ok());
+  EXPECT_EQ(Slurp(out / "summary.json"), "{}");
+  EXPECT_EQ(RunRatslam(ReplayArgs(out) + " --until 20 --overwrite", root_).exit_code, 0);
+  EXPECT_NE(Slurp(out / "summary.json"), "{}");
+  // Nothing of the guard's machinery is left among the outputs.
+  EXPECT_FALSE(fs::exists(out / OutputGuard::kStagingName));
+  EXPECT_FALSE(fs::exists(out / OutputGuard::kJournalName));
+  // The summary names where the outputs are, never the staging folder.
+  EXPECT_EQ(Slurp(out / "summary.json").find(OutputGuard::kStagingName), std::string::npos);
+}
+
+// A run started by `sweep run` ends when its runner dies, even by SIGKILL (the environment
+// variable sweep.h names asks for that): here a shell stands in for the runner, starts a slow
+// replay (an animation frame per event) with the variable set to its own pid, and kills itself.
+TEST_F(ReplayEndToEndTest, ARunEndsWithTheSweepRunnerThatStartedIt) {
+  const fs::path out = root_ / "orphan";
+  const fs::path pid_file = root_ / "orphan.pid";
+  const std::string script = "RATSLAM_END_WITH_PARENT=$$ " + std::string(RATSLAM_BINARY) + " " +
+                             ReplayArgs(out) + " --animate 1 >/dev/null 2>&1 & echo $! > " +
+                             pid_file.string() + "; sleep 2; kill -KILL $$";
+  (void)std::system(("bash -c '" + script + "'").c_str());
+  pid_t pid = 0;
+  std::ifstream(pid_file) >> pid;
+  ASSERT_GT(pid, 0);
+  // The orphan stops cleanly (SIGTERM, as Ctrl-C) and writes its outputs; wait for it.
+  bool ended = false;
+  for (int i = 0; i < 600 && !ended; ++i) {
+    ended = ::kill(pid, 0) != 0;
+    if (!ended) ::usleep(100000);
+  }
+  ASSERT_TRUE(ended) << "the run outlived its runner by a minute";
+  const nlohmann::json summary = Summary(out);
+  EXPECT_EQ(summary.value("interrupted", false), true) << summary.dump();
+  // A run whose parent is already gone when it starts stops at once.
+  const int status = std::system(("RATSLAM_END_WITH_PARENT=1 " + std::string(RATSLAM_BINARY) +
+                                  " replay --quiet --data " + (root_ / "data").string() +
+                                  " --out " + (root_ / "orphan_late").string())
+                                     .c_str());
+  EXPECT_TRUE(WIFSIGNALED(status) || WEXITSTATUS(status) != 0) << status;
+  EXPECT_FALSE(fs::exists(root_ / "orphan_late" / "summary.json"));
+}
+
+// --save-map never replaces a file without --overwrite.
+TEST_F(ReplayEndToEndTest, SaveMapRefusesToReplaceAFileWithoutOverwrite) {
+  const fs::path map = root_ / "existing.map";
+  std::ofstream(map) << "the user's file";
+  const fs::path out = root_ / "save_map_refused";
+  const Result r = RunRatslam(ReplayArgs(out) + " --until 20 --save-map " + map.string(), root_);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("--save-map " + map.string() + ": the file exists"), std::string::npos)
+      << r.err;
+  EXPECT_EQ(Slurp(map), "the user's file");
+  EXPECT_FALSE(fs::exists(out / "summary.json"));
+  ASSERT_EQ(
+      RunRatslam(ReplayArgs(out) + " --until 20 --overwrite --save-map " + map.string(), root_)
+          .exit_code,
+      0);
+  EXPECT_TRUE(LoadMapFile(map.string()).ok());
+}
+
+// Inputs that are not regular files (a FIFO, a device) are refused at once instead of blocking
+// or being read without end.
+TEST_F(ReplayEndToEndTest, DataThatIsNotARegularFileIsRefusedAtOnce) {
+  const fs::path fifo = root_ / "log.txt";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const fs::path bag = root_ / "fifo.bag";
+  ASSERT_EQ(::mkfifo(bag.c_str(), 0600), 0);
+  for (const fs::path& data : {fifo, bag, fs::path("/dev/zero")}) {
+    const Result r = RunRatslam(
+        "replay --quiet --data " + data.string() + " --out " + (root_ / "fifo_out").string(), root_,
+        60);
+    EXPECT_EQ(r.exit_code, 1) << data << "\n" << r.err;
+    EXPECT_NE(r.err.find("is not a regular file"), std::string::npos) << r.err;
+  }
+  const Result wifi = RunRatslam(
+      "wifi-map --data " + fifo.string() + " --out " + (root_ / "w.wifimap").string(), root_, 60);
+  EXPECT_EQ(wifi.exit_code, 1) << wifi.err;
+  EXPECT_NE(wifi.err.find("is not a regular file"), std::string::npos) << wifi.err;
+  const Result evaluate = RunRatslam("evaluate --quiet --map " + fifo.string() + " --query " +
+                                         fifo.string() + " --out " + (root_ / "ev").string(),
+                                     root_, 60);
+  EXPECT_EQ(evaluate.exit_code, 1) << evaluate.err;
+  EXPECT_NE(evaluate.err.find("is not a regular file"), std::string::npos) << evaluate.err;
+}
+
+// A map whose link points at no experience (one changed byte, checksum made to match) is
+// refused by route as by replay --load-map; route once crashed on it.
+TEST_F(ReplayEndToEndTest, EveryMapReaderRefusesADanglingLink) {
+  const fs::path out = root_ / "dangling";
+  const fs::path map = out / "run.map";
+  ASSERT_EQ(RunRatslam(ReplayArgs(out) + " --until 60 --save-map " + map.string(), root_).exit_code,
+            0);
+  StatusOr<MapFile> loaded = LoadMapFile(map.string());
+  ASSERT_TRUE(loaded.ok()) << loaded.status().message();
+  ASSERT_FALSE(loaded->state.ratslam.experience_map.links.empty());
+  loaded->state.ratslam.experience_map.links.front().to = 100000;
+  const fs::path bad = root_ / "dangling.map";
+  ASSERT_TRUE(SaveMapFile(*loaded, bad.string()).ok());
+  for (const std::string& command :
+       {"route --map " + bad.string() + " --to 0",
+        ReplayArgs(root_ / "dangling_resume") + " --load-map " + bad.string()}) {
+    const Result r = RunRatslam(command, root_, 120);
+    EXPECT_EQ(r.exit_code, 1) << command << "\n" << r.err;
+    EXPECT_NE(r.err.find("dangling.map: corrupt map file: experience map state: link 0"),
+              std::string::npos)
+        << r.err;
+  }
+  // A flipped byte anywhere is a checksum error, for every reader.
+  std::string bytes = Slurp(map);
+  bytes[bytes.size() / 3] ^= 0x10;
+  std::ofstream(bad, std::ios::binary | std::ios::trunc) << bytes;
+  const Result flipped = RunRatslam("route --map " + bad.string() + " --to 0", root_, 120);
+  EXPECT_EQ(flipped.exit_code, 1) << flipped.err;
+  EXPECT_NE(flipped.err.find("checksum mismatch"), std::string::npos) << flipped.err;
 }
 
 // Into a pipe a run prints summary.json on stdout, --quiet prints nothing there, and --json

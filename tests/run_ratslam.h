@@ -36,10 +36,14 @@ struct Result {
   std::string out;  // what it printed on stdout
 };
 
-// Runs `ratslam arguments` with stdout and stderr in files of `scratch`.
-inline Result RunRatslam(const std::string& arguments, const std::filesystem::path& scratch) {
+// Runs `ratslam arguments` with stdout and stderr in files of `scratch`. With `limit_s`, the
+// program is killed after that many seconds (exit code 124, as timeout(1) reports it): for tests
+// of inputs that once made it wait for ever.
+inline Result RunRatslam(const std::string& arguments, const std::filesystem::path& scratch,
+                         int limit_s = 0) {
   const std::filesystem::path err = scratch / "stderr.txt", out = scratch / "stdout.txt";
   const std::string command =
+      (limit_s > 0 ? "timeout -s KILL " + std::to_string(limit_s) + " " : std::string()) +
       std::string(RATSLAM_BINARY) + " " + arguments + " > " + out.string() + " 2> " + err.string();
   const int status = std::system(command.c_str());
   return {WEXITSTATUS(status), Slurp(err), Slurp(out)};

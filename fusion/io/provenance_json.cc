@@ -23,7 +23,7 @@ nlohmann::ordered_json RunObject(const RunProvenance& provenance,
   run["started_utc"] = provenance.started_utc;
   nlohmann::ordered_json list = nlohmann::ordered_json::array();
   for (const InputDescription& d : DescribeInputs(inputs)) {
-    list.push_back({{"path", d.path}, {"bytes", d.bytes}, {"files", d.files}});
+    list.push_back({{"path", provenance.Recorded(d.path)}, {"bytes", d.bytes}, {"files", d.files}});
   }
   run["inputs"] = list;
   run["seed"] = seed ? nlohmann::ordered_json(*seed) : nlohmann::ordered_json(nullptr);

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "common/output_guard.h"
 #include "common/text_file.h"
 #include "fusion/io/run_columns.h"
 #include "sensors/dataset/csv.h"
@@ -34,6 +35,9 @@ Status ReadId(const CsvTable& t, size_t row, const std::string& column, int64_t 
 }  // namespace
 
 StatusOr<RunFolder> ReadRunFolder(const std::string& folder) {
+  // A run killed while moving its outputs into place left them half moved: finish first, so
+  // that what is read is one run's outputs.
+  RATSLAM_RETURN_IF_ERROR(RecoverOutputFolder(folder));
   RunFolder run;
   StatusOr<CsvTable> ex = CsvTable::Read((fs::path(folder) / "experiences.csv").string(),
                                          kExperienceColumns.required, kExperienceColumns.optional);

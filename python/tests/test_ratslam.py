@@ -187,6 +187,18 @@ class RatslamModuleTest(unittest.TestCase):
         self.assertEqual(len(lost), 200)
         self.assertLess(lost.mean(), 0.5)
 
+    def test_version_and_bad_replay_arguments(self):
+        self.assertRegex(ratslam.__version__, r"^\d+\.\d+\.\d+")
+        with self.assertRaisesRegex(ratslam.Error, "until_s must be a finite number"):
+            ratslam.replay([self.data], os.path.join(self.root, "nan_run"), until_s=float("nan"))
+        with self.assertRaisesRegex(ratslam.Error, "the output folder is an empty path"):
+            ratslam.replay([self.data], "", until_s=5.0)
+        # Messages speak Python: overwrite=True, not the command line's --overwrite.
+        with self.assertRaises(ratslam.Error) as refused:
+            ratslam.replay([self.data], self.cli_run, until_s=5.0)
+        self.assertIn("overwrite=True", str(refused.exception))
+        self.assertNotIn("--overwrite", str(refused.exception))
+
     def test_session_refuses_bad_input(self):
         session = ratslam.Session(ratslam.Config.load(SYNTHETIC_CONFIG))
         session.odometry(1.0, 0.5, 0.0)
@@ -200,6 +212,18 @@ class RatslamModuleTest(unittest.TestCase):
             session.wifi(4.0, {"aa:bb": float("inf")})
         with self.assertRaisesRegex(ratslam.Error, "takes no descriptors"):
             session.descriptor(5.0, np.ones(4))
+        # What a data-set file could not hold is refused here too (it once made NaN poses and a
+        # map that could not be read back).
+        with self.assertRaisesRegex(ratslam.Error, "forward_speed must be a finite number"):
+            session.odometry(6.0, 1e308, 1e308)
+        with self.assertRaisesRegex(ratslam.Error, "time_s must be a finite number"):
+            session.odometry(1e300, 0.5, 0.0)
+        with self.assertRaisesRegex(ratslam.Error, "RSSI of aa:bb must be a finite number"):
+            session.wifi(7.0, {"aa:bb": 1e308})
+        with self.assertRaisesRegex(ratslam.Error, "heading_rad must be a finite number"):
+            session.compass(8.0, 1e308)
+        with self.assertRaisesRegex(ratslam.Error, "expected real numbers.*complex"):
+            session.descriptor(9.0, np.ones(4, dtype=complex))
         floors = ratslam.Config()
         floors.set("front_end.kind", "fused")
         floors.set("barometer.use_barometer", True)
