@@ -149,9 +149,16 @@ std::string Violation(const T& value, const Rule& rule) {
     if constexpr (std::is_integral_v<T>) {
       if (rule.odd && value % 2 == 0) ok = false;
     }
-    if (ok) return "";
-    if (!std::isfinite(v)) return "must be a finite number";
-    return "must be " + internal::InWords(rule);
+    if (!ok && !std::isfinite(v)) return "must be a finite number";
+    if (!ok) return "must be " + internal::InWords(rule);
+    if constexpr (std::is_floating_point_v<T>) {
+      // 1e-320 is "positive", but no setting means it: a cell that small made NaN poses.
+      if (std::fpclassify(value) == FP_SUBNORMAL) {
+        return "must be zero or a normal number (" + internal::Number(v) +
+               " is below the smallest normal double)";
+      }
+    }
+    return "";
   } else if constexpr (std::is_same_v<T, std::string>) {
     if (rule.not_empty && value.empty()) return "must not be empty";
     if (rule.relative_path) {

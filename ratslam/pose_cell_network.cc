@@ -5,6 +5,8 @@
 #include <complex>
 #include <numbers>
 #include <stdexcept>
+#include <string>
+#include <utility>
 
 #include "common/circular.h"
 
@@ -41,6 +43,26 @@ bool PoseCellOptions::IsValid(std::string* error) const {
   if (static_cast<long long>(dim_xy_cells) * dim_xy_cells * dim_theta_cells > kMaxPoseCells) {
     if (error)
       *error = "dim_xy_cells: grid of dim_xy_cells^2 x dim_theta_cells larger than 2^24 cells";
+    return false;
+  }
+  // A kernel wider than the (wrapping) grid adds each cell to itself several times and costs
+  // size^3 per active cell: 100001 once ran for minutes.
+  const int smallest = std::min(dim_xy_cells, dim_theta_cells);
+  for (const auto& [name, size] :
+       {std::pair<const char*, int>{"excitation_size_cells", excitation_size_cells},
+        {"inhibition_size_cells", inhibition_size_cells}}) {
+    if (size > smallest) {
+      if (error) {
+        *error = std::string(name) + ": " + std::to_string(size) +
+                 " is wider than the grid (at most min(dim_xy_cells, dim_theta_cells) = " +
+                 std::to_string(smallest) + ")";
+      }
+      return false;
+    }
+  }
+  // A cell so small that a metre of travel is more than 2^40 cells makes the poses meaningless.
+  if (cell_size_m < 1e-9) {
+    if (error) *error = "cell_size_m: must be at least 1e-9 m";
     return false;
   }
   return true;

@@ -8,6 +8,7 @@ build=${1:-build}
 out=${2:-out/sim-table}
 ratslam="$build/apps/ratslam"
 mkdir -p "$out"
+out=$(cd "$out" && pwd)  # absolute: paths inside a config are read relative to the config file
 worlds=(office circular day_night aliased_floors apartment)
 for w in "${worlds[@]}"; do
   [[ -f "$out/sim-$w/manifest.toml" ]] || "$ratslam" simulate --quiet --world "$w" --out "$out/sim-$w"
@@ -54,7 +55,9 @@ for w in day_night aliased_floors apartment; do
   row="| $w |"
   for m in "${fab_modes[@]}"; do
     cfg="$out/fabmap-$w-$m.toml"
-    sed -e "s/^mode = .*/mode = \"$m\"/" -e "s|out/sim-office/images|$out/sim-office/images|" configs/sim-fabmap.toml > "$cfg"
+    sed -e "s/^mode = .*/mode = \"$m\"/" \
+      -e "s|^training_images = .*|training_images = \"$out/sim-office/images\"|" \
+      configs/sim-fabmap.toml > "$cfg"
     if [[ -f "$model" ]]; then
       sed -i -e "s|^training_images = .*|file = \"$model\"|" "$cfg"
     fi

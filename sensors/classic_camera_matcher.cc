@@ -5,6 +5,7 @@
 #include <limits>
 #include <numbers>
 #include <stdexcept>
+#include <tuple>
 
 #if defined(__x86_64__)
 #include <immintrin.h>
@@ -318,6 +319,18 @@ StatusOr<std::vector<uint8_t>> ClassicCameraMatcher::MakeTemplate(
   const int crop_h = bottom - options_.crop_top_px;
   const int w = options_.template_width_px;
   const int h = options_.template_height_px;
+  // A crop edge outside the image is the configuration's fault, not the image's: name the key.
+  for (const auto& [key, edge, size] :
+       {std::tuple<const char*, int, int>{"crop_left_px", options_.crop_left_px, image.width},
+        {"crop_top_px", options_.crop_top_px, image.height},
+        {"crop_right_px", options_.crop_right_px, image.width},
+        {"crop_bottom_px", options_.crop_bottom_px, image.height}}) {
+    if (edge > size) {
+      return Status::Error("[camera] " + std::string(key) + " = " + std::to_string(edge) +
+                           " lies outside the " + std::to_string(image.width) + "x" +
+                           std::to_string(image.height) + " px image");
+    }
+  }
   if (image.pixels == nullptr || right > image.width || bottom > image.height) {
     return Status::Error("image of " + std::to_string(image.width) + "x" +
                          std::to_string(image.height) + " px is smaller than the crop");

@@ -162,7 +162,19 @@ TEST(ClassicCameraMatcherTest, ImageSmallerThanCropIsAnError) {
   const Image a = RandomImage(100, 40, 7);
   auto result = matcher.Observe(a.view(), 0.0);
   ASSERT_FALSE(result.ok());
-  EXPECT_NE(result.status().message().find("smaller than the crop"), std::string::npos);
+  EXPECT_NE(result.status().message().find(
+                "[camera] crop_right_px = 200 lies outside the 100x40 px image"),
+            std::string::npos)
+      << result.status().message();
+  // A left edge far outside is blamed on its key too (it once read as a negative crop width).
+  ClassicCameraOptions far;
+  far.crop_left_px = 2000000000;
+  ClassicCameraMatcher far_matcher(far);
+  auto far_result = far_matcher.Observe(a.view(), 0.0);
+  ASSERT_FALSE(far_result.ok());
+  EXPECT_NE(far_result.status().message().find("[camera] crop_left_px = 2000000000 lies outside"),
+            std::string::npos)
+      << far_result.status().message();
 }
 
 TEST(ClassicCameraMatcherTest, PatchNormalisationRemovesBrightnessChange) {

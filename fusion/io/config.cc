@@ -12,8 +12,10 @@
 #include <set>
 #include <sstream>
 
+#include "common/file_util.h"
 #include "common/text_file.h"
 #include "common/toml_binder.h"
+#include "sensors/dataset/dataset_loader.h"
 
 namespace ratslam {
 namespace {
@@ -173,10 +175,35 @@ std::optional<std::string> OpenRatslamEvidence(const std::string& text) {
 }  // namespace
 
 StatusOr<PipelineOptions> LoadConfigFile(const std::string& path) {
+  // A data set given where the configuration belongs (`--config LOG.txt --data x.toml`) is
+  // named as such, instead of "larger than 1048576 bytes" or a TOML syntax error.
+  auto data_instead = [&](const Status& error) {
+    if (IsRegularFile(path) && DetectDatasetFormat(path).ok()) {
+      return Status::Error(path +
+                           " is a data set, not a configuration: give it as --data, and "
+                           "the configuration (.toml) as --config");
+    }
+    return error;
+  };
   StatusOr<std::string> text = ReadRegularFile(path, "config file", kMaxConfigBytes);
-  if (!text.ok()) return text.status();
+  if (!text.ok()) return data_instead(text.status());
   StatusOr<PipelineOptions> parsed = ParseConfig(*text, path);
-  if (!parsed.ok()) {
+  if (parsed.ok()) {
+    // Paths inside a configuration are relative to its file (as a sweep file's are), not to the
+    // folder the program runs in: the resolved configuration holds them absolute.
+    const std::filesystem::path folder =
+        std::filesystem::absolute(std::filesystem::path(path)).parent_path();
+    for (std::string* p :
+         {&parsed->sensors.fabmap.visual_model.file,
+          &parsed->sensors.fabmap.visual_model.training_images, &parsed->video.odometry_log}) {
+      if (!p->empty() && std::filesystem::path(*p).is_relative()) {
+        *p = (folder / *p).lexically_normal().string();
+      }
+    }
+  } else {
+    if (Status data = data_instead(parsed.status()); data.message() != parsed.status().message()) {
+      return data;
+    }
     if (const auto evidence = OpenRatslamEvidence(*text)) {
       return Status::Error(path + " is an OpenRatSLAM configuration (" + *evidence +
                            "), not ours: convert it with `ratslam import-openratslam " + path +
@@ -390,6 +417,14 @@ StatusOr<PipelineOptions> ParseMapConfig(const std::string& text, uint32_t map_v
   return ParseConfigOnto(text, "the map's configuration", *base);
 }
 
+namespace {
+// Keys OpenRatSLAM reads (or its shipped files carry) that have no equivalent here: the viewer's
+// windows (../shared/reference/openratslam-facts.md, section 2, [draw]).
+constexpr const char* kOpenRatslamKeysWithoutEquivalent[] = {
+    "enable",     "vt_window_width", "vt_window_height", "media_path",
+    "image_file", "exp_map_size",    "posecells_size"};
+}  // namespace
+
 StatusOr<ImportedConfig> ImportOpenRatslamIni(const std::string& path) {
   StatusOr<std::string> text = ReadRegularFile(path, "INI file", kMaxConfigBytes);
   if (!text.ok()) return text.status();
@@ -567,6 +602,18 @@ StatusOr<ImportedConfig> ImportOpenRatslamIni(const std::string& path) {
     }
     auto it = setters.find(key);
     if (it == setters.end()) {
+      // OpenRatSLAM ignores a misspelt key and keeps its default: a key near one it reads is a
+      // typo, and an error here (its value would otherwise be lost without a word).
+      std::set<std::string> known = {std::begin(kOpenRatslamKeysWithoutEquivalent),
+                                     std::end(kOpenRatslamKeysWithoutEquivalent)};
+      for (const auto& [name, setter] : setters) known.insert(name);
+      if (!known.count(key)) {
+        const std::string suggestion = schema::DidYouMean(key, known);
+        if (!suggestion.empty()) {
+          return Status::Error(where + ": [" + section + "] unknown key '" + key + "'" +
+                               suggestion);
+        }
+      }
       imported.notes.push_back(where + ": [" + section + "] " + key + " = " + value +
                                " (not used: no equivalent)");
       continue;

@@ -44,6 +44,45 @@ TEST(ConfigTest, ReadsValuesAndAcceptsIntegersForReals) {
   EXPECT_TRUE(o->sensors.classic_camera.panoramic);
 }
 
+// A phone log given as the configuration is named as a data set, small or large (a log over the
+// size limit once read "config file is larger than 1048576 bytes").
+TEST(ConfigTest, ADataSetGivenAsTheConfigurationIsNamedAsOne) {
+  for (const size_t lines : {size_t{3}, size_t{30000}}) {
+    const std::filesystem::path log =
+        TestScratch().path() / ("walk" + std::to_string(lines) + ".txt");
+    {
+      std::ofstream out(log);
+      out << "% IPIN log\n";
+      for (size_t i = 0; i < lines; ++i) out << "ACCE;" << i * 0.02 << ";1;0.1;0.2;9.8;3\n";
+    }
+    StatusOr<PipelineOptions> options = LoadConfigFile(log.string());
+    ASSERT_FALSE(options.ok());
+    EXPECT_NE(options.status().message().find(log.string() +
+                                              " is a data set, not a configuration: give it as "
+                                              "--data"),
+              std::string::npos)
+        << options.status().message();
+  }
+}
+
+// Paths inside a configuration file are read relative to the file, wherever the program runs;
+// absolute ones stay as they are.
+TEST(ConfigTest, PathsInAConfigurationAreRelativeToItsFile) {
+  const std::filesystem::path folder = TestScratch().path() / "configs_here";
+  std::filesystem::create_directories(folder);
+  const std::filesystem::path config = folder / "paths.toml";
+  std::ofstream(config) << "[visual_model]\ntraining_images = \"../images\"\n"
+                           "file = \"/abs/model.bin\"\n[video]\nodometry_log = \"odo.txt\"\n";
+  StatusOr<PipelineOptions> o = LoadConfigFile(config.string());
+  ASSERT_TRUE(o.ok()) << o.status().message();
+  EXPECT_EQ(
+      o->sensors.fabmap.visual_model.training_images,
+      (std::filesystem::absolute(TestScratch().path()) / "images").lexically_normal().string());
+  EXPECT_EQ(o->sensors.fabmap.visual_model.file, "/abs/model.bin");
+  EXPECT_EQ(o->video.odometry_log,
+            (std::filesystem::absolute(folder) / "odo.txt").lexically_normal().string());
+}
+
 TEST(ConfigTest, UnknownKeyNamesLine) {
   EXPECT_EQ(ErrorOf("[pose_cells]\ndim_xy_cells = 30\ndim_xy_cell = 3\n"),
             "c.toml:3: unknown key 'dim_xy_cell' in [pose_cells] (did you mean 'dim_xy_cells'?)");
@@ -231,6 +270,27 @@ TEST(ConfigTest, ImportsOpenRatslamIniAndReportsUnusedKeys) {
   EXPECT_NE(spaced.status().message().find(":2: [general] topic_root = my robot"),
             std::string::npos)
       << spaced.status().message();
+  // Misspelt keys are errors with the key meant (their value was once lost without a word); keys
+  // of OpenRatSLAM's viewer and keys near none stay notes.
+  std::ofstream(path) << "[ratslam]\nvt_match_treshold=0.085\n";
+  StatusOr<ImportedConfig> typo = ImportOpenRatslamIni(path.string());
+  ASSERT_FALSE(typo.ok());
+  EXPECT_NE(
+      typo.status().message().find(":2: [ratslam] unknown key 'vt_match_treshold' (did you mean "
+                                   "'vt_match_threshold'?)"),
+      std::string::npos)
+      << typo.status().message();
+  std::ofstream(path) << "[ratslam]\nvt_restore=0.04\n";
+  StatusOr<ImportedConfig> short_name = ImportOpenRatslamIni(path.string());
+  ASSERT_FALSE(short_name.ok());
+  EXPECT_NE(short_name.status().message().find("(did you mean 'pc_vt_restore'?)"),
+            std::string::npos)
+      << short_name.status().message();
+  std::ofstream(path) << "[ratslam]\ntemplate_x_size=60\n[draw]\nexp_map_size=500\n"
+                         "posecells_size=250\n[other]\nfoo_bar_baz=1\n";
+  StatusOr<ImportedConfig> viewer = ImportOpenRatslamIni(path.string());
+  ASSERT_TRUE(viewer.ok()) << viewer.status().message();
+  EXPECT_EQ(viewer->notes.size(), 3u);
   std::ofstream(path) << "[ratslam]\npc_dim_xy=thirty\n";
   StatusOr<ImportedConfig> bad = ImportOpenRatslamIni(path.string());
   ASSERT_FALSE(bad.ok());

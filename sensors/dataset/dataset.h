@@ -62,6 +62,8 @@ struct Dataset {
   std::vector<CompassRow> compass;
   std::vector<PressureSample> pressure;       // barometer, hPa (floors: sensors/barometer.h)
   std::vector<double> session_start_times_s;  // more than one for a multi-session run
+  // Lines of phone logs that were malformed and skipped (only with lenient reading).
+  size_t skipped_malformed_lines = 0;
 
   // The image's path: `file` itself when absolute, else inside the image folder.
   std::string ImagePath(const ImageRow& row) const;

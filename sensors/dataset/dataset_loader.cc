@@ -22,12 +22,16 @@ StatusOr<DatasetFormat> DetectDatasetFormat(const std::string& path) {
     if (PathExists(fs::path(path) / "manifest.toml")) return DatasetFormat::kReplayFolder;
     return Status::Error(path + ": a folder without manifest.toml is not a replay data set");
   }
-  std::ifstream in(path);
-  if (!in) return Status::Error(path + ": no such file or folder");
+  if (!PathExists(path)) return Status::Error(path + ": no such file or folder");
+  // Only regular files: a FIFO would block the open for ever, a device never end.
+  std::ifstream in;
+  RATSLAM_RETURN_IF_ERROR(OpenRegularFile(path, "data set", &in));
   if (LooksLikeRosbag(path)) return DatasetFormat::kRosBag;
   if (LooksLikeVideo(path)) return DatasetFormat::kVideo;
+  // The format is told by a bounded prefix: 200 lines of at most 64 KiB (a file without line
+  // breaks, however large, costs 64 KiB here).
   std::string line;
-  for (int i = 0; i < 200 && std::getline(in, line); ++i) {
+  for (int i = 0; i < 200 && ReadLine(in, &line, size_t{1} << 16) == LineResult::kLine; ++i) {
     if (line.empty() || line[0] == '%') continue;
     if (line[0] == '#') {
       if (line.find("SiteID:") != std::string::npos ||
@@ -72,7 +76,9 @@ StatusOr<Dataset> LoadDataset(const std::string& path, const PhoneLogOptions& ph
   StatusOr<DatasetFormat> format = DetectDatasetFormat(path);
   if (!format.ok()) return format.status();
   PhoneLogReport report;
-  return Read(path, *format, phone_options, bag, video, &report);
+  StatusOr<Dataset> d = Read(path, *format, phone_options, bag, video, &report);
+  if (d.ok()) d->skipped_malformed_lines = report.skipped_malformed;
+  return d;
 }
 
 StatusOr<Dataset> LoadSessions(const std::vector<std::string>& paths,
@@ -96,6 +102,7 @@ StatusOr<Dataset> LoadSessions(const std::vector<std::string>& paths,
     if (!format.ok()) return format.status();
     StatusOr<Dataset> d = Read(path, *format, options, bag, video, &report);
     if (!d.ok()) return d.status();
+    joined.skipped_malformed_lines += report.skipped_malformed;
     if (format.value() == DatasetFormat::kIpinLog && !options.reference) {
       options.reference = report.reference;  // later logs share the first log's frame
     }

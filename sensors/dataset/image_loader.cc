@@ -21,6 +21,8 @@ StatusOr<GrayImage> FileImageLoader::Load(const std::string& path) {
     if (ParseVideoFrameReference(path, &bag, &message)) return videos_->Load(path);
     return Status::Error(path + ": image file missing");
   }
+  // OpenCV would open a FIFO and wait for a writer for ever.
+  if (!IsRegularFile(path)) return Status::Error(path + ": image is not a regular file");
   cv::Mat mat;
   try {
     mat = cv::imread(path, cv::IMREAD_GRAYSCALE);

@@ -71,6 +71,35 @@ void GeoToLocal(const GeoReference& reference, double latitude_deg, double longi
   *y_m = kEarthRadiusM * (latitude_deg - reference.latitude_deg) * to_rad;
 }
 
+namespace {
+
+// A sensor type as the logs write it: 2 to 8 capital letters or digits, starting with a letter
+// (WIFI, ACCE, BLE4, ...).
+bool IsSensorType(const std::string& type) {
+  if (type.size() < 2 || type.size() > 8 || !(type[0] >= 'A' && type[0] <= 'Z')) return false;
+  for (char c : type) {
+    if (!((c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9'))) return false;
+  }
+  return true;
+}
+
+// `text` quoted, with every byte that is not printable ASCII written as \xNN.
+std::string Printable(const std::string& text) {
+  std::string out = "'";
+  for (unsigned char c : text) {
+    if (c >= 0x20 && c < 0x7f) {
+      out += static_cast<char>(c);
+    } else {
+      char hex[5];
+      std::snprintf(hex, sizeof hex, "\\x%02x", c);
+      out += hex;
+    }
+  }
+  return out + "'";
+}
+
+}  // namespace
+
 StatusOr<PhoneLog> ParseIpinLog(const std::string& path, const PhoneLogOptions& options,
                                 PhoneLogReport* report) {
   std::ifstream in;
@@ -104,6 +133,17 @@ StatusOr<PhoneLog> ParseIpinLog(const std::string& path, const PhoneLogOptions& 
     auto fail = [&](const std::string& what) -> Status {
       return Status::Error(path + ":" + std::to_string(number) + ": " + type + ": " + what);
     };
+    // Unknown sensor types are skipped, but a line must have the shape of a sensor line
+    // (TYPE;..., TYPE four capitals or digits as in every log of the competition): random bytes,
+    // a run of NULs or a line cut before its first ';' are errors, not "other sensors".
+    if (!IsSensorType(type) || f.size() < 2) {
+      const Status status = Status::Error(path + ":" + std::to_string(number) +
+                                          ": not a sensor line of the form TYPE;... (it starts " +
+                                          Printable(line.substr(0, 24)) + ")");
+      if (!options.lenient) return status;
+      ++r.skipped_malformed;
+      continue;
+    }
     std::vector<double> v(f.size(), 0.0);
     // Every number is range-checked: a latitude of 4000 degrees or a floor of 1e300 is a
     // corrupt line, not a position 440,000 km away or floor 0.

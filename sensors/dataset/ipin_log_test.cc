@@ -5,6 +5,9 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "common/scratch_dir.h"
 #include "sensors/dataset/dataset_loader.h"
@@ -80,6 +83,50 @@ TEST(IpinLogTest, BrokenLinesNameFileAndLineOrAreCountedWhenLenient) {
   EXPECT_EQ(d->wifi.size(), 2u);
   fs::remove(path);
   EXPECT_FALSE(ReadIpinLog("/nonexistent.txt", {}).ok());
+}
+
+// Lines that are not of the TYPE;... shape (random bytes, NULs, a line cut before its first ';')
+// once counted as "other sensor types" and the log loaded: now they are errors naming the line,
+// or counted as malformed with lenient reading.
+TEST(IpinLogTest, LinesThatAreNotSensorLinesAreErrors) {
+  std::string garbage;
+  uint32_t state = 12345;
+  for (int i = 0; i < 4000; ++i) {
+    state = state * 1103515245u + 12345u;
+    const char c = static_cast<char>((state >> 16) & 0xFF);
+    garbage += c == '\n' ? 'x' : c;
+  }
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {garbage + "\n", "not a sensor line of the form TYPE;..."},
+      {std::string(10000, '\0') + "\n", "(it starts '\\x00\\x00"},
+      {"GYR\n", "(it starts 'GYR')"},
+      {"wifi;0.5;1;net;aa:bb;-60\n", "(it starts 'wifi;"},
+  };
+  for (const auto& [inserted, expected] : cases) {
+    std::string text = kFixture;
+    text.insert(text.find("POSI"), inserted);  // line 9
+    const fs::path path = WriteFixture("ratslam_ipin_garbage.txt", text);
+    StatusOr<Dataset> strict = ReadIpinLog(path.string(), {});
+    ASSERT_FALSE(strict.ok()) << expected;
+    EXPECT_NE(strict.status().message().find("ratslam_ipin_garbage.txt:9: not a sensor line"),
+              std::string::npos)
+        << strict.status().message();
+    EXPECT_NE(strict.status().message().find(expected), std::string::npos)
+        << strict.status().message();
+    PhoneLogOptions lenient;
+    lenient.lenient = true;
+    PhoneLogReport report;
+    StatusOr<Dataset> d = ReadIpinLog(path.string(), lenient, &report);
+    ASSERT_TRUE(d.ok()) << d.status().message();
+    EXPECT_GE(report.skipped_malformed, 1u);
+    EXPECT_EQ(d->wifi.size(), 2u);
+    EXPECT_EQ(d->ground_truth.size(), 2u);
+  }
+  // A log cut in the middle of its last line is an error too (its fields are missing).
+  std::string cut = kFixture;
+  cut.resize(cut.size() - 20);
+  const fs::path path = WriteFixture("ratslam_ipin_cut.txt", cut);
+  EXPECT_FALSE(ReadIpinLog(path.string(), {}).ok());
 }
 
 // Nonsense that once loaded silently: a latitude of 4000 degrees (y = 4.4e8 m), a floor of 1e300

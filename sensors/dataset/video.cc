@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "common/file_util.h"
+#include "common/text_file.h"
 #include "sensors/dataset/opencv_gray.h"
 #include "sensors/dataset/rosbag.h"
 
@@ -42,8 +43,8 @@ struct LogRow {
 // OpenRatSLAM's odometry log: a header line, then sec, nsec, trans_vel, rot_vel[, ...] per row,
 // separated by commas or white space.
 StatusOr<std::vector<LogRow>> ReadOdometryLog(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) return Status::Error(path + ": cannot open the odometry log");
+  std::ifstream in;
+  RATSLAM_RETURN_IF_ERROR(OpenRegularFile(path, "odometry log", &in));
   std::string line;
   std::vector<LogRow> rows;
   double first_sec = 0.0, first_nsec = 0.0;
