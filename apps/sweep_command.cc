@@ -110,8 +110,10 @@ int SweepCommand(const std::string& action, const Arguments& parsed) {
     std::signal(SIGINT, SIG_DFL);
     std::signal(SIGTERM, SIG_DFL);
     if (!report.ok()) return Fail(report.status());
-    std::cout << report->done << " run, " << report->skipped << " already done, " << report->failed
-              << " failed, " << report->pending << " pending\n";
+    if (!args->quiet) {
+      std::cout << report->done << " run, " << report->skipped << " already done, "
+                << report->failed << " failed, " << report->pending << " pending\n";
+    }
     if (report->pending > 0) return kExitInterrupted;
     return report->failed > 0 ? kExitError : kExitOk;
   }
@@ -203,6 +205,21 @@ int SweepCommand(const std::string& action, const Arguments& parsed) {
               << "), written to " << target << "/best.toml";
   }
   std::cout << "\n";
+  // A sweep that ranked nothing has failed, whatever ran: say why.
+  if (!report->best_point) {
+    std::cerr << MessagePrefix() << "no point could be ranked: ";
+    if (report->ok_without_objective > 0) {
+      std::cerr << report->ok_without_objective
+                << " run(s) succeeded but their summaries have no value for the objective"
+                   " (a misspelt metric?); see results.csv\n";
+    } else if (report->pending > 0) {
+      std::cerr << "no point has all its runs done yet (" << report->pending
+                << " pending); run the sweep first\n";
+    } else {
+      std::cerr << "every point has a failed run; see results.csv and the runs' stderr.txt\n";
+    }
+    return kExitError;
+  }
   return kExitOk;
 }
 

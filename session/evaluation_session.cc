@@ -62,6 +62,34 @@ void AddRates(const fabmap::EvaluationMetrics& m, const std::vector<double>& nea
 
 }  // namespace
 
+const std::vector<std::string>& EvaluationKeys() {
+  static const std::vector<std::string> keys = {"mode",
+                                                "map",
+                                                "query",
+                                                "config",
+                                                "map_nodes",
+                                                "queries",
+                                                "correct_within_m",
+                                                "misplaced_beyond_m",
+                                                "rejection_rate",
+                                                "floor_mistake_rate",
+                                                "by_map_distance",
+                                                "nearest_place_within_m",
+                                                "average_precision_within_m",
+                                                "new_place_calibration",
+                                                "baselines",
+                                                "floor_classification",
+                                                "wifi_words",
+                                                "wifi_map_scans",
+                                                "wifi_tree_scans",
+                                                "query_rssi_offsets_db",
+                                                "visual_words",
+                                                "query_time_ms",
+                                                "wall_time_s",
+                                                "run"};
+  return keys;
+}
+
 EvaluationSession::EvaluationSession(EvaluationSessionOptions options, OutputFolder* out,
                                      const Clock* clock, ProgressSink* progress,
                                      ImageLoader* images)

@@ -71,6 +71,10 @@ struct EvaluationResult {
   std::string json;            // evaluation.json
 };
 
+// Every top-level key evaluation.json can have (some only in some modes): sweeps check their
+// objective and metrics against it when planned. A test keeps it complete.
+const std::vector<std::string>& EvaluationKeys();
+
 class EvaluationSession {
  public:
   // `out` is required; `clock`, `progress` and `images` may be null (system clock, silence,

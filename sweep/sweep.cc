@@ -22,10 +22,13 @@
 #include <thread>
 
 #include "common/file_util.h"
+#include "common/output_guard.h"
 #include "common/random.h"
 #include "common/text_file.h"
 #include "common/toml_binder.h"
 #include "fusion/io/config.h"
+#include "fusion/io/run_outputs.h"
+#include "session/evaluation_session.h"
 
 extern char** environ;
 
@@ -468,6 +471,23 @@ StatusOr<SweepSpec> LoadSweepFile(const std::string& path) {
     }
   }
   spec.metrics.insert(spec.metrics.begin(), metrics.begin(), metrics.end());
+  // A misspelt metric once ran every task and ranked nothing: the names are checked now, by
+  // their first part against the keys the command's summary can have.
+  {
+    const std::vector<std::string>& keys =
+        settings.command == "evaluate" ? EvaluationKeys() : SummaryKeys();
+    const std::set<std::string> known(keys.begin(), keys.end());
+    const std::string file = settings.command == "evaluate" ? "evaluation.json" : "summary.json";
+    for (const std::string& m : spec.metrics) {
+      const std::string top = m.substr(0, m.find('.'));
+      if (known.count(top)) continue;
+      const std::vector<std::string> in_expression = objective->Metrics();
+      const bool in_objective =
+          std::find(in_expression.begin(), in_expression.end(), m) != in_expression.end();
+      return fail_at(in_objective ? "objective" : "metrics",
+                     "'" + m + "' is not a key of " + file + schema::DidYouMean(top, known));
+    }
+  }
   spec.objective = settings.objective;
   spec.aggregate = settings.aggregate;
   spec.goal = settings.goal;
@@ -822,11 +842,23 @@ StatusOr<Running> Start(const Plan& plan, const std::string& dir, int index,
   posix_spawnattr_init(&attributes);
   posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETPGROUP);
   posix_spawnattr_setpgroup(&attributes, 0);  // its own group: a terminal's Ctrl-C is ours
+  // The run ends with this runner, even one killed with SIGKILL (ratslam asks the kernel for a
+  // signal when its parent dies; see kEndWithParentVariable).
+  std::vector<std::string> environment;
+  const std::string marker = std::string(kEndWithParentVariable) + "=";
+  for (char** e = environ; *e != nullptr; ++e) {
+    if (std::string_view(*e).substr(0, marker.size()) != marker) environment.emplace_back(*e);
+  }
+  environment.push_back(marker + std::to_string(::getpid()));
+  std::vector<char*> envp;
+  for (std::string& e : environment) envp.push_back(e.data());
+  envp.push_back(nullptr);
   Running r;
   r.index = index;
   r.program = program;
   r.start = std::chrono::steady_clock::now();
-  const int rc = posix_spawn(&r.pid, program.c_str(), &actions, &attributes, argv.data(), environ);
+  const int rc =
+      posix_spawn(&r.pid, program.c_str(), &actions, &attributes, argv.data(), envp.data());
   posix_spawn_file_actions_destroy(&actions);
   posix_spawnattr_destroy(&attributes);
   if (rc != 0) return Status::Error(program + ": cannot start: " + std::strerror(rc));
@@ -1056,6 +1088,9 @@ Status RunHalving(const Plan& plan, const std::string& dir, const RunOptions& op
 StatusOr<RunReport> RunSweep(const std::string& dir, const RunOptions& options) {
   StatusOr<Plan> plan = ReadPlan(dir);
   if (!plan.ok()) return plan.status();
+  // Two runners on one folder would start every task twice and end each other's runs.
+  StatusOr<FolderLock> lock = FolderLock::Acquire(dir, "ratslam sweep run");
+  if (!lock.ok()) return lock.status();
   RunReport report;
   Status status;
   if (plan->spec.search == "halving") {
@@ -1291,7 +1326,8 @@ StatusOr<CollectReport> Collect(const std::string& dir) {
   CollectReport report;
   // After a finished successive halving, a task that never ran belongs to an eliminated point.
   const bool halving_done = PathExists(fs::path(dir) / "search.json");
-  std::string csv = "index,point,dataset,status,exit_code,wall_s";
+  // Data sets by number and by their paths (a number alone sent readers to plan.json).
+  std::string csv = "index,point,dataset,data,status,exit_code,wall_s";
   for (const Parameter& p : spec.parameters) {
     csv += ',';
     csv += CsvField(p.key);
@@ -1322,9 +1358,11 @@ StatusOr<CollectReport> Collect(const std::string& dir) {
     } else {
       ++report.failed;
     }
+    std::string data;
+    for (const std::string& d : spec.datasets[t.dataset]) data += (data.empty() ? "" : ";") + d;
     csv += std::to_string(t.index) + "," + std::to_string(t.point) + "," +
-           std::to_string(t.dataset) + "," + o->status + "," + std::to_string(o->exit_code) + "," +
-           schema::TomlNumber(o->wall_s);
+           std::to_string(t.dataset) + "," + CsvField(data) + "," + o->status + "," +
+           std::to_string(o->exit_code) + "," + schema::TomlNumber(o->wall_s);
     json parameters = json::object();
     for (const auto& [key, value] : t.overrides) {
       csv += ',';
@@ -1342,6 +1380,7 @@ StatusOr<CollectReport> Collect(const std::string& dir) {
     csv += CsvField(o->error) + "\n";
     objectives[t.point].push_back(o->status == "ok" ? ObjectiveOf(summary, spec.objective)
                                                     : std::nullopt);
+    if (o->status == "ok" && !objectives[t.point].back()) ++report.ok_without_objective;
     if (o->status == "ok" || o->status == "failed" || o->status == "timeout") {
       wall[t.point].first += o->wall_s;
       ++wall[t.point].second;

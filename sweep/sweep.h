@@ -151,10 +151,16 @@ struct PointSummary {
   int runs_ok = 0;
 };
 
+// Set by `sweep run` in the environment of each run it starts, to its own pid: the run (the
+// `ratslam` program) then asks to be sent SIGTERM when that parent dies, and stops at once if it
+// is already gone, so that no run outlives a killed runner.
+inline constexpr const char* kEndWithParentVariable = "RATSLAM_END_WITH_PARENT";
+
 struct CollectReport {
   std::vector<PointSummary> points;
   int ok = 0, failed = 0, pending = 0;
-  int eliminated = 0;  // never run: their point was dropped by successive halving
+  int eliminated = 0;            // never run: their point was dropped by successive halving
+  int ok_without_objective = 0;  // runs that succeeded but whose summary lacks the objective
   std::optional<int> best_point;
   double best_objective = 0.0;
 };

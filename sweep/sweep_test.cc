@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -14,8 +15,10 @@
 #include <set>
 #include <sstream>
 
+#include "common/output_guard.h"
 #include "common/scratch_dir.h"
 #include "fusion/io/config.h"
+#include "fusion/io/run_outputs.h"
 #include "sensors/dataset/dataset.h"
 
 extern char** environ;
@@ -333,10 +336,16 @@ data = ["data/b"]
   std::string header, line;
   std::getline(csv, header);
   EXPECT_EQ(header,
-            "index,point,dataset,status,exit_code,wall_s,wifi.match_threshold,map_ate_m,templates,"
-            "match_rate_within_m.5,error");
+            "index,point,dataset,data,status,exit_code,wall_s,wifi.match_threshold,map_ate_m,"
+            "templates,match_rate_within_m.5,error");
   int rows = 0;
-  while (std::getline(csv, line)) ++rows;
+  while (std::getline(csv, line)) {
+    ++rows;
+    // Each row names its data set by its path too (the fourth field: the paths are absolute).
+    size_t at = 0;
+    for (int field = 0; field < 3; ++field) at = line.find(',', at) + 1;
+    EXPECT_EQ(line.substr(at, 1), "/") << line;
+  }
   EXPECT_EQ(rows, 7);
 }
 
@@ -639,6 +648,9 @@ data = ["data/a"]
   RunOptions options;
   options.program = FakeProgram(log);
   options.jobs = 2;
+  // A run the killed runner was starting may still hold its copy of the folder's lock until its
+  // exec closes it (seen once under load): the lock is free within moments.
+  for (int i = 0; i < 500 && !FolderLock::Acquire(dir, "test").ok(); ++i) usleep(10000);
   StatusOr<RunReport> resumed = RunSweep(dir, options);
   ASSERT_TRUE(resumed.ok()) << resumed.status().message();
   EXPECT_EQ(resumed->skipped, static_cast<int>(before.size()));
@@ -683,7 +695,44 @@ data = ["data/a"]
         1;
     ASSERT_TRUE(p.objective.has_value());
     EXPECT_DOUBLE_EQ(*p.objective, expected);
+    // Every key a real summary has is one a sweep file may name (SummaryKeys is complete).
+    const std::vector<std::string>& keys = SummaryKeys();
+    for (const auto& [key, value] : summary.items()) {
+      EXPECT_NE(std::find(keys.begin(), keys.end(), key), keys.end()) << key;
+    }
   }
+  // While a runner works in the folder, a second one is refused at once.
+  {
+    StatusOr<FolderLock> held = FolderLock::Acquire(dir, "the first runner");
+    ASSERT_TRUE(held.ok()) << held.status().message();
+    StatusOr<RunReport> second = RunSweep(dir, options);
+    ASSERT_FALSE(second.ok());
+    EXPECT_NE(second.status().message().find("in use by another ratslam run"), std::string::npos)
+        << second.status().message();
+    EXPECT_NE(second.status().message().find("the first runner"), std::string::npos);
+  }
+  // A misspelt metric is refused when the sweep is planned, not after every task has run.
+  const std::string misspelt = Write("misspelt.toml", R"([sweep]
+objective = "map_ate"
+[[datasets]]
+data = ["data/a"]
+)");
+  EXPECT_EQ(LoadSweepFile(misspelt).status().message(),
+            misspelt +
+                ":2: sweep.objective: 'map_ate' is not a key of summary.json (did you "
+                "mean 'map_ate_m'?)");
+  const std::string misspelt_metric = Write("misspelt-metric.toml", R"([sweep]
+objective = "map_ate_m"
+metrics = ["templates", "match_rate.5"]
+[[datasets]]
+data = ["data/a"]
+)");
+  EXPECT_NE(LoadSweepFile(misspelt_metric)
+                .status()
+                .message()
+                .find("sweep.metrics: 'match_rate.5' is not a key of summary.json"),
+            std::string::npos)
+      << LoadSweepFile(misspelt_metric).status().message();
   const std::string bad = Write("bad-expression.toml", "[sweep]\nobjective = \"map_ate_m +\"\n");
   EXPECT_EQ(LoadSweepFile(bad).status().message(),
             bad + ":2: sweep.objective: cannot read the objective 'map_ate_m +' near character 12");

@@ -273,7 +273,11 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
 
   nlohmann::ordered_json j;
   j["dataset"] = dataset.name;
-  if (!dataset.folder.empty()) j["data_folder"] = dataset.folder;
+  if (!dataset.folder.empty()) j["data_folder"] = info.provenance.Recorded(dataset.folder);
+  // Malformed phone-log lines that --lenient skipped (absent: none).
+  if (dataset.skipped_malformed_lines > 0) {
+    j["skipped_malformed_lines"] = dataset.skipped_malformed_lines;
+  }
   j["frames"] = s.frames;
   j["templates"] = s.templates;
   j["experiences"] = s.experiences;
@@ -395,6 +399,59 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
   }
   s.json = j.dump(2) + "\n";
   return s;
+}
+
+const std::vector<std::string>& SummaryKeys() {
+  static const std::vector<std::string> keys = {"ate_points",
+                                                "barometer",
+                                                "compass_readings",
+                                                "config",
+                                                "config_fingerprint",
+                                                "cross_session_match_rate_within_m",
+                                                "cross_session_matches",
+                                                "current_experience",
+                                                "data_folder",
+                                                "data_time_s",
+                                                "dataset",
+                                                "events_done",
+                                                "events_total",
+                                                "experiences",
+                                                "fabmap_wifi_learned_from_scans",
+                                                "fabmap_wifi_learning",
+                                                "fabmap_wifi_models_built",
+                                                "fabmap_wifi_tree_scans",
+                                                "finished",
+                                                "floor_mistakes",
+                                                "floor_unverified_matches",
+                                                "frames",
+                                                "frames_by_source",
+                                                "frames_per_second",
+                                                "images_unused",
+                                                "interrupted",
+                                                "links",
+                                                "localisation",
+                                                "loop_closures",
+                                                "map_ate_m",
+                                                "match_rate_within_m",
+                                                "matches",
+                                                "odometry_ate_m",
+                                                "odometry_steps",
+                                                "refused_ambiguous_links",
+                                                "relaxation_capped_passes",
+                                                "resumed_from",
+                                                "run",
+                                                "sessions",
+                                                "skipped_malformed_lines",
+                                                "templates",
+                                                "trajectory_ate_m",
+                                                "view_injections",
+                                                "wall_seconds",
+                                                "wifi_revisit_aps_added",
+                                                "wifi_revisit_aps_dropped",
+                                                "wifi_rssi_offsets_db",
+                                                "wifi_scans",
+                                                "wifi_sequence"};
+  return keys;
 }
 
 StatusOr<RunSummary> WriteRunOutputs(OutputFolder& folder, const ReplayPipeline& pipeline,

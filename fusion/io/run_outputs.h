@@ -71,6 +71,10 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
 // ground_truth_tum.txt), experience_map.g2o,
 // frames.csv and summary.json into `folder`, all of them or none (a failure keeps the earlier
 // files and names the one that failed).
+// Every top-level key summary.json can have (some only under some configurations): sweeps check
+// their objective and metrics against it when planned. A test keeps it complete.
+const std::vector<std::string>& SummaryKeys();
+
 StatusOr<RunSummary> WriteRunOutputs(OutputFolder& folder, const ReplayPipeline& pipeline,
                                      const Dataset& dataset, const RunInfo& info);
 
