@@ -188,7 +188,10 @@ const std::vector<CommandSpec>& Commands() {
        "the experience map of a run",
        "",
        {Text("--run", "O", "run folder (written by replay)", true),
-        Text("--data", "D", "the run's data set, for ground truth; default: the one it names"),
+        Text("--data", "D",
+             "the run's data set for ground truth, repeated per session; default: the ones it "
+             "read",
+             false, true),
         Text("--out", "F", "image file; default: O/experience_map.png"), Size(),
         Choice("--color", "BY", "colour the experiences by time or by session",
                {"time", "session"}),

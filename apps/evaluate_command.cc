@@ -84,7 +84,10 @@ int EvaluateCommand(const Arguments& parsed) {
                             " queries, " + std::to_string(r.map.size()) + " mapped places";
   if (Status s = WriteCommandFigure(
           *args, (*out)->Path("localisation.png"),
-          [&](int w) { return LocalisationCurvesScene(curves, title, 30.0, w); }, kTwoColumnMm);
+          [&](int w) {
+            return LocalisationCurvesScene(curves, title, LocalisationAxisEndM(curves), w);
+          },
+          kTwoColumnMm);
       !s.ok()) {
     return fail(s);
   }

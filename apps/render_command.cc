@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "apps/cli.h"
+#include "common/file_util.h"
 #include "fusion/io/config.h"
 #include "fusion/io/map_file.h"
 #include "fusion/io/run_reader.h"
@@ -94,7 +95,49 @@ int RenderExperienceMap(const Arguments& args) {
   const std::string run_folder = args.values.at("--run");
   StatusOr<RunFolder> run = ReadRunFolder(run_folder);
   if (!run.ok()) return Fail(run.status().message());
-  ExperienceMapImageOptions options;
+  ExperienceMapImageData data;
+  data.experiences = run->experiences;
+  data.links = run->links;
+  data.current = run->current_experience;
+  if (!data.current && !run->frames.empty() && run->frames.back().experience_id >= 0) {
+    data.current = static_cast<uint32_t>(run->frames.back().experience_id);
+  }
+  // The run's own data sets (every session, phone logs too) read as the run read them, under its
+  // own configuration, unless --data names others: the figure is the one replay --render drew.
+  std::vector<std::string> inputs = run->inputs;
+  if (auto it = args.all.find("--data"); it != args.all.end()) {
+    inputs = it->second;
+  } else if (inputs.empty() && !run->dataset_folder.empty()) {
+    inputs = {run->dataset_folder};
+  }
+  ExperienceMapFigure figure;
+  if (inputs.empty()) {
+    figure.data = std::move(data);
+    figure.floors.assign(figure.data.experiences.size(), 0);
+  } else {
+    PipelineOptions config;
+    const fs::path config_path = fs::path(run_folder) / "config.toml";
+    if (IsRegularFile(config_path)) {
+      StatusOr<PipelineOptions> loaded = LoadConfigFile(config_path.string());
+      if (!loaded.ok()) return Fail(loaded.status().message());
+      config = *loaded;
+    }
+    PhoneLogOptions phone;
+    phone.lenient = true;  // for ground truth to draw: a line the run skipped is skipped here
+    phone.pdr = config.pdr;
+    StatusOr<Dataset> dataset = LoadSessions(inputs, phone, 1.0, config.bag, config.video);
+    if (!dataset.ok()) {
+      return Fail(dataset.status().message() +
+                  " (the data set the run read, for its ground truth; --data names another)");
+    }
+    // The ground truth the run reached: up to its trajectory's end, as replay --render drew it.
+    double until_s = run->frames.empty() ? -1.0 : run->frames.back().time_s;
+    StatusOr<std::vector<GroundTruthRow>> trajectory =
+        ReadTumTrajectory((fs::path(run_folder) / "trajectory_tum.txt").string());
+    if (trajectory.ok() && !trajectory->empty()) until_s = trajectory->back().time_s;
+    figure = ExperienceMapFigureOf(std::move(data), *dataset, until_s);
+  }
+  ExperienceMapImageOptions& options = figure.options;
   if (!ParseSize(args, &options.width_px, &options.height_px)) return kExitUsage;
   if (auto it = args.values.find("--color"); it != args.values.end()) {
     if (it->second == "time") {
@@ -109,32 +152,19 @@ int RenderExperienceMap(const Arguments& args) {
     auto times = ParseTimes(it->second);
     if (!times) return kExitUsage;
     options.session_start_times_s = *times;
-  } else if (options.coloring == MapColoring::kSession) {
+  } else if (options.coloring == MapColoring::kSession && options.session_start_times_s.empty()) {
     options.session_start_times_s = {run->experiences.empty() ? 0.0 : run->experiences[0].time_s};
-  }
-  ExperienceMapImageData data;
-  data.experiences = run->experiences;
-  data.links = run->links;
-  if (!run->frames.empty() && run->frames.back().experience_id >= 0) {
-    data.current = static_cast<uint32_t>(run->frames.back().experience_id);
-  }
-  const std::string data_folder =
-      args.values.count("--data") ? args.values.at("--data") : run->dataset_folder;
-  if (!data_folder.empty()) {
-    StatusOr<Dataset> dataset = ReadDataset(data_folder);
-    if (!dataset.ok()) return Fail(dataset.status().message());
-    data.ground_truth = GroundTruthInMapFrame(
-        data.experiences, dataset.value(), run->frames.empty() ? 0.0 : run->frames.back().time_s);
-    options.title = "experience map (" + dataset->name + ")";
   }
   const std::string out = args.values.count("--out")
                               ? args.values.at("--out")
                               : (fs::path(run_folder) / "experience_map.png").string();
-  Status status =
-      Write(args, out,
-            Sized(options,
-                  [&](const ExperienceMapImageOptions& o) { return ExperienceMapScene(data, o); }),
-            options.width_px, options.height_px);
+  Status status = Write(args, out,
+                        Sized(options,
+                              [&](const ExperienceMapImageOptions& o) {
+                                return ExperienceMapFloorsScene(figure.data, figure.floors,
+                                                                figure.truth_floors, o);
+                              }),
+                        options.width_px, options.height_px);
   return status.ok() ? kExitOk : Fail(status.message());
 }
 

@@ -119,6 +119,17 @@ TEST(IpinLocateTest, AParticleFilterLocatesAnotherPhoneInTheWifiMap) {
                  root);
   EXPECT_EQ(no_wifi.exit_code, 1);
   EXPECT_NE(no_wifi.err.find("no Wi-Fi scan"), std::string::npos) << no_wifi.err;
+  // Ten million particles would take most of an hour on this minute of walking: refused before
+  // the filter starts, naming the key.
+  std::ofstream(root / "many.toml") << "[particle_filter]\nparticles = 10000000\n";
+  const Result many = RunRatslam("locate --config " + (root / "many.toml").string() +
+                                     " --wifi-map " + map.string() + " --data " +
+                                     log("03").string() + " --out " + (root / "m").string(),
+                                 root, 120);
+  EXPECT_EQ(many.exit_code, 1);
+  EXPECT_NE(many.err.find("[particle_filter] particles = 10000000 would take about"),
+            std::string::npos)
+      << many.err;
   const Result no_truth = RunRatslam(
       "wifi-map --data " + (root / "empty").string() + " --out " + (root / "z.wifimap").string(),
       root);

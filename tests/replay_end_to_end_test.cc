@@ -197,6 +197,28 @@ TEST_F(ReplayEndToEndTest, ARunEndsWithTheSweepRunnerThatStartedIt) {
   EXPECT_FALSE(fs::exists(root_ / "orphan_late" / "summary.json"));
 }
 
+// `render experience-map` of a run folder draws what the run's --render drew, from the run's own
+// data sets (the demo: two sessions, coloured by session, its ground truth and title), pixel for
+// pixel; with --data given explicitly too.
+TEST_F(ReplayEndToEndTest, ReRenderingARunGivesTheImageTheRunDrew) {
+  const fs::path demo = root_ / "rerender";
+  ASSERT_EQ(RunRatslam("demo --quiet --out " + demo.string(), root_).exit_code, 0);
+  const std::string drawn = Slurp(demo / "experience_map.png");
+  ASSERT_FALSE(drawn.empty());
+  const fs::path again = root_ / "rerender.png";
+  const Result r = RunRatslam(
+      "render experience-map --run " + demo.string() + " --out " + again.string(), root_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(Slurp(again) == drawn) << "the re-rendered experience map differs";
+  const fs::path explicit_data = root_ / "rerender-data.png";
+  ASSERT_EQ(RunRatslam("render experience-map --run " + demo.string() + " --data " +
+                           (demo / "data").string() + " --out " + explicit_data.string(),
+                       root_)
+                .exit_code,
+            0);
+  EXPECT_TRUE(Slurp(explicit_data) == drawn);
+}
+
 // --save-map never replaces a file without --overwrite.
 TEST_F(ReplayEndToEndTest, SaveMapRefusesToReplaceAFileWithoutOverwrite) {
   const fs::path map = root_ / "existing.map";

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include "common/scratch_dir.h"
@@ -209,6 +210,19 @@ TEST(FigureOutputTest, NoTextRunsOffAFigureLaidOutForAPage) {
       }
     }
   }
+}
+
+// The distance axis ends just past the data, at 30 m at most (it always ran to 30 m, squeezing
+// errors of a few metres into a sixth of the panel).
+TEST(LocalisationFigureTest, TheDistanceAxisEndsJustPastTheData) {
+  const double inf = std::numeric_limits<double>::infinity();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(LocalisationAxisEndM({{"a", {1.0, 10.4, inf, nan}}, {"b", {7.0}}}), 15.0);
+  EXPECT_EQ(LocalisationAxisEndM({{"a", {0.2}}}), 5.0);
+  EXPECT_EQ(LocalisationAxisEndM({{"a", {10.0}}}), 10.0);
+  EXPECT_EQ(LocalisationAxisEndM({{"a", {95.0}}}), 30.0);
+  EXPECT_EQ(LocalisationAxisEndM({{"a", {inf, nan}}}), 30.0);
+  EXPECT_EQ(LocalisationAxisEndM({}, 20.0), 20.0);
 }
 
 }  // namespace

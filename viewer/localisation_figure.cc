@@ -8,6 +8,21 @@
 
 namespace ratslam {
 
+double LocalisationAxisEndM(const std::vector<LocalisationCurve>& curves, double at_most_m) {
+  double largest = 0.0;
+  bool any = false;
+  for (const LocalisationCurve& c : curves) {
+    for (double e : c.errors_m) {
+      if (std::isfinite(e)) {
+        largest = std::max(largest, e);
+        any = true;
+      }
+    }
+  }
+  if (!any) return at_most_m;
+  return std::min(at_most_m, std::max(5.0, 5.0 * std::ceil(largest / 5.0)));
+}
+
 Scene LocalisationCurvesScene(const std::vector<LocalisationCurve>& curves,
                               const std::string& title, double max_distance_m, int width_px) {
   const float left0 = 90, top = 80, gap = 130;

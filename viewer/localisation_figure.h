@@ -15,6 +15,11 @@ struct LocalisationCurve {
   std::vector<double> errors_m;  // per query: infinity for another floor, NaN for a rejection
 };
 
+// Where the curves' distance axis should end: the largest finite error of any curve, rounded up
+// to a multiple of 5 m (at least 5), and at most `at_most_m` (an axis running far past the data
+// squeezed the curves into its first third).
+double LocalisationAxisEndM(const std::vector<LocalisationCurve>& curves, double at_most_m = 30.0);
+
 // Two panels, 0..max_distance_m: correct within d (left) and misplaced beyond d (right), in %.
 // `width_px` > 0 lays the figure out that wide (for vector output); 0: the natural 1380 px.
 Scene LocalisationCurvesScene(const std::vector<LocalisationCurve>& curves,

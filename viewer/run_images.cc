@@ -161,6 +161,21 @@ Scene ExperienceMapFloorsScene(const ExperienceMapImageData& data,
   return scene;
 }
 
+ExperienceMapFigure ExperienceMapFigureOf(ExperienceMapImageData data, const Dataset& dataset,
+                                          double until_time_s) {
+  ExperienceMapFigure figure;
+  figure.options.title = "experience map (" + dataset.name + ")";
+  if (dataset.session_start_times_s.size() > 1) {
+    figure.options.coloring = MapColoring::kSession;
+    figure.options.session_start_times_s = dataset.session_start_times_s;
+  }
+  data.ground_truth =
+      GroundTruthInMapFrame(data.experiences, dataset, until_time_s, &figure.truth_floors);
+  figure.floors = ExperienceFloors(data.experiences, dataset);
+  figure.data = std::move(data);
+  return figure;
+}
+
 std::vector<TemplateGraphPoint> TemplateGraphOf(const RunView& run) {
   std::vector<TemplateGraphPoint> points;
   points.reserve(run.frames.size());
@@ -180,22 +195,18 @@ Status WriteRunImages(SceneRenderer* renderer, const RunView& run, const Dataset
   auto write = [&](const SceneBuilder& build, int w, int h, const char* name) -> Status {
     return WriteFigure(renderer, build, w, h, targets(name), width_mm).WithContext(name);
   };
-  ExperienceMapImageOptions map_options;
-  map_options.title = "experience map (" + dataset.name + ")";
   const std::vector<double>& sessions = dataset.session_start_times_s;
-  if (sessions.size() > 1) {
-    map_options.coloring = MapColoring::kSession;
-    map_options.session_start_times_s = sessions;
-  }
   {
-    // One panel per floor when the ground truth knows several.
-    ExperienceMapImageData map_data = ExperienceMapDataOf(run, dataset);
-    std::vector<int> truth_floors;
-    const auto& trajectory = run.trajectory;
-    map_data.ground_truth =
-        GroundTruthInMapFrame(map_data.experiences, dataset,
-                              trajectory.empty() ? -1.0 : trajectory.back().time_s, &truth_floors);
-    std::vector<int> floors = ExperienceFloors(map_data.experiences, dataset);
+    ExperienceMapImageData run_data;
+    run_data.experiences = run.map.experiences();
+    run_data.links = run.map.links();
+    run_data.current = run.map.current();
+    ExperienceMapFigure figure = ExperienceMapFigureOf(
+        std::move(run_data), dataset, run.trajectory.empty() ? -1.0 : run.trajectory.back().time_s);
+    ExperienceMapImageData& map_data = figure.data;
+    std::vector<int>& truth_floors = figure.truth_floors;
+    std::vector<int>& floors = figure.floors;
+    ExperienceMapImageOptions& map_options = figure.options;
     if (run.localisation) {
       // The map is another run's: this data set's path, placed by the frames localised (the
       // experiences' times belong to the other data set), on one panel.

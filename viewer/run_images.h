@@ -47,6 +47,18 @@ Scene ExperienceMapFloorsScene(const ExperienceMapImageData& data,
 
 // The experience-map figure data of a run, with the ground truth (if any) aligned to the map.
 ExperienceMapImageData ExperienceMapDataOf(const RunView& run, const Dataset& dataset);
+// What `replay --render` draws as experience_map: coloured by session for a multi-session data
+// set, the ground truth the run reached by `until_time_s` aligned to the map, one panel per floor
+// (ExperienceMapFloorsScene); `render experience-map` draws the same from a run folder.
+struct ExperienceMapFigure {
+  ExperienceMapImageData data;
+  std::vector<int> floors;        // per experience
+  std::vector<int> truth_floors;  // per ground-truth point of data.ground_truth
+  ExperienceMapImageOptions options;
+};
+ExperienceMapFigure ExperienceMapFigureOf(ExperienceMapImageData data, const Dataset& dataset,
+                                          double until_time_s);
+
 // One template-graph point per view frame.
 std::vector<TemplateGraphPoint> TemplateGraphOf(const RunView& run);
 

@@ -94,12 +94,33 @@ void ValueTicks(Scene& scene, const Range& range, float left, float top, float w
                 float height) {
   const double step = NiceStep(range.hi - range.lo, 5);
   for (double v = std::ceil(range.lo / step) * step; v <= range.hi; v += step) {
+    if (std::abs(v) < 1e-9 * step) v = 0.0;  // a sum of steps near 0 printed as "-0"
     const float y = top + height * static_cast<float>(1.0 - range.Fraction(v));
     scene.Line({left, y}, {left + width, y}, 1.0f, kGrid);
     scene.Text({left - 8, y + 5}, Short(v), 14, kInk, TextAnchor::kRight);
   }
   scene.Line({left, top + height}, {left + width, top + height}, 1.5f, kInk);
   scene.Line({left, top}, {left, top + height}, 1.5f, kInk);
+}
+
+// The value axis's title: the objective, with the unit its name ends in (map_ate_m: m).
+std::string ValueAxisTitle(const SweepFigureData& data) {
+  // The objective as the sweep aggregates it ("mean map_ate_m"): the unit is the metric's.
+  std::string o = data.objective;
+  for (const char* aggregate : {"mean ", "worst "}) {
+    if (o.rfind(aggregate, 0) == 0) o = o.substr(std::string(aggregate).size());
+  }
+  auto ends = [&](const std::string& suffix) {
+    return o.size() > suffix.size() &&
+           o.compare(o.size() - suffix.size(), suffix.size(), suffix) == 0;
+  };
+  const bool plain = o.find_first_of(" +-*/()") == std::string::npos;
+  const std::string& title = data.objective;
+  if (plain && ends("_m")) return title + " (m)";
+  if (plain && ends("_s")) return title + " (s)";
+  if (plain && ends("_db")) return title + " (dB)";
+  if (plain && ends("_ms")) return title + " (ms)";
+  return title;
 }
 
 std::string Goal(const SweepFigureData& data) {
@@ -154,6 +175,7 @@ Scene SweepParameterScene(const SweepFigureData& data, int width_px) {
     for (const SweepFigurePoint& p : data.points) values.push_back(p.values.at(k));
     const ValueAxis axis(values);
     ValueTicks(scene, range, left, top, panel_w, panel_h);
+    scene.Text({left - 8, top - 12}, ValueAxisTitle(data), 14, kInk);
     const auto& distinct = axis.distinct();
     const size_t every = std::max<size_t>(1, distinct.size() / 8);
     for (size_t i = 0; i < distinct.size(); i += every) {
@@ -253,6 +275,7 @@ Scene SweepParetoScene(const SweepFigureData& data, int width_px) {
   const double pad = x.hi > x.lo ? 0.05 * (x.hi - x.lo) : std::max(1e-3, 0.05 * x.lo);
   x = {std::max(0.0, x.lo - pad), x.hi + pad};
   ValueTicks(scene, y, left, top, width, height);
+  scene.Text({left - 8, top - 12}, ValueAxisTitle(data), 14, kInk);
   const double step = NiceStep(x.hi - x.lo, 6);
   for (double v = std::ceil(x.lo / step) * step; v <= x.hi; v += step) {
     const float px = left + width * static_cast<float>(x.Fraction(v));

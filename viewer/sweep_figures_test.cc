@@ -44,5 +44,31 @@ TEST(SweepFiguresTest, EveryParameterGetsAPanelWithItsValues) {
   EXPECT_GT(scene.triangles().size(), 0u);
 }
 
+// The value axis is titled with the objective and the unit its name ends in (the plots had no
+// y-axis label).
+TEST(SweepFiguresTest, TheValueAxisNamesTheObjectiveAndItsUnit) {
+  SweepFigureData d = Example();
+  d.objective = "map_ate_m";
+  EXPECT_TRUE(HasText(SweepParameterScene(d), "map_ate_m (m)"));
+  EXPECT_TRUE(HasText(SweepParetoScene(d), "map_ate_m (m)"));
+  d.objective = "mean map_ate_m";
+  EXPECT_TRUE(HasText(SweepParameterScene(d), "mean map_ate_m (m)"));
+  d.objective = "match_rate_within_m.5";
+  EXPECT_TRUE(HasText(SweepParameterScene(d), "match_rate_within_m.5"));
+  d.objective = "map_ate_m + 0.05 * templates";
+  EXPECT_TRUE(HasText(SweepParetoScene(d), "map_ate_m + 0.05 * templates"));
+}
+
+// A tick at zero reads "0", never "-0" (a sum of steps landing a hair below zero).
+TEST(SweepFiguresTest, NoTickReadsMinusZero) {
+  SweepFigureData d = Example();
+  for (SweepFigurePoint& p : d.points) {
+    if (p.objective) *p.objective -= 2.2;  // -0.2 .. 4.8: ticks step through zero
+  }
+  const Scene scene = SweepParameterScene(d);
+  EXPECT_FALSE(HasText(scene, "-0"));
+  EXPECT_TRUE(HasText(scene, "0"));
+}
+
 }  // namespace
 }  // namespace ratslam

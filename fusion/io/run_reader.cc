@@ -130,6 +130,14 @@ StatusOr<RunFolder> ReadRunFolder(const std::string& folder) {
     if (j.is_object() && j.contains("data_folder") && j["data_folder"].is_string()) {
       run.dataset_folder = j["data_folder"].get<std::string>();
     }
+    if (j.is_object() && j.contains("run") && j["run"].is_object() && j["run"].contains("inputs") &&
+        j["run"]["inputs"].is_array()) {
+      for (const nlohmann::json& input : j["run"]["inputs"]) {
+        if (input.is_object() && input.contains("path") && input["path"].is_string()) {
+          run.inputs.push_back(input["path"].get<std::string>());
+        }
+      }
+    }
     if (j.is_object() && j.contains("current_experience") &&
         j["current_experience"].is_number_unsigned() &&
         j["current_experience"].get<uint64_t>() < run.experiences.size()) {

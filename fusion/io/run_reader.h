@@ -18,6 +18,7 @@ struct RunFolder {
   std::vector<Link> links;
   std::vector<FrameRecord> frames;
   std::string dataset_folder;                  // from summary.json, if recorded
+  std::vector<std::string> inputs;             // the data sets the run read (summary.json's run)
   std::string dataset_name;                    // from summary.json, if recorded
   std::optional<uint32_t> current_experience;  // from summary.json, if recorded
 };
