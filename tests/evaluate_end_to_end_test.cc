@@ -147,6 +147,25 @@ TEST(EvaluateEndToEndTest, MicrosoftWalksWifiOnly) {
   std::ifstream q1(out / "queries.csv"), q2(again / "queries.csv");
   EXPECT_EQ(std::string(std::istreambuf_iterator<char>(q1), {}),
             std::string(std::istreambuf_iterator<char>(q2), {}));
+  // SIGTERM a second evaluation into the same folder (--overwrite): it stops with exit 130 and
+  // the folder keeps the first evaluation's outputs (it exited 143 with a partial folder).
+  {
+    std::ifstream first_in(out / "evaluation.json");
+    const std::string first((std::istreambuf_iterator<char>(first_in)), {});
+    std::string overwrite = command;
+    overwrite.replace(overwrite.find(" --out "), 7, " --overwrite --out ");
+    const fs::path code_file = out.parent_path() / "evaluate_msft_sigterm_code";
+    const std::string script = overwrite +
+                               " 2>/dev/null & p=$!; sleep 1; kill -TERM $p; wait $p; echo $? > " +
+                               code_file.string();
+    (void)std::system(("bash -c '" + script + "'").c_str());
+    int code = -1;
+    std::ifstream(code_file) >> code;
+    EXPECT_EQ(code, 130);
+    std::ifstream after_in(out / "evaluation.json");
+    EXPECT_EQ(std::string(std::istreambuf_iterator<char>(after_in), {}), first);
+    EXPECT_FALSE(fs::exists(out / ".ratslam-staging"));
+  }
   fs::remove_all(out);
   fs::remove_all(again);
 }
