@@ -28,6 +28,17 @@ inline std::string WithMatchingChecksum(std::string bytes) {
   return bytes;
 }
 
+// Runs `use` on the input as it is (formats from before checksums have none) and, when it
+// differs, behind a matching checksum (WithMatchingChecksum).
+template <typename Use>
+int AsIsAndChecksummed(const uint8_t* data, size_t size, Use use) {
+  const std::string bytes(reinterpret_cast<const char*>(data), size);
+  const std::string checked = WithMatchingChecksum(bytes);
+  use(bytes);
+  if (checked != bytes) use(checked);
+  return 0;
+}
+
 // Valid example inputs for this harness (the driver writes them with --seeds DIR).
 std::vector<std::string> FuzzSeeds();
 

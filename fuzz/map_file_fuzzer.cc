@@ -192,9 +192,5 @@ int DecodeAndRun(const std::string& bytes) {
 // The input as it is (old formats have no checksum), and behind a matching checksum, so that
 // mutations reach the decoder (a flipped byte under the checksum is refused: map_file_test).
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  const std::string bytes(reinterpret_cast<const char*>(data), size);
-  const std::string checked = ratslam::fuzz::WithMatchingChecksum(bytes);
-  DecodeAndRun(bytes);
-  if (checked != bytes) DecodeAndRun(checked);
-  return 0;
+  return ratslam::fuzz::AsIsAndChecksummed(data, size, DecodeAndRun);
 }

@@ -93,9 +93,5 @@ int DecodeAndUse(const std::string& bytes) {
 // mutations reach the decoder (a flipped byte under the checksum is refused:
 // particle_filter_test).
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  const std::string bytes(reinterpret_cast<const char*>(data), size);
-  const std::string checked = ratslam::fuzz::WithMatchingChecksum(bytes);
-  DecodeAndUse(bytes);
-  if (checked != bytes) DecodeAndUse(checked);
-  return 0;
+  return ratslam::fuzz::AsIsAndChecksummed(data, size, DecodeAndUse);
 }

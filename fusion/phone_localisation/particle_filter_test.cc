@@ -90,12 +90,18 @@ struct Field {
   }
 };
 
-WifiGpMap TrainedMap(const Field& field) {
+// Noise-free samples of the field every 2 m along x and 4 m along y.
+std::vector<WifiMapSample> FieldSamples(const Field& field) {
   std::vector<WifiMapSample> samples;
   for (double x = 0; x <= 40; x += 2.0) {
     for (double y = 0; y <= 20; y += 4.0)
       samples.push_back({{x, y}, 0, field.Scan({x, y}, nullptr)});
   }
+  return samples;
+}
+
+WifiGpMap TrainedMap(const Field& field) {
+  const std::vector<WifiMapSample> samples = FieldSamples(field);
   WifiGpOptions options;
   options.length_scale_m = 3.0;
   StatusOr<WifiGpMap> map = WifiGpMap::Build(samples, options);
@@ -106,16 +112,10 @@ WifiGpMap TrainedMap(const Field& field) {
 // A cell far too small for the area is refused before anything is allocated, naming the key and
 // what it would take (1 cm cells, 12 m margins, 15 APs over this 40 m x 20 m floor: 4e8 cells).
 TEST(WifiGpMapTest, AGridThatWouldNotFitInMemoryIsRefusedUpFront) {
-  const Field field;
-  std::vector<WifiMapSample> samples;
-  for (double x = 0; x <= 40; x += 2.0) {
-    for (double y = 0; y <= 20; y += 4.0)
-      samples.push_back({{x, y}, 0, field.Scan({x, y}, nullptr)});
-  }
   WifiGpOptions options;
   options.cell_size_m = 0.01;
   options.grid_margin_m = 12;
-  const StatusOr<WifiGpMap> map = WifiGpMap::Build(samples, options);
+  const StatusOr<WifiGpMap> map = WifiGpMap::Build(FieldSamples(Field()), options);
   ASSERT_FALSE(map.ok());
   EXPECT_NE(map.status().message().find("[wifi_map] cell_size_m = 0.01 m would need up to"),
             std::string::npos)

@@ -40,6 +40,13 @@ fs::path WriteFixture(const std::string& name, const std::string& text) {
   return path;
 }
 
+// The log read with malformed lines skipped and counted in `report`.
+StatusOr<Dataset> ReadLeniently(const fs::path& path, PhoneLogReport* report) {
+  PhoneLogOptions lenient;
+  lenient.lenient = true;
+  return ReadIpinLog(path.string(), lenient, report);
+}
+
 TEST(IpinLogTest, ReadsScansCompassAndGroundTruth) {
   const fs::path path = WriteFixture("ratslam_ipin_fixture.txt", kFixture);
   PhoneLogReport report;
@@ -74,10 +81,8 @@ TEST(IpinLogTest, BrokenLinesNameFileAndLineOrAreCountedWhenLenient) {
       strict.status().message().find("ratslam_ipin_broken.txt:11: WIFI: RSS(dBm) is not a number"),
       std::string::npos)
       << strict.status().message();
-  PhoneLogOptions lenient;
-  lenient.lenient = true;
   PhoneLogReport report;
-  StatusOr<Dataset> d = ReadIpinLog(path.string(), lenient, &report);
+  StatusOr<Dataset> d = ReadLeniently(path, &report);
   ASSERT_TRUE(d.ok()) << d.status().message();
   EXPECT_EQ(report.skipped_malformed, 2u);
   EXPECT_EQ(d->wifi.size(), 2u);
@@ -113,10 +118,8 @@ TEST(IpinLogTest, LinesThatAreNotSensorLinesAreErrors) {
         << strict.status().message();
     EXPECT_NE(strict.status().message().find(expected), std::string::npos)
         << strict.status().message();
-    PhoneLogOptions lenient;
-    lenient.lenient = true;
     PhoneLogReport report;
-    StatusOr<Dataset> d = ReadIpinLog(path.string(), lenient, &report);
+    StatusOr<Dataset> d = ReadLeniently(path, &report);
     ASSERT_TRUE(d.ok()) << d.status().message();
     EXPECT_GE(report.skipped_malformed, 1u);
     EXPECT_EQ(d->wifi.size(), 2u);
