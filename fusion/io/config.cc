@@ -177,16 +177,15 @@ std::optional<std::string> OpenRatslamEvidence(const std::string& text) {
 StatusOr<PipelineOptions> LoadConfigFile(const std::string& path) {
   // A data set given where the configuration belongs (`--config LOG.txt --data x.toml`) is
   // named as such, instead of "larger than 1048576 bytes" or a TOML syntax error.
-  auto data_instead = [&](const Status& error) {
-    if (IsRegularFile(path) && DetectDatasetFormat(path).ok()) {
-      return Status::Error(path +
-                           " is a data set, not a configuration: give it as --data, and "
-                           "the configuration (.toml) as --config");
-    }
-    return error;
+  // Asked only once reading or parsing failed: a good configuration is never sniffed.
+  auto is_data_set = [&] { return IsRegularFile(path) && DetectDatasetFormat(path).ok(); };
+  const auto data_set = [&] {
+    return Status::Error(path +
+                         " is a data set, not a configuration: give it as --data, and the "
+                         "configuration (.toml) as --config");
   };
   StatusOr<std::string> text = ReadRegularFile(path, "config file", kMaxConfigBytes);
-  if (!text.ok()) return data_instead(text.status());
+  if (!text.ok()) return is_data_set() ? data_set() : text.status();
   StatusOr<PipelineOptions> parsed = ParseConfig(*text, path);
   if (parsed.ok()) {
     // Paths inside a configuration are relative to its file (as a sweep file's are), not to the
@@ -201,9 +200,7 @@ StatusOr<PipelineOptions> LoadConfigFile(const std::string& path) {
       }
     }
   } else {
-    if (Status data = data_instead(parsed.status()); data.message() != parsed.status().message()) {
-      return data;
-    }
+    if (is_data_set()) return data_set();
     if (const auto evidence = OpenRatslamEvidence(*text)) {
       return Status::Error(path + " is an OpenRatSLAM configuration (" + *evidence +
                            "), not ours: convert it with `ratslam import-openratslam " + path +

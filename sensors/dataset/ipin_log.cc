@@ -61,18 +61,6 @@ bool ParseDouble(const std::string& text, double* value) {
   return result.ec == std::errc() && result.ptr == last && std::isfinite(*value);
 }
 
-}  // namespace
-
-void GeoToLocal(const GeoReference& reference, double latitude_deg, double longitude_deg,
-                double* x_m, double* y_m) {
-  const double to_rad = std::numbers::pi / 180.0;
-  *x_m = kEarthRadiusM * std::cos(reference.latitude_deg * to_rad) *
-         (longitude_deg - reference.longitude_deg) * to_rad;
-  *y_m = kEarthRadiusM * (latitude_deg - reference.latitude_deg) * to_rad;
-}
-
-namespace {
-
 // A sensor type as the logs write it: 2 to 8 capital letters or digits, starting with a letter
 // (WIFI, ACCE, BLE4, ...).
 bool IsSensorType(const std::string& type) {
@@ -99,6 +87,14 @@ std::string Printable(const std::string& text) {
 }
 
 }  // namespace
+
+void GeoToLocal(const GeoReference& reference, double latitude_deg, double longitude_deg,
+                double* x_m, double* y_m) {
+  const double to_rad = std::numbers::pi / 180.0;
+  *x_m = kEarthRadiusM * std::cos(reference.latitude_deg * to_rad) *
+         (longitude_deg - reference.longitude_deg) * to_rad;
+  *y_m = kEarthRadiusM * (latitude_deg - reference.latitude_deg) * to_rad;
+}
 
 StatusOr<PhoneLog> ParseIpinLog(const std::string& path, const PhoneLogOptions& options,
                                 PhoneLogReport* report) {
