@@ -132,10 +132,10 @@ TEST(IpinLocateTest, AParticleFilterLocatesAnotherPhoneInTheWifiMap) {
       << many.err;
   // A 1 cm grid cell (1e8 cells to fit here: minutes and a gigabyte) is refused up front too.
   std::ofstream(root / "fine.toml") << "[wifi_map]\ncell_size_m = 0.01\n";
-  const Result fine = RunRatslam("wifi-map --config " + (root / "fine.toml").string() +
-                                     " --data " + log("01").string() + " --out " +
-                                     (root / "fine.wifimap").string(),
-                                 root, 120);
+  const Result fine =
+      RunRatslam("wifi-map --config " + (root / "fine.toml").string() + " --data " +
+                     log("01").string() + " --out " + (root / "fine.wifimap").string(),
+                 root, 120);
   EXPECT_EQ(fine.exit_code, 1);
   EXPECT_NE(fine.err.find("[wifi_map] cell_size_m = 0.01 m would need up to"), std::string::npos)
       << fine.err;
