@@ -263,6 +263,27 @@ void PlacePeople(const World& world, int floor, double time_s, FloorGeometry* g)
   mesh.id = id;
 }
 
+// What a session is called in figures and summaries: its lighting, with its route when the
+// world's sessions walk more than one, "reversed" when walked backwards, and its place among
+// sessions that would otherwise share a name ("day, 2").
+std::string SessionName(const World& world, int index) {
+  auto base = [&](const Session& s) {
+    bool one_route = true;
+    for (const Session& other : world.sessions) one_route = one_route && other.route == s.route;
+    std::string name = one_route ? s.lighting : s.route + ", " + s.lighting;
+    if (s.reverse) name += ", reversed";
+    return name;
+  };
+  const std::string name = base(world.sessions[index]);
+  int same = 0, position = 0;
+  for (size_t i = 0; i < world.sessions.size(); ++i) {
+    if (base(world.sessions[i]) != name) continue;
+    ++same;
+    if (static_cast<int>(i) <= index) position = same;
+  }
+  return same > 1 ? name + ", " + std::to_string(position) : name;
+}
+
 }  // namespace
 
 ViewMesh FloorMesh(const World& world, int floor, double time_s) {
@@ -327,6 +348,7 @@ Status Simulate(const World& world, uint64_t seed, ViewRenderer* renderer,
     if (p.session != session) {
       session = p.session;
       dataset->session_start_times_s.push_back(p.time_s);
+      dataset->session_names.push_back(SessionName(world, session));
       dataset->odometry.push_back({p.time_s, 0.0, 0.0});  // no motion across the gap
       next_image = next_scan = next_compass = p.time_s;
     } else {

@@ -235,6 +235,31 @@ TEST(SimulatorTest, TrajectoryFollowsTheRouteAndCompassFeelsDisturbances) {
   EXPECT_GT(worst_near, 15.0);  // the route passes 1 m from the centre: 40 exp(-1/2) = 24 deg
 }
 
+// Sessions are named by what sets them apart: lighting, the route when several are walked,
+// "reversed", and an ordinal among sessions that would otherwise share a name.
+TEST(SimulatorTest, SessionsAreNamedByWhatSetsThemApart) {
+  World w = Small();
+  w.sessions.front().laps = 0.25;
+  Session night = w.sessions.front();
+  night.lighting = "night";
+  Session back = w.sessions.front();
+  back.reverse = true;
+  w.sessions = {w.sessions.front(), night, w.sessions.front(), back};
+  Dataset d;
+  SimulationReport report;
+  ASSERT_TRUE(Simulate(w, 3, nullptr, "", &d, &report).ok());
+  ASSERT_EQ(d.session_start_times_s.size(), 4u);
+  EXPECT_EQ(d.session_names,
+            (std::vector<std::string>{"day, 1", "night", "day, 2", "day, reversed"}));
+  Route other = w.routes.front();
+  other.name = "short";
+  w.routes.push_back(other);
+  w.sessions = {w.sessions[0], w.sessions[1]};
+  w.sessions[1].route = "short";
+  ASSERT_TRUE(Simulate(w, 3, nullptr, "", &d, &report).ok());
+  EXPECT_EQ(d.session_names, (std::vector<std::string>{"r, day", "short, night"}));
+}
+
 TEST(WorldTest, ErrorsNameTheLineAndRoundTrip) {
   auto unknown = ParseWorld(
       std::string(kSmallWorld) + "[[walls]]\nfrom = [0, 0]\nto = [1, 0]\ncolour = 3\n", "w.toml");

@@ -179,24 +179,81 @@ std::vector<Point2> AlignGroundTruthToMap(const std::vector<Point2>& map_points,
   return out;
 }
 
-void FittedTitle(Scene& scene, ScenePoint position, const std::string& text, float height_px,
-                 float max_width_px, Rgba color) {
-  float h = height_px;
-  while (h > 13.0f && TextWidthPx(text, h) > max_width_px) h -= 1.0f;
+namespace {
+
+// `text` with its middle elided until it fits `max_width_px` at `height_px`.
+std::string ElideMiddle(const std::string& text, float height_px, float max_width_px) {
   std::string fitted = text;
-  // Elide the middle, a character at a time from the centre outwards.
-  for (size_t cut = 1; TextWidthPx(fitted, h) > max_width_px && cut + 2 < text.size(); ++cut) {
+  // A character at a time from the centre outwards.
+  for (size_t cut = 1; TextWidthPx(fitted, height_px) > max_width_px && cut + 2 < text.size();
+       ++cut) {
     const size_t keep = text.size() - cut;
     fitted = text.substr(0, (keep + 1) / 2) + "..." + text.substr(text.size() - keep / 2);
   }
-  scene.Text(position, fitted, h, color);
+  return fitted;
+}
+
+}  // namespace
+
+float FittedText::ExtraHeightPx() const {
+  return lines.size() > 1 ? 1.25f * height_px * static_cast<float>(lines.size() - 1) : 0.0f;
+}
+
+FittedText FitTitle(const std::string& text, float height_px, float max_width_px, int max_lines) {
+  constexpr float kSmallest = 13.0f;
+  FittedText out;
+  // Two lines are tried before the type gets small: 15 px is the last size on one line.
+  const float one_line_floor = max_lines > 1 ? std::min(height_px, 15.0f) : kSmallest;
+  float h = height_px;
+  while (h > one_line_floor && TextWidthPx(text, h) > max_width_px) h -= 1.0f;
+  if (TextWidthPx(text, h) <= max_width_px || max_lines < 2) {
+    out.height_px = h;
+    out.lines = {ElideMiddle(text, h, max_width_px)};
+    return out;
+  }
+  // The break (at a space) that makes the wider of the two lines narrowest.
+  size_t best = std::string::npos;
+  float best_width = std::numeric_limits<float>::infinity();
+  for (size_t i = text.find(' '); i != std::string::npos; i = text.find(' ', i + 1)) {
+    const float wider = std::max(TextWidthPx(text.substr(0, i), height_px),
+                                 TextWidthPx(text.substr(i + 1), height_px));
+    if (wider < best_width) best_width = wider, best = i;
+  }
+  if (best == std::string::npos) {
+    out.height_px = kSmallest;
+    out.lines = {ElideMiddle(text, kSmallest, max_width_px)};
+    return out;
+  }
+  const std::string first = text.substr(0, best), second = text.substr(best + 1);
+  h = height_px;
+  while (h > kSmallest && std::max(TextWidthPx(first, h), TextWidthPx(second, h)) > max_width_px) {
+    h -= 1.0f;
+  }
+  out.height_px = h;
+  out.lines = {ElideMiddle(first, h, max_width_px), ElideMiddle(second, h, max_width_px)};
+  return out;
+}
+
+void DrawTitle(Scene& scene, ScenePoint position, const FittedText& title, Rgba color) {
+  for (size_t i = 0; i < title.lines.size(); ++i) {
+    scene.Text({position.x, position.y + 1.25f * title.height_px * static_cast<float>(i)},
+               title.lines[i], title.height_px, color);
+  }
+}
+
+void FittedTitle(Scene& scene, ScenePoint position, const std::string& text, float height_px,
+                 float max_width_px, Rgba color) {
+  DrawTitle(scene, position, FitTitle(text, height_px, max_width_px), color);
 }
 
 Scene ExperienceMapScene(const ExperienceMapImageData& data,
                          const ExperienceMapImageOptions& options, WorldToImage* transform) {
   Scene scene(options.width_px, options.height_px, kWhite);
   const float w = static_cast<float>(options.width_px), h = static_cast<float>(options.height_px);
-  const float margin = 30, top_band = 66;
+  const float margin = 30;
+  const FittedText title = FitTitle(options.title.empty() ? "experience map" : options.title, 18,
+                                    w - 2 * margin, /*max_lines=*/2);
+  const float top_band = 66 + title.ExtraHeightPx();
   // The bottom band holds the scale bar and the legend; the legend moves to a row of its own
   // when both do not fit side by side (small images).
   float bottom_band = 60;
@@ -270,7 +327,10 @@ Scene ExperienceMapScene(const ExperienceMapImageData& data,
          }});
   } else if (options.coloring == MapColoring::kSession) {
     for (size_t i = 0; i < options.session_start_times_s.size(); ++i) {
-      const std::string label = "session " + std::to_string(i + 1);
+      const std::string label =
+          i < options.session_names.size() && !options.session_names[i].empty()
+              ? options.session_names[i]
+              : "session " + std::to_string(i + 1);
       items.push_back({20 + TextWidthPx(label, 14), [i, label](Scene& s, float x, float y) {
                          s.Rect(x, y - 7, 14, 14, CategoryColor(static_cast<int>(i)));
                          s.Text({x + 20, y + 5}, label, 14, kInk);
@@ -357,9 +417,8 @@ Scene ExperienceMapScene(const ExperienceMapImageData& data,
   }
 
   // Title, and the counts on a line of their own.
-  FittedTitle(scene, {margin, 26}, options.title.empty() ? "experience map" : options.title, 18,
-              w - 2 * margin);
-  scene.Text({margin, 50},
+  DrawTitle(scene, {margin, 26}, title);
+  scene.Text({margin, 50 + title.ExtraHeightPx()},
              std::to_string(data.experiences.size()) + " experiences, " + std::to_string(n_links) +
                  " links, " + std::to_string(loop_closures) +
                  (loop_closures == 1 ? " loop closure" : " loop closures") +
@@ -422,12 +481,18 @@ Scene TemplateGraphScene(const std::vector<TemplateGraphPoint>& points,
                      sc.Disc({x + 3, y}, 2.5f, kExperienceColor, 8);
                      sc.Text({x + 12, y + 5}, "experience", 14, kInk);
                    }});
+  // A long title (a data set's name at a column's width) takes a second line, not an ellipsis.
+  const FittedText title = FitTitle(options.title.empty() ? "template graph" : options.title, 18,
+                                    options.width_px - 40.0f, /*max_lines=*/2);
+  const float legend_top = 52 + title.ExtraHeightPx();
   const float right = static_cast<float>(options.width_px) - 30;
   const std::vector<std::vector<size_t>> rows = FlowRows(items, right - 20);
-  for (size_t r = 0; r < rows.size(); ++r) DrawRow(scene, items, rows[r], right, 52 + 24.0f * r);
+  for (size_t r = 0; r < rows.size(); ++r) {
+    DrawRow(scene, items, rows[r], right, legend_top + 24.0f * r);
+  }
   // Two panels over one time axis: template ids above, experience ids below (on one axis the
   // experience dots hid under the template circles, their ids being nearly the same).
-  const float plot_top = 52 + 24.0f * rows.size() + 30;
+  const float plot_top = legend_top + 24.0f * rows.size() + 30;
   const float gap = 72;  // the upper panel's tick labels and the lower panel's axis title
   const float both = static_cast<float>(options.height_px) - plot_top - 70;
   const float panel_h = std::max(20.0f, (both - gap) / 2);
@@ -450,7 +515,9 @@ Scene TemplateGraphScene(const std::vector<TemplateGraphPoint>& points,
     for (const PlotArea* plot : {&upper, &lower}) {
       scene.Rect(a.x, plot->top, b.x - a.x, plot->height, span_shades[k % 2]);
     }
-    scene.Text({0.5f * (a.x + b.x), upper.top + 20}, span.label, 14, kInk, TextAnchor::kCenter);
+    // A label wider than its span (long session names side by side) loses its middle.
+    scene.Text({0.5f * (a.x + b.x), upper.top + 20}, ElideMiddle(span.label, 14, b.x - a.x - 8), 14,
+               kInk, TextAnchor::kCenter);
   }
   DrawAxes(scene, upper, "", "template id");
   DrawAxes(scene, lower, "time (s)", "experience id");
@@ -470,8 +537,7 @@ Scene TemplateGraphScene(const std::vector<TemplateGraphPoint>& points,
     scene.Disc(lower.Map(p.time_s, static_cast<double>(p.experience_id)), many ? 1.0f : 1.8f,
                kExperienceColor, 6);
   }
-  FittedTitle(scene, {20, 26}, options.title.empty() ? "template graph" : options.title, 18,
-              options.width_px - 40.0f);
+  DrawTitle(scene, {20, 26}, title);
   return scene;
 }
 

@@ -47,9 +47,19 @@ struct WorldBounds {
   double min_x_m = 0, min_y_m = 0, max_x_m = 0, max_y_m = 0;
 };
 
-// Draws a left-aligned title that fits `max_width_px`: smaller type first (down to 13 px, our
-// smallest), then the middle of the text elided with "..." (a long data-set name keeps its
-// start and end).
+// A title laid out to fit `max_width_px`: smaller type first (down to 13 px, our smallest); then,
+// with `max_lines` 2, broken at the space that balances two lines; then the middle of a line
+// elided with "..." (a long data-set name keeps its start and end).
+struct FittedText {
+  std::vector<std::string> lines;
+  float height_px = 18;
+  // How far below the first line's baseline the last line's is (0 for one line).
+  float ExtraHeightPx() const;
+};
+FittedText FitTitle(const std::string& text, float height_px, float max_width_px,
+                    int max_lines = 1);
+void DrawTitle(Scene& scene, ScenePoint position, const FittedText& title, Rgba color = kInk);
+// FitTitle on one line, drawn.
 void FittedTitle(Scene& scene, ScenePoint position, const std::string& text, float height_px,
                  float max_width_px, Rgba color = kInk);
 
@@ -60,6 +70,7 @@ struct ExperienceMapImageOptions {
   std::optional<std::pair<double, double>> time_range_s;  // fixed colour range; default: the data
   MapColoring coloring = MapColoring::kTime;
   std::vector<double> session_start_times_s;  // ascending; sessions for kSession colouring
+  std::vector<std::string> session_names;     // their legend labels ("session N" where missing)
   std::string title;
   // Panels of a multi-floor figure: `legend` false leaves the scale bar and legend out (the
   // band they take stays, so that every panel has the same scale); `legend_data`, when set,

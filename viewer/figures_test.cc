@@ -3,9 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <set>
 
 #include "render/image.h"
 #include "render/renderer.h"
+#include "render/vector_figure.h"
 #include "viewer/run_images.h"
 
 namespace ratslam {
@@ -186,6 +188,61 @@ TEST(FittedTitleTest, ShrinksThenElidesTheMiddle) {
   EXPECT_EQ(t.text.substr(t.text.size() - 6), "run 7)");
 }
 
+// With two lines allowed, a title too long for a column breaks at a space into two lines that
+// both fit, losing nothing; the figure's content moves down by the second line.
+TEST(FittedTitleTest, TwoLinesKeepTheWholeTitle) {
+  const std::string name =
+      "template graph (IPIN2023_T3_TrainingTrial51_repetition02 +3 sessions, walking)";
+  // A column's width (88 mm) as the vector figures lay it out.
+  const float width = VectorLayoutWidthPx(88.0) - 40.0f;
+  const FittedText one = FitTitle(name, 18, width);
+  ASSERT_EQ(one.lines.size(), 1u);
+  EXPECT_NE(one.lines[0].find("..."), std::string::npos);
+  const FittedText two = FitTitle(name, 18, width, 2);
+  ASSERT_EQ(two.lines.size(), 2u);
+  EXPECT_EQ(two.lines[0] + " " + two.lines[1], name);
+  for (const std::string& line : two.lines) EXPECT_LE(TextWidthPx(line, two.height_px), width);
+  EXPECT_GE(two.height_px, one.height_px);
+  EXPECT_GT(two.ExtraHeightPx(), 0);
+  EXPECT_EQ(FitTitle("short", 18, width, 2).lines.size(), 1u);
+
+  std::vector<TemplateGraphPoint> points = {{0, 0, 0, DecisionSource::kNew},
+                                            {30, 1, 1, DecisionSource::kNew}};
+  TemplateGraphImageOptions options;
+  options.width_px = VectorLayoutWidthPx(88.0);
+  options.title = name;
+  const Scene scene = TemplateGraphScene(points, options);
+  float title_bottom = 0, legend_top = 1e9;
+  std::string drawn;
+  for (const SceneText& t : scene.texts()) {
+    if (name.find(t.text) != std::string::npos && t.text.size() > 10) {
+      drawn += (drawn.empty() ? "" : " ") + t.text;
+      title_bottom = std::max(title_bottom, t.position.y);
+    }
+    if (t.text == "new template") legend_top = t.position.y;
+  }
+  EXPECT_EQ(drawn, name);
+  EXPECT_GT(legend_top - 14, title_bottom);  // the legend's text sits below the title's
+}
+
+// The session legend reads the sessions' names, not their numbers.
+TEST(ExperienceMapSceneTest, SessionLegendNamesTheSessions) {
+  ExperienceMapImageOptions options;
+  options.coloring = MapColoring::kSession;
+  options.session_start_times_s = {0.0, 1.5};
+  options.session_names = {"day", "night"};
+  const Scene scene = ExperienceMapScene(LMap(), options);
+  std::set<std::string> texts;
+  for (const SceneText& t : scene.texts()) texts.insert(t.text);
+  EXPECT_TRUE(texts.count("day") && texts.count("night"));
+  EXPECT_FALSE(texts.count("session 1"));
+  options.session_names.clear();
+  std::set<std::string> numbered;
+  const Scene unnamed = ExperienceMapScene(LMap(), options);
+  for (const SceneText& t : unnamed.texts()) numbered.insert(t.text);
+  EXPECT_TRUE(numbered.count("session 1") && numbered.count("session 2"));
+}
+
 TEST(TemplateGraphSceneTest, EmptyInputStillGivesAFigure) {
   const Scene scene = TemplateGraphScene({}, {});
   EXPECT_EQ(scene.width(), 1600);
@@ -230,6 +287,22 @@ TEST(TemplateGraphSceneTest, AdjacentSpansHaveDifferentShades) {
   EXPECT_FALSE(same(shades[0], shades[2]));
   EXPECT_FALSE(same(shades[2], shades[4]));
   EXPECT_TRUE(same(shades[0], shades[1]));  // one span, one shade in both panels
+
+  // Labels wider than their spans lose their middles and never overlap.
+  options.width_px = 600;
+  options.shaded_spans = {{0, 15, "IPIN2023_T3_TrainingTrial01_repetition01"},
+                          {15, 30, "IPIN2023_T3_TrainingTrial01_repetition02"}};
+  const Scene narrow = TemplateGraphScene(points, options);
+  std::vector<const SceneText*> labels;
+  for (const SceneText& t : narrow.texts()) {
+    if (t.text.find("...") != std::string::npos) labels.push_back(&t);
+  }
+  ASSERT_EQ(labels.size(), 2u);
+  EXPECT_EQ(labels[0]->text.substr(labels[0]->text.size() - 2), "01");
+  EXPECT_EQ(labels[1]->text.substr(labels[1]->text.size() - 2), "02");
+  const float right_of_first = labels[0]->position.x + TextWidthPx(labels[0]->text, 14) / 2;
+  const float left_of_second = labels[1]->position.x - TextWidthPx(labels[1]->text, 14) / 2;
+  EXPECT_LT(right_of_first, left_of_second);
 }
 
 // Session and curve colours never read as the loop-closure red (220, 50, 32): in multi-session

@@ -168,6 +168,9 @@ ExperienceMapFigure ExperienceMapFigureOf(ExperienceMapImageData data, const Dat
   if (dataset.session_start_times_s.size() > 1) {
     figure.options.coloring = MapColoring::kSession;
     figure.options.session_start_times_s = dataset.session_start_times_s;
+    for (size_t i = 0; i < dataset.session_start_times_s.size(); ++i) {
+      figure.options.session_names.push_back(dataset.SessionName(i));
+    }
   }
   data.ground_truth =
       GroundTruthInMapFrame(data.experiences, dataset, until_time_s, &figure.truth_floors);
@@ -247,11 +250,11 @@ Status WriteRunImages(SceneRenderer* renderer, const RunView& run, const Dataset
   }
   TemplateGraphImageOptions graph_options;
   graph_options.title = "template graph (" + dataset.name + ")";
-  // Every other session shaded.
-  for (size_t i = 0; sessions.size() > 1 && i < sessions.size(); i += 2) {
+  // Each session a shaded span with its name (the figure alternates two shades).
+  for (size_t i = 0; sessions.size() > 1 && i < sessions.size(); ++i) {
     const double end =
         i + 1 < sessions.size() ? sessions[i + 1] : std::numeric_limits<double>::infinity();
-    graph_options.shaded_spans.push_back({sessions[i], end, "session " + std::to_string(i + 1)});
+    graph_options.shaded_spans.push_back({sessions[i], end, dataset.SessionName(i)});
   }
   const std::vector<TemplateGraphPoint> points = TemplateGraphOf(run);
   RATSLAM_RETURN_IF_ERROR(write(

@@ -328,8 +328,14 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
                       {"floor_offset_changes", floors->floor_offset_changes},
                       {"session_floor_offsets", floors->session_floor_offsets}};
   }
-  if (dataset.session_start_times_s.size() > 1)
+  if (dataset.session_start_times_s.size() > 1) {
     j["sessions"] = dataset.session_start_times_s.size();
+    std::vector<std::string> names;
+    for (size_t i = 0; i < dataset.session_start_times_s.size(); ++i) {
+      names.push_back(dataset.SessionName(i));
+    }
+    j["session_names"] = names;
+  }
   if (pipeline.wifi_sequence().options().enabled) {
     j["wifi_sequence"] = SequenceSummary(pipeline.wifi_sequence(), map, dataset);
   }
@@ -440,6 +446,7 @@ const std::vector<std::string>& SummaryKeys() {
                                                 "relaxation_capped_passes",
                                                 "resumed_from",
                                                 "run",
+                                                "session_names",
                                                 "sessions",
                                                 "skipped_malformed_lines",
                                                 "templates",

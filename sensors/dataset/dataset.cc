@@ -47,6 +47,7 @@ struct Manifest {
   int format_version = 0;
   std::string name;
   std::vector<double> session_start_times_s;
+  std::vector<std::string> session_names;
 
   template <typename V>
   void VisitFields(V&& v) {
@@ -56,6 +57,8 @@ struct Manifest {
     v("session_start_times_s", session_start_times_s,
       "times at which the sessions of a multi-session data set start",
       schema::Unit("s").NonNegative().Increasing());
+    v("session_names", session_names,
+      "what figures and summaries call the sessions, one per session start", schema::Any());
   }
 };
 
@@ -192,6 +195,11 @@ std::string Dataset::ImagePath(const ImageRow& row) const {
   return (fs::path(folder) / image_folder / row.file).string();
 }
 
+std::string Dataset::SessionName(size_t index) const {
+  if (index < session_names.size() && !session_names[index].empty()) return session_names[index];
+  return "session " + std::to_string(index + 1);
+}
+
 StatusOr<Dataset> ReadDataset(const std::string& folder) {
   const std::string manifest_path = (fs::path(folder) / "manifest.toml").string();
   if (!IsDirectory(folder)) return Status::Error(folder + ": not a data-set folder");
@@ -229,6 +237,15 @@ StatusOr<Dataset> ReadDataset(const std::string& folder) {
   d.folder = folder;
   d.name = parsed->contains("name") ? manifest.name : fs::path(folder).filename().string();
   d.session_start_times_s = manifest.session_start_times_s;
+  if (!manifest.session_names.empty() &&
+      manifest.session_names.size() != std::max<size_t>(1, manifest.session_start_times_s.size())) {
+    return Status::Error(
+        schema::TomlWhere(manifest_path, parsed->get("session_names")) +
+        ": session_names: " + std::to_string(manifest.session_names.size()) + " names for " +
+        std::to_string(std::max<size_t>(1, manifest.session_start_times_s.size())) +
+        " sessions (one per session_start_times_s entry)");
+  }
+  d.session_names = manifest.session_names;
   if (!streams.image_folder.empty()) d.image_folder = streams.image_folder;
   const std::map<std::string, std::string> files = {
       {"odometry", streams.odometry},         {"images", streams.images},
@@ -325,6 +342,18 @@ Status WriteDataset(const Dataset& d, const std::string& folder) {
     manifest += "session_start_times_s = [";
     for (size_t i = 0; i < d.session_start_times_s.size(); ++i) {
       manifest += (i ? ", " : "") + num(d.session_start_times_s[i], "session start");
+    }
+    manifest += "]\n";
+  }
+  if (!d.session_names.empty()) {
+    if (d.session_names.size() != std::max<size_t>(1, d.session_start_times_s.size())) {
+      return Status::Error(
+          folder + ": " + std::to_string(d.session_names.size()) + " session names for " +
+          std::to_string(std::max<size_t>(1, d.session_start_times_s.size())) + " sessions");
+    }
+    manifest += "session_names = [";
+    for (size_t i = 0; i < d.session_names.size(); ++i) {
+      manifest += (i ? ", " : "") + TomlQuoted(d.session_names[i]);
     }
     manifest += "]\n";
   }

@@ -62,11 +62,15 @@ struct Dataset {
   std::vector<CompassRow> compass;
   std::vector<PressureSample> pressure;       // barometer, hPa (floors: sensors/barometer.h)
   std::vector<double> session_start_times_s;  // more than one for a multi-session run
+  // One per session start when known (empty otherwise): what figures and summaries call them.
+  std::vector<std::string> session_names;
   // Lines of phone logs that were malformed and skipped (only with lenient reading).
   size_t skipped_malformed_lines = 0;
 
   // The image's path: `file` itself when absolute, else inside the image folder.
   std::string ImagePath(const ImageRow& row) const;
+  // The name of session `index`: its recorded name, else "session N" (1-based).
+  std::string SessionName(size_t index) const;
 };
 
 // Reads a replay data-set folder. Errors name the file, line and column. Streams must be regular

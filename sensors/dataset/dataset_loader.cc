@@ -121,6 +121,7 @@ StatusOr<Dataset> LoadSessions(const std::vector<std::string>& paths,
     if (!std::isfinite(first)) return Status::Error(path + ": empty data set");
     const double shift = std::isfinite(end_of_previous) ? end_of_previous + gap_s - first : 0.0;
     joined.session_start_times_s.push_back(first + shift);
+    joined.session_names.push_back(d->name);
     // A still row at the session's start; rows at that same time add no motion (a row's speed
     // holds from the previous row's time to its own) and would repeat the time stamp.
     joined.odometry.push_back({first + shift, 0.0, 0.0});
@@ -151,6 +152,16 @@ StatusOr<Dataset> LoadSessions(const std::vector<std::string>& paths,
     }
     if (joined.name.empty()) joined.name = d->name;
     end_of_previous = last + shift;
+  }
+  // Two sessions from files of one name (two folders' phone.txt) are told apart by their order.
+  for (size_t i = 0; i < joined.session_names.size(); ++i) {
+    const std::string name = joined.session_names[i];
+    if (std::count(joined.session_names.begin(), joined.session_names.end(), name) > 1) {
+      int k = 0;
+      for (std::string& n : joined.session_names) {
+        if (n == name) n += " (" + std::to_string(++k) + ")";
+      }
+    }
   }
   joined.name +=
       " +" + std::to_string(paths.size() - 1) + (paths.size() == 2 ? " session" : " sessions");

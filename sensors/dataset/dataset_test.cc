@@ -86,6 +86,46 @@ TEST_F(DatasetTest, LoadSessionsKeepsAJoinedFoldersSessions) {
   EXPECT_EQ(single->session_start_times_s, (std::vector<double>{0.25}));
 }
 
+// Sessions keep their names: a joined folder's from its manifest (written and read back), joined
+// files' from the files, two of one name told apart by their order; a manifest whose names do
+// not match its sessions names the key.
+TEST_F(DatasetTest, SessionNamesRoundTripAndComeFromTheJoinedFiles) {
+  Dataset d = ReadDataset(folder_.string()).value();
+  d.session_start_times_s = {0.0, 0.05};
+  d.session_names = {"summer \"day\"", "winter"};
+  const fs::path copy = folder_ / "named";
+  ASSERT_TRUE(WriteDataset(d, copy.string()).ok());
+  StatusOr<Dataset> back = LoadSessions({copy.string()}, {});
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  EXPECT_EQ(back->session_names, d.session_names);
+  EXPECT_EQ(back->SessionName(1), "winter");
+  EXPECT_EQ(Dataset{}.SessionName(2), "session 3");
+
+  d.session_names = {"only one"};
+  EXPECT_NE(WriteDataset(d, (folder_ / "refused").string()).message().find("1 session names for 2"),
+            std::string::npos);
+  Write("manifest.toml",
+        "format = \"ratslam-replay\"\nformat_version = 1\nname = \"t\"\n"
+        "session_start_times_s = [0.0, 0.4]\nsession_names = [\"a\"]\n[streams]\n"
+        "odometry = \"odometry.csv\"\n");
+  EXPECT_NE(ReadError().find("manifest.toml:5: session_names: 1 names for 2 sessions"),
+            std::string::npos)
+      << ReadError();
+
+  const fs::path a = folder_ / "a", b = folder_ / "b";
+  Dataset one = ReadDataset(copy.string()).value();
+  one.session_start_times_s.clear();
+  one.session_names.clear();
+  one.name = "morning";
+  ASSERT_TRUE(WriteDataset(one, a.string()).ok());
+  one.name = "evening";
+  ASSERT_TRUE(WriteDataset(one, b.string()).ok());
+  StatusOr<Dataset> joined = LoadSessions({a.string(), b.string(), a.string()}, {});
+  ASSERT_TRUE(joined.ok()) << joined.status().message();
+  EXPECT_EQ(joined->session_names,
+            (std::vector<std::string>{"morning (1)", "evening", "morning (2)"}));
+}
+
 TEST_F(DatasetTest, TruncatedRowNamesFileAndLine) {
   Write("odometry.csv", "time_s,forward_speed_m_per_s,turn_rate_rad_per_s\n0,0,0\n0.1,1\n");
   const std::string error = ReadError();
