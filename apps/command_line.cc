@@ -236,9 +236,18 @@ const std::vector<CommandSpec>& Commands() {
        "pr_curve.csv, localisation.png and pr_curve.png to O. M and Q may be the same data set: "
        "[evaluation] split and map_fraction then divide it. A data set is a replay folder, a "
        "phone log or a folder of them, a UJIIndoorLoc CSV, a long-term UJI library set (any of "
-       "its files, e.g. db/01/trn01rss.csv) or an image folder.",
+       "its files, e.g. db/01/trn01rss.csv) or an image folder. With --frame-tolerance, M and Q "
+       "are image folders of two traverses of one route (e.g. summer and winter): every frame "
+       "of Q is placed on M by the sequence matcher ([sequence]) and by single frames, right "
+       "within N frames of its true place (same file name, else same position, else "
+       "--ground-truth): evaluation.json, queries.csv, pr_curve.csv, pr_curve.png, "
+       "difference_matrix.png.",
        {kConfig, Text("--map", "M", "data set to map", true),
         Text("--query", "Q", "data set to localise", true),
+        Whole("--frame-tolerance", "N",
+              "image-sequence place recognition: right within N reference frames", 0, 1000000),
+        Text("--ground-truth", "CSV",
+             "with --frame-tolerance: query,reference file-name pairs (default: by name)"),
         Text("--out", "O", "output folder", true), kOverwrite, kLenient, kQuiet, kJson,
         Formats("formats of the figures: png, pdf, svg, comma-separated (default png)"),
         WidthMm("page width of PDF and SVG figures (default 180: two panels)")},

@@ -11,17 +11,142 @@
 #include "common/number_text.h"
 #include "common/output_folder.h"
 #include "common/provenance.h"
+#include "fusion/io/config.h"
 #include "render/renderer.h"
+#include "sensors/dataset/image_loader.h"
 #include "session/evaluation_session.h"
+#include "session/image_sequence_evaluation.h"
 #include "viewer/localisation_figure.h"
 
 namespace ratslam {
+namespace {
+
+// Place recognition along a route: two image folders, right within N frames.
+int ImageSequenceEvaluate(const Arguments& args, const PipelineOptions& pipeline) {
+  auto fail = [](const Status& s) {
+    std::cerr << MessagePrefix() << s.message() << "\n";
+    return kExitError;
+  };
+  ImageSequenceEvaluationOptions options;
+  options.reference_folder = args.values.at("--map");
+  options.query_folder = args.values.at("--query");
+  options.ground_truth_csv = args.Value("--ground-truth");
+  options.frame_tolerance = std::stoi(args.values.at("--frame-tolerance"));
+  options.matcher = pipeline.sequence;
+  for (const std::string& folder : {options.reference_folder, options.query_folder}) {
+    if (!IsImageSequenceFolder(folder)) {
+      return fail(Status::Error(folder + ": with --frame-tolerance, --map and --query are "
+                                         "folders of images (png, jpg, pgm, ...)"));
+    }
+  }
+  const std::string out_path = args.values.at("--out");
+  auto out = DiskFolder::Open(out_path);
+  if (!out.ok()) return fail(out.status());
+  ProgressPrinter progress(stderr, args.quiet);
+  StopCooperatively();
+  FileImageLoader loader;
+  StatusOr<ImageSequenceEvaluation> e = EvaluateImageSequences(
+      options, &loader,
+      [&](size_t done, size_t total) {
+        if (done % 100 == 0 || done == total) {
+          ProgressUpdate u;
+          u.phase = "queries";
+          u.done = done;
+          u.total = total;
+          progress.Update(u);
+        }
+      },
+      &StopFlag());
+  progress.Finish();
+  if (!e.ok()) {
+    if (StopFlag().load()) {
+      std::cerr << MessagePrefix() << "interrupted; no outputs written\n";
+      return kExitInterrupted;
+    }
+    return fail(e.status());
+  }
+  if (Status s =
+          WriteImageSequenceOutputs(options, *e, PrintConfig(pipeline), ConfigFingerprint(pipeline),
+                                    args.Provenance(), out->get());
+      !s.ok()) {
+    return fail(s);
+  }
+  const PlaceRecognitionMetrics& seq = e->sequence_metrics;
+  const PlaceRecognitionMetrics& single = e->single_metrics;
+  const std::string tolerance = " (right within " + std::to_string(options.frame_tolerance) +
+                                (options.frame_tolerance == 1 ? " frame)" : " frames)");
+  {
+    std::vector<std::string> labels = {
+        "sequences of " + std::to_string(options.matcher.sequence_length) + " frames",
+        "single frames"};
+    std::vector<std::vector<double>> recall(2), precision(2);
+    for (size_t k = 0; k < 2; ++k) {
+      for (const PrecisionRecall& p : (k == 0 ? seq : single).curve) {
+        recall[k].push_back(p.recall);
+        precision[k].push_back(p.precision);
+      }
+    }
+    const std::string title =
+        "place recognition: " + std::to_string(seq.queries) + " queries" + tolerance;
+    if (Status s = WriteCommandFigure(args, (*out)->Path("pr_curve.png"),
+                                      [&](int w) {
+                                        return PrecisionRecallScene(
+                                            labels, recall, precision, title, w,
+                                            "accepted: the answer's margin over the runner-up "
+                                            ">= a threshold");
+                                      });
+        !s.ok()) {
+      return fail(s);
+    }
+  }
+  {
+    DifferenceMatrixFigure figure;
+    figure.differences = e->differences;
+    for (const QueryAnswer& a : e->sequence) figure.answers.push_back(a.match.reference);
+    figure.truth = e->truth;
+    figure.frame_tolerance = options.frame_tolerance;
+    figure.title = "differences and sequence answers";
+    if (Status s = WriteCommandFigure(args, (*out)->Path("difference_matrix.png"),
+                                      [&](int) { return DifferenceMatrixScene(figure); });
+        !s.ok()) {
+      return fail(s);
+    }
+  }
+  char table[512];
+  std::snprintf(table, sizeof table,
+                "%-14s %9s %9s %8s %12s %9s\n"
+                "%-14s %8.1f%% %8.1f%% %8.3f %11.1f%% %9zu\n"
+                "%-14s %8.1f%% %8.1f%% %8.3f %11.1f%% %9zu\n",
+                "matcher", "recall@1", "recall@5", "PR AUC", "R@100%prec", "declined", "sequence",
+                100 * seq.recall_at_1, 100 * seq.recall_at_5, seq.pr_auc,
+                100 * seq.recall_at_100_precision, seq.declined, "single frame",
+                100 * single.recall_at_1, 100 * single.recall_at_5, single.pr_auc,
+                100 * single.recall_at_100_precision, single.declined);
+  std::string text = table;
+  text += "(" + std::to_string(seq.queries) + " queries" + tolerance + ", " +
+          std::to_string(e->reference_files.size()) + " references; matching " +
+          ShortestNumber(std::round(e->match_seconds * 1000) / 1000) + " s)\n";
+  text += MessagePrefix() + "outputs in " + args.Shown(out_path) +
+          " (evaluation.json; --json prints it here)\n";
+  std::ifstream json((*out)->Path("evaluation.json"), std::ios::binary);
+  std::stringstream json_text;
+  json_text << json.rdbuf();
+  PrintOutcome(args.values.count("--json") > 0, args.quiet, json_text.str(), text);
+  return kExitOk;
+}
+
+}  // namespace
 
 int EvaluateCommand(const Arguments& parsed) {
   const Arguments* args = &parsed;
   EvaluationSessionOptions options;
   const auto pipeline = LoadOptions(*args, &options.config_path);
   if (!pipeline) return kExitError;
+  if (args->values.count("--frame-tolerance")) return ImageSequenceEvaluate(*args, *pipeline);
+  if (args->values.count("--ground-truth")) {
+    std::cerr << MessagePrefix() << "--ground-truth needs --frame-tolerance\n";
+    return kExitUsage;
+  }
   options.pipeline = *pipeline;
   options.map_path = args->values.at("--map");
   options.query_path = args->values.at("--query");

@@ -23,7 +23,8 @@ bool PipelineOptions::IsValid(std::string* error) const {
          check(pdr.IsValid(&inner), "pdr") &&
          check(visual_odometry.IsValid(&inner), "visual_odometry") && ratslam.IsValid(error) &&
          check(wifi_sequence.IsValid(&inner), "wifi_sequence") && sensors.fabmap.IsValid(error) &&
-         check(evaluation.IsValid(&inner), "evaluation") && check(bag.IsValid(&inner), "bag") &&
+         check(evaluation.IsValid(&inner), "evaluation") &&
+         check(sequence.IsValid(&inner), "sequence") && check(bag.IsValid(&inner), "bag") &&
          check(video.IsValid(&inner), "video");
 }
 

@@ -25,6 +25,7 @@
 #include "sensors/dataset/rosbag.h"
 #include "sensors/dataset/video.h"
 #include "sensors/pedestrian_dead_reckoning.h"
+#include "sensors/sequence_matcher.h"
 #include "sensors/visual_odometry.h"
 
 namespace ratslam {
@@ -37,6 +38,7 @@ struct PipelineOptions {
   RatslamOptions ratslam;
   WifiSequenceOptions wifi_sequence;     // Wi-Fi sequence loop closure beside the front end
   fabmap::EvaluationOptions evaluation;  // `ratslam evaluate` only: how map and queries split
+  SequenceMatcherOptions sequence;       // `ratslam evaluate` on image sequences
   BagTopics bag;       // which topics of a ROS bag make the data set (not part of a map's identity)
   VideoOptions video;  // how a video's frames get times and odometry (ditto)
 
@@ -70,6 +72,7 @@ struct PipelineOptions {
     v("wifi_words", sensors.fabmap.localiser.wifi_words);
     v("virtual_wifi", sensors.fabmap.localiser.virtual_wifi);
     v("evaluation", evaluation);
+    v("sequence", sequence);
     v("bag", bag);
     v("video", video);
   }

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <tuple>
 
+#include "render/image.h"
 #include "viewer/figures.h"
 
 namespace ratslam {
@@ -83,14 +85,14 @@ Scene LocalisationCurvesScene(const std::vector<LocalisationCurve>& curves,
 Scene PrecisionRecallScene(const std::vector<std::string>& labels,
                            const std::vector<std::vector<double>>& recall,
                            const std::vector<std::vector<double>>& precision,
-                           const std::string& title, int width_px) {
+                           const std::string& title, int width_px, const std::string& subtitle) {
   const float left = 90, top = 104;
   const float panel = width_px > 0 ? std::max(200.0f, width_px - left - 60) : 560;
   const float legend_h = 28.0f * static_cast<float>(labels.size());
   Scene scene(static_cast<int>(left + panel + 60), static_cast<int>(top + panel + 90 + legend_h),
               Rgba{255, 255, 255, 255});
-  scene.Text({20, 32}, title, 20, kInk);
-  scene.Text({20, 58}, "accepted: the best place's posterior >= a threshold", 14, kInk);
+  FittedTitle(scene, {20, 32}, title, 20, left + panel + 40);
+  FittedTitle(scene, {20, 58}, subtitle, 14, left + panel + 40);
   auto to_px = [&](double r, double p) {
     return ScenePoint{static_cast<float>(left + panel * r),
                       static_cast<float>(top + panel * (1 - p))};
@@ -118,6 +120,102 @@ Scene PrecisionRecallScene(const std::vector<std::string>& labels,
     const float y = top + panel + 80 + 28.0f * c;
     scene.Rect(left, y - 10, 28, 6, CategoryColor(static_cast<int>(c)));
     scene.Text({left + 38, y - 2}, labels[c], 16, kInk);
+  }
+  return scene;
+}
+
+Scene DifferenceMatrixScene(const DifferenceMatrixFigure& f) {
+  const int rows = static_cast<int>(f.differences.size());
+  const int cols = rows > 0 ? static_cast<int>(f.differences[0].size()) : 0;
+  const int cells_y = std::max(1, std::min(rows, f.max_cells));
+  const int cells_x = std::max(1, std::min(cols, f.max_cells));
+  const float left = 90, top = 84, side = 600;
+  const float plot_w = side,
+              plot_h = side * std::min(2.0f, std::max(0.5f, float(rows) / std::max(1, cols)));
+  Scene scene(static_cast<int>(left + plot_w + 40), static_cast<int>(top + plot_h + 110),
+              Rgba{255, 255, 255, 255});
+  FittedTitle(scene, {20, 32}, f.title, 20, left + plot_w + 20);
+  FittedTitle(scene, {20, 58}, "darker: more alike (each query's row stretched to its range)", 14,
+              left + plot_w + 20);
+  SceneImage image;
+  image.left = left;
+  image.top = top;
+  image.width = plot_w;
+  image.height = plot_h;
+  image.pixels_wide = cells_x;
+  image.pixels_high = cells_y;
+  image.rgba.assign(static_cast<size_t>(cells_x) * cells_y * 4, 255);
+  // Each row stretched between its own 2nd and 98th percentiles: seasons differ in brightness
+  // overall, and a global scale hides the structure of all but the most alike rows.
+  std::vector<double> cell(static_cast<size_t>(cells_x) * cells_y, 0.0), count(cell.size(), 0.0);
+  for (int q = 0; q < rows; ++q) {
+    std::vector<float> sorted = f.differences[q];
+    if (sorted.empty()) continue;
+    std::sort(sorted.begin(), sorted.end());
+    const double lo = sorted[sorted.size() * 2 / 100], hi = sorted[sorted.size() * 98 / 100];
+    const int y = static_cast<int>(static_cast<int64_t>(q) * cells_y / rows);
+    for (int r = 0; r < cols && r < static_cast<int>(f.differences[q].size()); ++r) {
+      const double v = hi > lo ? std::clamp((f.differences[q][r] - lo) / (hi - lo), 0.0, 1.0) : 0.5;
+      const size_t k = static_cast<size_t>(y) * cells_x +
+                       static_cast<size_t>(static_cast<int64_t>(r) * cells_x / cols);
+      cell[k] += v;
+      count[k] += 1;
+    }
+  }
+  for (size_t k = 0; k < cell.size(); ++k) {
+    const uint8_t g =
+        static_cast<uint8_t>(std::lround(255 * (count[k] > 0 ? cell[k] / count[k] : 1.0)));
+    image.rgba[4 * k] = image.rgba[4 * k + 1] = image.rgba[4 * k + 2] = g;
+  }
+  scene.Image(std::move(image));
+  auto at = [&](double reference, double query) {
+    return ScenePoint{static_cast<float>(left + plot_w * (reference + 0.5) / std::max(1, cols)),
+                      static_cast<float>(top + plot_h * (query + 0.5) / std::max(1, rows))};
+  };
+  // The true places: a thin blue line through runs of consecutive truths.
+  std::vector<ScenePoint> line;
+  for (int q = 0; q <= rows; ++q) {
+    const bool known = q < rows && q < static_cast<int>(f.truth.size()) && f.truth[q] >= 0;
+    if (known && !line.empty() && std::abs(f.truth[q] - f.truth[q - 1]) > 5) {
+      if (line.size() > 1) scene.Polyline(line, 1.0f, Rgba{40, 110, 220, 160});
+      line.clear();
+    }
+    if (known) {
+      line.push_back(at(f.truth[q], q));
+    } else {
+      if (line.size() > 1) scene.Polyline(line, 1.0f, Rgba{40, 110, 220, 160});
+      line.clear();
+    }
+  }
+  const Rgba right{30, 160, 60, 255}, wrong{220, 50, 32, 255};
+  for (int q = 0; q < rows && q < static_cast<int>(f.answers.size()); ++q) {
+    if (f.answers[q] < 0) continue;
+    const bool ok = q < static_cast<int>(f.truth.size()) && f.truth[q] >= 0 &&
+                    std::abs(f.answers[q] - f.truth[q]) <= f.frame_tolerance;
+    scene.Disc(at(f.answers[q], q), 1.6f, ok ? right : wrong, 6);
+  }
+  scene.Rect(left, top, plot_w, 1, kInk);
+  scene.Text({left + plot_w / 2, top + plot_h + 30},
+             "reference frame (0 to " + std::to_string(std::max(0, cols - 1)) + ")", 16, kInk,
+             TextAnchor::kCenter);
+  scene.Text({left - 10, top + 14}, "0", 15, kInk, TextAnchor::kRight);
+  scene.Text({left - 10, top + plot_h}, std::to_string(std::max(0, rows - 1)), 15, kInk,
+             TextAnchor::kRight);
+  scene.Text({20, top + plot_h / 2}, "query", 16, kInk);
+  // The legend, entries side by side as wide as their words.
+  const float y = top + plot_h + 70;
+  float x = left;
+  for (const auto& [color, label, dot] :
+       {std::tuple{right, "answer within the tolerance", true},
+        std::tuple{wrong, "beyond it", true},
+        std::tuple{Rgba{40, 110, 220, 255}, "true place", false}}) {
+    if (dot) {
+      scene.Disc({x + 6, y - 5}, 5, color, 10);
+    } else {
+      scene.Rect(x, y - 6, 14, 2, color);
+    }
+    scene.Text({x + 18, y}, label, 15, kInk);
+    x += 18 + TextWidthPx(label, 15) + 28;
   }
   return scene;
 }

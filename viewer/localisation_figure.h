@@ -29,10 +29,24 @@ Scene LocalisationCurvesScene(const std::vector<LocalisationCurve>& curves,
 // Precision (y) against recall (x), both 0..100 %, one curve per distance d of `labels`:
 // `recall[k]` and `precision[k]` are the points of curve k, from the highest threshold down.
 // `width_px` as for LocalisationCurvesScene (natural: 710 px).
-Scene PrecisionRecallScene(const std::vector<std::string>& labels,
-                           const std::vector<std::vector<double>>& recall,
-                           const std::vector<std::vector<double>>& precision,
-                           const std::string& title, int width_px = 0);
+Scene PrecisionRecallScene(
+    const std::vector<std::string>& labels, const std::vector<std::vector<double>>& recall,
+    const std::vector<std::vector<double>>& precision, const std::string& title, int width_px = 0,
+    const std::string& subtitle = "accepted: the best place's posterior >= a threshold");
+
+// Image-sequence place recognition: the difference matrix (queries down, references across;
+// darker is more alike, each query row stretched over its own range), the true places as a thin
+// line and each query's answer as a dot, green within the tolerance and red beyond. Large
+// matrices are averaged down to at most `max_cells` a side.
+struct DifferenceMatrixFigure {
+  std::vector<std::vector<float>> differences;  // [query][reference]
+  std::vector<int> answers;                     // per query; -1 declined
+  std::vector<int> truth;                       // per query; -1 unknown
+  int frame_tolerance = 1;
+  std::string title;
+  int max_cells = 600;
+};
+Scene DifferenceMatrixScene(const DifferenceMatrixFigure& figure);
 
 }  // namespace ratslam
 

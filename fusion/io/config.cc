@@ -329,7 +329,8 @@ struct AddedSection {
   const char* name;
 };
 constexpr AddedSection kSectionsAddedAfter[] = {
-    {5, "wifi_sequence"}, {7, "bag"}, {7, "video"}, {7, "descriptors"}, {7, "barometer"},
+    {5, "wifi_sequence"}, {7, "bag"},       {7, "video"},
+    {7, "descriptors"},   {7, "barometer"}, {8, "sequence"},
 };
 
 }  // namespace

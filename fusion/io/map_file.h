@@ -26,8 +26,10 @@ namespace ratslam {
 // state: its configurations have the link noise keys experience_map.link_sigma_* (the
 // least_squares relaxation scheme and the g2o information), which older maps resume with at
 // their defaults. Version 8 changes no state: the file ends with a CRC-32C of every byte before
-// it (common/checksum.h), so a flipped byte is an error instead of a different map.
-inline constexpr uint32_t kMapFormatVersion = 8;
+// it (common/checksum.h), so a flipped byte is an error instead of a different map. Version 9
+// changes no state: its configurations have the [sequence] section (image-sequence matching),
+// which older maps resume with at its defaults.
+inline constexpr uint32_t kMapFormatVersion = 9;
 inline constexpr uint32_t kFirstChecksummedMapFormatVersion = 8;
 inline constexpr uint32_t kOldestMapFormatVersion = 2;
 

@@ -1,0 +1,130 @@
+// Place recognition over image sequences after Milford and Wyeth, "SeqSLAM: Visual route-based
+// navigation for sunny summer days and stormy winter nights" (ICRA 2012): images are patch
+// normalised, every query is compared with every reference by mean absolute difference, each
+// query's row of differences is contrast-enhanced over a window of references (the paper's
+// eq. 1), and a query is placed by the best straight line through the last `sequence_length`
+// rows over a range of velocities (references per query frame). The published parameter values
+// (64x32 images, patch side 8, sequence length 10, velocities 0.8 to 1.2, a window of 10
+// references) are the defaults.
+//
+// The matcher is incremental: a query costs one row of differences against the references
+// (8-bit SIMD sums of absolute differences) and one search, never a rebuild. Frames with almost
+// no contrast (black frames in tunnels, lens caps) are "blank": a blank query is declined and a
+// blank reference is never the answer.
+#ifndef RATSLAM_SENSORS_SEQUENCE_MATCHER_H_
+#define RATSLAM_SENSORS_SEQUENCE_MATCHER_H_
+
+#include <cstdint>
+#include <deque>
+#include <string>
+#include <vector>
+
+#include "common/schema.h"
+#include "common/status.h"
+
+namespace ratslam {
+
+struct SequenceMatcherOptions {
+  int patch_px = 8;             // side of the patches normalised to zero mean, unit spread
+  int sequence_length = 10;     // query frames in a sequence (the paper's d_s)
+  double min_velocity = 0.8;    // slowest line searched, reference frames per query frame
+  double max_velocity = 1.2;    // fastest
+  int velocity_steps = 5;       // velocities tried, evenly spaced from min to max
+  int contrast_window = 10;     // references in the contrast-enhancement window (R_window)
+  int exclusion_window = 10;    // references either side of the best kept out of the runner-up
+  double blank_contrast = 8.0;  // grey levels, 5th to 95th percentile, under which: blank
+
+  bool IsValid(std::string* error) const;
+
+  template <typename Visitor>
+  void VisitFields(Visitor&& v) {
+    v("patch_px", patch_px, "side of the square patches normalised to zero mean and unit spread",
+      schema::Unit("px").Within(1, 256));
+    v("sequence_length", sequence_length,
+      "query frames in a matched sequence (1: single frames, no sequence)",
+      schema::Unit("frames").Within(1, 1000));
+    v("min_velocity", min_velocity, "slowest line searched, reference frames per query frame",
+      schema::Unit("frames/frame").Within(0, 100));
+    v("max_velocity", max_velocity, "fastest line searched, reference frames per query frame",
+      schema::Unit("frames/frame").Within(0, 100));
+    v("velocity_steps", velocity_steps, "velocities tried, evenly spaced from min to max",
+      schema::Unit("count").Within(1, 1000));
+    v("contrast_window", contrast_window,
+      "references in the window that enhances each difference's contrast (0: off)",
+      schema::Unit("frames").Within(0, 100000));
+    v("exclusion_window", exclusion_window,
+      "references either side of the best match left out when finding the runner-up",
+      schema::Unit("frames").Within(0, 100000));
+    v("blank_contrast", blank_contrast,
+      "grey levels between a frame's 5th and 95th percentiles below which it is blank (never "
+      "matched)",
+      schema::Unit("grey levels").Within(0, 255));
+  }
+};
+
+// An image after patch normalisation: one byte per pixel (128 + 32 standard deviations of its
+// patch, clamped), rows padded with 128 to a multiple of 32 bytes.
+struct PreparedFrame {
+  int width = 0, height = 0;
+  std::vector<uint8_t> bytes;
+  bool blank = false;
+};
+
+// `pixels` is width x height, rows top to bottom without padding.
+PreparedFrame PrepareFrame(const uint8_t* pixels, int width, int height, int patch_px,
+                           double blank_contrast);
+
+// Mean absolute difference per pixel (0..255) of two frames of one size.
+double FrameDifference(const PreparedFrame& a, const PreparedFrame& b);
+
+struct PlaceCandidate {
+  int reference = -1;  // index of the reference
+  double score = 0.0;  // lower is better (the sequence's summed enhanced difference)
+};
+
+struct SequenceMatch {
+  bool declined = true;  // blank query, or no reference to match
+  int reference = -1;    // the best reference (the place of the newest query frame)
+  // How much better the best is than the best outside the exclusion window around it: a margin
+  // in the units of the score per frame, larger is surer (0 when there is no runner-up).
+  double confidence = 0.0;
+  std::vector<PlaceCandidate> candidates;  // best first, each outside the others' windows
+};
+
+class SequenceMatcher {
+ public:
+  // `options` must be valid (IsValid); throws std::invalid_argument otherwise.
+  explicit SequenceMatcher(const SequenceMatcherOptions& options);
+
+  // References in route order; all frames (references and queries) must have one size.
+  Status AddReference(PreparedFrame frame);
+  size_t references() const { return references_.size(); }
+  bool reference_blank(size_t i) const { return references_[i].blank; }
+
+  // The next query frame of the route being localised: its place by the sequence ending at it
+  // (`sequence`), and by itself alone (`single`: the smallest raw difference, the baseline).
+  // Up to `candidates` places each.
+  struct Result {
+    SequenceMatch sequence;
+    SequenceMatch single;
+    std::vector<float> differences;  // this query's raw row (mean absolute difference 0..255)
+  };
+  StatusOr<Result> AddQuery(const PreparedFrame& frame, int candidates = 5);
+
+  // Forgets the queries (a new query route starts); the references stay.
+  void ResetQueries() { rows_.clear(); }
+
+ private:
+  struct Row {
+    std::vector<float> enhanced;  // contrast-enhanced differences, one per reference
+    float neutral = 0.0f;         // at blank references, and for lines before the route starts
+    bool blank = false;
+  };
+  SequenceMatcherOptions options_;
+  std::vector<PreparedFrame> references_;
+  std::deque<Row> rows_;  // the newest sequence_length query rows, newest last
+};
+
+}  // namespace ratslam
+
+#endif  // RATSLAM_SENSORS_SEQUENCE_MATCHER_H_

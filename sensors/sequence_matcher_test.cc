@@ -1,0 +1,142 @@
+#include "sensors/sequence_matcher.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <vector>
+
+#include "common/random.h"
+
+namespace ratslam {
+namespace {
+
+constexpr int kW = 64, kH = 32;
+
+std::vector<uint8_t> Texture(uint64_t seed) {
+  Random random(seed);
+  std::vector<uint8_t> p(kW * kH);
+  for (uint8_t& v : p) v = static_cast<uint8_t>(random.Uniform(20, 230));
+  return p;
+}
+
+std::vector<uint8_t> Noisy(std::vector<uint8_t> p, double sigma, Random* random) {
+  for (uint8_t& v : p) {
+    v = static_cast<uint8_t>(std::clamp(std::lround(v + random->Gaussian(0, sigma)), 0L, 255L));
+  }
+  return p;
+}
+
+PreparedFrame Prepare(const std::vector<uint8_t>& p, const SequenceMatcherOptions& o = {}) {
+  return PrepareFrame(p.data(), kW, kH, o.patch_px, o.blank_contrast);
+}
+
+// A patch of two grey levels becomes 128 -/+ 32 (one standard deviation either side); a flat
+// image is blank and all 128; rows are padded with 128 to 32 bytes.
+TEST(PrepareFrameTest, PatchesBecomeZeroMeanUnitSpreadBytes) {
+  std::vector<uint8_t> p(8 * 2);
+  for (int x = 0; x < 8; ++x) p[x] = 0, p[8 + x] = 100;  // two rows: 0s, then 100s
+  const PreparedFrame f = PrepareFrame(p.data(), 8, 2, 8, 3.0);
+  ASSERT_EQ(f.bytes.size(), 64u);
+  EXPECT_FALSE(f.blank);
+  EXPECT_EQ(f.bytes[0], 96);
+  EXPECT_EQ(f.bytes[32], 160);
+  EXPECT_EQ(f.bytes[8], 128);  // padding
+  const std::vector<uint8_t> flat(8 * 2, 7);
+  const PreparedFrame g = PrepareFrame(flat.data(), 8, 2, 8, 3.0);
+  EXPECT_TRUE(g.blank);
+  EXPECT_TRUE(std::all_of(g.bytes.begin(), g.bytes.end(), [](uint8_t b) { return b == 128; }));
+}
+
+// The SIMD difference equals the plain sum over the pixels, divided by their number.
+TEST(FrameDifferenceTest, EqualsThePlainMeanAbsoluteDifference) {
+  for (uint64_t seed = 1; seed < 20; ++seed) {
+    const PreparedFrame a = Prepare(Texture(seed)), b = Prepare(Texture(seed + 100));
+    double plain = 0;
+    const int stride = static_cast<int>(a.bytes.size()) / kH;
+    for (int y = 0; y < kH; ++y) {
+      for (int x = 0; x < kW; ++x) {
+        plain += std::abs(a.bytes[y * stride + x] - b.bytes[y * stride + x]);
+      }
+    }
+    EXPECT_DOUBLE_EQ(FrameDifference(a, b), plain / (kW * kH)) << seed;
+    EXPECT_EQ(FrameDifference(a, a), 0.0);
+  }
+}
+
+// Perceptual aliasing: the route shows 100 places, then the same places again in another order.
+// A frame of the second half looks exactly like one of the first, so a single frame cannot tell
+// them apart; ten frames in order can. Every query from the tenth on is placed exactly.
+TEST(SequenceMatcherTest, SequencesResolveWhatSingleFramesCannot) {
+  std::vector<int> order(100);
+  std::iota(order.begin(), order.end(), 0);
+  std::vector<int> shuffled = order;
+  Random random(7);
+  for (int i = 99; i > 0; --i) std::swap(shuffled[i], shuffled[random.NextU64() % (i + 1)]);
+  order.insert(order.end(), shuffled.begin(), shuffled.end());
+  SequenceMatcherOptions options;
+  SequenceMatcher matcher(options);
+  for (int place : order) ASSERT_TRUE(matcher.AddReference(Prepare(Texture(place))).ok());
+  int sequence_right = 0, single_right = 0, counted = 0;
+  for (int j = 0; j < static_cast<int>(order.size()); ++j) {
+    const auto r = matcher.AddQuery(Prepare(Noisy(Texture(order[j]), 12, &random)));
+    ASSERT_TRUE(r.ok());
+    if (j < options.sequence_length - 1 || j < 100) continue;  // the aliased half, full sequences
+    ++counted;
+    sequence_right += r->sequence.reference == j;
+    single_right += r->single.reference == j;
+    ASSERT_EQ(r->sequence.candidates.size(), 5u);
+  }
+  EXPECT_EQ(sequence_right, counted);
+  // Each second-half frame has an identical twin in the first half: the two differences are
+  // equal, and a tie goes to the lower index, so a single frame always answers the twin.
+  EXPECT_EQ(single_right, 0);
+}
+
+// A query route driven 1.2 times as fast as the reference route (every 6 reference frames in 5
+// query frames) is followed within a frame once a sequence is full; a blank query is declined and
+// a blank reference is never an answer.
+TEST(SequenceMatcherTest, FollowsAFasterRouteAndNeverClaimsBlankFrames) {
+  SequenceMatcher matcher{SequenceMatcherOptions{}};
+  const std::vector<uint8_t> black(kW * kH, 0);
+  for (int r = 0; r < 240; ++r) {
+    ASSERT_TRUE(matcher.AddReference(Prepare(r == 120 ? black : Texture(1000 + r))).ok());
+  }
+  EXPECT_TRUE(matcher.reference_blank(120));
+  Random random(3);
+  for (int j = 0; j < 195; ++j) {
+    const int truth = static_cast<int>(std::lround(1.2 * j));
+    const auto r =
+        matcher.AddQuery(Prepare(truth == 120 ? black : Noisy(Texture(1000 + truth), 40, &random)));
+    ASSERT_TRUE(r.ok());
+    if (truth == 120) {
+      EXPECT_TRUE(r->sequence.declined);
+      EXPECT_TRUE(r->single.declined);
+      continue;
+    }
+    for (const PlaceCandidate& c : r->sequence.candidates) EXPECT_NE(c.reference, 120);
+    for (const PlaceCandidate& c : r->single.candidates) EXPECT_NE(c.reference, 120);
+    if (j >= 9) {
+      EXPECT_LE(std::abs(r->sequence.reference - truth), 1) << j;
+    }
+  }
+}
+
+TEST(SequenceMatcherTest, FramesOfAnotherSizeAreErrors) {
+  SequenceMatcher matcher{SequenceMatcherOptions{}};
+  ASSERT_TRUE(matcher.AddReference(Prepare(Texture(1))).ok());
+  const std::vector<uint8_t> small(32 * 16, 50);
+  const PreparedFrame f = PrepareFrame(small.data(), 32, 16, 8, 3.0);
+  EXPECT_NE(matcher.AddReference(f).message().find("32x16, the first was 64x32"),
+            std::string::npos);
+  EXPECT_FALSE(matcher.AddQuery(f).ok());
+  SequenceMatcherOptions bad;
+  bad.max_velocity = 0.5;
+  std::string error;
+  EXPECT_FALSE(bad.IsValid(&error));
+  EXPECT_THROW(SequenceMatcher{bad}, std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace ratslam

@@ -1,0 +1,301 @@
+#include "session/image_sequence_evaluation.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "common/file_util.h"
+#include "common/number_text.h"
+#include "fusion/io/provenance_json.h"
+#include "sensors/dataset/csv.h"
+
+namespace ratslam {
+namespace {
+
+namespace fs = std::filesystem;
+
+bool IsImageName(const fs::path& p) {
+  std::string ext = p.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  for (const char* e : {".png", ".jpg", ".jpeg", ".pgm", ".ppm", ".bmp", ".tif", ".tiff"}) {
+    if (ext == e) return true;
+  }
+  return false;
+}
+
+double Seconds(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+bool Within(const QueryAnswer& a, int reference, int tolerance) {
+  return a.truth >= 0 && reference >= 0 && std::abs(reference - a.truth) <= tolerance;
+}
+
+nlohmann::ordered_json MetricsJson(const PlaceRecognitionMetrics& m) {
+  nlohmann::ordered_json j;
+  j["queries"] = m.queries;
+  j["declined"] = m.declined;
+  j["recall_at_1"] = m.recall_at_1;
+  j["recall_at_5"] = m.recall_at_5;
+  j["pr_auc"] = m.pr_auc;
+  j["recall_at_100_precision"] = m.recall_at_100_precision;
+  return j;
+}
+
+}  // namespace
+
+bool IsImageSequenceFolder(const std::string& path) {
+  std::error_code ec;
+  if (!fs::is_directory(path, ec) || fs::exists(fs::path(path) / "manifest.toml", ec)) {
+    return false;
+  }
+  for (const fs::directory_entry& e : fs::directory_iterator(path, ec)) {
+    if (e.is_regular_file(ec) && IsImageName(e.path())) return true;
+  }
+  return false;
+}
+
+StatusOr<std::vector<std::string>> ListImageSequence(const std::string& folder) {
+  std::error_code ec;
+  if (!fs::is_directory(folder, ec)) return Status::Error(folder + ": not a folder");
+  std::vector<std::string> names;
+  for (const fs::directory_entry& e : fs::directory_iterator(folder, ec)) {
+    if (e.is_regular_file(ec) && IsImageName(e.path())) {
+      names.push_back(e.path().filename().string());
+    }
+  }
+  if (ec) return Status::Error(folder + ": " + ec.message());
+  if (names.empty()) return Status::Error(folder + ": no image files (png, jpg, pgm, ...)");
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+StatusOr<std::vector<int>> PairQueriesWithReferences(const std::vector<std::string>& references,
+                                                     const std::vector<std::string>& queries,
+                                                     const std::string& ground_truth_csv) {
+  std::map<std::string, int> reference_index, query_index;
+  for (size_t i = 0; i < references.size(); ++i) reference_index[references[i]] = int(i);
+  for (size_t i = 0; i < queries.size(); ++i) query_index[queries[i]] = int(i);
+  std::vector<int> truth(queries.size(), -1);
+  if (!ground_truth_csv.empty()) {
+    StatusOr<CsvTable> t = CsvTable::Read(ground_truth_csv, {"query", "reference"});
+    if (!t.ok()) return t.status();
+    for (size_t r = 0; r < t->rows(); ++r) {
+      StatusOr<std::string> q = t->Text(r, "query"), ref = t->Text(r, "reference");
+      if (!q.ok()) return q.status();
+      if (!ref.ok()) return ref.status();
+      const auto qi = query_index.find(*q);
+      if (qi == query_index.end()) {
+        return t->ErrorAt(r, "query", "'" + *q + "' is not an image of the query folder");
+      }
+      const auto ri = reference_index.find(*ref);
+      if (ri == reference_index.end()) {
+        return t->ErrorAt(r, "reference", "'" + *ref + "' is not an image of the reference folder");
+      }
+      if (truth[qi->second] >= 0) {
+        return t->ErrorAt(r, "query", "'" + *q + "' is paired twice");
+      }
+      truth[qi->second] = ri->second;
+    }
+    return truth;
+  }
+  const bool by_name = std::all_of(queries.begin(), queries.end(), [&](const std::string& q) {
+    return reference_index.count(q) > 0;
+  });
+  if (by_name) {
+    for (size_t i = 0; i < queries.size(); ++i) truth[i] = reference_index[queries[i]];
+    return truth;
+  }
+  if (queries.size() == references.size()) {
+    for (size_t i = 0; i < queries.size(); ++i) truth[i] = static_cast<int>(i);
+    return truth;
+  }
+  return Status::Error("cannot pair the " + std::to_string(queries.size()) + " queries with the " +
+                       std::to_string(references.size()) +
+                       " references: their file names differ and so do their numbers; give "
+                       "--ground-truth (a CSV with columns query,reference)");
+}
+
+PlaceRecognitionMetrics MetricsOf(const std::vector<QueryAnswer>& answers, int frame_tolerance) {
+  PlaceRecognitionMetrics m;
+  std::vector<const QueryAnswer*> accepted;
+  size_t right_at_1 = 0, right_at_5 = 0;
+  for (const QueryAnswer& a : answers) {
+    if (a.truth < 0) continue;
+    ++m.queries;
+    if (a.match.declined) {
+      ++m.declined;
+      continue;
+    }
+    right_at_1 += Within(a, a.match.reference, frame_tolerance);
+    const size_t top = std::min<size_t>(5, a.match.candidates.size());
+    right_at_5 += std::any_of(
+        a.match.candidates.begin(), a.match.candidates.begin() + top,
+        [&](const PlaceCandidate& c) { return Within(a, c.reference, frame_tolerance); });
+    accepted.push_back(&a);
+  }
+  if (m.queries == 0) return m;
+  const double n = static_cast<double>(m.queries);
+  m.recall_at_1 = right_at_1 / n;
+  m.recall_at_5 = right_at_5 / n;
+  // Most confident first; ties are accepted together (one threshold cannot split them).
+  std::stable_sort(accepted.begin(), accepted.end(),
+                   [](const QueryAnswer* a, const QueryAnswer* b) {
+                     return a->match.confidence > b->match.confidence;
+                   });
+  size_t right = 0;
+  double last_recall = 0.0;
+  bool perfect = true;
+  for (size_t i = 0; i < accepted.size(); ++i) {
+    right += Within(*accepted[i], accepted[i]->match.reference, frame_tolerance);
+    if (i + 1 < accepted.size() &&
+        accepted[i + 1]->match.confidence == accepted[i]->match.confidence) {
+      continue;
+    }
+    PrecisionRecall p;
+    p.recall = right / n;
+    p.precision = static_cast<double>(right) / static_cast<double>(i + 1);
+    p.threshold = accepted[i]->match.confidence;
+    m.pr_auc += p.precision * (p.recall - last_recall);
+    last_recall = p.recall;
+    perfect = perfect && right == i + 1;
+    if (perfect) m.recall_at_100_precision = p.recall;
+    m.curve.push_back(p);
+  }
+  return m;
+}
+
+StatusOr<ImageSequenceEvaluation> EvaluateImageSequences(
+    const ImageSequenceEvaluationOptions& options, ImageLoader* loader,
+    const std::function<void(size_t, size_t)>& progress, const std::atomic<bool>* stop) {
+  std::string error;
+  if (!options.matcher.IsValid(&error)) return Status::Error("[sequence] " + error);
+  if (options.frame_tolerance < 0) return Status::Error("frame tolerance must not be negative");
+  const auto start = std::chrono::steady_clock::now();
+  ImageSequenceEvaluation e;
+  StatusOr<std::vector<std::string>> refs = ListImageSequence(options.reference_folder);
+  if (!refs.ok()) return refs.status();
+  StatusOr<std::vector<std::string>> queries = ListImageSequence(options.query_folder);
+  if (!queries.ok()) return queries.status();
+  e.reference_files = std::move(*refs);
+  e.query_files = std::move(*queries);
+  StatusOr<std::vector<int>> truth =
+      PairQueriesWithReferences(e.reference_files, e.query_files, options.ground_truth_csv);
+  if (!truth.ok()) return truth.status();
+  e.truth = std::move(*truth);
+
+  const SequenceMatcherOptions& o = options.matcher;
+  auto prepare = [&](const std::string& folder,
+                     const std::string& name) -> StatusOr<PreparedFrame> {
+    const std::string path = (fs::path(folder) / name).string();
+    StatusOr<GrayImage> image = loader->Load(path);
+    if (!image.ok()) return image.status();
+    return PrepareFrame(image->pixels.data(), image->width, image->height, o.patch_px,
+                        o.blank_contrast);
+  };
+  SequenceMatcher matcher(o);
+  for (const std::string& name : e.reference_files) {
+    if (stop && stop->load()) return Status::Error("stopped");
+    StatusOr<PreparedFrame> f = prepare(options.reference_folder, name);
+    if (!f.ok()) return f.status();
+    e.blank_references += f->blank;
+    if (Status s = matcher.AddReference(std::move(*f)); !s.ok()) {
+      return Status::Error((fs::path(options.reference_folder) / name).string() + ": " +
+                           s.message());
+    }
+  }
+  std::vector<PreparedFrame> query_frames;
+  query_frames.reserve(e.query_files.size());
+  for (const std::string& name : e.query_files) {
+    if (stop && stop->load()) return Status::Error("stopped");
+    StatusOr<PreparedFrame> f = prepare(options.query_folder, name);
+    if (!f.ok()) return f.status();
+    e.blank_queries += f->blank;
+    query_frames.push_back(std::move(*f));
+  }
+  e.load_seconds = Seconds(start);
+
+  const auto matching = std::chrono::steady_clock::now();
+  for (size_t q = 0; q < query_frames.size(); ++q) {
+    if (stop && stop->load()) return Status::Error("stopped");
+    StatusOr<SequenceMatcher::Result> r = matcher.AddQuery(query_frames[q]);
+    if (!r.ok()) {
+      return Status::Error((fs::path(options.query_folder) / e.query_files[q]).string() + ": " +
+                           r.status().message());
+    }
+    e.sequence.push_back({e.truth[q], std::move(r->sequence)});
+    e.single.push_back({e.truth[q], std::move(r->single)});
+    e.differences.push_back(std::move(r->differences));
+    if (progress) progress(q + 1, query_frames.size());
+  }
+  e.match_seconds = Seconds(matching);
+  e.sequence_metrics = MetricsOf(e.sequence, options.frame_tolerance);
+  e.single_metrics = MetricsOf(e.single, options.frame_tolerance);
+  return e;
+}
+
+Status WriteImageSequenceOutputs(const ImageSequenceEvaluationOptions& options,
+                                 const ImageSequenceEvaluation& e, const std::string& config_toml,
+                                 uint64_t config_fingerprint, const RunProvenance& provenance,
+                                 OutputFolder* out) {
+  nlohmann::ordered_json j;
+  j["mode"] = "image_sequence";
+  j["map"] = options.reference_folder;
+  j["query"] = options.query_folder;
+  if (!options.ground_truth_csv.empty()) j["ground_truth"] = options.ground_truth_csv;
+  j["references"] = e.reference_files.size();
+  j["blank_references"] = e.blank_references;
+  j["query_frames"] = e.query_files.size();
+  j["blank_queries"] = e.blank_queries;
+  j["frame_tolerance"] = options.frame_tolerance;
+  j["sequence_length"] = options.matcher.sequence_length;
+  const PlaceRecognitionMetrics& m = e.sequence_metrics;
+  j["queries"] = m.queries;
+  j["declined"] = m.declined;
+  j["recall_at_1"] = m.recall_at_1;
+  j["recall_at_5"] = m.recall_at_5;
+  j["pr_auc"] = m.pr_auc;
+  j["recall_at_100_precision"] = m.recall_at_100_precision;
+  j["baselines"]["single_frame"] = MetricsJson(e.single_metrics);
+  j["load_seconds"] = e.load_seconds;
+  j["match_seconds"] = e.match_seconds;
+  j["query_time_ms"] =
+      e.query_files.empty() ? 0.0 : 1000.0 * e.match_seconds / e.query_files.size();
+  j["run"] = RunObject(provenance, {options.reference_folder, options.query_folder}, std::nullopt,
+                       config_fingerprint);
+  std::ostringstream csv;
+  csv << "query,file,truth,sequence_match,sequence_confidence,sequence_correct,single_match,"
+         "single_confidence,single_correct\n";
+  for (size_t q = 0; q < e.query_files.size(); ++q) {
+    auto cells = [&](const QueryAnswer& a) {
+      std::string s;
+      if (a.match.declined) return std::string(",,") + (a.truth >= 0 ? "0" : "");
+      s = std::to_string(a.match.reference) + ',' + ShortestNumber(a.match.confidence) + ',';
+      if (a.truth >= 0) s += Within(a, a.match.reference, options.frame_tolerance) ? "1" : "0";
+      return s;
+    };
+    csv << q << ',' << e.query_files[q] << ','
+        << (e.truth[q] >= 0 ? std::to_string(e.truth[q]) : std::string()) << ','
+        << cells(e.sequence[q]) << ',' << cells(e.single[q]) << '\n';
+  }
+  std::ostringstream pr;
+  pr << "method,threshold,precision,recall\n";
+  for (const auto& [name, metrics] :
+       {std::pair{"sequence", &e.sequence_metrics}, std::pair{"single_frame", &e.single_metrics}}) {
+    for (const PrecisionRecall& p : metrics->curve) {
+      pr << name << ',' << ShortestNumber(p.threshold) << ',' << ShortestNumber(p.precision) << ','
+         << ShortestNumber(p.recall) << '\n';
+    }
+  }
+  return out->Write({{"config.toml", config_toml},
+                     {"evaluation.json", j.dump(2) + "\n"},
+                     {"queries.csv", csv.str()},
+                     {"pr_curve.csv", pr.str()}});
+}
+
+}  // namespace ratslam
