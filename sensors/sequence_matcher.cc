@@ -60,20 +60,25 @@ SadKernel ChooseSad() {
 const SadKernel kSad = ChooseSad();
 
 // Up to `count` places, best first, none within `exclusion` references of a better one; places
-// with an infinite score are never taken.
+// with an infinite score are never taken. A scan per place (count is small): sorting every
+// reference cost more than the whole search.
 std::vector<PlaceCandidate> Candidates(const std::vector<double>& score, int count, int exclusion) {
-  std::vector<int> order(score.size());
-  std::iota(order.begin(), order.end(), 0);
-  // Ties go to the lower index, so the answer never depends on the sort's internals.
-  std::sort(order.begin(), order.end(),
-            [&](int a, int b) { return score[a] < score[b] || (score[a] == score[b] && a < b); });
   std::vector<PlaceCandidate> out;
-  for (int i : order) {
-    if (static_cast<int>(out.size()) >= count || !std::isfinite(score[i])) break;
-    const bool apart = std::all_of(out.begin(), out.end(), [&](const PlaceCandidate& c) {
-      return std::abs(c.reference - i) > exclusion;
-    });
-    if (apart) out.push_back({i, score[i]});
+  const int n = static_cast<int>(score.size());
+  while (static_cast<int>(out.size()) < count) {
+    int best = -1;
+    for (int i = 0; i < n; ++i) {
+      // Strictly smaller: a tie goes to the lower index.
+      if (!(score[i] < (best < 0 ? std::numeric_limits<double>::infinity() : score[best]))) {
+        continue;
+      }
+      const bool apart = std::all_of(out.begin(), out.end(), [&](const PlaceCandidate& c) {
+        return std::abs(c.reference - i) > exclusion;
+      });
+      if (apart) best = i;
+    }
+    if (best < 0) break;
+    out.push_back({best, score[best]});
   }
   return out;
 }
