@@ -1,5 +1,5 @@
 // The `ratslam` command line: every sub-command, its options and their types, parsed with CLI11.
-// One table describes the commands; the parser, `--help`, the README's command reference and
+// One table describes the commands; the parser, `--help`, docs/cli.md's command reference and
 // the bash completion all come from it, so they cannot disagree.
 #ifndef RATSLAM_APPS_COMMAND_LINE_H_
 #define RATSLAM_APPS_COMMAND_LINE_H_
@@ -30,7 +30,7 @@ std::variant<ParsedCommand, int> ParseCommandLine(int argc, const char* const* a
 // Every command path, in the order of the reference.
 std::vector<std::string> CommandPaths();
 
-// The README's command reference: each command's `--help`, in Markdown.
+// docs/cli.md's command reference: each command's `--help`, in Markdown.
 std::string CommandReference();
 
 // A bash completion script for `ratslam` (commands and options): `source <(ratslam

@@ -168,11 +168,12 @@ TEST(CommandLineTest, TheLimitsOfARangeAreAccepted) {
   }
 }
 
-// The README's command reference is this program's help, so the two cannot drift apart.
-// RATSLAM_UPDATE_README=1 rewrites the README's block (then review the diff).
+// docs/cli.md's command reference is this program's help, so the two cannot drift apart.
+// RATSLAM_UPDATE_README=1 rewrites its block (then review the diff).
 TEST(CommandLineTest, ReadmeCarriesTheCurrentCommandReference) {
-  std::ifstream in(std::string(RATSLAM_SOURCE_DIR) + "/README.md");
-  ASSERT_TRUE(in) << "README.md not found";
+  const std::string path = std::string(RATSLAM_SOURCE_DIR) + "/docs/cli.md";
+  std::ifstream in(path);
+  ASSERT_TRUE(in) << path << " not found";
   std::stringstream s;
   s << in.rdbuf();
   const std::string readme = s.str();
@@ -180,15 +181,15 @@ TEST(CommandLineTest, ReadmeCarriesTheCurrentCommandReference) {
   const std::string end = "<!-- command reference: end -->";
   const size_t a = readme.find(begin);
   const size_t b = readme.find(end);
-  ASSERT_NE(a, std::string::npos) << "README.md has no '" << begin << "' marker";
+  ASSERT_NE(a, std::string::npos) << path << " has no '" << begin << "' marker";
   ASSERT_NE(b, std::string::npos);
   if (std::getenv("RATSLAM_UPDATE_README") != nullptr) {
-    std::ofstream(std::string(RATSLAM_SOURCE_DIR) + "/README.md")
-        << readme.substr(0, a + begin.size()) << CommandReference() << readme.substr(b);
-    GTEST_SKIP() << "README.md rewritten";
+    std::ofstream(path) << readme.substr(0, a + begin.size()) << CommandReference()
+                        << readme.substr(b);
+    GTEST_SKIP() << path << " rewritten";
   }
   EXPECT_EQ(readme.substr(a + begin.size(), b - a - begin.size()), CommandReference())
-      << "README.md's command reference is out of date: rerun this test with "
+      << "docs/cli.md's command reference is out of date: rerun this test with "
          "RATSLAM_UPDATE_README=1";
 }
 

@@ -506,8 +506,8 @@ py::dict Evaluate(const std::string& map, const std::string& query, const std::s
 PYBIND11_MODULE(ratslam, m) {
   using namespace ratslam::python;
   m.doc() =
-      "RatSLAM: replays, localisation on saved maps and frame-by-frame sessions (see the README's "
-      "Python section).";
+      "RatSLAM: replays, localisation on saved maps and frame-by-frame sessions (see "
+      "docs/python.md).";
   py::register_exception<Error>(m, "Error", PyExc_RuntimeError);
   m.attr("__version__") = ratslam::RatslamVersion();
 

@@ -6,7 +6,7 @@
 # fingerprint answer per scan on the same map scans, and the sum likelihood on a map made from a
 # RatSLAM run of repetitions 01 and 02 instead (configs/ipin2023-wifi-compass.toml; positions from
 # the run's final map, scored after its alignment onto the truth). Errors in metres at the scans
-# with ground truth; a Markdown table (the README's). The last columns: the sum likelihood with
+# with ground truth; a Markdown table (docs/results/wifi-sequence.md). The last columns: the sum likelihood with
 # [particle_filter] online_rssi_offset = true (the located phone's offset to the map's scans
 # estimated from its own scans) and the offset it removed at the end (dB).
 # Usage: scripts/ipin_locate_table.sh [DATA_DIR] [OUT_DIR]

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Wi-Fi sequence loop closure (Kudo and Miura, section III) on every IPIN 2023 Track 3 training
 # route: single walks and all repetitions as one multi-session run, in four modes, as a Markdown
-# table (the README's). Modes:
+# table (docs/results/wifi-sequence.md). Modes:
 #   pdr+compass  front end none, no loop closure: dead reckoning with compass facings (baseline)
 #   seq alone    configs/ipin2023-wifi-sequence-alone.toml
 #   b_out        configs/ipin2023-wifi-compass.toml (RatSLAM's own Wi-Fi loop closure)

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The README's IPIN table: Wi-Fi RatSLAM on the IPIN 2023 Track 3 training logs (the four
+# The IPIN table of docs/results/ipin.md: Wi-Fi RatSLAM on the IPIN 2023 Track 3 training logs (the four
 # repetitions of each route as one multi-session run, Wi-Fi alone and with the compass; two single
 # walks; route 51 with and without the barometer), with the shipped configs and, for comparison,
 # without the online RSSI offset ([fused] online_rssi_offset = false), and as they were before

@@ -2,9 +2,9 @@
 //
 // Microsoft ILC 2.0 walks, Wi-Fi-only FABMAP, split by walk: with 16 incremental RSSI words and
 // the new-place decision learnt from the map's walks 33.4 % of the 640 queries are within 5 m and
-// 0.5 % on another floor (README; 35.2 % and 4.2 % without the calibration). We check the
-// report's consistency and a floor well below that (25 % within 5 m; floor mistakes under 20 %,
-// against 80 % for an answer drawn at random among 5 floors), and the calibration below.
+// 0.5 % on another floor (docs/results/fabmap.md; 35.2 % and 4.2 % without the calibration). We
+// check the report's consistency and a floor well below that (25 % within 5 m; floor mistakes under
+// 20 %, against 80 % for an answer drawn at random among 5 floors), and the calibration below.
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -1,7 +1,7 @@
 // The papers' scenarios on the built-in simulated worlds: each test runs the relevant modes
 // end to end (`ratslam simulate`, `replay`, `evaluate`) and checks the direction of the papers'
 // findings, not their numbers. Margins leave room around the values measured when the test
-// was written (in comments; the README's scenario table has them all).
+// was written (in comments; docs/simulator.md's scenario table has them all).
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -37,7 +37,8 @@ StatusOr<SplitUnit> SplitUnitFromString(const std::string& name);
 // kYouden: the threshold with the best Youden's J over near and far nodes. kNearRecall: the
 // highest threshold that still accepts `new_place_near_recall` of the near nodes (far ones are
 // only reported): it needs no far nodes, and keeps its promise where map and queries are alike
-// (the same users), but accepts more far queries where they differ (README, new-place table).
+// (the same users), but accepts more far queries where they differ (docs/results/fabmap.md,
+// new-place table).
 enum class NewPlaceRule { kNearRecall, kYouden };
 std::string ToString(NewPlaceRule rule);
 StatusOr<NewPlaceRule> NewPlaceRuleFromString(const std::string& name);

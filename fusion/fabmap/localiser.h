@@ -71,7 +71,8 @@ struct LocaliserSettings {
   FabmapOptions fabmap;
   DetectorModel visual_detector;  // openFABMAP's defaults (0.39, 0)
   // An access point in range is heard far more reliably than a visual word is detected: with
-  // 0.39 nearly every UJIIndoorLoc query is rejected (97%); 0.9 gives 6.7% (see the README).
+  // 0.39 nearly every UJIIndoorLoc query is rejected (97%); 0.9 gives 6.7% (see
+  // docs/results/fabmap.md).
   DetectorModel wifi_detector{0.9, 0.0};
   WifiWordOptions wifi_words;
   VirtualSampleOptions virtual_wifi;
