@@ -2,8 +2,8 @@
 # The IPIN table of docs/results/ipin.md: Wi-Fi RatSLAM on the IPIN 2023 Track 3 training logs (the four
 # repetitions of each route as one multi-session run, Wi-Fi alone and with the compass; two single
 # walks; route 51 with and without the barometer), with the shipped configs and, for comparison,
-# without the online RSSI offset ([fused] online_rssi_offset = false), and as they were before
-# 2026-12-02: also OpenRatSLAM's frame memory ([local_view] memory line removed) and then also
+# without the online RSSI offset ([fused] online_rssi_offset = false), and as they were before those
+# two changes: also OpenRatSLAM's frame memory ([local_view] memory line removed) and then also
 # the calibration gesture counted as steps ([pdr] min_orientation_steadiness = 0).
 # PDR-only is the dead-reckoning error of the same runs (odometry_ate_m).
 # Usage: scripts/ipin_table.sh [DATA_DIR] [OUT_DIR]

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The new-place decision on queries near the map and far from it (issue 12, item 6), as a
+# The new-place decision on queries near the map and far from it, as a
 # Markdown table: Wi-Fi-only FABMAP with its own arg-max and with the threshold learnt from the
 # map's sessions ([evaluation] calibrate_new_place) by each new_place_rule, beside the k-NN and
 # eq. 6 fingerprint baselines of the same run, on the Microsoft walks (split by walk) and on

@@ -16,7 +16,7 @@ if [[ "${SANITIZE:-0}" == 1 ]]; then
   # Mesa's shader disk cache runs its own thread ("disk$0"), which is still exiting at exit too
   # (the same tracer crash, seen in a CI run on `evaluate`): no disk cache under sanitizers.
   export MESA_SHADER_CACHE_DISABLE=true
-  # The tracer crash still comes back now and then under load (CI, 2026-12-03: `evaluate` in
+  # The tracer crash still comes back now and then under load (once in CI: `evaluate` in
   # SimulatedScenarios.ApartmentEarlyFusionIsNoWorseThanVision; the same test passed 3 of 3
   # times alone). A failing test runs once more: a sanitizer report from our own code is
   # deterministic and fails both times, the tracer's crash does not.

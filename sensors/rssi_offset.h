@@ -1,4 +1,4 @@
-// A phone's RSSI offset to the map, estimated online per session (issue 12, item 4): phones read
+// A phone's RSSI offset to the map, estimated online per session: phones read
 // the same place several dB apart, a difference that Wi-Fi kernels and RSSI bins both turn into
 // "another place". Shared by the fused and FABMAP front ends, the phone particle filter and
 // evaluate (per query session).

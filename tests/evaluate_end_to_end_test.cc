@@ -89,7 +89,7 @@ TEST(EvaluateEndToEndTest, MicrosoftWalksWifiOnly) {
   EXPECT_LT(j["floor_mistake_rate"].get<double>(), 0.2);
   // The shipped config learns the new-place decision from the map's walks. Without it FABMAP
   // answered 17 % of the queries far from every map place (> 10 m) on another floor and
-  // rejected 3.4 % of them, for 4.2 % floor mistakes over all queries; issue 12 asks for at most
+  // rejected 3.4 % of them, for 4.2 % floor mistakes over all queries; the target is at most
   // 3 %. We require that, most far queries rejected, and near ones (<= 5 m) still located:
   // rejecting everything would reject all near ones too.
   const nlohmann::json& calibration = j["new_place_calibration"];

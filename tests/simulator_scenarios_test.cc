@@ -167,7 +167,7 @@ TEST_F(SimulatedScenarios, AliasedFloorsWifiPreventsFloorMistakes) {
 TEST_F(SimulatedScenarios, ApartmentEarlyFusionIsNoWorseThanVision) {
 #if defined(__SANITIZE_ADDRESS__)
   // In the sanitizer suite the `evaluate` this runs ends with LeakSanitizer's own tracer crashing
-  // at exit ("Tracer caught signal 11", twice in a row in CI on 2026-12-03, with llvmpipe's
+  // at exit ("Tracer caught signal 11", twice in a row in CI, with llvmpipe's
   // threads and Mesa's shader cache already off; it passes alone). AddressSanitizer reports
   // nothing before that; the plain build runs this check.
   GTEST_SKIP() << "LeakSanitizer's tracer crashes at the exit of this evaluate run";
