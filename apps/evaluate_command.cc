@@ -104,6 +104,7 @@ int ImageSequenceEvaluate(const Arguments& args, const PipelineOptions& pipeline
     figure.differences = e->differences;
     for (const QueryAnswer& a : e->sequence) figure.answers.push_back(a.match.reference);
     figure.truth = e->truth;
+    figure.blank_references = e->reference_blank;
     figure.frame_tolerance = options.frame_tolerance;
     figure.title = "differences and sequence answers";
     if (Status s = WriteCommandFigure(args, (*out)->Path("difference_matrix.png"),

@@ -204,6 +204,7 @@ StatusOr<ImageSequenceEvaluation> EvaluateImageSequences(
     StatusOr<PreparedFrame> f = prepare(options.reference_folder, name);
     if (!f.ok()) return f.status();
     e.blank_references += f->blank;
+    e.reference_blank.push_back(f->blank);
     if (Status s = matcher.AddReference(std::move(*f)); !s.ok()) {
       return Status::Error((fs::path(options.reference_folder) / name).string() + ": " +
                            s.message());

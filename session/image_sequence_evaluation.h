@@ -70,6 +70,7 @@ struct ImageSequenceEvaluation {
   std::vector<int> truth;                                 // per query
   std::vector<QueryAnswer> sequence, single;              // per query
   size_t blank_references = 0, blank_queries = 0;
+  std::vector<bool> reference_blank;  // per reference
   PlaceRecognitionMetrics sequence_metrics, single_metrics;
   // Every query's raw differences, for the difference-matrix figure (queries x references).
   std::vector<std::vector<float>> differences;

@@ -135,7 +135,8 @@ Scene DifferenceMatrixScene(const DifferenceMatrixFigure& f) {
   Scene scene(static_cast<int>(left + plot_w + 40), static_cast<int>(top + plot_h + 110),
               Rgba{255, 255, 255, 255});
   FittedTitle(scene, {20, 32}, f.title, 20, left + plot_w + 20);
-  FittedTitle(scene, {20, 58}, "darker: more alike (each query's row stretched to its range)", 14,
+  FittedTitle(scene, {20, 58},
+              "darker: more alike (each row on its own scale); white: blank references", 14,
               left + plot_w + 20);
   SceneImage image;
   image.left = left;
@@ -155,7 +156,10 @@ Scene DifferenceMatrixScene(const DifferenceMatrixFigure& f) {
     const double lo = sorted[sorted.size() * 2 / 100], hi = sorted[sorted.size() * 98 / 100];
     const int y = static_cast<int>(static_cast<int64_t>(q) * cells_y / rows);
     for (int r = 0; r < cols && r < static_cast<int>(f.differences[q].size()); ++r) {
-      const double v = hi > lo ? std::clamp((f.differences[q][r] - lo) / (hi - lo), 0.0, 1.0) : 0.5;
+      const bool blank = r < static_cast<int>(f.blank_references.size()) && f.blank_references[r];
+      const double v = blank     ? 1.0
+                       : hi > lo ? std::clamp((f.differences[q][r] - lo) / (hi - lo), 0.0, 1.0)
+                                 : 0.5;
       const size_t k = static_cast<size_t>(y) * cells_x +
                        static_cast<size_t>(static_cast<int64_t>(r) * cells_x / cols);
       cell[k] += v;

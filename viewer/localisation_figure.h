@@ -35,13 +35,14 @@ Scene PrecisionRecallScene(
     const std::string& subtitle = "accepted: the best place's posterior >= a threshold");
 
 // Image-sequence place recognition: the difference matrix (queries down, references across;
-// darker is more alike, each query row stretched over its own range), the true places as a thin
-// line and each query's answer as a dot, green within the tolerance and red beyond. Large
-// matrices are averaged down to at most `max_cells` a side.
+// darker is more alike, each query row stretched over its own range, blank references white), the
+// true places as a thin line and each query's answer as a dot, green within the tolerance and red
+// beyond. Large matrices are averaged down to at most `max_cells` a side.
 struct DifferenceMatrixFigure {
   std::vector<std::vector<float>> differences;  // [query][reference]
   std::vector<int> answers;                     // per query; -1 declined
   std::vector<int> truth;                       // per query; -1 unknown
+  std::vector<bool> blank_references;           // drawn white: never an answer
   int frame_tolerance = 1;
   std::string title;
   int max_cells = 600;
