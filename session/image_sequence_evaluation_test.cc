@@ -1,6 +1,14 @@
 #include "session/image_sequence_evaluation.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "common/random.h"
 
 namespace ratslam {
 namespace {
@@ -58,6 +66,64 @@ TEST(PairQueriesTest, ByNameThenByPositionElseAnError) {
   const auto e = PairQueriesWithReferences({"a.png", "b.png"}, {"x.png"}, "");
   ASSERT_FALSE(e.ok());
   EXPECT_NE(e.status().message().find("--ground-truth"), std::string::npos);
+}
+
+namespace fs = std::filesystem;
+
+class ImageFoldersTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    root_ = fs::temp_directory_path() / ("ratslam_image_sequence_" + std::to_string(::getpid()));
+    fs::remove_all(root_);
+    fs::create_directories(root_ / "ref");
+    fs::create_directories(root_ / "query");
+  }
+  void TearDown() override { fs::remove_all(root_); }
+  // A 64x32 texture of place `place`, with Gaussian noise of `sigma` grey levels.
+  void Write(const fs::path& path, int place, double sigma, Random* noise) {
+    Random texture(100 + place);
+    cv::Mat image(32, 64, CV_8UC1);
+    for (int y = 0; y < 32; ++y) {
+      for (int x = 0; x < 64; ++x) {
+        image.at<uint8_t>(y, x) =
+            cv::saturate_cast<uint8_t>(texture.Uniform(20, 230) + noise->Gaussian(0, sigma));
+      }
+    }
+    ASSERT_TRUE(cv::imwrite(path.string(), image));
+  }
+  fs::path root_;
+};
+
+// Forty places written as PNG files; the queries, the same places with noise and named alike, are
+// placed exactly by single frames and, once a sequence is full, by sequences (the oracle is the
+// file name). A file that is not an image
+// is an error naming it.
+TEST_F(ImageFoldersTest, PlacesEveryQueryByNameAndNamesABadFile) {
+  Random noise(9);
+  for (int i = 0; i < 40; ++i) {
+    char name[32];
+    std::snprintf(name, sizeof name, "frame-%03d.png", i);
+    Write(root_ / "ref" / name, i, 0, &noise);
+    Write(root_ / "query" / name, i, 20, &noise);
+  }
+  ImageSequenceEvaluationOptions options;
+  options.reference_folder = (root_ / "ref").string();
+  options.query_folder = (root_ / "query").string();
+  options.frame_tolerance = 0;
+  FileImageLoader loader;
+  StatusOr<ImageSequenceEvaluation> e = EvaluateImageSequences(options, &loader, {}, nullptr);
+  ASSERT_TRUE(e.ok()) << e.status().message();
+  EXPECT_TRUE(IsImageSequenceFolder(options.query_folder));
+  EXPECT_EQ(e->sequence_metrics.queries, 40u);
+  EXPECT_DOUBLE_EQ(e->single_metrics.recall_at_1, 1.0);
+  // A sequence is full from the tenth query on; from there every answer is exact.
+  for (size_t q = 9; q < e->sequence.size(); ++q) EXPECT_EQ(e->sequence[q].match.reference, int(q));
+  EXPECT_EQ(e->blank_references, 0u);
+
+  std::ofstream(root_ / "query" / "frame-020.png") << "not a PNG";
+  e = EvaluateImageSequences(options, &loader, {}, nullptr);
+  ASSERT_FALSE(e.ok());
+  EXPECT_NE(e.status().message().find("frame-020.png"), std::string::npos) << e.status().message();
 }
 
 }  // namespace
