@@ -5,6 +5,7 @@
 #include <iostream>
 #include <sstream>
 #include <string>
+#include <utility>
 
 #include "apps/cli.h"
 #include "apps/progress.h"
@@ -101,7 +102,7 @@ int ImageSequenceEvaluate(const Arguments& args, const PipelineOptions& pipeline
   }
   {
     DifferenceMatrixFigure figure;
-    figure.differences = e->differences;
+    figure.differences = std::move(e->differences);  // the outputs are written; not used again
     for (const QueryAnswer& a : e->sequence) figure.answers.push_back(a.match.reference);
     figure.truth = e->truth;
     figure.blank_references = e->reference_blank;

@@ -255,13 +255,8 @@ Status WriteImageSequenceOutputs(const ImageSequenceEvaluationOptions& options,
   j["blank_queries"] = e.blank_queries;
   j["frame_tolerance"] = options.frame_tolerance;
   j["sequence_length"] = options.matcher.sequence_length;
-  const PlaceRecognitionMetrics& m = e.sequence_metrics;
-  j["queries"] = m.queries;
-  j["declined"] = m.declined;
-  j["recall_at_1"] = m.recall_at_1;
-  j["recall_at_5"] = m.recall_at_5;
-  j["pr_auc"] = m.pr_auc;
-  j["recall_at_100_precision"] = m.recall_at_100_precision;
+  const nlohmann::ordered_json sequence = MetricsJson(e.sequence_metrics);
+  for (const auto& [key, value] : sequence.items()) j[key] = value;
   j["baselines"]["single_frame"] = MetricsJson(e.single_metrics);
   j["load_seconds"] = e.load_seconds;
   j["match_seconds"] = e.match_seconds;
