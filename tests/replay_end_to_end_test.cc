@@ -927,11 +927,9 @@ void ExpectPicture(const fs::path& png, int width, int height) {
 TEST_F(ReplayEndToEndTest, RenderWritesImagesFromRunsAndMaps) {
   if (!CreateOsMesaRenderer().ok()) GTEST_SKIP() << "OSMesa unavailable";
   const fs::path out = root_ / "rendered";
-  ASSERT_EQ(RunRatslam(
-                ReplayArgs(out) + " --render --animate 2000 --save-map " + (out / "m.map").string(),
-                root_)
-                .exit_code,
-            0);
+  const Result replay = RunRatslam(
+      ReplayArgs(out) + " --render --animate 2000 --save-map " + (out / "m.map").string(), root_);
+  ASSERT_EQ(replay.exit_code, 0) << replay.err;
   ExpectPicture(out / "experience_map.png", 1600, 1200);
   ExpectPicture(out / "template_graph.png", 1600, 1200);  // two panels
   ExpectPicture(out / "pose_cells.png", 1200, 620);
