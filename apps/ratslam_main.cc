@@ -15,6 +15,7 @@
 #include <iostream>
 #include <limits>
 #include <map>
+#include <opencv2/core/utility.hpp>
 #include <optional>
 #include <string>
 #include <variant>
@@ -577,6 +578,13 @@ void EndWithParent() {
 // (std::bad_alloc). Either way the program says so and exits non-zero instead of aborting.
 int main(int argc, char** argv) {
   EndWithParent();
+#if defined(RATSLAM_SANITIZED_BUILD)
+  // OpenCV's parallel loops (the animation's MJPEG encoder, SIFT) start a TBB worker thread that
+  // outlives its work and ends only during process exit, where it races LeakSanitizer's at-exit
+  // check: "Tracer caught signal 11" and exit 1 (CI, --render --animate, twice in a row).
+  // Sanitizer builds run OpenCV sequentially; its loops split work, never results.
+  cv::setNumThreads(0);
+#endif
   try {
     return Dispatch(argc, argv);
   } catch (const std::bad_alloc&) {
