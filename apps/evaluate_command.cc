@@ -33,7 +33,7 @@ int ImageSequenceEvaluate(const Arguments& args, const PipelineOptions& pipeline
   options.query_folder = args.values.at("--query");
   options.ground_truth_csv = args.Value("--ground-truth");
   options.frame_tolerance = std::stoi(args.values.at("--frame-tolerance"));
-  options.matcher = pipeline.sequence;
+  options.matcher = pipeline.sensors.sequence;
   for (const std::string& folder : {options.reference_folder, options.query_folder}) {
     if (!IsImageSequenceFolder(folder)) {
       return fail(Status::Error(folder + ": with --frame-tolerance, --map and --query are "

@@ -127,8 +127,10 @@ bool FusedOptions::IsValid(std::string* error) const {
   return true;
 }
 
-std::unique_ptr<FrontEnd> CreateFrontEnd(const FrontEndSettings& s,
-                                         const FrontEndResources& resources) {
+namespace {
+
+std::unique_ptr<FrontEnd> CreateDecidingFrontEnd(const FrontEndSettings& s,
+                                                 const FrontEndResources& resources) {
   switch (s.front_end.kind) {
     case FrontEndKind::kClassicCamera:
       return front_end_internal::MakeClassicCameraFrontEnd(s.classic_camera);
@@ -150,6 +152,17 @@ std::unique_ptr<FrontEnd> CreateFrontEnd(const FrontEndSettings& s,
     }
   }
   return nullptr;
+}
+
+}  // namespace
+
+std::unique_ptr<FrontEnd> CreateFrontEnd(const FrontEndSettings& s,
+                                         const FrontEndResources& resources) {
+  std::unique_ptr<FrontEnd> front_end = CreateDecidingFrontEnd(s, resources);
+  if (front_end && s.sequence.recognise_views) {
+    return front_end_internal::MakeSequenceRecognition(std::move(front_end), s.sequence);
+  }
+  return front_end;
 }
 
 }  // namespace ratslam

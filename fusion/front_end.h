@@ -64,6 +64,7 @@
 #include "sensors/dataset/dataset.h"
 #include "sensors/dataset/image_loader.h"
 #include "sensors/kernel_camera_matcher.h"
+#include "sensors/sequence_matcher.h"
 #include "sensors/wifi_fingerprint_matcher.h"
 
 namespace ratslam {
@@ -366,6 +367,9 @@ struct FrontEndSettings {
   FloorOptions barometer;
   FabmapSettings fabmap;
   DescriptorOptions descriptors;
+  // Image sequences (SeqSLAM): `ratslam evaluate --frame-tolerance`, and with recognise_views a
+  // sequence recogniser in front of the classic camera and fused front ends.
+  SequenceMatcherOptions sequence;
 };
 
 // Makes a fresh front end (for kCustom); called again for every restore.

@@ -44,6 +44,12 @@ std::unique_ptr<FrontEnd> MakeFabmapFrontEnd(const FabmapSettings& settings,
                                              const FloorOptions& floors,
                                              std::shared_ptr<const FabmapResources> resources);
 
+// Sequence recognition in front of `inner` ([sequence] recognise_views; fusion/
+// sequence_recognition.cc): a camera frame whose sequence is recognised re-uses the template of
+// the frame it matched, and `inner` decides every other frame.
+std::unique_ptr<FrontEnd> MakeSequenceRecognition(std::unique_ptr<FrontEnd> inner,
+                                                  const SequenceMatcherOptions& options);
+
 }  // namespace ratslam::front_end_internal
 
 #endif  // RATSLAM_FUSION_FRONT_END_INTERNAL_H_

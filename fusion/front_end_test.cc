@@ -7,6 +7,8 @@
 #include <functional>
 #include <tuple>
 
+#include "common/random.h"
+
 namespace ratslam {
 namespace {
 
@@ -750,6 +752,103 @@ TEST(FusedFrontEndTest, SecondSessionsFloorOffsetComesFromWifiVotes) {
       EXPECT_EQ(w.front_end->TemplateFloor(id), 1) << id;
     }
   }
+}
+
+}  // namespace
+}  // namespace ratslam
+
+namespace ratslam {
+namespace {
+
+// A 64x32 image per place (blocks of 4x4 pixels, so that block means differ between places); on
+// the second lap the same place darker, flatter and noisy.
+GrayImage Place(int place, int lap, Random* noise) {
+  Random texture(7000 + static_cast<uint64_t>(place));
+  std::vector<double> blocks(16 * 8);
+  for (double& b : blocks) b = texture.Uniform(20, 230);
+  GrayImage image{64, 32, std::vector<uint8_t>(64 * 32)};
+  for (int y = 0; y < 32; ++y) {
+    for (int x = 0; x < 64; ++x) {
+      const double p = blocks[(y / 4) * 16 + x / 4];
+      const double seen = lap == 0 ? p : 40 + 0.5 * p + noise->Gaussian(0, 10);
+      image.pixels[y * 64 + x] = static_cast<uint8_t>(std::clamp(std::lround(seen), 0L, 255L));
+    }
+  }
+  return image;
+}
+
+FrontEndSettings SequenceSettings(bool recognise) {
+  FrontEndSettings s;
+  s.front_end.kind = FrontEndKind::kClassicCamera;
+  s.sequence.recognise_views = recognise;
+  s.sequence.recency_frames = 30;
+  s.sequence.min_references = 60;
+  return s;
+}
+
+// One route of 150 places driven twice, the second time in other light. The classic camera alone
+// recognises nothing on the second lap (every frame a new template); with sequence recognition
+// the first lap still makes a template per place and never claims one of its own, every
+// second-lap frame whose sequence is full (and continues the previous frame's line) is
+// recognised, and every recognised frame re-uses the template of its own place, with injection.
+TEST(SequenceRecognitionTest, SecondLapInOtherLightReusesTheFirstLapsTemplates) {
+  constexpr int kPlaces = 150;
+  for (const bool recognise : {false, true}) {
+    std::unique_ptr<FrontEnd> front_end = CreateFrontEnd(SequenceSettings(recognise));
+    Random noise(3);
+    int reused = 0;
+    for (int lap = 0; lap < 2; ++lap) {
+      for (int place = 0; place < kPlaces; ++place) {
+        const double t = lap * kPlaces + place;
+        auto d = front_end->OnImage(t, Place(place, lap, &noise));
+        ASSERT_TRUE(d.ok()) << d.status().message();
+        ASSERT_TRUE(d->has_value());
+        const FrameDecision& f = **d;
+        if (lap == 0) {
+          ASSERT_TRUE(f.view.is_new) << place;
+          ASSERT_EQ(f.view.template_id, static_cast<uint32_t>(place));
+        } else if (!f.view.is_new) {
+          EXPECT_TRUE(recognise) << "the classic camera alone matched place " << place;
+          EXPECT_EQ(f.view.template_id, static_cast<uint32_t>(place));
+          EXPECT_TRUE(f.view.allow_injection);
+          ++reused;
+        }
+      }
+    }
+    // Sequences are full from the 10th frame (lines before the lap's start run through the
+    // first lap's end, which can end earlier); recognition starts one frame later.
+    if (recognise) {
+      EXPECT_GE(reused, kPlaces - 10);
+    } else {
+      EXPECT_EQ(reused, 0);
+    }
+  }
+}
+
+// A run resumed from saved state decides every later frame as the unbroken run does; bytes it
+// did not write are refused; and the option needs a front end that takes camera frames.
+TEST(SequenceRecognitionTest, StateRoundTripsAndTheOptionNeedsACamera) {
+  const FrontEndSettings settings = SequenceSettings(true);
+  std::unique_ptr<FrontEnd> a = CreateFrontEnd(settings);
+  std::unique_ptr<FrontEnd> b = CreateFrontEnd(settings);
+  Random noise_a(5), noise_b(5);
+  for (int i = 0; i < 190; ++i) {
+    ASSERT_TRUE(a->OnImage(i, Place(i % 150, i / 150, &noise_a)).ok());
+    Place(i % 150, i / 150, &noise_b);  // the same noise drawn
+  }
+  const std::string saved = a->EncodeState();
+  ASSERT_TRUE(b->DecodeState(saved).ok());
+  for (int i = 190; i < 300; ++i) {
+    auto da = a->OnImage(i, Place(i % 150, i / 150, &noise_a));
+    auto db = b->OnImage(i, Place(i % 150, i / 150, &noise_b));
+    ASSERT_TRUE(da.ok() && db.ok());
+    EXPECT_EQ((*da)->view.template_id, (*db)->view.template_id) << i;
+    EXPECT_EQ((*da)->view.is_new, (*db)->view.is_new) << i;
+  }
+  std::unique_ptr<FrontEnd> c = CreateFrontEnd(settings);
+  EXPECT_FALSE(c->DecodeState(saved.substr(0, saved.size() - 3)).ok());
+  EXPECT_FALSE(c->DecodeState(saved + "x").ok());
+  EXPECT_EQ(c->size(), 0u);
 }
 
 }  // namespace

@@ -24,8 +24,21 @@ bool PipelineOptions::IsValid(std::string* error) const {
          check(visual_odometry.IsValid(&inner), "visual_odometry") && ratslam.IsValid(error) &&
          check(wifi_sequence.IsValid(&inner), "wifi_sequence") && sensors.fabmap.IsValid(error) &&
          check(evaluation.IsValid(&inner), "evaluation") &&
-         check(sequence.IsValid(&inner), "sequence") && check(bag.IsValid(&inner), "bag") &&
-         check(video.IsValid(&inner), "video");
+         check(sensors.sequence.IsValid(&inner), "sequence") && check(bag.IsValid(&inner), "bag") &&
+         check(video.IsValid(&inner), "video") && SequenceRecognitionFits(error);
+}
+
+bool PipelineOptions::SequenceRecognitionFits(std::string* error) const {
+  if (!sensors.sequence.recognise_views || sensors.front_end.kind == FrontEndKind::kClassicCamera ||
+      (sensors.front_end.kind == FrontEndKind::kFused && sensors.fused.use_camera)) {
+    return true;
+  }
+  if (error) {
+    *error =
+        "sequence.recognise_views recognises camera frames: it needs [front_end] kind = "
+        "\"classic_camera\", or \"fused\" with [fused] use_camera = true";
+  }
+  return false;
 }
 
 namespace {

@@ -38,11 +38,12 @@ struct PipelineOptions {
   RatslamOptions ratslam;
   WifiSequenceOptions wifi_sequence;     // Wi-Fi sequence loop closure beside the front end
   fabmap::EvaluationOptions evaluation;  // `ratslam evaluate` only: how map and queries split
-  SequenceMatcherOptions sequence;       // `ratslam evaluate` on image sequences
   BagTopics bag;       // which topics of a ROS bag make the data set (not part of a map's identity)
   VideoOptions video;  // how a video's frames get times and odometry (ditto)
 
   bool IsValid(std::string* error) const;
+  // [sequence] recognise_views needs a front end that takes camera frames.
+  bool SequenceRecognitionFits(std::string* error) const;
 
   // Visits (section name, options struct) pairs in file order.
   template <typename Visitor>
@@ -72,7 +73,7 @@ struct PipelineOptions {
     v("wifi_words", sensors.fabmap.localiser.wifi_words);
     v("virtual_wifi", sensors.fabmap.localiser.virtual_wifi);
     v("evaluation", evaluation);
-    v("sequence", sequence);
+    v("sequence", sensors.sequence);
     v("bag", bag);
     v("video", video);
   }

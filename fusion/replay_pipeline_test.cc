@@ -439,3 +439,24 @@ TEST(ReplayPipelineWifiSequenceTest, RunsBesideTheFabmapFrontEnd) {
 
 }  // namespace
 }  // namespace ratslam
+
+namespace ratslam {
+namespace {
+
+// Sequence recognition needs a front end that takes camera frames.
+TEST(PipelineOptionsTest, SequenceRecognitionNeedsACameraFrontEnd) {
+  PipelineOptions o;
+  o.sensors.sequence.recognise_views = true;
+  std::string error;
+  EXPECT_TRUE(o.IsValid(&error)) << error;  // classic camera
+  o.sensors.front_end.kind = FrontEndKind::kFused;
+  EXPECT_FALSE(o.IsValid(&error));
+  EXPECT_NE(error.find("sequence.recognise_views"), std::string::npos) << error;
+  o.sensors.fused.use_camera = true;
+  EXPECT_TRUE(o.IsValid(&error)) << error;
+  o.sensors.front_end.kind = FrontEndKind::kFabmap;
+  EXPECT_FALSE(o.IsValid(&error));
+}
+
+}  // namespace
+}  // namespace ratslam

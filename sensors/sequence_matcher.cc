@@ -115,6 +115,14 @@ bool SequenceMatcherOptions::IsValid(std::string* error) const {
   if (velocity_steps < 1) return fail("velocity_steps must be at least 1");
   if (contrast_window < 0 || exclusion_window < 0) return fail("windows must not be negative");
   if (!(blank_contrast >= 0)) return fail("blank_contrast must not be negative");
+  if (image_width_px < 0 || image_height_px < 0) return fail("image sizes must not be negative");
+  if ((image_width_px == 0) != (image_height_px == 0)) {
+    return fail("image_width_px and image_height_px are both set or both 0");
+  }
+  if (!(min_confidence >= 0)) return fail("min_confidence must not be negative");
+  if (recency_frames < 0 || min_references < 0) {
+    return fail("recency_frames and min_references must not be negative");
+  }
   return true;
 }
 
@@ -174,6 +182,61 @@ PreparedFrame PrepareFrame(const uint8_t* pixels, int width, int height, int pat
   return f;
 }
 
+std::vector<uint8_t> ResizeByArea(const uint8_t* pixels, int width, int height, int to_width,
+                                  int to_height) {
+  std::vector<uint8_t> out(static_cast<size_t>(to_width) * to_height);
+  // Output pixel x covers input [x * sx, (x + 1) * sx); each input pixel it touches counts by
+  // the length of the overlap (separably in x and y).
+  const double sx = static_cast<double>(width) / to_width;
+  const double sy = static_cast<double>(height) / to_height;
+  struct Span {
+    int first = 0;
+    std::vector<double> weights;
+  };
+  auto spans = [](int to, double scale, int limit) {
+    std::vector<Span> out(to);
+    for (int o = 0; o < to; ++o) {
+      const double a = o * scale, b = (o + 1) * scale;
+      const int first = static_cast<int>(std::floor(a));
+      const int last = std::min(limit - 1, static_cast<int>(std::ceil(b)) - 1);
+      out[o].first = first;
+      for (int i = first; i <= last; ++i) {
+        out[o].weights.push_back(std::min<double>(b, i + 1) - std::max<double>(a, i));
+      }
+    }
+    return out;
+  };
+  const std::vector<Span> xs = spans(to_width, sx, width), ys = spans(to_height, sy, height);
+  for (int oy = 0; oy < to_height; ++oy) {
+    for (int ox = 0; ox < to_width; ++ox) {
+      double sum = 0, area = 0;
+      for (size_t j = 0; j < ys[oy].weights.size(); ++j) {
+        const uint8_t* row = pixels + static_cast<size_t>(ys[oy].first + j) * width;
+        for (size_t i = 0; i < xs[ox].weights.size(); ++i) {
+          const double w = ys[oy].weights[j] * xs[ox].weights[i];
+          sum += w * row[xs[ox].first + i];
+          area += w;
+        }
+      }
+      out[static_cast<size_t>(oy) * to_width + ox] =
+          static_cast<uint8_t>(std::clamp(std::lround(sum / area), 0L, 255L));
+    }
+  }
+  return out;
+}
+
+PreparedFrame PrepareFrame(const uint8_t* pixels, int width, int height,
+                           const SequenceMatcherOptions& options) {
+  if (options.image_width_px > 0 && width > 0 && height > 0 &&
+      (width != options.image_width_px || height != options.image_height_px)) {
+    const std::vector<uint8_t> resized =
+        ResizeByArea(pixels, width, height, options.image_width_px, options.image_height_px);
+    return PrepareFrame(resized.data(), options.image_width_px, options.image_height_px,
+                        options.patch_px, options.blank_contrast);
+  }
+  return PrepareFrame(pixels, width, height, options.patch_px, options.blank_contrast);
+}
+
 double FrameDifference(const PreparedFrame& a, const PreparedFrame& b) {
   const size_t n = std::min(a.bytes.size(), b.bytes.size());
   const double pixels = static_cast<double>(a.width) * a.height;
@@ -194,13 +257,43 @@ Status SequenceMatcher::AddReference(PreparedFrame frame) {
                          std::to_string(references_[0].height));
   }
   references_.push_back(std::move(frame));
-  rows_.clear();  // rows no longer cover every reference
+  return Status::Ok();
+}
+
+Status SequenceMatcher::SetState(State state) {
+  for (size_t i = 0; i < state.references.size(); ++i) {
+    const PreparedFrame& f = state.references[i];
+    const PreparedFrame& first = state.references[0];
+    const size_t stride = (static_cast<size_t>(std::max(f.width, 0)) + kRowAlignment - 1) /
+                          kRowAlignment * kRowAlignment;
+    if (f.width < 0 || f.height < 0 || f.width != first.width || f.height != first.height ||
+        f.bytes.size() != stride * static_cast<size_t>(f.height)) {
+      return Status::Error("sequence matcher state: reference " + std::to_string(i) +
+                           " has the wrong size");
+    }
+  }
+  if (state.rows.size() > static_cast<size_t>(options_.sequence_length)) {
+    return Status::Error("sequence matcher state: " + std::to_string(state.rows.size()) +
+                         " query rows, more than sequence_length");
+  }
+  for (const Row& row : state.rows) {
+    if (row.enhanced.size() > state.references.size() || !std::isfinite(row.neutral) ||
+        !std::all_of(row.enhanced.begin(), row.enhanced.end(),
+                     [](float v) { return std::isfinite(v); })) {
+      return Status::Error(
+          "sequence matcher state: a query row is longer than the references "
+          "or not finite");
+    }
+  }
+  references_ = std::move(state.references);
+  rows_ = std::move(state.rows);
   return Status::Ok();
 }
 
 StatusOr<SequenceMatcher::Result> SequenceMatcher::AddQuery(const PreparedFrame& frame,
-                                                            int candidates) {
+                                                            int candidates, int searchable) {
   const int n = static_cast<int>(references_.size());
+  const int answers = searchable < 0 ? n : std::min(n, searchable);
   if (n > 0 && (frame.width != references_[0].width || frame.height != references_[0].height)) {
     return Status::Error("query is " + std::to_string(frame.width) + "x" +
                          std::to_string(frame.height) + ", the references are " +
@@ -256,7 +349,7 @@ StatusOr<SequenceMatcher::Result> SequenceMatcher::AddQuery(const PreparedFrame&
   {
     std::vector<double> score(n, inf);
     if (!frame.blank) {
-      for (int r = 0; r < n; ++r) {
+      for (int r = 0; r < answers; ++r) {
         if (!references_[r].blank) score[r] = result.differences[r];
       }
     }
@@ -282,12 +375,15 @@ StatusOr<SequenceMatcher::Result> SequenceMatcher::AddQuery(const PreparedFrame&
       for (int k = 0; k < rows; ++k) {
         const Row& back = rows_[rows - 1 - k];  // query frame newest - k
         if (back.blank) continue;
-        const int offset = std::min(n, static_cast<int>(std::lround(v * k)));
+        const int offset = std::min(answers, static_cast<int>(std::lround(v * k)));
+        // References added after this row was made are unseen by it: neutral.
+        const int known = std::min(answers, offset + static_cast<int>(back.enhanced.size()));
         const float* e = back.enhanced.data();
         for (int i = 0; i < offset; ++i) sum[i] += back.neutral;
-        for (int i = offset; i < n; ++i) sum[i] += e[i - offset];
+        for (int i = offset; i < known; ++i) sum[i] += e[i - offset];
+        for (int i = known; i < answers; ++i) sum[i] += back.neutral;
       }
-      for (int i = 0; i < n; ++i) {
+      for (int i = 0; i < answers; ++i) {
         if (references_[i].blank) continue;
         score[i] = std::min(score[i], static_cast<double>(sum[i]) / used);
       }

@@ -33,6 +33,15 @@ struct SequenceMatcherOptions {
   int contrast_window = 10;     // references in the contrast-enhancement window (R_window)
   int exclusion_window = 10;    // references either side of the best kept out of the runner-up
   double blank_contrast = 8.0;  // grey levels, 5th to 95th percentile, under which: blank
+  int image_width_px = 0;       // frames are resized to this width first (area average); 0: keep
+  int image_height_px = 0;      // and to this height; 0: keep
+  // Replay (sequence recognition in the classic camera and fused front ends): a camera frame
+  // whose sequence matches an earlier stretch of the route with at least min_confidence re-uses
+  // the template of the frame it matched; otherwise the front end decides as before.
+  bool recognise_views = false;
+  double min_confidence = 0.3;  // least margin of the best line over the runner-up, per frame
+  int recency_frames = 50;      // the newest this-many frames are never matched
+  int min_references = 100;     // frames older than recency_frames before anything is matched
 
   bool IsValid(std::string* error) const;
 
@@ -59,6 +68,29 @@ struct SequenceMatcherOptions {
       "grey levels between a frame's 5th and 95th percentiles below which it is blank (never "
       "matched)",
       schema::Unit("grey levels").Within(0, 255));
+    v("image_width_px", image_width_px,
+      "frames are first resized to this width by area averaging (0: as read); the paper used "
+      "64x32",
+      schema::Unit("px").Within(0, 4096));
+    v("image_height_px", image_height_px, "and to this height (0: as read)",
+      schema::Unit("px").Within(0, 4096));
+    v("recognise_views", recognise_views,
+      "replay with the classic camera or fused (use_camera) front end: a camera frame whose "
+      "sequence of the newest sequence_length frames matches an earlier stretch of the route "
+      "with at least min_confidence re-uses the template of the frame it matched (a loop "
+      "closure); otherwise the front end decides alone",
+      schema::Any());
+    v("min_confidence", min_confidence,
+      "recognise_views: least margin of the best sequence over the best one outside "
+      "exclusion_window, in contrast-enhanced differences per frame",
+      schema::Unit("").Within(0, 1000));
+    v("recency_frames", recency_frames,
+      "recognise_views: frames this recent are never matched (the stretch just travelled)",
+      schema::Unit("frames").Within(0, 1000000));
+    v("min_references", min_references,
+      "recognise_views: frames past recency_frames needed before a sequence is recognised (a "
+      "margin over few candidates happens by chance)",
+      schema::Unit("frames").Within(0, 1000000));
   }
 };
 
@@ -73,6 +105,16 @@ struct PreparedFrame {
 // `pixels` is width x height, rows top to bottom without padding.
 PreparedFrame PrepareFrame(const uint8_t* pixels, int width, int height, int patch_px,
                            double blank_contrast);
+
+// `pixels` (width x height, unpadded) resized to `to_width` x `to_height` by area averaging
+// (each output pixel the mean of the input area it covers, partial pixels weighted by their
+// share), rounded to the nearest grey level. Sizes must be positive.
+std::vector<uint8_t> ResizeByArea(const uint8_t* pixels, int width, int height, int to_width,
+                                  int to_height);
+
+// PrepareFrame after the resize the options ask for (image_width_px / image_height_px).
+PreparedFrame PrepareFrame(const uint8_t* pixels, int width, int height,
+                           const SequenceMatcherOptions& options);
 
 // Mean absolute difference per pixel (0..255) of two frames of one size.
 double FrameDifference(const PreparedFrame& a, const PreparedFrame& b);
@@ -96,7 +138,9 @@ class SequenceMatcher {
   // `options` must be valid (IsValid); throws std::invalid_argument otherwise.
   explicit SequenceMatcher(const SequenceMatcherOptions& options);
 
-  // References in route order; all frames (references and queries) must have one size.
+  // References in route order; all frames (references and queries) must have one size. Queries
+  // made before a reference was added treat it as unseen (a neutral term) in later searches, so
+  // one route can be queried and then added, frame by frame (recognition while mapping).
   Status AddReference(PreparedFrame frame);
   size_t references() const { return references_.size(); }
   bool reference_blank(size_t i) const { return references_[i].blank; }
@@ -109,20 +153,33 @@ class SequenceMatcher {
     SequenceMatch single;
     std::vector<float> differences;  // this query's raw row (mean absolute difference 0..255)
   };
-  StatusOr<Result> AddQuery(const PreparedFrame& frame, int candidates = 5);
+  // Only references below `searchable` (all when negative) can be answers.
+  StatusOr<Result> AddQuery(const PreparedFrame& frame, int candidates = 5, int searchable = -1);
 
+  // Query frames in the current sequence (at most sequence_length).
+  size_t queries_in_sequence() const { return rows_.size(); }
   // Forgets the queries (a new query route starts); the references stay.
   void ResetQueries() { rows_.clear(); }
 
- private:
   struct Row {
-    std::vector<float> enhanced;  // contrast-enhanced differences, one per reference
+    std::vector<float> enhanced;  // contrast-enhanced differences, one per reference then known
     float neutral = 0.0f;         // at blank references, and for lines before the route starts
     bool blank = false;
   };
+  // Everything a later query depends on, for saving and resuming.
+  struct State {
+    std::vector<PreparedFrame> references;
+    std::deque<Row> rows;
+  };
+  State state() const { return {references_, rows_}; }
+  // Fails, keeping the current state, on frames of different sizes or wrong byte counts, more
+  // rows than sequence_length, a row longer than the references or holding NaN.
+  Status SetState(State state);
+
+ private:
   SequenceMatcherOptions options_;
-  std::vector<PreparedFrame> references_;
-  std::deque<Row> rows_;  // the newest sequence_length query rows, newest last
+  std::vector<PreparedFrame> references_;  // in route order
+  std::deque<Row> rows_;                   // the newest sequence_length query rows, newest last
 };
 
 }  // namespace ratslam

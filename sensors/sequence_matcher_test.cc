@@ -138,5 +138,89 @@ TEST(SequenceMatcherTest, FramesOfAnotherSizeAreErrors) {
   EXPECT_THROW(SequenceMatcher{bad}, std::invalid_argument);
 }
 
+// Area averaging: 4x2 to 2x1 is the mean of each 2x2 block; 3 to 2 columns weighs the middle
+// pixel half to each side (exactly: (10 + 0.5 * 40) / 1.5 = 20 and (0.5 * 40 + 70) / 1.5 = 60).
+TEST(ResizeByAreaTest, EachPixelIsTheMeanOfTheAreaItCovers) {
+  const std::vector<uint8_t> blocks = {0, 10, 100, 200, 20, 30, 50, 50};
+  EXPECT_EQ(ResizeByArea(blocks.data(), 4, 2, 2, 1), (std::vector<uint8_t>{15, 100}));
+  const std::vector<uint8_t> three = {10, 40, 70};
+  EXPECT_EQ(ResizeByArea(three.data(), 3, 1, 2, 1), (std::vector<uint8_t>{20, 60}));
+  // Up-sampling copies: every output pixel lies inside one input pixel.
+  EXPECT_EQ(ResizeByArea(three.data(), 3, 1, 6, 1), (std::vector<uint8_t>{10, 10, 40, 40, 70, 70}));
+  // Frames of another size become the configured size before patch normalisation.
+  SequenceMatcherOptions o;
+  o.image_width_px = kW / 2;
+  o.image_height_px = kH / 2;
+  const std::vector<uint8_t> big = Texture(5);
+  const PreparedFrame f = PrepareFrame(big.data(), kW, kH, o);
+  EXPECT_EQ(f.width, kW / 2);
+  EXPECT_EQ(f.height, kH / 2);
+  o.image_height_px = 0;
+  EXPECT_FALSE(o.IsValid(nullptr));  // both sizes or neither
+}
+
+// Recognition while mapping: one route driven twice, each frame queried against the frames
+// before it and then added. `searchable` keeps the newest 30 frames out of the answers, and
+// every frame of the second lap (noisier) is placed on its first-lap twin, with a margin, once
+// its sequence is full.
+TEST(SequenceMatcherTest, GrowingReferencesRecogniseTheSecondLap) {
+  SequenceMatcherOptions options;
+  SequenceMatcher matcher(options);
+  Random random(11);
+  const int lap = 120;
+  int placed = 0;
+  for (int j = 0; j < 2 * lap; ++j) {
+    const PreparedFrame f = Prepare(Noisy(Texture(500 + j % lap), j < lap ? 5 : 30, &random));
+    const int searchable = std::max(0, static_cast<int>(matcher.references()) - 30);
+    const auto r = matcher.AddQuery(f, 1, searchable);
+    ASSERT_TRUE(r.ok());
+    if (searchable == 0) {
+      EXPECT_TRUE(r->sequence.declined) << j;
+    } else {
+      EXPECT_LT(r->sequence.reference, searchable) << j;
+    }
+    if (j >= lap + options.sequence_length - 1) {
+      EXPECT_EQ(r->sequence.reference, j - lap) << j;
+      EXPECT_GE(r->sequence.confidence, 0.3) << j;
+      ++placed;
+    }
+    ASSERT_TRUE(matcher.AddReference(f).ok());
+  }
+  EXPECT_EQ(placed, lap - options.sequence_length + 1);
+}
+
+// Saved state resumes to the same answers; a state with a row longer than the references, or a
+// reference of another size, is refused and the matcher keeps what it had.
+TEST(SequenceMatcherTest, StateRoundTripsAndBadStateIsRefused) {
+  SequenceMatcherOptions options;
+  SequenceMatcher a(options);
+  Random random(2);
+  for (int j = 0; j < 60; ++j) {
+    const PreparedFrame f = Prepare(Texture(900 + j % 30));
+    ASSERT_TRUE(a.AddQuery(f, 1).ok());
+    ASSERT_TRUE(a.AddReference(f).ok());
+  }
+  SequenceMatcher b(options);
+  ASSERT_TRUE(b.SetState(a.state()).ok());
+  for (int j = 0; j < 10; ++j) {
+    const PreparedFrame f = Prepare(Noisy(Texture(900 + j), 20, &random));
+    const auto ra = a.AddQuery(f, 3), rb = b.AddQuery(f, 3);
+    ASSERT_TRUE(ra.ok() && rb.ok());
+    EXPECT_EQ(ra->sequence.reference, rb->sequence.reference);
+    EXPECT_EQ(ra->sequence.confidence, rb->sequence.confidence);
+  }
+  SequenceMatcher::State bad = a.state();
+  bad.rows.back().enhanced.push_back(0.0f);
+  bad.rows.back().enhanced.resize(bad.references.size() + 1);
+  EXPECT_FALSE(b.SetState(bad).ok());
+  bad = a.state();
+  bad.references[3].bytes.pop_back();
+  EXPECT_FALSE(b.SetState(bad).ok());
+  bad = a.state();
+  bad.rows.front().neutral = std::nanf("");
+  EXPECT_FALSE(b.SetState(bad).ok());
+  EXPECT_EQ(b.references(), a.references());
+}
+
 }  // namespace
 }  // namespace ratslam

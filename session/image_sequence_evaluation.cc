@@ -195,8 +195,7 @@ StatusOr<ImageSequenceEvaluation> EvaluateImageSequences(
     const std::string path = (fs::path(folder) / name).string();
     StatusOr<GrayImage> image = loader->Load(path);
     if (!image.ok()) return image.status();
-    return PrepareFrame(image->pixels.data(), image->width, image->height, o.patch_px,
-                        o.blank_contrast);
+    return PrepareFrame(image->pixels.data(), image->width, image->height, o);
   };
   SequenceMatcher matcher(o);
   for (const std::string& name : e.reference_files) {

@@ -5,7 +5,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
+#include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
 #include "common/circular.h"
@@ -158,6 +160,64 @@ nlohmann::ordered_json SequenceSummary(const WifiSequenceLoopCloser& closer,
 }
 
 }  // namespace
+
+CrossSessionPlaces ScoreCrossSessionPlaces(const std::vector<FrameRecord>& frames,
+                                           const Dataset& dataset) {
+  CrossSessionPlaces out;
+  out.correct.assign(std::size(kPlaceTolerancesFrames), 0);
+  const std::vector<double>& starts = dataset.session_start_times_s;
+  if (starts.size() < 2 || dataset.images.empty()) return out;
+  auto session_at = [&](double t) {
+    size_t s = 0;
+    while (s + 1 < starts.size() && t >= starts[s + 1]) ++s;
+    return s;
+  };
+  // By session: each image name's position among the session's images.
+  std::vector<std::map<std::string, int64_t>> position(starts.size());
+  std::vector<int64_t> count(starts.size(), 0);
+  for (const ImageRow& row : dataset.images) {
+    const size_t s = session_at(row.time_s);
+    position[s].emplace(std::filesystem::path(row.file).filename().string(), count[s]++);
+  }
+  // Frames in time order pair with the image of the same time.
+  struct Place {
+    size_t session = 0;
+    std::string name;
+  };
+  std::vector<std::optional<Place>> place_of(frames.size());
+  for (size_t f = 0, i = 0; f < frames.size(); ++f) {
+    while (i < dataset.images.size() && dataset.images[i].time_s < frames[f].time_s) ++i;
+    if (i < dataset.images.size() && dataset.images[i].time_s == frames[f].time_s) {
+      place_of[f] = Place{session_at(frames[f].time_s),
+                          std::filesystem::path(dataset.images[i].file).filename().string()};
+      ++i;
+    }
+  }
+  std::map<uint32_t, size_t> made_by;  // template -> the frame that made it
+  for (size_t f = 0; f < frames.size(); ++f) {
+    if (frames[f].is_new) made_by.emplace(frames[f].template_id, f);
+  }
+  for (size_t f = 0; f < frames.size(); ++f) {
+    if (!place_of[f] || place_of[f]->session == 0) continue;
+    const Place& here = *place_of[f];
+    bool earlier_has_it = false;
+    for (size_t s = 0; s < here.session; ++s) earlier_has_it |= position[s].count(here.name) > 0;
+    if (!earlier_has_it) continue;
+    ++out.frames;
+    const auto made = made_by.find(frames[f].template_id);
+    if (made == made_by.end() || !place_of[made->second]) continue;
+    const Place& there = *place_of[made->second];
+    if (there.session >= here.session) continue;
+    ++out.matched;
+    const auto namesake = position[there.session].find(here.name);
+    if (namesake == position[there.session].end()) continue;
+    const int64_t apart = std::abs(namesake->second - position[there.session].at(there.name));
+    for (size_t k = 0; k < out.correct.size(); ++k) {
+      out.correct[k] += apart <= kPlaceTolerancesFrames[k];
+    }
+  }
+  return out;
+}
 
 std::vector<double> LocalisationErrors(const std::vector<LocalisationRecord>& records,
                                        const std::vector<GroundTruthRow>& ground_truth,
@@ -339,6 +399,26 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
   if (pipeline.wifi_sequence().options().enabled) {
     j["wifi_sequence"] = SequenceSummary(pipeline.wifi_sequence(), map, dataset);
   }
+  if (const CrossSessionPlaces places = ScoreCrossSessionPlaces(state.frames, dataset);
+      places.frames > 0) {
+    const auto share = [](size_t n, size_t of) {
+      return of == 0 ? 0.0 : static_cast<double>(n) / static_cast<double>(of);
+    };
+    nlohmann::ordered_json p, correct, wrong, precision;
+    p["frames"] = places.frames;
+    p["matched"] = places.matched;
+    p["matched_share"] = share(places.matched, places.frames);
+    for (size_t k = 0; k < places.correct.size(); ++k) {
+      const std::string n = std::to_string(kPlaceTolerancesFrames[k]);
+      correct[n] = share(places.correct[k], places.frames);
+      wrong[n] = share(places.matched - places.correct[k], places.frames);
+      precision[n] = share(places.correct[k], places.matched);
+    }
+    p["correct_share_within_frames"] = correct;
+    p["wrong_share_within_frames"] = wrong;
+    p["precision_within_frames"] = precision;
+    j["cross_session_places"] = p;
+  }
   j["events_done"] = state.next_event;
   j["events_total"] = state.events_total;
   j["finished"] = pipeline.finished();
@@ -415,6 +495,7 @@ const std::vector<std::string>& SummaryKeys() {
                                                 "config_fingerprint",
                                                 "cross_session_match_rate_within_m",
                                                 "cross_session_matches",
+                                                "cross_session_places",
                                                 "current_experience",
                                                 "data_folder",
                                                 "data_time_s",

@@ -60,6 +60,22 @@ void RecordPose(const ExperienceMap& map, const TrajectoryRecord& record, double
 // (a fit to fewer would fit them almost exactly, whatever they are).
 // `truth` (optional) gets the true position, NaN where none. With `session_starts` nothing is
 // interpolated between two sessions (GroundTruthAt).
+// Cross-session place recognition scored by image file names: in data sets whose sessions
+// photograph the same places under the same names (Nordland's seasons), a frame of a later
+// session that ends on a template made in an earlier session is correct within N frames when the
+// template's first frame is at most N images from the frame's namesake in that session.
+struct CrossSessionPlaces {
+  size_t frames = 0;   // image frames of later sessions whose name an earlier session has
+  size_t matched = 0;  // of them, frames on a template made in an earlier session
+  // Of the matched, those correct within each tolerance of kPlaceTolerancesFrames.
+  std::vector<size_t> correct;
+};
+inline constexpr int kPlaceTolerancesFrames[] = {0, 1, 2, 5};
+// Frames pair with images by time. Nothing (frames == 0) when the data set has one session or
+// no name recurs.
+CrossSessionPlaces ScoreCrossSessionPlaces(const std::vector<FrameRecord>& frames,
+                                           const Dataset& dataset);
+
 std::vector<double> LocalisationErrors(const std::vector<LocalisationRecord>& records,
                                        const std::vector<GroundTruthRow>& ground_truth,
                                        std::vector<Point2>* truth = nullptr,

@@ -50,3 +50,40 @@ TEST(LocalisationErrorsTest, RigidFitThenDistanceAndNoFitToAHandful) {
 
 }  // namespace
 }  // namespace ratslam
+
+namespace ratslam {
+namespace {
+
+// Two sessions photograph places a..e under the same names (the second also z, which the first
+// never saw). Second-session frames: a on a's template (0 images apart), b on d's (2 apart), c a
+// new template, d on d's (0 apart), z on b's (not scored: no namesake before). Four frames
+// scored, three matched, correct within 0 and 1: two; within 2 and 5: three.
+TEST(CrossSessionPlacesTest, ScoresByTheNamesakeInTheTemplatesSession) {
+  Dataset d;
+  d.session_start_times_s = {0.0, 100.0};
+  const std::vector<std::string> names = {"a.png", "b.png", "c.png", "d.png", "e.png"};
+  std::vector<FrameRecord> frames;
+  for (int i = 0; i < 5; ++i) {
+    d.images.push_back({1.0 + i, "/x/summer/" + names[i], i + 2});
+    frames.push_back({1.0 + i, static_cast<uint32_t>(i), true, -1, DecisionSource::kNew, false});
+  }
+  const std::vector<std::pair<std::string, int>> later = {
+      {"a.png", 0}, {"b.png", 3}, {"c.png", 5}, {"d.png", 3}, {"z.png", 1}};
+  for (size_t i = 0; i < later.size(); ++i) {
+    const double t = 101.0 + static_cast<double>(i);
+    d.images.push_back({t, "/x/winter/" + later[i].first, static_cast<int>(i) + 2});
+    const bool made = later[i].second == 5;
+    frames.push_back({t, static_cast<uint32_t>(later[i].second), made, -1,
+                      made ? DecisionSource::kNew : DecisionSource::kCamera, false});
+  }
+  const CrossSessionPlaces p = ScoreCrossSessionPlaces(frames, d);
+  EXPECT_EQ(p.frames, 4u);
+  EXPECT_EQ(p.matched, 3u);
+  EXPECT_EQ(p.correct, (std::vector<size_t>{2, 2, 3, 3}));
+  // One session: nothing to score.
+  d.session_start_times_s = {0.0};
+  EXPECT_EQ(ScoreCrossSessionPlaces(frames, d).frames, 0u);
+}
+
+}  // namespace
+}  // namespace ratslam
