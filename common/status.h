@@ -36,8 +36,13 @@ class [[nodiscard]] Status {
 template <typename T>
 class [[nodiscard]] StatusOr {
  public:
-  StatusOr(T value) : value_(std::move(value)) {}          // NOLINT: implicit by design.
-  StatusOr(Status status) : status_(std::move(status)) {}  // NOLINT: implicit by design.
+  StatusOr(T value) : value_(std::move(value)) {}  // NOLINT: implicit by design.
+  // From an error. An OK status holds no value, so it cannot stand for one: a StatusOr made
+  // from one is an error that says so (a bug in the caller), never "ok without a value".
+  StatusOr(Status status)  // NOLINT: implicit by design.
+      : status_(status.ok() ? Status::Error(kOkWithoutValue) : std::move(status)) {}
+  static constexpr const char* kOkWithoutValue =
+      "internal error: a StatusOr was made from an OK status, without a value";
 
   bool ok() const { return status_.ok(); }
   const Status& status() const { return status_; }
