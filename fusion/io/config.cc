@@ -237,6 +237,47 @@ std::string PrintLocateConfig(const LocateOptions& options, bool comments) {
 
 namespace {
 
+// A printed configuration with comments as markdown: a heading and a table per section.
+std::string MarkdownTables(const std::string& printed) {
+  std::ostringstream out;
+  std::istringstream in(printed);
+  std::string line, comment;
+  auto cell = [](std::string text) {
+    std::string escaped;
+    for (char c : text) escaped += c == '|' ? std::string("\\|") : std::string(1, c);
+    return escaped;
+  };
+  while (std::getline(in, line)) {
+    if (line.empty()) continue;
+    if (line.front() == '[') {
+      out << "\n### " << line << "\n\n| key | default | meaning (unit; range) |\n|---|---|---|\n";
+      comment.clear();
+      continue;
+    }
+    if (line.rfind("# ", 0) == 0) {
+      comment += (comment.empty() ? "" : " ") + line.substr(2);
+      continue;
+    }
+    const size_t eq = line.find(" = ");
+    if (eq == std::string::npos) continue;
+    out << "| `" << line.substr(0, eq) << "` | `" << cell(line.substr(eq + 3)) << "` | "
+        << cell(comment) << " |\n";
+    comment.clear();
+  }
+  return out.str();
+}
+
+}  // namespace
+
+std::string ConfigReferenceMarkdown() {
+  return "\n## Replay, evaluation and sweeps (`--config`)\n" +
+         MarkdownTables(PrintConfig(PipelineOptions(), true)) +
+         "\n## `ratslam locate` (`--config`)\n" +
+         MarkdownTables(PrintLocateConfig(LocateOptions(), true));
+}
+
+namespace {
+
 uint64_t Fnv1a(const std::string& text) {
   uint64_t hash = 0xcbf29ce484222325ULL;
   for (unsigned char c : text) {

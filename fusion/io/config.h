@@ -24,6 +24,10 @@ StatusOr<PipelineOptions> ParseConfigOnto(const std::string& text, const std::st
 // The resolved configuration as TOML, every key present; with `comments`, each key is preceded
 // by its documentation line. ParseConfig(PrintConfig(x)) == x.
 std::string PrintConfig(const PipelineOptions& options, bool comments = true);
+// Every section and key of the replay configuration and of `ratslam locate` with its default,
+// unit, range and meaning, as markdown tables (docs/config.md): made from the same field lists
+// that read and print configurations, so it cannot drift from them.
+std::string ConfigReferenceMarkdown();
 
 // The same for `ratslam wifi-map` and `ratslam locate` ([wifi_map], [particle_filter], [pdr]).
 StatusOr<LocateOptions> ParseLocateConfig(const std::string& text, const std::string& source_name);
