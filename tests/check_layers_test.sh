@@ -1,0 +1,22 @@
+#!/usr/bin/env bash
+# scripts/check_layers.py on a made-up two-library tree (a known answer: the low library's header
+# includes the high one's), then on this project with its known list.
+# Usage: check_layers_test.sh SOURCE_DIR BUILD_DIR
+set -euo pipefail
+source_dir=$1
+build_dir=$2
+tree=$(mktemp -d)
+trap 'rm -rf "$tree"' EXIT
+mkdir -p "$tree/src/low" "$tree/src/high" "$tree/build"
+printf '#include "high/b.h"\n' > "$tree/src/low/a.h"
+printf '#include "low/a.h"\n' > "$tree/src/high/b.h"
+printf 'STATIC_LIBRARY|ratslam_low|%s/src/low||\nSTATIC_LIBRARY|ratslam_high|%s/src/high|ratslam::low|\n' \
+  "$tree" "$tree" > "$tree/build/ratslam_layers.txt"
+if out=$(/usr/bin/python3 "$source_dir/scripts/check_layers.py" "$tree/build" "$tree/src"); then
+  echo "check_layers.py accepted a lower layer including a higher one:"; echo "$out"; exit 1
+fi
+grep -qF "NEW: low/a.h:1: includes high/b.h of ratslam_high, which ratslam_low does not link" <<< "$out" || {
+  echo "unexpected report:"; echo "$out"; exit 1; }
+if grep -q "high/b.h:1" <<< "$out"; then echo "flagged the allowed direction: $out"; exit 1; fi
+/usr/bin/python3 "$source_dir/scripts/check_layers.py" "$build_dir" "$source_dir" \
+  "$source_dir/scripts/layers_known.txt"
