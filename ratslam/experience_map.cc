@@ -264,7 +264,10 @@ void ExperienceMap::Touch(uint32_t id) {
   const Experience& e = state_.experiences[id];
   pass_start_[id] = {e.x_m, e.y_m, e.theta_rad};
   touched_.push_back(id);
-  ::sincos(e.theta_rad, &experience_sin_[id], &experience_cos_[id]);  // glibc: both at once
+  if (experience_trig_rad_[id] != e.theta_rad) {  // NaN compares unequal: computed the first time
+    ::sincos(e.theta_rad, &experience_sin_[id], &experience_cos_[id]);  // glibc: both at once
+    experience_trig_rad_[id] = e.theta_rad;
+  }
 }
 
 bool ExperienceMap::GrowRegion(uint32_t id, uint32_t above, bool this_pass) {
@@ -293,6 +296,7 @@ void ExperienceMap::RelaxIncremental() {
   pass_start_.resize(n);
   experience_cos_.resize(n);
   experience_sin_.resize(n);
+  experience_trig_rad_.resize(n, std::numeric_limits<double>::quiet_NaN());
   const double tolerance_m = options_.relaxation_tolerance_m;
   const double tolerance_rad = options_.relaxation_tolerance_rad;
   std::vector<uint32_t>& region = state_.relaxation_pending_links;

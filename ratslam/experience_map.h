@@ -251,6 +251,9 @@ class ExperienceMap {
   // region (ahead_: still in this pass).
   std::vector<double> link_cos_, link_sin_;
   std::vector<double> experience_cos_, experience_sin_;
+  // The rotation experience_cos_/sin_ were computed from (NaN: never): an experience whose
+  // rotation the last passes left alone needs no new sincos.
+  std::vector<double> experience_trig_rad_;
   std::vector<Pose2> pass_start_;
   std::vector<uint64_t> touched_pass_;
   std::vector<uint32_t> ahead_, grown_, touched_;
