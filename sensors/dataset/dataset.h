@@ -1,6 +1,6 @@
 // The replay data-set format: a folder with `manifest.toml` and one CSV per stream, plus an
-// image folder. Times are in seconds; units are in the column names. See configs/README.md
-// ("Replay data-set format") for the full description.
+// image folder. Times are in seconds; units are in the column names. See
+// docs/data-formats.md for the full description.
 #ifndef RATSLAM_SENSORS_DATASET_DATASET_H_
 #define RATSLAM_SENSORS_DATASET_DATASET_H_
 
