@@ -138,10 +138,42 @@ std::optional<double> SecondsOfText(const std::string& text) {
   return SecondsOfCivil(parts[0], parts[1], parts[2], parts[3], parts[4], parts[5]);
 }
 
+// The published files' form: yyyymmddHHMMSSfff (17 digits, milliseconds last) or yyyymmddHHMMSS
+// (14), e.g. 20160602155217232. Nothing when the text is not 14 or 17 digits.
+std::optional<double> SecondsOfDigits(const std::string& text) {
+  if ((text.size() != 17 && text.size() != 14) ||
+      !std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; })) {
+    return std::nullopt;
+  }
+  auto part = [&](size_t at, size_t length) {
+    double v = 0;
+    for (size_t i = at; i < at + length; ++i) v = v * 10 + (text[i] - '0');
+    return v;
+  };
+  const double milliseconds = text.size() == 17 ? part(14, 3) : 0.0;
+  const auto civil =
+      SecondsOfCivil(part(0, 4), part(4, 2), part(6, 2), part(8, 2), part(10, 2), part(12, 2));
+  if (!civil) return std::nullopt;
+  return *civil + milliseconds / 1000.0;
+}
+
 // The row's time in seconds, or an error.
 Status ParseTime(const Rows& rows, size_t row, double* seconds) {
   const std::vector<std::string>& f = rows.fields[row];
   if (f.size() == 1) {
+    if (f[0].size() == 17 || f[0].size() == 14) {
+      // Digits only: the published timestamp form (a number of seconds has at most 13 digits
+      // before 2100, so 14 and 17 digits are never seconds).
+      if (const auto s = SecondsOfDigits(f[0])) {
+        *seconds = *s;
+        return Status::Ok();
+      }
+      if (std::all_of(f[0].begin(), f[0].end(), [](char c) { return c >= '0' && c <= '9'; })) {
+        return FieldError(
+            rows, row, "time",
+            "'" + f[0] + "' is not a date yyyymmddHHMMSS" + (f[0].size() == 17 ? "fff" : ""));
+      }
+    }
     double v = 0;
     if (ParseNumber(f[0], &v)) {
       if (v >= kDatenumMin && v <= kDatenumMax) {

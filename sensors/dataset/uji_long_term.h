@@ -10,9 +10,11 @@
 //                 named "AP001", "AP002", ... so that sets of different months share AP names.
 //   <set>crd.csv  x and y (metres) and the floor.                                  (required)
 //   <set>tms.csv  the time of the row: seconds (a number), a MATLAB date number (a number between
-//                 719529 and 767011, i.e. the years 1970 to 2100, in days), six numbers (year,
-//                 month, day, hour, minute, second) or text "YYYY-MM-DD HH:MM:SS" (UTC); years
-//                 1970 to 2100.
+//                 719529 and 767011, i.e. the years 1970 to 2100, in days), 17 digits
+//                 yyyymmddHHMMSSfff as the published files hold them (e.g. 20160602155217232;
+//                 local time, read as if UTC: every row of a set shifts alike), or 14 digits
+//                 without the milliseconds, six numbers (year, month, day, hour, minute, second)
+//                 or text "YYYY-MM-DD HH:MM:SS" (UTC); years 1970 to 2100.
 //                 (optional; without it the row number is the time)
 //   <set>ids.csv  whole numbers; the first is kept as the row's identifier.          (optional)
 //

@@ -132,6 +132,25 @@ TEST(UjiLongTermTest, BadInputNamesFileLineAndField) {
 // A fuzzer finding (fuzz/regressions/uji_long_term_fuzzer/datenum-before-1970-negative-time):
 // 706330 was read as a MATLAB date number of 1933, a negative time. Date numbers now start at
 // 1970-01-01 (719529); below that a number is seconds.
+// The published files hold 17-digit times yyyymmddHHMMSSfff; 14 digits drop the milliseconds.
+// Oracle: Python's calendar.timegm: 2016-06-02 15:52:17 = 1464882737, 2017-01-31 09:05:00 =
+// 1485853500. Digits that are no date are an error naming the form.
+TEST(UjiLongTermTest, ReadsThePublishedSeventeenDigitTimes) {
+  const std::string path = WriteSet("published/trn01", "100,-71\n100,-60\n", "1,2,3\n4,5,3\n",
+                                    "20160602155217232\n20170131090500\n");
+  auto scans = ReadUjiLongTermSet(path);
+  ASSERT_TRUE(scans.ok()) << scans.status().message();
+  EXPECT_DOUBLE_EQ((*scans)[0].time_s, 1464882737.232);
+  EXPECT_EQ((*scans)[1].time_s, 1485853500.0);
+  const std::string bad = WriteSet("published_bad/trn01", "100,-71\n100,-60\n", "1,2,3\n4,5,3\n",
+                                   "20160602155217232\n20161302155217232\n");
+  auto refused = ReadUjiLongTermSet(bad);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.status().message().find("tms.csv:2: field 'time'"), std::string::npos)
+      << refused.status().message();
+  EXPECT_NE(refused.status().message().find("yyyymmddHHMMSSfff"), std::string::npos);
+}
+
 TEST(UjiLongTermTest, NoTimeBeforeTheEpoch) {
   const std::string path =
       WriteSet("epoch/trn01", "100,-71\n100,-60\n", "1,2,3\n4,5,3\n", "706330\n719529\n");
