@@ -849,6 +849,24 @@ TEST(SequenceRecognitionTest, StateRoundTripsAndTheOptionNeedsACamera) {
   EXPECT_FALSE(c->DecodeState(saved.substr(0, saved.size() - 3)).ok());
   EXPECT_FALSE(c->DecodeState(saved + "x").ok());
   EXPECT_EQ(c->size(), 0u);
+  // Damaged bytes (flipped, cut short) are refused or taken, never a crash; a refused state
+  // leaves the front end as it was (here: the saved run's 150 templates).
+  ASSERT_TRUE(c->DecodeState(saved).ok());
+  const uint32_t templates = c->size();
+  Random damage(17);
+  for (int i = 0; i < 300; ++i) {
+    std::string bytes = saved;
+    for (int k = 0; k < 4; ++k) {
+      bytes[damage.NextU64() % bytes.size()] = static_cast<char>(damage.NextU64() & 0xff);
+    }
+    if (i % 3 == 0) bytes.resize(damage.NextU64() % bytes.size());
+    std::unique_ptr<FrontEnd> d = CreateFrontEnd(settings);
+    ASSERT_TRUE(d->DecodeState(saved).ok());
+    if (!d->DecodeState(bytes).ok()) {
+      EXPECT_EQ(d->size(), templates) << i;
+      EXPECT_EQ(d->EncodeState(), saved) << i;
+    }
+  }
 }
 
 }  // namespace

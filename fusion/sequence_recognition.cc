@@ -151,14 +151,23 @@ class SequenceRecognition : public FrontEnd {
                            " frame templates for " + std::to_string(state.references.size()) +
                            " frames (settled " + std::to_string(settled) + ")");
     }
+    // The wrapped front end is decoded first (the frames' templates are checked against it) and
+    // put back as it was when anything after fails: a refused state changes nothing.
+    const std::string before = inner_->EncodeState();
     RATSLAM_RETURN_IF_ERROR(inner_->DecodeState(inner));
+    Status fits = Status::Ok();
     for (uint32_t t : template_of) {
       if (t != kNoTemplate && t >= inner_->size()) {
-        return Status::Error("sequence recognition state: a frame names template " +
+        fits = Status::Error("sequence recognition state: a frame names template " +
                              std::to_string(t) + " of " + std::to_string(inner_->size()));
+        break;
       }
     }
-    RATSLAM_RETURN_IF_ERROR(matcher_.SetState(std::move(state)));
+    if (fits.ok()) fits = matcher_.SetState(std::move(state));
+    if (!fits.ok()) {
+      (void)inner_->DecodeState(before);  // bytes it wrote itself: taken back
+      return fits;
+    }
     template_of_ = std::move(template_of);
     settled_ = settled;
     previous_ = previous;
