@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "common/version.h"
+#include "tests/generated_block.h"
 
 namespace ratslam {
 namespace {
@@ -169,28 +170,8 @@ TEST(CommandLineTest, TheLimitsOfARangeAreAccepted) {
 }
 
 // docs/cli.md's command reference is this program's help, so the two cannot drift apart.
-// RATSLAM_UPDATE_README=1 rewrites its block (then review the diff).
 TEST(CommandLineTest, ReadmeCarriesTheCurrentCommandReference) {
-  const std::string path = std::string(RATSLAM_SOURCE_DIR) + "/docs/cli.md";
-  std::ifstream in(path);
-  ASSERT_TRUE(in) << path << " not found";
-  std::stringstream s;
-  s << in.rdbuf();
-  const std::string readme = s.str();
-  const std::string begin = "<!-- command reference: begin -->\n";
-  const std::string end = "<!-- command reference: end -->";
-  const size_t a = readme.find(begin);
-  const size_t b = readme.find(end);
-  ASSERT_NE(a, std::string::npos) << path << " has no '" << begin << "' marker";
-  ASSERT_NE(b, std::string::npos);
-  if (std::getenv("RATSLAM_UPDATE_README") != nullptr) {
-    std::ofstream(path) << readme.substr(0, a + begin.size()) << CommandReference()
-                        << readme.substr(b);
-    GTEST_SKIP() << path << " rewritten";
-  }
-  EXPECT_EQ(readme.substr(a + begin.size(), b - a - begin.size()), CommandReference())
-      << "docs/cli.md's command reference is out of date: rerun this test with "
-         "RATSLAM_UPDATE_README=1";
+  e2e::ExpectGeneratedBlock("docs/cli.md", "command reference", CommandReference());
 }
 
 // The completion script is valid bash and completes commands, sub-commands and options.

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "common/scratch_dir.h"
+#include "tests/generated_block.h"
 
 namespace ratslam {
 namespace {
@@ -458,27 +459,10 @@ namespace ratslam {
 namespace {
 
 // docs/config.md's key tables are made from the field lists that read and print configurations,
-// so they cannot drift apart. RATSLAM_UPDATE_README=1 rewrites its block (then review the diff).
+// so they cannot drift apart (tests/generated_block.h).
 TEST(ConfigReferenceTest, DocsCarryTheCurrentKeyTables) {
-  const std::string path = std::string(RATSLAM_SOURCE_DIR) + "/docs/config.md";
-  std::ifstream in(path);
-  ASSERT_TRUE(in) << path << " not found";
-  std::stringstream s;
-  s << in.rdbuf();
-  const std::string doc = s.str();
-  const std::string begin = "<!-- config reference: begin -->\n";
-  const std::string end = "<!-- config reference: end -->";
-  const size_t a = doc.find(begin);
-  const size_t b = doc.find(end);
-  ASSERT_NE(a, std::string::npos) << path << " has no '" << begin << "' marker";
-  ASSERT_NE(b, std::string::npos);
   const std::string tables = ConfigReferenceMarkdown();
-  if (std::getenv("RATSLAM_UPDATE_README") != nullptr) {
-    std::ofstream(path) << doc.substr(0, a + begin.size()) << tables << doc.substr(b);
-    GTEST_SKIP() << path << " rewritten";
-  }
-  EXPECT_EQ(doc.substr(a + begin.size(), b - a - begin.size()), tables)
-      << "docs/config.md is out of date: rerun this test with RATSLAM_UPDATE_README=1";
+  e2e::ExpectGeneratedBlock("docs/config.md", "config reference", tables);
   // Every key of the default configuration has a row (a known key, a known answer).
   EXPECT_NE(tables.find("| `recognise_views` | `false` |"), std::string::npos);
   EXPECT_NE(tables.find("### [pose_cells]"), std::string::npos);
