@@ -216,16 +216,9 @@ void ReplayPipeline::FeedCompass(const CompassRow& row) {
   slam_->SetCompassHeading(front_end_->CompassHeading());
 }
 
-size_t ReplayPipeline::SessionAt(double time_s) const {
-  const std::vector<double>& starts = dataset_.session_start_times_s;
-  size_t session = 0;
-  while (session + 1 < starts.size() && time_s >= starts[session + 1]) ++session;
-  return session;
-}
-
 void ReplayPipeline::AnnounceSession(double time_s) {
   if (!dataset_.session_start_times_s.empty()) {
-    front_end_->OnSessionStart(dataset_.session_start_times_s[SessionAt(time_s)]);
+    front_end_->OnSessionStart(dataset_.session_start_times_s[dataset_.SessionAt(time_s)]);
   }
 }
 
@@ -282,7 +275,8 @@ Status ReplayPipeline::AddSequencePose(const WifiScan& scan) {
   const ExperienceMap& map = slam_->experience_map();
   SequencePose pose;
   pose.time_s = scan.time_s;
-  pose.travel_m = state_.travel_m + kSessionGapM * static_cast<double>(SessionAt(scan.time_s));
+  pose.travel_m =
+      state_.travel_m + kSessionGapM * static_cast<double>(dataset_.SessionAt(scan.time_s));
   pose.odometry = {state_.odometry_x_m, state_.odometry_y_m, state_.odometry_theta_rad};
   pose.compass_heading_rad = front_end_->CompassHeading();
   if (map.current()) {

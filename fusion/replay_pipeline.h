@@ -191,8 +191,6 @@ class ReplayPipeline {
   void AnnounceSession(double time_s);
   Status Apply(const FrameDecision& decision);
   Status AddSequencePose(const WifiScan& scan);
-  // The data set's session (index into session_start_times_s; 0 without any) at `time_s`.
-  size_t SessionAt(double time_s) const;
   Status LinkLoop(const std::optional<SequenceLoop>& loop, double time_s);
 
   PipelineOptions options_;

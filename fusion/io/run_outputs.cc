@@ -167,16 +167,11 @@ CrossSessionPlaces ScoreCrossSessionPlaces(const std::vector<FrameRecord>& frame
   out.correct.assign(std::size(kPlaceTolerancesFrames), 0);
   const std::vector<double>& starts = dataset.session_start_times_s;
   if (starts.size() < 2 || dataset.images.empty()) return out;
-  auto session_at = [&](double t) {
-    size_t s = 0;
-    while (s + 1 < starts.size() && t >= starts[s + 1]) ++s;
-    return s;
-  };
   // By session: each image name's position among the session's images.
   std::vector<std::map<std::string, int64_t>> position(starts.size());
   std::vector<int64_t> count(starts.size(), 0);
   for (const ImageRow& row : dataset.images) {
-    const size_t s = session_at(row.time_s);
+    const size_t s = dataset.SessionAt(row.time_s);
     position[s].emplace(std::filesystem::path(row.file).filename().string(), count[s]++);
   }
   // Frames in time order pair with the image of the same time.
@@ -188,7 +183,7 @@ CrossSessionPlaces ScoreCrossSessionPlaces(const std::vector<FrameRecord>& frame
   for (size_t f = 0, i = 0; f < frames.size(); ++f) {
     while (i < dataset.images.size() && dataset.images[i].time_s < frames[f].time_s) ++i;
     if (i < dataset.images.size() && dataset.images[i].time_s == frames[f].time_s) {
-      place_of[f] = Place{session_at(frames[f].time_s),
+      place_of[f] = Place{dataset.SessionAt(frames[f].time_s),
                           std::filesystem::path(dataset.images[i].file).filename().string()};
       ++i;
     }

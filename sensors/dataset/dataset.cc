@@ -200,6 +200,15 @@ std::string Dataset::SessionName(size_t index) const {
   return "session " + std::to_string(index + 1);
 }
 
+size_t Dataset::SessionAt(double time_s) const {
+  size_t session = 0;
+  while (session + 1 < session_start_times_s.size() &&
+         time_s >= session_start_times_s[session + 1]) {
+    ++session;
+  }
+  return session;
+}
+
 StatusOr<Dataset> ReadDataset(const std::string& folder) {
   const std::string manifest_path = (fs::path(folder) / "manifest.toml").string();
   if (!IsDirectory(folder)) return Status::Error(folder + ": not a data-set folder");

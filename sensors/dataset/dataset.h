@@ -71,6 +71,8 @@ struct Dataset {
   std::string ImagePath(const ImageRow& row) const;
   // The name of session `index`: its recorded name, else "session N" (1-based).
   std::string SessionName(size_t index) const;
+  // The session a time belongs to: the last one started at or before it (0 before any).
+  size_t SessionAt(double time_s) const;
 };
 
 // Reads a replay data-set folder. Errors name the file, line and column. Streams must be regular
