@@ -299,7 +299,7 @@ int Synthesize(const SyntheticOptions& options, const std::string& folder,
   if (!bag_path.empty()) {
     // OpenRatSLAM's topic names under the root "synthetic" (what topic_root=synthetic implies).
     const BagTopics topics{"/synthetic/camera/image/compressed", "/synthetic/odom",
-                           "/synthetic/ground_truth"};
+                           "/synthetic/ground_truth", ""};
     StatusOr<Dataset> written = ReadDataset(folder);
     FileImageLoader images;
     Status s = written.ok() ? WriteRosbag(*written, &images, topics, bag_path) : written.status();

@@ -34,7 +34,8 @@ std::vector<std::string> FuzzSeeds() {
   }
   Pattern images;
   const std::string path = (Scratch().path() / "seed.bag").string();
-  if (!WriteRosbag(d, &images, {"/r/camera/image/compressed", "/r/odom", "/r/pose"}, path).ok()) {
+  if (!WriteRosbag(d, &images, {"/r/camera/image/compressed", "/r/odom", "/r/pose", ""}, path)
+           .ok()) {
     return {"#ROSBAG V2.0\n"};
   }
   std::ifstream in(path, std::ios::binary);
@@ -46,7 +47,7 @@ std::vector<std::string> FuzzSeeds() {
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace ratslam;
   const std::string path = fuzz::WriteScratchFile("input.bag", data, size);
-  StatusOr<Dataset> d = ReadRosbag(path, {"", "", "/r/pose"});
+  StatusOr<Dataset> d = ReadRosbag(path, {"", "", "/r/pose", ""});
   if (!d.ok()) {
     if (d.status().message().find("input.bag") == std::string::npos) __builtin_trap();
     return 0;

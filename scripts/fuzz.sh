@@ -20,7 +20,8 @@ bash scripts/setup.sh clang-14 libfuzzer-14-dev
 
 harnesses=(config_fuzzer ini_fuzzer map_file_fuzzer visual_model_fuzzer dataset_fuzzer
            ipin_log_fuzzer msft_log_fuzzer ujiindoorloc_fuzzer uji_long_term_fuzzer world_fuzzer sweep_file_fuzzer wifi_map_fuzzer
-           run_folder_fuzzer output_list_fuzzer rosbag_fuzzer video_log_fuzzer descriptor_fuzzer)
+           run_folder_fuzzer output_list_fuzzer rosbag_fuzzer ros2_bag_fuzzer ros2_cdr_fuzzer video_log_fuzzer
+           descriptor_fuzzer)
 if (($#)); then harnesses=("$@"); fi
 
 source scripts/ccache_env.sh
@@ -55,6 +56,10 @@ done
 for f in $(find "$shared/msft-ilc20-site1" -name '*.txt' 2>/dev/null | sort | head -n 2); do
   [[ -d $build/corpus/msft_log_fuzzer ]] && excerpt msft_log_fuzzer "$f" 400
 done
+# ROS 2 bags from the independent writers the tests use (skipped where node or npm is missing).
+if [[ -d $build/corpus/ros2_bag_fuzzer ]] && bash scripts/ros2_fixtures.sh "$build/ros2-seeds" 2>/dev/null; then
+  cp "$build"/ros2-seeds/raw*.mcap "$build/corpus/ros2_bag_fuzzer/"
+fi
 [[ -d $build/corpus/ujiindoorloc_fuzzer ]] &&
   excerpt ujiindoorloc_fuzzer "$shared/ujiindoorloc/trainingData.csv" 8
 

@@ -12,6 +12,7 @@ packages=(
   libgtest-dev libgmock-dev googletest libbenchmark-dev
   pybind11-dev python3-pybind11 python3-numpy python3-dev
   librosbag-storage-dev libsensor-msgs-dev libnav-msgs-dev
+  libzstd-dev liblz4-dev libsqlite3-dev
   "$@"
 )
 

@@ -1,6 +1,7 @@
 // Runs the `ratslam` program as a user would and checks its outputs.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -526,6 +527,54 @@ TEST_F(ReplayEndToEndTest, BagReplayGivesTheFolderReplaysMap) {
                  root_);
   ASSERT_EQ(localised.exit_code, 0) << localised.err;
   EXPECT_LT(Summary(dir / "localised")["localisation"]["lost_fraction"].get<double>(), 0.1);
+}
+
+// The synthetic loop written as ROS 2 bags by independent writers (scripts/ros2_fixtures.sh:
+// Foxglove's MCAP writer and CDR serialiser, SQLite) replays to the folder's map bit for bit: an
+// MCAP file with zstd chunks, one with no chunks and no summary (read by scanning), and a rosbag2
+// sqlite3 folder; `import` turns the MCAP back into a folder that gives the same map again.
+TEST_F(ReplayEndToEndTest, Ros2BagsReplayToTheFolderReplaysMap) {
+  const fs::path dir = root_ / "ros2";
+  const Result made = RunRatslam("synthesize --out " + (dir / "data").string(), root_);
+  ASSERT_EQ(made.exit_code, 0) << made.err;
+  const std::string command = "bash " + std::string(RATSLAM_SOURCE_DIR) +
+                              "/scripts/ros2_fixtures.sh " + (dir / "bags").string() + " " +
+                              (dir / "data").string() + " 2>" + (dir / "fixtures.log").string();
+  const int rc = std::system(command.c_str());
+  if (WIFEXITED(rc) && WEXITSTATUS(rc) == 77) {
+    GTEST_SKIP() << "ROS 2 bags from independent writers not made: " << Slurp(dir / "fixtures.log");
+  }
+  ASSERT_EQ(rc, 0) << Slurp(dir / "fixtures.log");
+  std::ofstream(dir / "ros2.toml")
+      << Slurp(config_) << "\n[bag]\nground_truth_topic = \"/ground_truth\"\n";
+  auto replay = [&](const fs::path& data, const std::string& out) {
+    return RunRatslam("replay --quiet --config " + (dir / "ros2.toml").string() + " --data " +
+                          data.string() + " --out " + (dir / out).string(),
+                      root_);
+  };
+  const Result folder = replay(dir / "data", "from_folder");
+  ASSERT_EQ(folder.exit_code, 0) << folder.err;
+  for (const char* bag : {"loop_zstd.mcap", "loop_nosummary.mcap", "loop_db3"}) {
+    const std::string out = std::string("from_") + bag;
+    const Result from_bag = replay(dir / "bags" / bag, out);
+    ASSERT_EQ(from_bag.exit_code, 0) << bag << ": " << from_bag.err;
+    for (const char* name : {"experiences.csv", "links.csv", "frames.csv", "trajectory_tum.txt"}) {
+      EXPECT_EQ(Slurp(dir / "from_folder" / name), Slurp(dir / out / name)) << bag << " " << name;
+    }
+    const nlohmann::json summary = Summary(dir / out);
+    ASSERT_TRUE(summary.contains("map_ate_m")) << bag << ": the bag's ground truth was not read";
+    EXPECT_GT(summary["loop_closures"].get<int>(), 0);
+  }
+  const Result imported = RunRatslam("import --quiet --config " + (dir / "ros2.toml").string() +
+                                         " --data " + (dir / "bags" / "loop_zstd.mcap").string() +
+                                         " --out " + (dir / "imported").string(),
+                                     root_);
+  ASSERT_EQ(imported.exit_code, 0) << imported.err;
+  EXPECT_TRUE(fs::exists(dir / "imported" / "images" / "000000.png"));
+  const Result again = replay(dir / "imported", "from_import");
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  EXPECT_EQ(Slurp(dir / "from_folder" / "experiences.csv"),
+            Slurp(dir / "from_import" / "experiences.csv"));
 }
 
 // The synthetic loop as a Motion-JPEG video with OpenRatSLAM's odometry log beside it (what its

@@ -12,6 +12,7 @@
 #include "common/file_util.h"
 #include "common/text_file.h"
 #include "sensors/dataset/msft_log.h"
+#include "sensors/dataset/rosbag2.h"
 #include "sensors/dataset/video.h"
 
 namespace ratslam {
@@ -20,13 +21,17 @@ namespace fs = std::filesystem;
 StatusOr<DatasetFormat> DetectDatasetFormat(const std::string& path) {
   if (IsDirectory(path)) {
     if (PathExists(fs::path(path) / "manifest.toml")) return DatasetFormat::kReplayFolder;
-    return Status::Error(path + ": a folder without manifest.toml is not a replay data set");
+    if (LooksLikeRos2Bag(path)) return DatasetFormat::kRos2Bag;
+    return Status::Error(path +
+                         ": a folder without manifest.toml (a replay data set) or metadata.yaml (a "
+                         "ROS 2 bag) is not a data set");
   }
   if (!PathExists(path)) return Status::Error(path + ": no such file or folder");
   // Only regular files: a FIFO would block the open for ever, a device never end.
   std::ifstream in;
   RATSLAM_RETURN_IF_ERROR(OpenRegularFile(path, "data set", &in));
   if (LooksLikeRosbag(path)) return DatasetFormat::kRosBag;
+  if (LooksLikeRos2Bag(path)) return DatasetFormat::kRos2Bag;
   if (LooksLikeVideo(path)) return DatasetFormat::kVideo;
   // The format is told by a bounded prefix: 200 lines of at most 64 KiB (a file without line
   // breaks, however large, costs 64 KiB here).
@@ -47,8 +52,8 @@ StatusOr<DatasetFormat> DetectDatasetFormat(const std::string& path) {
   }
   return Status::Error(
       path +
-      ": unknown data-set format (expected a replay folder, a ROS 1 bag, an IPIN log or a "
-      "Microsoft walk)");
+      ": unknown data-set format (expected a replay folder, a ROS 1 or ROS 2 bag, an IPIN log or "
+      "a Microsoft walk)");
 }
 
 namespace {
@@ -64,6 +69,8 @@ StatusOr<Dataset> Read(const std::string& path, DatasetFormat format,
       return ReadMicrosoftLog(path, phone_options, report);
     case DatasetFormat::kRosBag:
       return ReadRosbag(path, bag);
+    case DatasetFormat::kRos2Bag:
+      return ReadRos2Bag(path, bag);
     case DatasetFormat::kVideo:
       return ReadVideo(path, video);
   }
@@ -176,6 +183,7 @@ Status CopyImagesInto(Dataset* dataset, const std::string& folder,
   fs::create_directories(images, ec);
   if (ec) return Status::Error(images.string() + ": cannot create: " + ec.message());
   BagImageReader bags;
+  Ros2ImageReader ros2_bags;
   VideoFrameReader videos;
   std::vector<std::string> names(dataset->images.size());
   for (size_t i = 0; i < dataset->images.size(); ++i) {
@@ -185,6 +193,11 @@ Status CopyImagesInto(Dataset* dataset, const std::string& folder,
     uint64_t message = 0;
     if (!PathExists(source) && ParseBagImageReference(source, &bag, &message)) {
       StatusOr<EncodedImage> encoded = bags.Encoded(source);
+      if (!encoded.ok()) return encoded.status();
+      bytes.assign(encoded->bytes.begin(), encoded->bytes.end());
+      extension = encoded->extension;
+    } else if (!PathExists(source) && ParseRos2ImageReference(source, &bag, &message)) {
+      StatusOr<EncodedImage> encoded = ros2_bags.Encoded(source);
       if (!encoded.ok()) return encoded.status();
       bytes.assign(encoded->bytes.begin(), encoded->bytes.end());
       extension = encoded->extension;

@@ -14,11 +14,12 @@
 
 namespace ratslam {
 
-enum class DatasetFormat { kReplayFolder, kIpinLog, kMicrosoftLog, kRosBag, kVideo };
+enum class DatasetFormat { kReplayFolder, kIpinLog, kMicrosoftLog, kRosBag, kRos2Bag, kVideo };
 
 // A folder with manifest.toml: the replay format; a file starting "#ROSBAG V2.0": a ROS 1 bag
-// (topics from `bag`); a file named like a video (.avi, .mp4, ...): a video with its odometry log
-// (sensors/dataset/video.h); a file whose lines look like
+// (topics from `bag`); an MCAP file, a rosbag2 sqlite3 file or a folder with metadata.yaml: a ROS 2
+// bag (sensors/dataset/rosbag2.h, topics from `bag`); a file named like a video (.avi, .mp4, ...):
+// a video with its odometry log (sensors/dataset/video.h); a file whose lines look like
 // `WIFI;...`/`ACCE;...` (after `%` comments): an IPIN log; tab-separated `unix_ms TYPE_...`
 // lines: a Microsoft Indoor Location Competition walk. Anything else is an error naming the path.
 StatusOr<DatasetFormat> DetectDatasetFormat(const std::string& path);

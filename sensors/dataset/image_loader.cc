@@ -5,12 +5,15 @@
 
 #include "common/file_util.h"
 #include "sensors/dataset/rosbag.h"
+#include "sensors/dataset/rosbag2.h"
 #include "sensors/dataset/video.h"
 
 namespace ratslam {
 
 FileImageLoader::FileImageLoader()
-    : bags_(std::make_unique<BagImageReader>()), videos_(std::make_unique<VideoFrameReader>()) {}
+    : bags_(std::make_unique<BagImageReader>()),
+      ros2_bags_(std::make_unique<Ros2ImageReader>()),
+      videos_(std::make_unique<VideoFrameReader>()) {}
 FileImageLoader::~FileImageLoader() = default;
 
 StatusOr<GrayImage> FileImageLoader::Load(const std::string& path) {
@@ -18,6 +21,7 @@ StatusOr<GrayImage> FileImageLoader::Load(const std::string& path) {
   uint64_t message = 0;
   if (!PathExists(path)) {  // then maybe a bag's message or a video's frame
     if (ParseBagImageReference(path, &bag, &message)) return bags_->Load(path);
+    if (ParseRos2ImageReference(path, &bag, &message)) return ros2_bags_->Load(path);
     if (ParseVideoFrameReference(path, &bag, &message)) return videos_->Load(path);
     return Status::Error(path + ": image file missing");
   }

@@ -25,11 +25,13 @@ class ImageLoader {
 };
 
 class BagImageReader;
+class Ros2ImageReader;
 class VideoFrameReader;
 
 // Reads any format OpenCV's imgcodecs reads (PNG, JPEG, PGM, ...) and converts it to grey; a path
-// `<file>.bag#<n>` is message n of a ROS bag (sensors/dataset/rosbag.h), `<video>#<n>` frame n of
-// a video (sensors/dataset/video.h).
+// `<file>.bag#<n>` is message n of a ROS bag (sensors/dataset/rosbag.h), `<file>.mcap#<n>` or
+// `<file>.db3#<n>` one of a ROS 2 bag (sensors/dataset/rosbag2.h), `<video>#<n>` frame n of a video
+// (sensors/dataset/video.h).
 class FileImageLoader : public ImageLoader {
  public:
   FileImageLoader();
@@ -38,6 +40,7 @@ class FileImageLoader : public ImageLoader {
 
  private:
   std::unique_ptr<BagImageReader> bags_;
+  std::unique_ptr<Ros2ImageReader> ros2_bags_;
   std::unique_ptr<VideoFrameReader> videos_;
 };
 

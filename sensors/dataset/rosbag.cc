@@ -9,6 +9,7 @@
 #include <rosbag/view.h>
 #include <sensor_msgs/CompressedImage.h>
 #include <sensor_msgs/Image.h>
+#include <sensor_msgs/Imu.h>
 
 #include <algorithm>
 #include <cctype>
@@ -24,7 +25,8 @@
 #include <set>
 
 #include "common/file_util.h"
-#include "sensors/dataset/opencv_gray.h"
+#include "sensors/dataset/bag_common.h"
+#include "sensors/dataset/ros_image.h"
 #include "sensors/dataset/rosbag_check.h"
 
 namespace ratslam {
@@ -32,135 +34,28 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr const char* kCompressedImage = "sensor_msgs/CompressedImage";
-constexpr const char* kRawImage = "sensor_msgs/Image";
-constexpr const char* kOdometry = "nav_msgs/Odometry";
-constexpr const char* kPoseStamped = "geometry_msgs/PoseStamped";
-
-std::string Quoted(const std::set<std::string>& names) {
-  if (names.empty()) return "none";
-  std::string s;
-  for (const std::string& n : names) s += (s.empty() ? "" : ", ") + n;
-  return s;
-}
-
 // Nanoseconds of the header stamp, or of the record time where the stamp is zero (unset).
 int64_t Nanoseconds(const ros::Time& stamp, const ros::Time& record) {
   const ros::Time& t = stamp.isZero() ? record : stamp;
   return int64_t{t.sec} * 1000000000 + int64_t{t.nsec};
 }
 
-// Picks the topic for one stream. `types` are the message types it accepts.
-StatusOr<std::string> ResolveTopic(const std::string& bag, const std::string& what,
-                                   const std::string& key, const std::string& wanted,
-                                   const std::map<std::string, std::string>& topic_types,
-                                   const std::set<std::string>& types, bool try_compressed,
-                                   bool required_when_named) {
-  std::set<std::string> candidates;
-  std::set<std::string> all;
-  for (const auto& [topic, type] : topic_types) {
-    all.insert(topic + " (" + type + ")");
-    if (types.count(type)) candidates.insert(topic);
-  }
-  if (wanted.empty()) {
-    if (candidates.size() > 1) {
-      return Status::Error(bag + ": " + std::to_string(candidates.size()) + " " + what +
-                           " topics (" + Quoted(candidates) + "): choose one with [bag] " + key);
-    }
-    return candidates.empty() ? std::string() : *candidates.begin();
-  }
-  std::string name = NormaliseRosTopic(wanted);
-  if (!topic_types.count(name) && try_compressed && topic_types.count(name + "/compressed")) {
-    name += "/compressed";
-  }
-  auto it = topic_types.find(name);
-  if (it == topic_types.end()) {
-    if (!required_when_named) return std::string();
-    return Status::Error(bag + ": no topic " + name + " ([bag] " + key + "); the bag has " +
-                         Quoted(all));
-  }
-  if (!types.count(it->second)) {
-    return Status::Error(bag + ": topic " + name + " ([bag] " + key + ") carries " + it->second +
-                         ", not " + what + " messages (" + Quoted(types) + ")");
-  }
-  return name;
-}
+constexpr const char* kCompressedImage = "sensor_msgs/CompressedImage";
+constexpr const char* kRawImage = "sensor_msgs/Image";
+constexpr const char* kOdometry = "nav_msgs/Odometry";
+constexpr const char* kPoseStamped = "geometry_msgs/PoseStamped";
+constexpr const char* kImu = "sensor_msgs/Imu";
 
-StatusOr<GrayImage> DecodeCompressed(const sensor_msgs::CompressedImage& msg,
-                                     const std::string& where) {
-  if (msg.data.empty()) return Status::Error(where + ": empty compressed image");
-  cv::Mat mat;
-  try {
-    const cv::Mat raw(1, static_cast<int>(msg.data.size()), CV_8U,
-                      const_cast<uint8_t*>(msg.data.data()));
-    mat = cv::imdecode(raw, cv::IMREAD_GRAYSCALE);
-  } catch (const cv::Exception& e) {
-    return Status::Error(where + ": cannot decode image (format '" + msg.format +
-                         "'): " + e.what());
-  }
-  if (mat.empty()) {
-    return Status::Error(where + ": cannot decode image (format '" + msg.format + "')");
-  }
-  return GrayFromMat(mat, where);
-}
-
-// A raw image as an OpenCV matrix in BGR(A) or grey, after checking its size fields.
-StatusOr<cv::Mat> RawToMat(const sensor_msgs::Image& msg, const std::string& where) {
-  const std::string& enc = msg.encoding;
-  int channels = 0, depth_bytes = 1;
-  if (enc == "mono8" || enc == "8UC1") {
-    channels = 1;
-  } else if (enc == "mono16" || enc == "16UC1") {
-    channels = 1;
-    depth_bytes = 2;
-  } else if (enc == "bgr8" || enc == "rgb8" || enc == "8UC3") {
-    channels = 3;
-  } else if (enc == "bgra8" || enc == "rgba8" || enc == "8UC4") {
-    channels = 4;
-  } else {
-    return Status::Error(where + ": image encoding '" + enc +
-                         "' is not read (mono8, mono16, bgr8, rgb8, bgra8, rgba8)");
-  }
-  const uint64_t row_bytes = uint64_t{msg.width} * static_cast<uint64_t>(channels * depth_bytes);
-  if (msg.width == 0 || msg.height == 0 || msg.width > 65535 || msg.height > 65535) {
-    return Status::Error(where + ": image size " + std::to_string(msg.width) + "x" +
-                         std::to_string(msg.height) + " out of range");
-  }
-  if (msg.step < row_bytes || uint64_t{msg.step} * msg.height > msg.data.size()) {
-    return Status::Error(where + ": image step " + std::to_string(msg.step) + " and height " +
-                         std::to_string(msg.height) + " do not fit its " +
-                         std::to_string(msg.data.size()) + " bytes of data");
-  }
-  const int w = static_cast<int>(msg.width), h = static_cast<int>(msg.height);
-  cv::Mat mat(h, w, CV_8UC(channels));
-  for (int r = 0; r < h; ++r) {
-    const uint8_t* src = msg.data.data() + static_cast<size_t>(r) * msg.step;
-    uint8_t* dst = mat.ptr<uint8_t>(r);
-    if (depth_bytes == 1) {
-      std::copy(src, src + static_cast<size_t>(w) * channels, dst);
-    } else {
-      for (int c = 0; c < w; ++c) {  // the high byte of each 16-bit value
-        dst[c] = msg.is_bigendian ? src[2 * c] : src[2 * c + 1];
-      }
-    }
-  }
-  if (enc == "rgb8") cv::cvtColor(mat, mat, cv::COLOR_RGB2BGR);
-  if (enc == "rgba8") cv::cvtColor(mat, mat, cv::COLOR_RGBA2BGRA);
-  return mat;
-}
-
-std::string ExtensionOf(const sensor_msgs::CompressedImage& msg) {
-  std::string format;
-  for (char c : msg.format)
-    format += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  const auto& d = msg.data;
-  if (d.size() >= 8 && d[0] == 0x89 && d[1] == 'P' && d[2] == 'N' && d[3] == 'G') return "png";
-  if (d.size() >= 3 && d[0] == 0xFF && d[1] == 0xD8 && d[2] == 0xFF) return "jpg";
-  if (format.find("png") != std::string::npos) return "png";
-  if (format.find("jpeg") != std::string::npos || format.find("jpg") != std::string::npos) {
-    return "jpg";
-  }
-  return "";
+RawImageView ViewOf(const sensor_msgs::Image& msg) {
+  RawImageView v;
+  v.height = msg.height;
+  v.width = msg.width;
+  v.encoding = msg.encoding;
+  v.big_endian = msg.is_bigendian != 0;
+  v.step = msg.step;
+  v.data = msg.data.data();
+  v.size = msg.data.size();
+  return v;
 }
 
 // librosbag logs through console_bridge, to stdout and stderr; library code prints nothing
@@ -234,6 +129,16 @@ const char* LayoutOf<geometry_msgs::PoseStamped>() {
   return "Hddddddd";
 }
 
+// header, orientation (4) + covariance (9), angular velocity (3) + covariance (9), linear
+// acceleration (3) + covariance (9)
+template <>
+const char* LayoutOf<sensor_msgs::Imu>() {
+  return "H"
+         "ddddddddddddd"
+         "dddddddddddd"
+         "dddddddddddd";
+}
+
 // m.instantiate<T>() once the message's lengths are known to fit; throws otherwise (the callers
 // turn exceptions into errors naming the bag).
 template <typename T>
@@ -267,7 +172,7 @@ StatusOr<Dataset> ReadRosbag(const std::string& path, const BagTopics& topics) {
   RATSLAM_RETURN_IF_ERROR(CheckRosbagStructure(path));
   SilenceRosLogging();
   const std::string reference = fs::absolute(path).string() + "#";
-  std::vector<int64_t> image_ns, odometry_ns, truth_ns;  // stamps, exact
+  BagDatasetBuilder builder;
   try {
     rosbag::Bag bag;
     bag.open(path, rosbag::bagmode::Read);
@@ -280,32 +185,25 @@ StatusOr<Dataset> ReadRosbag(const std::string& path, const BagTopics& topics) {
                              " and " + c->datatype);
       }
     }
-    StatusOr<std::string> image_topic =
-        ResolveTopic(path, "image", "image_topic", topics.image_topic, topic_types,
-                     {kCompressedImage, kRawImage}, true, true);
-    if (!image_topic.ok()) return image_topic.status();
-    StatusOr<std::string> odometry_topic =
-        ResolveTopic(path, "odometry", "odometry_topic", topics.odometry_topic, topic_types,
-                     {kOdometry}, false, true);
-    if (!odometry_topic.ok()) return odometry_topic.status();
-    std::string truth_topic;
-    if (!topics.ground_truth_topic.empty()) {
-      StatusOr<std::string> t =
-          ResolveTopic(path, "ground-truth", "ground_truth_topic", topics.ground_truth_topic,
-                       topic_types, {kPoseStamped, kOdometry}, false, true);
-      if (!t.ok()) return t.status();
-      truth_topic = *t;
-    }
-    std::map<std::string, int64_t> last_time;  // per topic, for the order check
+    StatusOr<SelectedBagTopics> selected_topics = SelectBagTopics(
+        path, topics, topic_types,
+        {{kCompressedImage, kRawImage}, {kOdometry}, {kPoseStamped, kOdometry}, {kImu}});
+    if (!selected_topics.ok()) return selected_topics.status();
+    const std::string& image_topic = selected_topics->image;
+    const std::string& odometry_topic = selected_topics->odometry;
+    const std::string& truth_topic = selected_topics->ground_truth;
+    const std::string& imu_topic = selected_topics->imu;
     uint64_t n = 0;
     for (const rosbag::MessageInstance& m : view) {
       const uint64_t index = n++;
       const std::string& topic = m.getTopic();
-      if (topic != *image_topic && topic != *odometry_topic && topic != truth_topic) continue;
+      if (topic != image_topic && topic != odometry_topic && topic != truth_topic &&
+          topic != imu_topic) {
+        continue;
+      }
       const std::string where = path + ": message " + std::to_string(index) + " on " + topic;
-      int64_t time_ns = 0;
-      if (topic == *image_topic) {
-        ImageRow row;
+      if (topic == image_topic) {
+        int64_t time_ns = 0;
         if (m.getDataType() == kCompressedImage) {
           auto msg = Instantiate<sensor_msgs::CompressedImage>(m);
           if (!msg) return Status::Error(where + ": not a " + std::string(kCompressedImage));
@@ -315,27 +213,24 @@ StatusOr<Dataset> ReadRosbag(const std::string& path, const BagTopics& topics) {
           if (!msg) return Status::Error(where + ": not a " + std::string(kRawImage));
           time_ns = Nanoseconds(msg->header.stamp, m.getTime());
         }
-        image_ns.push_back(time_ns);
-        row.file = reference + std::to_string(index);
-        row.line = static_cast<int>(std::min<uint64_t>(index, 0x7fffffff));
-        d.images.push_back(row);
-      } else if (topic == *odometry_topic) {
+        RATSLAM_RETURN_IF_ERROR(
+            builder.AddImage(time_ns, topic, where, reference + std::to_string(index), index));
+      } else if (topic == odometry_topic) {
         auto msg = Instantiate<nav_msgs::Odometry>(m);
         if (!msg) return Status::Error(where + ": not a " + std::string(kOdometry));
-        time_ns = Nanoseconds(msg->header.stamp, m.getTime());
-        OdometryRow row;
-        odometry_ns.push_back(time_ns);
-        row.forward_speed_m_per_s = msg->twist.twist.linear.x;
-        row.turn_rate_rad_per_s = msg->twist.twist.angular.z;
-        if (!std::isfinite(row.forward_speed_m_per_s)) {
-          return Status::Error(where + ": twist.twist.linear.x is not a finite number");
-        }
-        if (!std::isfinite(row.turn_rate_rad_per_s)) {
-          return Status::Error(where + ": twist.twist.angular.z is not a finite number");
-        }
-        d.odometry.push_back(row);
+        RATSLAM_RETURN_IF_ERROR(builder.AddOdometry(Nanoseconds(msg->header.stamp, m.getTime()),
+                                                    topic, where, msg->twist.twist.linear.x,
+                                                    msg->twist.twist.angular.z));
+      } else if (topic == imu_topic) {
+        auto msg = Instantiate<sensor_msgs::Imu>(m);
+        if (!msg) return Status::Error(where + ": not a " + std::string(kImu));
+        const auto& q = msg->orientation;
+        RATSLAM_RETURN_IF_ERROR(builder.AddCompass(Nanoseconds(msg->header.stamp, m.getTime()),
+                                                   topic, where,
+                                                   YawOfQuaternion(q.x, q.y, q.z, q.w)));
       } else {
         geometry_msgs::Pose pose;
+        int64_t time_ns = 0;
         if (m.getDataType() == kPoseStamped) {
           auto msg = Instantiate<geometry_msgs::PoseStamped>(m);
           if (!msg) return Status::Error(where + ": not a " + std::string(kPoseStamped));
@@ -348,50 +243,15 @@ StatusOr<Dataset> ReadRosbag(const std::string& path, const BagTopics& topics) {
           pose = msg->pose.pose;
         }
         const auto& q = pose.orientation;
-        GroundTruthRow row;
-        truth_ns.push_back(time_ns);
-        row.x_m = pose.position.x;
-        row.y_m = pose.position.y;
-        row.theta_rad =
-            std::atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z));
-        if (!std::isfinite(row.x_m) || !std::isfinite(row.y_m) || !std::isfinite(row.theta_rad)) {
-          return Status::Error(where + ": pose is not finite");
-        }
-        d.ground_truth.push_back(row);
-      }
-      auto [it, first] = last_time.emplace(topic, time_ns);
-      if (!first) {
-        if (time_ns < it->second) {
-          char text[160];
-          std::snprintf(text, sizeof text,
-                        ": header stamp goes backwards (%.9f s after %.9f s on this topic)",
-                        static_cast<double>(time_ns) * 1e-9,
-                        static_cast<double>(it->second) * 1e-9);
-          return Status::Error(where + text);
-        }
-        it->second = time_ns;
+        RATSLAM_RETURN_IF_ERROR(builder.AddGroundTruth(time_ns, topic, where, pose.position.x,
+                                                       pose.position.y,
+                                                       YawOfQuaternion(q.x, q.y, q.z, q.w)));
       }
     }
   } catch (const std::exception& e) {
     return BagError(path, e);
   }
-  // Seconds after the earliest selected message, from whole nanoseconds (a double holding
-  // seconds since 1970 keeps only about 0.1 us).
-  int64_t t0 = std::numeric_limits<int64_t>::max();
-  for (const auto* stamps : {&image_ns, &odometry_ns, &truth_ns}) {
-    if (!stamps->empty()) t0 = std::min(t0, stamps->front());
-  }
-  if (t0 == std::numeric_limits<int64_t>::max()) {
-    return Status::Error(path + ": the bag has no image, odometry or ground-truth messages on " +
-                         "the selected topics");
-  }
-  auto seconds = [t0](int64_t ns) { return static_cast<double>(ns - t0) / 1e9; };
-  for (size_t i = 0; i < d.images.size(); ++i) d.images[i].time_s = seconds(image_ns[i]);
-  for (size_t i = 0; i < d.odometry.size(); ++i) d.odometry[i].time_s = seconds(odometry_ns[i]);
-  for (size_t i = 0; i < d.ground_truth.size(); ++i) {
-    d.ground_truth[i].time_s = seconds(truth_ns[i]);
-  }
-  return d;
+  return std::move(builder).Finish(std::move(d), path);
 }
 
 class BagImageReader::Impl {
@@ -457,14 +317,12 @@ StatusOr<GrayImage> BagImageReader::Load(const std::string& reference) {
   try {
     if ((*m)->getDataType() == kCompressedImage) {
       auto msg = Instantiate<sensor_msgs::CompressedImage>(**m);
-      if (msg) return DecodeCompressed(*msg, reference);
+      if (msg) {
+        return GrayFromCompressedImage(msg->data.data(), msg->data.size(), msg->format, reference);
+      }
     } else if ((*m)->getDataType() == kRawImage) {
       auto msg = Instantiate<sensor_msgs::Image>(**m);
-      if (msg) {
-        StatusOr<cv::Mat> mat = RawToMat(*msg, reference);
-        if (!mat.ok()) return mat.status();
-        return GrayFromMat(*mat, reference);
-      }
+      if (msg) return GrayFromRawImage(ViewOf(*msg), reference);
     }
   } catch (const std::exception& e) {
     return Status::Error(reference + ": cannot read the message: " + e.what());
@@ -482,7 +340,7 @@ StatusOr<EncodedImage> BagImageReader::Encoded(const std::string& reference) {
       auto msg = Instantiate<sensor_msgs::CompressedImage>(**m);
       if (msg) {
         EncodedImage out;
-        out.extension = ExtensionOf(*msg);
+        out.extension = CompressedImageExtension(msg->data.data(), msg->data.size(), msg->format);
         if (out.extension.empty()) {
           return Status::Error(reference + ": compressed image format '" + msg->format +
                                "' is neither PNG nor JPEG");
@@ -492,19 +350,7 @@ StatusOr<EncodedImage> BagImageReader::Encoded(const std::string& reference) {
       }
     } else if ((*m)->getDataType() == kRawImage) {
       auto msg = Instantiate<sensor_msgs::Image>(**m);
-      if (msg) {
-        StatusOr<cv::Mat> mat = RawToMat(*msg, reference);
-        if (!mat.ok()) return mat.status();
-        StatusOr<GrayImage> grey = GrayFromMat(*mat, reference);
-        if (!grey.ok()) return grey.status();
-        const cv::Mat g(grey->height, grey->width, CV_8U, grey->pixels.data());
-        EncodedImage out;
-        out.extension = "png";
-        if (!cv::imencode(".png", g, out.bytes)) {
-          return Status::Error(reference + ": cannot encode PNG");
-        }
-        return out;
-      }
+      if (msg) return PngFromRawImage(ViewOf(*msg), reference);
     }
   } catch (const std::exception& e) {
     return Status::Error(reference + ": cannot read the message: " + e.what());

@@ -1,7 +1,8 @@
 // ROS 1 bags (format 2.0) as data sets: camera images (sensor_msgs/CompressedImage or
 // sensor_msgs/Image), odometry (nav_msgs/Odometry: header.stamp, twist.twist.linear.x and
 // twist.twist.angular.z, as OpenRatSLAM reads it; the pose is ignored) and, optionally, ground
-// truth (geometry_msgs/PoseStamped or nav_msgs/Odometry poses). Read offline through Debian's
+// truth (geometry_msgs/PoseStamped or nav_msgs/Odometry poses) and a compass (the yaw of
+// sensor_msgs/Imu orientations, counter-clockwise from x). Read offline through Debian's
 // librosbag-storage-dev; no roscore. Builds without it answer every call with an error that says
 // how to get it.
 //
@@ -29,6 +30,7 @@ struct BagTopics {
   std::string image_topic;         // also found with "/compressed" appended (image_transport)
   std::string odometry_topic;      // empty and none in the bag: no odometry (visual odometry)
   std::string ground_truth_topic;  // empty: no ground truth
+  std::string imu_topic;           // empty: no compass from an IMU
 
   bool IsValid(std::string* error) const;
 
@@ -42,6 +44,9 @@ struct BagTopics {
       "nav_msgs/Odometry topic; empty: the bag's only one (none: no odometry)", schema::Any());
     v("ground_truth_topic", ground_truth_topic,
       "geometry_msgs/PoseStamped or nav_msgs/Odometry poses as ground truth; empty: none",
+      schema::Any());
+    v("imu_topic", imu_topic,
+      "sensor_msgs/Imu topic whose orientation's yaw is the compass heading; empty: none",
       schema::Any());
   }
 };

@@ -76,7 +76,7 @@ class RosbagTest : public ::testing::Test {
 TEST_F(RosbagTest, WrittenDataSetReadsBackToTheNanosecondAndPixel) {
   const Dataset d = Sample(40);
   IndexedImages images;
-  BagTopics topics{"/robot/camera/image/compressed", "/robot/odom", "/overhead/pose"};
+  BagTopics topics{"/robot/camera/image/compressed", "/robot/odom", "/overhead/pose", ""};
   ASSERT_TRUE(WriteRosbag(d, &images, topics, Path("a.bag")).ok());
   EXPECT_FALSE(fs::exists(Path("a.bag.partial")));
   // OpenRatSLAM's style of naming: the topic without "/compressed" finds the compressed one.
@@ -172,7 +172,7 @@ TEST_F(RosbagTest, RawAndCompressedEncodingsDecodeToTheExpectedGrey) {
     m.header.stamp = ros::Time(6, 0);
     bag.write("/stlucia/camera/image/compressed", m.header.stamp, m);
   }
-  d = ReadRosbag(Path("jpeg.bag"), {"/stlucia/camera/image", "", ""});
+  d = ReadRosbag(Path("jpeg.bag"), {"/stlucia/camera/image", "", "", ""});
   ASSERT_TRUE(d.ok()) << d.status().message();
   ASSERT_EQ(d->images.size(), 2u);
   StatusOr<GrayImage> jpeg = loader.Load(d->ImagePath(d->images[0]));
@@ -208,21 +208,21 @@ TEST_F(RosbagTest, TopicsAreChosenOrTheErrorSaysWhichToChoose) {
                    "/overhead/camera/image/compressed): choose one with [bag] image_topic"),
             std::string::npos)
       << e;
-  StatusOr<Dataset> d = ReadRosbag(Path("two.bag"), {"/irat_red/camera/image", "", ""});
+  StatusOr<Dataset> d = ReadRosbag(Path("two.bag"), {"/irat_red/camera/image", "", "", ""});
   ASSERT_TRUE(d.ok()) << d.status().message();
   EXPECT_EQ(d->images.size(), 1u);
   EXPECT_EQ(d->odometry.size(), 1u);
-  e = ReadError(Path("two.bag"), {"/irat_red/camera/image", "/irat_red/odometry", ""});
+  e = ReadError(Path("two.bag"), {"/irat_red/camera/image", "/irat_red/odometry", "", ""});
   EXPECT_NE(e.find("no topic /irat_red/odometry ([bag] odometry_topic); the bag has "
                    "/irat_red/camera/image/compressed (sensor_msgs/CompressedImage)"),
             std::string::npos)
       << e;
-  e = ReadError(Path("two.bag"), {"/irat_red/odom", "", ""});
+  e = ReadError(Path("two.bag"), {"/irat_red/odom", "", "", ""});
   EXPECT_NE(e.find("topic /irat_red/odom ([bag] image_topic) carries nav_msgs/Odometry, not "
                    "image messages"),
             std::string::npos)
       << e;
-  BagTopics bad{"/cam era", "", ""};
+  BagTopics bad{"/cam era", "", "", ""};
   std::string why;
   EXPECT_FALSE(bad.IsValid(&why));
   EXPECT_NE(why.find("image_topic '/cam era'"), std::string::npos) << why;
@@ -270,7 +270,8 @@ TEST_F(RosbagTest, StampsGoingBackwardsAndNonFiniteValuesAreErrorsNamingTheMessa
 
 TEST_F(RosbagTest, TruncatedAndCorruptedBagsAreErrorsNotPartialDataSets) {
   IndexedImages images;
-  ASSERT_TRUE(WriteRosbag(Sample(30), &images, {"/c/image", "/c/odom", ""}, Path("a.bag")).ok());
+  ASSERT_TRUE(
+      WriteRosbag(Sample(30), &images, {"/c/image", "/c/odom", "", ""}, Path("a.bag")).ok());
   std::ifstream in(Path("a.bag"), std::ios::binary);
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   ASSERT_GT(bytes.size(), 1000u);
@@ -302,7 +303,7 @@ TEST_F(RosbagTest, TruncatedAndCorruptedBagsAreErrorsNotPartialDataSets) {
   // of each message is checked first now.
   e = ReadError(
       std::string(RATSLAM_SOURCE_DIR) + "/fuzz/regressions/rosbag_fuzzer/oom-image-data-length-4gb",
-      {"", "", "/r/pose"});
+      {"", "", "/r/pose", ""});
   EXPECT_NE(e.find("sensor_msgs/CompressedImage on /r/camera/image/compressed holds a field "
                    "longer than the message"),
             std::string::npos)
@@ -366,12 +367,12 @@ TEST_F(RosbagTest, WriterRefusesWhatABagCannotHold) {
   IndexedImages images;
   Dataset d = Sample(3);
   d.wifi.push_back({0.5, {{"aa:bb", -50}}});
-  Status s = WriteRosbag(d, &images, {"/c", "/o", ""}, Path("w.bag"));
+  Status s = WriteRosbag(d, &images, {"/c", "/o", "", ""}, Path("w.bag"));
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.message().find("Wi-Fi scans, compass and barometer readings are not written"),
             std::string::npos);
   EXPECT_FALSE(fs::exists(Path("w.bag")));
-  s = WriteRosbag(Sample(3), &images, {"", "/o", ""}, Path("w.bag"));
+  s = WriteRosbag(Sample(3), &images, {"", "/o", "", ""}, Path("w.bag"));
   EXPECT_FALSE(s.ok());
 }
 
