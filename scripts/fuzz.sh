@@ -58,7 +58,7 @@ for f in $(find "$shared/msft-ilc20-site1" -name '*.txt' 2>/dev/null | sort | he
 done
 # ROS 2 bags from the independent writers the tests use (skipped where node or npm is missing).
 if [[ -d $build/corpus/ros2_bag_fuzzer ]] && bash scripts/ros2_fixtures.sh "$build/ros2-seeds" 2>/dev/null; then
-  cp "$build"/ros2-seeds/raw*.mcap "$build/corpus/ros2_bag_fuzzer/"
+  cp "$build"/ros2-seeds/raw*.mcap "$build"/ros2-seeds/raw_db3/*.db3 "$build/corpus/ros2_bag_fuzzer/"
 fi
 [[ -d $build/corpus/ujiindoorloc_fuzzer ]] &&
   excerpt ujiindoorloc_fuzzer "$shared/ujiindoorloc/trainingData.csv" 8

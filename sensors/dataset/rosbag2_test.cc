@@ -88,10 +88,21 @@ class Rosbag2Test : public ::testing::Test {
 // The fixture's raw images, IMU and odometry, with the values the writer was given.
 TEST_F(Rosbag2Test, RawImagesImuAndOdometryFromAnIndependentWriter) {
   MAKE_FIXTURES_OR_SKIP(folder_ / "fx", "");
-  const std::string bag = (folder_ / "fx" / "raw.mcap").string();
-  ASSERT_TRUE(LooksLikeRos2Bag(bag));
   BagTopics topics;
   topics.imu_topic = "/imu";
+  for (const char* name : {"raw_lz4.mcap", "raw_nosummary.mcap", "raw_db3"}) {
+    const std::string bag = (folder_ / "fx" / name).string();
+    ASSERT_TRUE(LooksLikeRos2Bag(bag)) << name;
+    StatusOr<Dataset> d = ReadRos2Bag(bag, topics);
+    ASSERT_TRUE(d.ok()) << d.status().message();
+    FileImageLoader loader;
+    ASSERT_EQ(d->images.size(), 3u);
+    StatusOr<GrayImage> image = loader.Load(d->ImagePath(d->images[2]));
+    ASSERT_TRUE(image.ok()) << image.status().message();
+    EXPECT_EQ(image->pixels.size(), 4u) << name;
+  }
+  const std::string bag = (folder_ / "fx" / "raw.mcap").string();
+  ASSERT_TRUE(LooksLikeRos2Bag(bag));
   StatusOr<Dataset> d = ReadRos2Bag(bag, topics);
   ASSERT_TRUE(d.ok()) << d.status().message();
   ASSERT_EQ(d->images.size(), 3u);

@@ -6,8 +6,8 @@
 //   node make_fixtures.mjs --modules DIR/node_modules --out DIR [--data REPLAY_FOLDER]
 //
 // Always writes raw.mcap (raw images in mono8, rgb8 and bgr8 with known pixels, an IMU and an
-// odometry message with known values; zstd chunks), and the same as raw_lz4.mcap and
-// raw_nosummary.mcap (seeds for the fuzzer). With --data, writes that replay folder's images (as PNG
+// odometry message with known values; zstd chunks), and the same as raw_lz4.mcap,
+// raw_nosummary.mcap and raw_db3/ (a sqlite3 rosbag2 folder). With --data, writes that replay folder's images (as PNG
 // CompressedImage), odometry, ground truth (PoseStamped) and headings (Imu orientation) as
 // loop_zstd.mcap, loop_lz4.mcap, loop_plain.mcap (uncompressed chunks), loop_nosummary.mcap (no
 // chunks, no index, no summary section: readers must scan), loop_db3/ (a rosbag2 folder with
@@ -294,6 +294,7 @@ fs.mkdirSync(args.out, { recursive: true });
 await writeMcap(path.join(args.out, "raw.mcap"), rawMessages(), { compression: "zstd" });
 await writeMcap(path.join(args.out, "raw_lz4.mcap"), rawMessages(), { compression: "lz4" });
 await writeMcap(path.join(args.out, "raw_nosummary.mcap"), rawMessages(), { indexed: false });
+await writeDb3Folder(path.join(args.out, "raw_db3"), rawMessages());
 if (args.data) {
   const messages = messagesOf(args.data);
   await writeMcap(path.join(args.out, "loop_zstd.mcap"), messages, { compression: "zstd" });
