@@ -46,7 +46,8 @@ std::unique_ptr<FrontEnd> MakeFabmapFrontEnd(const FabmapSettings& settings,
 
 // Sequence recognition in front of `inner` ([sequence] recognise_views; fusion/
 // sequence_recognition.cc): a camera frame whose sequence is recognised re-uses the template of
-// the frame it matched, and `inner` decides every other frame.
+// the frame it matched, a blank frame (no contrast) gives no view, and `inner` decides every
+// other frame.
 std::unique_ptr<FrontEnd> MakeSequenceRecognition(std::unique_ptr<FrontEnd> inner,
                                                   const SequenceMatcherOptions& options);
 

@@ -825,6 +825,34 @@ TEST(SequenceRecognitionTest, SecondLapInOtherLightReusesTheFirstLapsTemplates) 
   }
 }
 
+// Black frames (a tunnel on each lap) give no view with sequence recognition: the classic camera
+// alone matches the second lap's black frame to the first lap's, at the other end of the route.
+TEST(SequenceRecognitionTest, BlackFramesGiveNoView) {
+  const GrayImage black{64, 32, std::vector<uint8_t>(64 * 32, 2)};
+  for (const bool recognise : {false, true}) {
+    std::unique_ptr<FrontEnd> front_end = CreateFrontEnd(SequenceSettings(recognise));
+    Random noise(3);
+    std::vector<std::optional<FrameDecision>> black_decisions;
+    for (int lap = 0; lap < 2; ++lap) {
+      for (int place = 0; place < 100; ++place) {
+        const bool tunnel = (lap == 0 && place == 20) || (lap == 1 && place == 80);
+        auto d = front_end->OnImage(lap * 100 + place, tunnel ? black : Place(place, lap, &noise));
+        ASSERT_TRUE(d.ok()) << d.status().message();
+        if (tunnel) black_decisions.push_back(*d);
+      }
+    }
+    ASSERT_EQ(black_decisions.size(), 2u);
+    if (recognise) {
+      EXPECT_FALSE(black_decisions[0].has_value());
+      EXPECT_FALSE(black_decisions[1].has_value());
+    } else {
+      ASSERT_TRUE(black_decisions[0].has_value() && black_decisions[1].has_value());
+      EXPECT_FALSE(black_decisions[1]->view.is_new);
+      EXPECT_EQ(black_decisions[1]->view.template_id, black_decisions[0]->view.template_id);
+    }
+  }
+}
+
 // A run resumed from saved state decides every later frame as the unbroken run does; bytes it
 // did not write are refused; and the option needs a front end that takes camera frames.
 TEST(SequenceRecognitionTest, StateRoundTripsAndTheOptionNeedsACamera) {

@@ -49,7 +49,11 @@ class SequenceRecognition : public FrontEnd {
         step >= 0 && step <= static_cast<int64_t>(std::ceil(options_.max_velocity)) + 1;
     previous_ = confident ? m.reference : -1;
     std::optional<FrameDecision> decision;
-    if (continues && template_of_[m.reference] != kNoTemplate) {
+    if (frame.blank) {
+      // No view at all: a frame without contrast (a tunnel, night, a lens cap) looks like every
+      // other such frame, so the wrapped front end would match it to any earlier one anywhere.
+      // The pose cells keep integrating odometry through it.
+    } else if (continues && template_of_[m.reference] != kNoTemplate) {
       FrameDecision d;
       d.view.time_s = time_s;
       d.view.template_id = template_of_[m.reference];

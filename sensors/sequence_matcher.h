@@ -37,7 +37,8 @@ struct SequenceMatcherOptions {
   int image_height_px = 0;      // and to this height; 0: keep
   // Replay (sequence recognition in the classic camera and fused front ends): a camera frame
   // whose sequence matches an earlier stretch of the route with at least min_confidence re-uses
-  // the template of the frame it matched; otherwise the front end decides as before.
+  // the template of the frame it matched; a blank frame gives no view; otherwise the front end
+  // decides as before.
   bool recognise_views = false;
   double min_confidence = 0.3;  // least margin of the best line over the runner-up, per frame
   int recency_frames = 50;      // the newest this-many frames are never matched
@@ -78,7 +79,8 @@ struct SequenceMatcherOptions {
       "replay with the classic camera or fused (use_camera) front end: a camera frame whose "
       "sequence of the newest sequence_length frames matches an earlier stretch of the route "
       "with at least min_confidence re-uses the template of the frame it matched (a loop "
-      "closure); otherwise the front end decides alone",
+      "closure); a blank frame (blank_contrast) gives no view; otherwise the front end decides "
+      "alone",
       schema::Any());
     v("min_confidence", min_confidence,
       "recognise_views: least margin of the best sequence over the best one outside "

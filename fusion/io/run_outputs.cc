@@ -188,6 +188,18 @@ CrossSessionPlaces ScoreCrossSessionPlaces(const std::vector<FrameRecord>& frame
       ++i;
     }
   }
+  // Every later image whose place an earlier session has counts, with a view or without one (a
+  // blank frame gives none): a frame without a view is not matched.
+  auto earlier_has = [&](size_t session, const std::string& name) {
+    for (size_t s = 0; s < session; ++s) {
+      if (position[s].count(name) > 0) return true;
+    }
+    return false;
+  };
+  for (const ImageRow& row : dataset.images) {
+    const size_t s = dataset.SessionAt(row.time_s);
+    out.frames += s > 0 && earlier_has(s, std::filesystem::path(row.file).filename().string());
+  }
   std::map<uint32_t, size_t> made_by;  // template -> the frame that made it
   for (size_t f = 0; f < frames.size(); ++f) {
     if (frames[f].is_new) made_by.emplace(frames[f].template_id, f);
@@ -195,10 +207,7 @@ CrossSessionPlaces ScoreCrossSessionPlaces(const std::vector<FrameRecord>& frame
   for (size_t f = 0; f < frames.size(); ++f) {
     if (!place_of[f] || place_of[f]->session == 0) continue;
     const Place& here = *place_of[f];
-    bool earlier_has_it = false;
-    for (size_t s = 0; s < here.session; ++s) earlier_has_it |= position[s].count(here.name) > 0;
-    if (!earlier_has_it) continue;
-    ++out.frames;
+    if (!earlier_has(here.session, here.name)) continue;
     const auto made = made_by.find(frames[f].template_id);
     if (made == made_by.end() || !place_of[made->second]) continue;
     const Place& there = *place_of[made->second];

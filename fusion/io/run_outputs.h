@@ -65,7 +65,8 @@ void RecordPose(const ExperienceMap& map, const TrajectoryRecord& record, double
 // session that ends on a template made in an earlier session is correct within N frames when the
 // template's first frame is at most N images from the frame's namesake in that session.
 struct CrossSessionPlaces {
-  size_t frames = 0;   // image frames of later sessions whose name an earlier session has
+  size_t frames = 0;   // images of later sessions whose name an earlier session has (with a
+                       // view or without: a frame without one is not matched)
   size_t matched = 0;  // of them, frames on a template made in an earlier session
   // Of the matched, those correct within each tolerance of kPlaceTolerancesFrames.
   std::vector<size_t> correct;
