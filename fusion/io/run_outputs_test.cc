@@ -80,6 +80,12 @@ TEST(CrossSessionPlacesTest, ScoresByTheNamesakeInTheTemplatesSession) {
   EXPECT_EQ(p.frames, 4u);
   EXPECT_EQ(p.matched, 3u);
   EXPECT_EQ(p.correct, (std::vector<size_t>{2, 2, 3, 3}));
+  // A later image that gave no view (a blank frame) is a frame, not matched.
+  d.images.push_back({110.0, "/x/winter/e.png", 9});
+  const CrossSessionPlaces with_blank = ScoreCrossSessionPlaces(frames, d);
+  EXPECT_EQ(with_blank.frames, 5u);
+  EXPECT_EQ(with_blank.matched, 3u);
+  EXPECT_EQ(with_blank.correct, p.correct);
   // One session: nothing to score.
   d.session_start_times_s = {0.0};
   EXPECT_EQ(ScoreCrossSessionPlaces(frames, d).frames, 0u);
