@@ -70,11 +70,16 @@ class FabmapFrontEnd : public FrontEnd {
     floors_.OnSessionStart(start_s);
     if (settings_.front_end.online_rssi_offset) offset_.OnSessionStart(start_s, size());
   }
-  std::vector<double> RssiOffsetsDb() const override {
-    if (!settings_.front_end.online_rssi_offset) return {};
-    return offset_.OffsetsDb();
+  FrontEndReport Report() const override {
+    FrontEndReport r;
+    if (settings_.front_end.online_rssi_offset) r.rssi_offsets_db = offset_.OffsetsDb();
+    r.floors = floors_.Report();
+    r.fabmap_learning = FabmapLearningReport{
+        settings_.front_end.wifi_learning,
+        online() ? learned_from_ : static_cast<uint64_t>(resources_->scans.scans.size()),
+        online() ? relearnt_ : 1, localiser_ ? localiser_->wifi_tree_scans() : 0};
+    return r;
   }
-  std::optional<FloorReport> floor_report() const override { return floors_.Report(); }
   std::optional<int> TemplateFloor(uint32_t id) const override { return floors_.TemplateFloor(id); }
   std::optional<double> CompassHeading() const override { return std::nullopt; }
   bool WantsImages() const override { return fabmap::UsesVision(mode()); }
@@ -82,12 +87,6 @@ class FabmapFrontEnd : public FrontEnd {
   void SettleForLocalisation() override {
     settled_ = size();
     floors_.SettleForLocalisation();
-  }
-  std::optional<FabmapLearningReport> fabmap_learning() const override {
-    return FabmapLearningReport{
-        settings_.front_end.wifi_learning,
-        online() ? learned_from_ : static_cast<uint64_t>(resources_->scans.scans.size()),
-        online() ? relearnt_ : 1, localiser_ ? localiser_->wifi_tree_scans() : 0};
   }
 
   std::string EncodeState() const override {

@@ -3,43 +3,9 @@
 // Wi-Fi scan when no camera is used).
 //
 // kClassicCamera: the OpenRatSLAM camera matcher (sensors/classic_camera_matcher.h).
-// kFused: the Wi-Fi RatSLAM paper's front end (section III): 12x9 camera templates (eq. 7),
-// Wi-Fi fingerprints (eqs. 3-6) and a compass (eq. 2), combined by the b_out rule (eqs. 8-12):
-// the best match per sensor counts only if it reaches the sensor's threshold and is not among
-// the last k templates (k in templates and/or seconds); the camera is preferred when it matches,
-// else Wi-Fi, else a new joint template (camera view + newest Wi-Fi scan + heading) is stored.
-// Our reading of "novel": a best match above threshold that is merely recent is familiar, not
-// novel. Taken literally, eqs. 10-12 would store a new template at every frame while the robot
-// stands still (its best match is always the template just stored). So a recent best above
-// threshold re-uses that template without pose-cell injection (as OpenRatSLAM treats its newest
-// templates); only both sensors below threshold make a new template.
-// Wi-Fi is evaluated at the camera rate with the newest scan; scans older than max_wifi_age_s
-// count as absent. Any sensor can be switched off (Wi-Fi only, camera only, fused).
-// kFabmap: FABMAP (fusion/fabmap) decides: a place it recognises with at least
-// match_probability is the active view; otherwise (the new place wins) the observation becomes a
-// new place and template. With decide_by_log_odds the best mapped place is the active view when
-// its log odds against the new place reach match_log_odds (the log of the two posteriors' ratio,
-// from the likelihoods, so finite where the posteriors saturate at 0 and 1): the rule whose
-// threshold `ratslam evaluate` learns ([evaluation] calibrate_new_place). Any FABMAP mode works
-// (vision, wifi, early, late, sequential). The Wi-Fi words, tree and virtual samples come from an
-// exploration of the data set's own scans (the fusion paper's section 3: Wi-Fi vocabularies exist
-// only after exploring), spaced by odometry travel and time; the visual model is loaded from
-// [visual_model] file or trained.
-// Floors ([barometer] use_barometer with a pressure stream; fused and FABMAP front ends): each
-// session's barometer gives levels (sensors/barometer.h); a template stores its session and
-// level, or "unknown" when made on the stairs (in transit). A session is on its first level
-// until the first dwell (walks start standing). A match needs the barometer to agree: within a
-// session the same level; across sessions the same floor in the map's frame, where a later
-// session starts with offset 0 to the first (walks of one building usually start on one floor)
-// and Wi-Fi revises it: each scan on a level votes with its best confident match among earlier
-// sessions' templates on a level, whatever their floor, when that match beats the best on every
-// other floor by 1.5 times (an ambiguous scan abstains); a vote says the template's floor minus
-// ours, and a value other than 0 that leads every other (0 included) by floor_offset_min_votes
-// moves the session's offset. A query or template of unknown floor matches nothing that has a
-// floor, so a scan taken on the stairs becomes a new template. Sessions without barometer
-// readings are unconstrained, as before. FABMAP: the best place the barometer allows must still
-// pass the decision rule (match_probability, or match_log_odds with decide_by_log_odds); its
-// votes use the posterior of places as the score and match_probability as the threshold.
+// kFused: the Wi-Fi RatSLAM paper's camera, Wi-Fi and compass front end (fusion/fused_options.h).
+// kFabmap: FABMAP decides the active view (fusion/fabmap_front_end_options.h).
+// Floors from the barometer for the fused and FABMAP front ends: fusion/fused_options.h.
 // kDescriptors: per-image descriptors computed elsewhere (fusion/descriptor_table.h) matched by
 // cosine similarity with min_similarity and the same recency rule; pixels are never loaded.
 // kCustom: a front end of your own (see "Writing a front end" below FrontEnd).
@@ -54,12 +20,10 @@
 #include "common/schema.h"
 #include "common/status.h"
 #include "fusion/descriptor_table.h"
-#include "fusion/fabmap/localiser.h"
-#include "fusion/fabmap/visual_model.h"
-#include "fusion/fabmap/vocabulary.h"
+#include "fusion/fabmap_front_end_options.h"
+#include "fusion/fused_options.h"
 #include "ratslam/local_view_cells.h"
 #include "ratslam/records.h"
-#include "sensors/barometer.h"
 #include "sensors/classic_camera_matcher.h"
 #include "sensors/dataset/dataset.h"
 #include "sensors/dataset/image_loader.h"
@@ -90,198 +54,6 @@ struct FrontEndOptions {
   }
 };
 
-struct FusedOptions {
-  bool use_camera = false;      // 12x9 camera templates (eq. 7)
-  bool use_wifi = true;         // Wi-Fi fingerprints (eqs. 3-6)
-  bool use_compass = false;     // heading per template; relative orientation of eq. 2
-  int recency_templates = 0;    // k: a match must be at least this many templates old
-  double recency_s = 40.0;      // k: and at least this many seconds old (paper: 40 s)
-  double max_wifi_age_s = 5.0;  // an older newest scan counts as absent
-  // Per-device RSSI offset, estimated online: each scan of a later session is compared with the
-  // earlier sessions' templates by the spread of its RSSI differences (a constant offset costs
-  // nothing there); the median difference to the best one is an estimate, and once there are
-  // rssi_offset_min_estimates of them their median is removed from the session's scans (in
-  // matching and in the templates it stores). No ground truth, no per-phone constant.
-  bool online_rssi_offset = false;
-  int rssi_offset_min_common_aps = 5;  // an estimate needs this many APs in common
-  int rssi_offset_min_estimates = 10;  // estimates before the offset is applied
-  // Maps that keep up with access points changing after them (long-term data): a scan whose
-  // Wi-Fi match to an old template (a revisit, past the recency of eqs. 10-11) reaches this
-  // weight updates that template's fingerprint (WifiFingerprintMatcher::FollowRevisit: the APs
-  // it heard that the template lacks are added, the template's strong APs it did not hear are
-  // dropped), once per scan. 0: off.
-  double revisit_update_weight = 0.0;
-
-  bool IsValid(std::string* error) const;
-
-  template <typename Visitor>
-  void VisitFields(Visitor&& v) {
-    v("use_camera", use_camera, "use 12x9 camera templates (eq. 7); frames are camera images",
-      schema::Any());
-    v("use_wifi", use_wifi, "use Wi-Fi fingerprints (eqs. 3-6); without a camera, scans are frames",
-      schema::Any());
-    v("use_compass", use_compass,
-      "store a heading with each template; matches give the relative orientation of eq. 2",
-      schema::Any());
-    v("recency_templates", recency_templates,
-      "k of eqs. 10-11 in templates: newer matches do not count",
-      schema::Unit("templates").NonNegative());
-    v("recency_s", recency_s, "k of eqs. 10-11 in seconds: matches newer than this do not count",
-      schema::Unit("s").NonNegative());
-    v("max_wifi_age_s", max_wifi_age_s, "a Wi-Fi scan older than this counts as absent at a frame",
-      schema::Unit("s").NonNegative());
-    v("online_rssi_offset", online_rssi_offset,
-      "estimate each later session's RSSI offset to the earlier sessions' templates online and "
-      "remove it from its scans (phones that read several dB apart)",
-      schema::Any());
-    v("rssi_offset_min_common_aps", rssi_offset_min_common_aps,
-      "APs a scan must share with an earlier session's template to estimate the offset",
-      schema::Unit("APs").AtLeast(1));
-    v("rssi_offset_min_estimates", rssi_offset_min_estimates,
-      "offset estimates of a session before its median is applied",
-      schema::Unit("scans").AtLeast(1));
-    v("revisit_update_weight", revisit_update_weight,
-      "a revisit whose Wi-Fi match reaches this weight (eq. 6) updates the template's "
-      "fingerprint once per scan: the scan's APs it lacks are added, its APs above "
-      "penalty_floor_dbm that the scan did not hear are dropped (APs changed since the map was "
-      "made); 0: off",
-      schema::Unit("").Within(0, 1));
-  }
-};
-
-// Floors from the barometer for the front ends that match Wi-Fi (fused and FABMAP; see
-// "Floors" above): the switch, the vote lead, and the floor tracker's own settings.
-struct FloorOptions {
-  bool use_barometer = false;      // floors from a pressure stream, when there is one
-  int floor_offset_min_votes = 3;  // lead of a floor offset over any other value
-  BarometerOptions tracker;
-
-  bool IsValid(std::string* error) const;
-  template <typename Visitor>
-  void VisitFields(Visitor&& v) {
-    v("use_barometer", use_barometer,
-      "with a pressure stream: give templates a floor (level) from the barometer and never match "
-      "across floors or from the stairs (fused and FABMAP front ends); without one, no effect",
-      schema::Any());
-    v("floor_offset_min_votes", floor_offset_min_votes,
-      "a later session's floors start level with the first session's; its Wi-Fi matches to "
-      "earlier sessions vote, and a floor offset that leads every other by this many votes "
-      "replaces the current one",
-      schema::Unit("votes").AtLeast(1));
-    tracker.VisitFields(v);
-  }
-};
-
-// What the barometer said over a run (front ends with use_barometer and a pressure stream).
-struct FloorReport {
-  uint64_t pressure_readings = 0;
-  uint64_t floor_changes = 0;         // over all sessions (sensors/barometer.h)
-  uint64_t frames_floor_unknown = 0;  // frames on the stairs or before a session's first level
-  uint64_t new_templates_by_floor_rule = 0;  // would have matched a template on another floor
-  uint64_t templates_with_floor = 0;
-  uint64_t floor_offset_changes = 0;  // times Wi-Fi votes moved a session's floor offset
-  // By session: the offset of its floors to the first session's.
-  std::vector<int> session_floor_offsets;
-};
-
-// Where the FABMAP front end's Wi-Fi words, tree and unknown world come from.
-//   kWholeDataSet: every scan of the data set, future sessions included (an exploration done
-//     before the run, as in the fusion paper's benchmark; not causal).
-//   kOnline: only the scans seen so far: learnt after `online_first_scans` scans and again each
-//     time the count doubles (mapped places are re-added to the relearnt model); before the first
-//     model every frame is a new place. A decision at time t never depends on data after t.
-enum class WifiLearning { kWholeDataSet, kOnline };
-std::string ToString(WifiLearning learning);
-StatusOr<WifiLearning> WifiLearningFromString(const std::string& name);
-
-struct FabmapFrontEndOptions {
-  double match_probability = 0.5;  // least posterior of the best place to re-use its template
-  int recency_templates = 0;       // a match this many templates old or newer: no injection
-  double recency_s = 10.0;         // nor one made less than this long ago
-  double max_wifi_age_s = 5.0;     // an older newest scan counts as absent at an image frame
-  WifiLearning wifi_learning = WifiLearning::kWholeDataSet;  // see WifiLearning
-  int online_first_scans = 20;      // kOnline: scans before the first Wi-Fi model
-  bool decide_by_log_odds = false;  // the best place's log odds, not its posterior, decide
-  double match_log_odds = 0.0;      // with decide_by_log_odds: least log odds of the best place
-  // Per-device RSSI offset, estimated online as in [fused] (sensors/rssi_offset.h) and removed
-  // from a later session's scans before they become Wi-Fi words and places.
-  bool online_rssi_offset = false;
-  int rssi_offset_min_common_aps = 5;
-  int rssi_offset_min_estimates = 10;
-
-  bool IsValid(std::string* error) const;
-  template <typename Visitor>
-  void VisitFields(Visitor&& v) {
-    v("match_probability", match_probability,
-      "least FABMAP posterior of the best place for its template to become active",
-      schema::Unit("").Above(0).AtMost(1));
-    v("recency_templates", recency_templates,
-      "matches to one of the newest this-many templates re-use it without injection",
-      schema::Unit("templates").NonNegative());
-    v("recency_s", recency_s, "so do matches to a template made less than this long ago",
-      schema::Unit("s").NonNegative());
-    v("max_wifi_age_s", max_wifi_age_s, "a Wi-Fi scan older than this counts as absent at a frame",
-      schema::Unit("s").NonNegative());
-    v("wifi_learning", wifi_learning,
-      "Wi-Fi words, tree and unknown world from whole_data_set (every scan, future included) or "
-      "online (only the scans seen so far, relearnt as their number doubles)",
-      schema::Any());
-    v("online_first_scans", online_first_scans,
-      "online: scans before the first Wi-Fi model (every frame is a new place until then)",
-      schema::Unit("scans").AtLeast(1));
-    v("decide_by_log_odds", decide_by_log_odds,
-      "the best mapped place becomes active when its log odds against the new place reach "
-      "match_log_odds (instead of its posterior reaching match_probability)",
-      schema::Any());
-    v("match_log_odds", match_log_odds,
-      "decide_by_log_odds: least log(p(best place) / p(new place)), nats; 0 is the arg-max, "
-      "negative values accept places the new place beats",
-      schema::Unit("nats").Within(-1000, 1000));
-    v("online_rssi_offset", online_rssi_offset,
-      "estimate each later session's RSSI offset to the earlier sessions' places online and "
-      "remove it from its scans before they become Wi-Fi words (phones that read several dB "
-      "apart)",
-      schema::Any());
-    v("rssi_offset_min_common_aps", rssi_offset_min_common_aps,
-      "APs a scan must share with an earlier session's place to estimate the offset",
-      schema::Unit("APs").AtLeast(1));
-    v("rssi_offset_min_estimates", rssi_offset_min_estimates,
-      "offset estimates of a session before its median is applied",
-      schema::Unit("scans").AtLeast(1));
-  }
-};
-
-// FABMAP localisation (fusion/fabmap): modes, models, words and the benchmark's split.
-struct FabmapSettings {
-  fabmap::LocaliserSettings localiser;
-  fabmap::FeatureOptions features;
-  fabmap::VocabularyOptions vocabulary;
-  fabmap::VisualModelOptions visual_model;
-  FabmapFrontEndOptions front_end;
-
-  bool IsValid(std::string* error) const;
-};
-
-// What the FABMAP front end is built from, prepared once per run (PrepareFabmapResources).
-struct FabmapResources {
-  std::optional<fabmap::TrainedVisualModel> visual;  // to turn images into words
-  // The localiser with no places yet (words, trees, unknown world): each front end, and each
-  // restore, starts from a copy instead of learning the Wi-Fi tree again. Whole-data-set
-  // learning only; online learning builds its own from `scans`.
-  std::shared_ptr<const fabmap::Localiser> empty_localiser;
-  // Every scan of the data set in order, with the odometry travel before it (online learning
-  // uses the first n of them after the n-th scan, never more).
-  fabmap::WifiExploration scans;
-};
-
-// How a FABMAP front end learnt its Wi-Fi model, for the run's summary.
-struct FabmapLearningReport {
-  WifiLearning wifi_learning = WifiLearning::kWholeDataSet;
-  uint64_t wifi_learned_from_scans = 0;  // scans behind the current Wi-Fi model
-  uint64_t wifi_relearnt = 0;            // times the model was (re)built during the run
-  uint64_t wifi_tree_scans = 0;          // of the scans, those that learnt the Wi-Fi tree
-};
-
 struct FrameDecision {
   ViewDecision view;
   DecisionSource source = DecisionSource::kNew;
@@ -305,6 +77,19 @@ struct FrameDecision {
 //  - Return errors as Status; never print or exit.
 // Set [front_end] kind = "custom" and give the session (SessionEnvironment::custom_front_end) or
 // the pipeline (FrontEndResources::custom) a factory that makes a fresh front end.
+// What a front end reports for a run's summary; each part only from the front ends it concerns.
+struct FrontEndReport {
+  // The RSSI offset (dB) removed from each session's scans so far, by session (front ends that
+  // estimate one); the last entry is the current session's.
+  std::vector<double> rssi_offsets_db;
+  // APs that revisits added to and dropped from templates ([fused] revisit_update_weight).
+  std::optional<std::pair<uint64_t, uint64_t>> revisit_ap_updates;
+  // Floors, from front ends that track them.
+  std::optional<FloorReport> floors;
+  // How a FABMAP front end's Wi-Fi model was learnt.
+  std::optional<FabmapLearningReport> fabmap_learning;
+};
+
 class FrontEnd {
  public:
   virtual ~FrontEnd() = default;
@@ -338,24 +123,14 @@ class FrontEnd {
   // A new session (another walk, perhaps another phone) starts at `start_s`; called before each
   // Wi-Fi scan with its session's start (repeats are no news). Default: nothing.
   virtual void OnSessionStart(double /*start_s*/) {}
-  // The RSSI offset (dB) removed from each session's scans so far, by session (front ends that
-  // estimate one); the last entry is the current session's.
-  virtual std::vector<double> RssiOffsetsDb() const { return {}; }
-  // APs that revisits added to and dropped from templates ([fused] revisit_update_weight);
-  // nothing when off.
-  virtual std::optional<std::pair<uint64_t, uint64_t>> RevisitApUpdates() const {
-    return std::nullopt;
-  }
+  // What this front end has to say about the run so far, for summaries (default: nothing).
+  virtual FrontEndReport Report() const { return {}; }
   // Localisation on a saved map: the templates stored so far were made by another run on
   // another clock, so a match to one of them is never recent. Front ends with a recency rule
   // in seconds must honour this; the default does nothing.
   virtual void SettleForLocalisation() {}
-  // Front ends that track floors report them; others return nothing.
-  virtual std::optional<FloorReport> floor_report() const { return std::nullopt; }
   // A template's floor relative to the first session's first level, when known.
   virtual std::optional<int> TemplateFloor(uint32_t /*id*/) const { return std::nullopt; }
-  // FABMAP front ends say how their Wi-Fi model was learnt; others return nothing.
-  virtual std::optional<FabmapLearningReport> fabmap_learning() const { return std::nullopt; }
 };
 
 struct FrontEndSettings {

@@ -403,7 +403,7 @@ TEST(FusedFrontEndTest, OnlineRssiOffsetBridgesTwoPhones) {
         }
       }
     }
-    *offsets = f->RssiOffsetsDb();
+    *offsets = f->Report().rssi_offsets_db;
     *state = f->EncodeState();
     return std::make_pair(matches, close);
   };
@@ -428,7 +428,7 @@ TEST(FusedFrontEndTest, OnlineRssiOffsetBridgesTwoPhones) {
   settings.fused.online_rssi_offset = true;
   std::unique_ptr<FrontEnd> restored = CreateFrontEnd(settings);
   ASSERT_TRUE(restored->DecodeState(state).ok());
-  EXPECT_EQ(restored->RssiOffsetsDb(), offsets);
+  EXPECT_EQ(restored->Report().rssi_offsets_db, offsets);
   EXPECT_EQ(restored->EncodeState(), state);
   std::string truncated = state;
   truncated.pop_back();
@@ -484,7 +484,7 @@ TEST(FabmapFrontEndTest, OnlineRssiOffsetBridgesTwoPhones) {
         w.close += std::abs(x_of_template[decision.view.template_id] - x_of_scan[i]) <= 6.0;
       }
     }
-    w.offsets = f->RssiOffsetsDb();
+    w.offsets = f->Report().rssi_offsets_db;
     w.state = f->EncodeState();
     return w;
   };
@@ -506,7 +506,7 @@ TEST(FabmapFrontEndTest, OnlineRssiOffsetBridgesTwoPhones) {
   ASSERT_TRUE(resources.ok());
   std::unique_ptr<FrontEnd> restored = CreateFrontEnd(settings, *resources);
   ASSERT_TRUE(restored->DecodeState(online.state).ok());
-  EXPECT_EQ(restored->RssiOffsetsDb(), online.offsets);
+  EXPECT_EQ(restored->Report().rssi_offsets_db, online.offsets);
   EXPECT_EQ(restored->EncodeState(), online.state);
   std::string truncated = online.state;
   truncated.pop_back();
@@ -555,7 +555,7 @@ std::pair<double, std::pair<uint64_t, uint64_t>> MonthsOfApChanges(double update
   }
   if (state) *state = f->EncodeState();
   return {static_cast<double>(recognised) / scans,
-          f->RevisitApUpdates().value_or(std::pair<uint64_t, uint64_t>(0, 0))};
+          f->Report().revisit_ap_updates.value_or(std::pair<uint64_t, uint64_t>(0, 0))};
 }
 
 // Without updates the last session, six of ten APs replaced, recognises none of the first
@@ -583,7 +583,7 @@ TEST(FusedFrontEndTest, RevisitsFollowAccessPointChanges) {
     std::unique_ptr<FrontEnd> restored = CreateFrontEnd(settings);
     ASSERT_TRUE(restored->DecodeState(state).ok());
     EXPECT_EQ(restored->EncodeState(), state);
-    EXPECT_EQ(restored->RevisitApUpdates(), updates);
+    EXPECT_EQ(restored->Report().revisit_ap_updates, updates);
     std::string truncated = state;
     truncated.pop_back();
     EXPECT_FALSE(restored->DecodeState(truncated).ok());
@@ -739,7 +739,7 @@ TEST(FusedFrontEndTest, SecondSessionsFloorOffsetComesFromWifiVotes) {
       cross_floor += floor != 1;
     }
   }
-  const std::optional<FloorReport> report = w.front_end->floor_report();
+  const std::optional<FloorReport> report = w.front_end->Report().floors;
   ASSERT_TRUE(report.has_value());
   EXPECT_EQ(report->session_floor_offsets, (std::vector<int>{0, 1}));
   EXPECT_EQ(report->floor_offset_changes, 1u);

@@ -62,7 +62,6 @@ class FusedFrontEnd : public FrontEnd {
   Status OnPressure(double time_s, double pressure_hpa) override {
     return floors_.OnPressure(time_s, pressure_hpa);
   }
-  std::optional<FloorReport> floor_report() const override { return floors_.Report(); }
   std::optional<int> TemplateFloor(uint32_t id) const override { return floors_.TemplateFloor(id); }
   std::optional<double> CompassHeading() const override {
     return options_.use_compass ? heading_rad_ : std::nullopt;
@@ -78,13 +77,14 @@ class FusedFrontEnd : public FrontEnd {
     floors_.OnSessionStart(start_s);
     if (options_.online_rssi_offset) offset_.OnSessionStart(start_s, size());
   }
-  std::optional<std::pair<uint64_t, uint64_t>> RevisitApUpdates() const override {
-    if (options_.revisit_update_weight > 0) return std::pair(aps_added_, aps_dropped_);
-    return std::nullopt;
-  }
-  std::vector<double> RssiOffsetsDb() const override {
-    if (!options_.online_rssi_offset) return {};
-    return offset_.OffsetsDb();
+  FrontEndReport Report() const override {
+    FrontEndReport r;
+    if (options_.revisit_update_weight > 0) {
+      r.revisit_ap_updates = std::pair(aps_added_, aps_dropped_);
+    }
+    if (options_.online_rssi_offset) r.rssi_offsets_db = offset_.OffsetsDb();
+    r.floors = floors_.Report();
+    return r;
   }
 
   std::string EncodeState() const override {

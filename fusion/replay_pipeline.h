@@ -170,16 +170,16 @@ class ReplayPipeline {
   Pose2 MapPose(const SequencePose& pose) const;
   // How a FABMAP front end learnt its Wi-Fi model; nothing for the other front ends.
   std::optional<FabmapLearningReport> fabmap_learning() const {
-    return front_end_->fabmap_learning();
+    return front_end_->Report().fabmap_learning;
   }
   // The RSSI offsets removed per session ([fused] online_rssi_offset); empty otherwise.
-  std::vector<double> rssi_offsets_db() const { return front_end_->RssiOffsetsDb(); }
+  std::vector<double> rssi_offsets_db() const { return front_end_->Report().rssi_offsets_db; }
   // APs added to and dropped from templates by revisits ([fused] revisit_update_weight).
   std::optional<std::pair<uint64_t, uint64_t>> revisit_ap_updates() const {
-    return front_end_->RevisitApUpdates();
+    return front_end_->Report().revisit_ap_updates;
   }
   // What the barometer said ([barometer] use_barometer with a pressure stream); nothing otherwise.
-  std::optional<FloorReport> floor_report() const { return front_end_->floor_report(); }
+  std::optional<FloorReport> floor_report() const { return front_end_->Report().floors; }
   // A template's floor relative to the first session's first level, when the front end knows.
   std::optional<int> template_floor(uint32_t id) const { return front_end_->TemplateFloor(id); }
 

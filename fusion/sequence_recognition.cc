@@ -85,15 +85,11 @@ class SequenceRecognition : public FrontEnd {
   bool NeedsPixels() const override { return true; }
   uint32_t size() const override { return inner_->size(); }
   void OnSessionStart(double start_s) override { inner_->OnSessionStart(start_s); }
-  std::vector<double> RssiOffsetsDb() const override { return inner_->RssiOffsetsDb(); }
-  std::optional<std::pair<uint64_t, uint64_t>> RevisitApUpdates() const override {
-    return inner_->RevisitApUpdates();
-  }
+  FrontEndReport Report() const override { return inner_->Report(); }
   void SettleForLocalisation() override {
     settled_ = static_cast<int64_t>(matcher_.references());
     inner_->SettleForLocalisation();
   }
-  std::optional<FloorReport> floor_report() const override { return inner_->floor_report(); }
   std::optional<int> TemplateFloor(uint32_t id) const override { return inner_->TemplateFloor(id); }
 
   std::string EncodeState() const override {
