@@ -460,6 +460,7 @@ StatusOr<std::unique_ptr<McapReader>> McapReader::Open(const std::string& path) 
     std::map<uint64_t, const ChunkInfo*> chunk_at;
     for (const ChunkInfo& c : reader->chunks_) chunk_at[c.record_offset] = &c;
     Scanner summary(reader.get());
+    summary.schemas_ = scanner.schemas_;  // a summary may repeat channels without their schemas
     const size_t messages_before = reader->messages_.size();
     StatusOr<uint64_t> checked = walk(
         summary_start, summary_end, -1,

@@ -90,7 +90,8 @@ TEST_F(Rosbag2Test, RawImagesImuAndOdometryFromAnIndependentWriter) {
   MAKE_FIXTURES_OR_SKIP(folder_ / "fx", "");
   BagTopics topics;
   topics.imu_topic = "/imu";
-  for (const char* name : {"raw_lz4.mcap", "raw_nosummary.mcap", "raw_db3"}) {
+  for (const char* name :
+       {"raw_lz4.mcap", "raw_nosummary.mcap", "raw_channels_only.mcap", "raw_db3"}) {
     const std::string bag = (folder_ / "fx" / name).string();
     ASSERT_TRUE(LooksLikeRos2Bag(bag)) << name;
     StatusOr<Dataset> d = ReadRos2Bag(bag, topics);

@@ -7,7 +7,8 @@
 //
 // Always writes raw.mcap (raw images in mono8, rgb8 and bgr8 with known pixels, an IMU and an
 // odometry message with known values; zstd chunks), and the same as raw_lz4.mcap,
-// raw_nosummary.mcap and raw_db3/ (a sqlite3 rosbag2 folder). With --data, writes that replay folder's images (as PNG
+// raw_nosummary.mcap, raw_channels_only.mcap (a summary repeating channels but not their
+// schemas) and raw_db3/ (a sqlite3 rosbag2 folder). With --data, writes that replay folder's images (as PNG
 // CompressedImage), odometry, ground truth (PoseStamped) and headings (Imu orientation) as
 // loop_zstd.mcap, loop_lz4.mcap, loop_plain.mcap (uncompressed chunks), loop_nosummary.mcap (no
 // chunks, no index, no summary section: readers must scan), loop_db3/ (a rosbag2 folder with
@@ -162,9 +163,9 @@ const COMPRESSORS = {
   plain: (data) => ({ compression: "", compressedData: data }),
 };
 
-async function writeMcap(file, messages, { compression, indexed = true, chunkSize = 64 * 1024 }) {
+async function writeMcap(file, messages, { compression, indexed = true, chunkSize = 64 * 1024, repeatSchemas = true }) {
   const sink = new FileSink();
-  const options = { writable: sink, chunkSize };
+  const options = { writable: sink, chunkSize, repeatSchemas };
   if (compression) options.compressChunk = COMPRESSORS[compression];
   if (!indexed) {
     Object.assign(options, {
@@ -294,6 +295,7 @@ fs.mkdirSync(args.out, { recursive: true });
 await writeMcap(path.join(args.out, "raw.mcap"), rawMessages(), { compression: "zstd" });
 await writeMcap(path.join(args.out, "raw_lz4.mcap"), rawMessages(), { compression: "lz4" });
 await writeMcap(path.join(args.out, "raw_nosummary.mcap"), rawMessages(), { indexed: false });
+await writeMcap(path.join(args.out, "raw_channels_only.mcap"), rawMessages(), { compression: "zstd", repeatSchemas: false });
 await writeDb3Folder(path.join(args.out, "raw_db3"), rawMessages());
 if (args.data) {
   const messages = messagesOf(args.data);
