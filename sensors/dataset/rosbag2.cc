@@ -3,6 +3,7 @@
 #include <sqlite3.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -474,8 +475,7 @@ StatusOr<Dataset> ReadRos2Bag(const std::string& path, const BagTopics& topics) 
         }));
   }
   Dataset d;
-  d.name = fs::path(path).filename().string();
-  if (!IsDirectory(path)) d.name = fs::path(path).stem().string();
+  d.name = IsDirectory(path) ? fs::path(path).filename().string() : fs::path(path).stem().string();
   d.folder = path;
   d.image_folder = "";
   return std::move(builder).Finish(std::move(d), path);
