@@ -67,7 +67,7 @@ Workload* GetWorkload() {
 }
 
 // Arguments: map size (0 shipped config, 1 OpenRatSLAM scale); 0 full relaxation, 1
-// incremental, 2 none.
+// incremental, 2 none, 3 least squares at loop closures.
 void BM_SyntheticReplay(benchmark::State& state) {
   Workload* w = GetWorkload();
   if (!w->error.empty()) {
@@ -77,8 +77,9 @@ void BM_SyntheticReplay(benchmark::State& state) {
   PipelineOptions options = w->options;
   if (state.range(0) == 1) options.sensors.classic_camera.match_threshold = 0.015;
   ExperienceMapOptions& map = options.ratslam.experience_map;
-  map.relaxation_scheme =
-      state.range(1) == 0 ? RelaxationScheme::kFull : RelaxationScheme::kIncremental;
+  map.relaxation_scheme = state.range(1) == 0   ? RelaxationScheme::kFull
+                          : state.range(1) == 3 ? RelaxationScheme::kLeastSquares
+                                                : RelaxationScheme::kIncremental;
   if (state.range(1) == 2) map.relaxation_sweeps = 0;
   uint64_t frames = 0, link_updates = 0;
   size_t templates = 0, experiences = 0, links = 0;
@@ -108,8 +109,8 @@ void BM_SyntheticReplay(benchmark::State& state) {
       benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 BENCHMARK(BM_SyntheticReplay)
-    ->ArgNames({"openratslam_scale", "scheme_full0_incremental1_none2"})
-    ->ArgsProduct({{0, 1}, {0, 1, 2}})
+    ->ArgNames({"openratslam_scale", "scheme_full0_incremental1_none2_lsq3"})
+    ->ArgsProduct({{0, 1}, {0, 1, 2, 3}})
     ->Unit(benchmark::kMillisecond);
 
 }  // namespace

@@ -86,5 +86,39 @@ TEST(WrapAngleNearTest, EqualsWrapAngleBitForBit) {
   EXPECT_TRUE(std::isnan(WrapAngleNear(std::nan(""))));
 }
 
+// SinCosOfSmallAngle against libm's sin and cos: within 2 ulp of them on both series ranges,
+// their edges, tiny and subnormal angles, and exactly sincos beyond 1/16 (and for NaN).
+TEST(SinCosOfSmallAngleTest, AgreesWithLibmWithinTwoUlp) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> small(-0.0625, 0.0625);
+  std::uniform_real_distribution<double> exponent(-60.0, -4.0);
+  std::vector<double> inputs = {0.0,    -0.0,    0x1p-10, -0x1p-10, std::nextafter(0x1p-10, 1.0),
+                                0.0625, -0.0625, 1e-300,  4.9e-324, std::nextafter(0.0625, 1.0),
+                                0.5,    -3.0,    100.0};
+  for (int i = 0; i < 200000; ++i) {
+    inputs.push_back(small(rng));
+    const double tiny = std::exp2(exponent(rng));
+    inputs.push_back(i % 2 ? tiny : -tiny);
+  }
+  auto ulps = [](double got, double want) {
+    return std::abs(got - want) / (std::nextafter(std::abs(want), INFINITY) - std::abs(want));
+  };
+  for (double x : inputs) {
+    double s, c;
+    SinCosOfSmallAngle(x, &s, &c);
+    ASSERT_LE(ulps(s, std::sin(x)), 2.0) << std::hexfloat << x;
+    ASSERT_LE(ulps(c, std::cos(x)), 2.0) << std::hexfloat << x;
+    if (std::abs(x) > 0.0625) {
+      double ls, lc;
+      ::sincos(x, &ls, &lc);
+      EXPECT_EQ(s, ls);
+      EXPECT_EQ(c, lc);
+    }
+  }
+  double s, c;
+  SinCosOfSmallAngle(std::nan(""), &s, &c);
+  EXPECT_TRUE(std::isnan(s) && std::isnan(c));
+}
+
 }  // namespace
 }  // namespace ratslam

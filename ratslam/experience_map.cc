@@ -77,14 +77,18 @@ void ExperienceMap::AddLink(uint32_t from, uint32_t to, double time_s,
   state_.experiences[from].link_ids.push_back(link.id);
   state_.experiences[to].link_ids.push_back(link.id);
   state_.links.push_back(link);
-  link_cos_.push_back(std::cos(link.heading_rad));
-  link_sin_.push_back(std::sin(link.heading_rad));
+  relax_links_.push_back(ToRelaxLink(link));
   // The newest id: the region stays ascending. Least squares waits for a loop closure.
   const bool pending =
       options_.relaxation_scheme == RelaxationScheme::kIncremental ||
       (options_.relaxation_scheme == RelaxationScheme::kLeastSquares && loop_closure);
   if (pending) state_.relaxation_pending_links.push_back(link.id);
   in_region_.push_back(pending ? 1 : 0);
+  if (outside_.size() < state_.experiences.size()) outside_.resize(state_.experiences.size(), 0);
+  if (!pending) {
+    ++outside_[from];
+    ++outside_[to];
+  }
   if (options_.relaxation_scheme == RelaxationScheme::kLeastSquares && !loop_closure) {
     // `to` is new, a leaf: the least-squares optimum satisfies its one link exactly. Its
     // position already does; its facing takes the link's (the compass difference when there is
@@ -206,12 +210,11 @@ void ExperienceMap::RelaxLeastSquares() {
     ++least_squares_failures_;
     return;  // the map is unchanged; the pending closure is retried at the next action
   }
-  for (uint32_t l : state_.relaxation_pending_links) in_region_[l] = 0;
+  for (uint32_t l : state_.relaxation_pending_links) LeaveRegion(l);
   state_.relaxation_pending_links.clear();
 }
 
-ExperienceMap::EndMotion ExperienceMap::UpdateLink(const Link& l, double cos_direction,
-                                                   double sin_direction) {
+void ExperienceMap::UpdateLink(const Link& l, double cos_direction, double sin_direction) {
   const double c = options_.relaxation_correction;
   Experience& a = state_.experiences[l.from];
   Experience& b = state_.experiences[l.to];
@@ -221,8 +224,89 @@ ExperienceMap::EndMotion ExperienceMap::UpdateLink(const Link& l, double cos_dir
   const double ex_m = b.x_m - px;
   const double ey_m = b.y_m - py;
   const double et = WrapAngleNear(b.theta_rad - (a.theta_rad + l.facing_rad));
-  const bool a_fixed = options_.anchor_first_experience && l.from == 0;
-  const bool b_fixed = options_.anchor_first_experience && l.to == 0;
+  if (!(options_.anchor_first_experience && l.from == 0)) {
+    a.x_m += ex_m * c;
+    a.y_m += ey_m * c;
+    a.theta_rad = WrapAngleNear(a.theta_rad + et * c);
+  }
+  if (!(options_.anchor_first_experience && l.to == 0)) {
+    b.x_m -= ex_m * c;
+    b.y_m -= ey_m * c;
+    b.theta_rad = WrapAngleNear(b.theta_rad - et * c);
+  }
+}
+
+void ExperienceMap::RelaxFull() {
+  // OpenRatSLAM's scheme, bit for bit as before the incremental one existed (WrapAngleNear equals
+  // WrapAngle): the reference the incremental scheme is measured against.
+  for (uint32_t l : state_.relaxation_pending_links) LeaveRegion(l);
+  state_.relaxation_pending_links.clear();
+  const std::vector<Experience>& ex = state_.experiences;
+  for (int sweep = 0; sweep < options_.relaxation_sweeps; ++sweep) {
+    for (const Link& l : state_.links) {
+      const double direction = ex[l.from].theta_rad + l.heading_rad;
+      UpdateLink(l, std::cos(direction), std::sin(direction));
+    }
+    link_updates_ += state_.links.size();
+  }
+}
+
+ExperienceMap::RelaxLink ExperienceMap::ToRelaxLink(const Link& l) {
+  return {l.from,      l.to, l.distance_m, std::cos(l.heading_rad), std::sin(l.heading_rad),
+          l.facing_rad};
+}
+
+ExperienceMap::RelaxPose& ExperienceMap::Touch(uint32_t id) {
+  RelaxPose& p = relax_poses_[id];
+  if (p.call != call_) {  // first touch in this call: load the pose from the map
+    p.call = call_;
+    const Experience& e = state_.experiences[id];
+    p.x_m = e.x_m;
+    p.y_m = e.y_m;
+    p.theta_rad = e.theta_rad;
+    if (experience_trig_rad_[id] != e.theta_rad) {  // NaN compares unequal: computed the first time
+      ::sincos(e.theta_rad, &experience_sin_[id], &experience_cos_[id]);  // glibc: both at once
+      experience_trig_rad_[id] = e.theta_rad;
+    }
+    p.cos_theta = experience_cos_[id];
+    p.sin_theta = experience_sin_[id];
+    p.trig_theta_rad = e.theta_rad;
+    loaded_.push_back(id);
+  }
+  if (p.pass != pass_) {
+    // A pass reads each experience's rotation once, at its first touch: the cos and sin of the
+    // last pass turned by what the experience rotated since (angle sum formulas), so a pass calls
+    // no trig function per experience.
+    if (p.theta_rad != p.trig_theta_rad) {
+      double sin_turn, cos_turn;
+      SinCosOfSmallAngle(WrapAngleNear(p.theta_rad - p.trig_theta_rad), &sin_turn, &cos_turn);
+      const double c = p.cos_theta, s = p.sin_theta;
+      p.cos_theta = c * cos_turn - s * sin_turn;
+      p.sin_theta = s * cos_turn + c * sin_turn;
+      p.trig_theta_rad = p.theta_rad;
+    }
+    p.pass = pass_;
+    p.start_x_m = p.x_m;
+    p.start_y_m = p.y_m;
+    p.start_theta_rad = p.theta_rad;
+    touched_.push_back(id);
+  }
+  return p;
+}
+
+ExperienceMap::EndMotion ExperienceMap::UpdateRelaxLink(const RelaxLink& l, RelaxPose& a,
+                                                        RelaxPose& b, bool a_fixed,
+                                                        bool b_fixed) const {
+  const double c = options_.relaxation_correction;
+  // The link's direction: a's rotation (as the pass first read it) plus the link's heading.
+  const double cos_direction = a.cos_theta * l.cos_heading - a.sin_theta * l.sin_heading;
+  const double sin_direction = a.sin_theta * l.cos_heading + a.cos_theta * l.sin_heading;
+  // Where the link says b should be, seen from a.
+  const double px = a.x_m + l.distance_m * cos_direction;
+  const double py = a.y_m + l.distance_m * sin_direction;
+  const double ex_m = b.x_m - px;
+  const double ey_m = b.y_m - py;
+  const double et = WrapAngleNear(b.theta_rad - (a.theta_rad + l.facing_rad));
   const double moved_m = (std::abs(ex_m) + std::abs(ey_m)) * c;
   const double moved_rad = std::abs(et) * c;
   EndMotion motion{0.0, 0.0, 0.0, 0.0};
@@ -243,34 +327,14 @@ ExperienceMap::EndMotion ExperienceMap::UpdateLink(const Link& l, double cos_dir
   return motion;
 }
 
-void ExperienceMap::RelaxFull() {
-  // OpenRatSLAM's scheme, bit for bit as before the incremental one existed (WrapAngleNear equals
-  // WrapAngle): the reference the incremental scheme is measured against.
-  for (uint32_t l : state_.relaxation_pending_links) in_region_[l] = 0;
-  state_.relaxation_pending_links.clear();
-  const std::vector<Experience>& ex = state_.experiences;
-  for (int sweep = 0; sweep < options_.relaxation_sweeps; ++sweep) {
-    for (const Link& l : state_.links) {
-      const double direction = ex[l.from].theta_rad + l.heading_rad;
-      UpdateLink(l, std::cos(direction), std::sin(direction));
-    }
-    link_updates_ += state_.links.size();
-  }
-}
-
-void ExperienceMap::Touch(uint32_t id) {
-  if (touched_pass_[id] == pass_) return;
-  touched_pass_[id] = pass_;
-  const Experience& e = state_.experiences[id];
-  pass_start_[id] = {e.x_m, e.y_m, e.theta_rad};
-  touched_.push_back(id);
-  if (experience_trig_rad_[id] != e.theta_rad) {  // NaN compares unequal: computed the first time
-    ::sincos(e.theta_rad, &experience_sin_[id], &experience_cos_[id]);  // glibc: both at once
-    experience_trig_rad_[id] = e.theta_rad;
-  }
+void ExperienceMap::LeaveRegion(uint32_t link) {
+  in_region_[link] = 0;
+  ++outside_[relax_links_[link].from];
+  ++outside_[relax_links_[link].to];
 }
 
 bool ExperienceMap::GrowRegion(uint32_t id, uint32_t above, bool this_pass) {
+  if (outside_[id] == 0) return false;  // all its links are in the region already
   bool grown = false;
   const size_t cap = static_cast<size_t>(options_.relaxation_max_region_links);
   for (uint32_t k : state_.experiences[id].link_ids) {
@@ -280,6 +344,8 @@ bool ExperienceMap::GrowRegion(uint32_t id, uint32_t above, bool this_pass) {
       break;
     }
     in_region_[k] = 1;
+    --outside_[relax_links_[k].from];
+    --outside_[relax_links_[k].to];
     grown_.push_back(k);
     grown = true;
     if (this_pass) {
@@ -291,15 +357,18 @@ bool ExperienceMap::GrowRegion(uint32_t id, uint32_t above, bool this_pass) {
 }
 
 void ExperienceMap::RelaxIncremental() {
+  std::vector<uint32_t>& region = state_.relaxation_pending_links;
+  if (region.empty() || options_.relaxation_sweeps == 0) return;
   const size_t n = state_.experiences.size();
-  touched_pass_.resize(n, 0);
-  pass_start_.resize(n);
+  relax_poses_.resize(n);
   experience_cos_.resize(n);
   experience_sin_.resize(n);
   experience_trig_rad_.resize(n, std::numeric_limits<double>::quiet_NaN());
+  ++call_;
+  loaded_.clear();
   const double tolerance_m = options_.relaxation_tolerance_m;
   const double tolerance_rad = options_.relaxation_tolerance_rad;
-  std::vector<uint32_t>& region = state_.relaxation_pending_links;
+  const bool anchor = options_.anchor_first_experience;
   for (int sweep = 0; sweep < options_.relaxation_sweeps && !region.empty(); ++sweep) {
     ++pass_;
     capped_this_pass_ = false;
@@ -319,19 +388,18 @@ void ExperienceMap::RelaxIncremental() {
       } else {
         l = region[next++];
       }
-      const Link& link = state_.links[l];
-      Touch(link.from);
-      Touch(link.to);
-      const double ca = experience_cos_[link.from], sa = experience_sin_[link.from];
-      const EndMotion motion = UpdateLink(link, ca * link_cos_[l] - sa * link_sin_[l],
-                                          sa * link_cos_[l] + ca * link_sin_[l]);
+      const RelaxLink& link = relax_links_[l];
+      RelaxPose& a = Touch(link.from);
+      RelaxPose& b = Touch(link.to);
+      const EndMotion motion =
+          UpdateRelaxLink(link, a, b, anchor && link.from == 0, anchor && link.to == 0);
       ++link_updates_;
       // A large step of an end reaches its links further on in this same pass, as in a full
       // pass; links before it join when the pass has moved the end.
-      if (motion.a_m > tolerance_m || motion.a_rad > tolerance_rad) {
+      if ((motion.a_m > tolerance_m || motion.a_rad > tolerance_rad) && outside_[link.from] > 0) {
         grown |= GrowRegion(link.from, l + 1, true);
       }
-      if (motion.b_m > tolerance_m || motion.b_rad > tolerance_rad) {
+      if ((motion.b_m > tolerance_m || motion.b_rad > tolerance_rad) && outside_[link.to] > 0) {
         grown |= GrowRegion(link.to, l + 1, true);
       }
     }
@@ -341,17 +409,16 @@ void ExperienceMap::RelaxIncremental() {
     // and is done when a pass moves nothing on net by more than the tolerances.
     bool settled = true;
     for (uint32_t id : touched_) {
-      const Experience& e = state_.experiences[id];
-      const Pose2& start = pass_start_[id];
-      if (std::abs(e.x_m - start.x_m) + std::abs(e.y_m - start.y_m) > tolerance_m ||
-          std::abs(WrapAngleNear(e.theta_rad - start.theta_rad)) > tolerance_rad) {
+      const RelaxPose& p = relax_poses_[id];
+      if (std::abs(p.x_m - p.start_x_m) + std::abs(p.y_m - p.start_y_m) > tolerance_m ||
+          std::abs(WrapAngleNear(p.theta_rad - p.start_theta_rad)) > tolerance_rad) {
         settled = false;
         grown |= GrowRegion(id, 0, false);
       }
     }
     if (capped_this_pass_) ++capped_passes_;
     if (settled && !grown) {
-      for (uint32_t l : region) in_region_[l] = 0;
+      for (uint32_t l : region) LeaveRegion(l);
       region.clear();
       break;
     }
@@ -364,6 +431,13 @@ void ExperienceMap::RelaxIncremental() {
     const size_t cap = static_cast<size_t>(options_.relaxation_max_region_links);
     if (cap > 0 && region.size() > cap) TrimRegion(cap);
   }
+  for (uint32_t id : loaded_) {
+    const RelaxPose& p = relax_poses_[id];
+    Experience& e = state_.experiences[id];
+    e.x_m = p.x_m;
+    e.y_m = p.y_m;
+    e.theta_rad = p.theta_rad;
+  }
 }
 
 void ExperienceMap::TrimRegion(size_t cap) {
@@ -374,24 +448,23 @@ void ExperienceMap::TrimRegion(size_t cap) {
   capped_this_pass_ = true;
   std::vector<uint32_t>& region = state_.relaxation_pending_links;
   auto net = [&](uint32_t id) {
-    if (touched_pass_[id] != pass_) return 0.0;
-    const Experience& e = state_.experiences[id];
-    const Pose2& start = pass_start_[id];
-    return std::max(
-        (std::abs(e.x_m - start.x_m) + std::abs(e.y_m - start.y_m)) /
-            options_.relaxation_tolerance_m,
-        std::abs(WrapAngleNear(e.theta_rad - start.theta_rad)) / options_.relaxation_tolerance_rad);
+    const RelaxPose& p = relax_poses_[id];
+    if (p.call != call_ || p.pass != pass_) return 0.0;
+    return std::max((std::abs(p.x_m - p.start_x_m) + std::abs(p.y_m - p.start_y_m)) /
+                        options_.relaxation_tolerance_m,
+                    std::abs(WrapAngleNear(p.theta_rad - p.start_theta_rad)) /
+                        options_.relaxation_tolerance_rad);
   };
   std::vector<std::pair<double, uint32_t>> ranked;
   ranked.reserve(region.size());
   for (uint32_t l : region) {
-    const Link& link = state_.links[l];
+    const RelaxLink& link = relax_links_[l];
     ranked.emplace_back(std::max(net(link.from), net(link.to)), l);
   }
   // Largest movement first, then the higher id: the first `cap` stay.
   std::nth_element(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(cap), ranked.end(),
                    std::greater<>());
-  for (size_t i = cap; i < ranked.size(); ++i) in_region_[ranked[i].second] = 0;
+  for (size_t i = cap; i < ranked.size(); ++i) LeaveRegion(ranked[i].second);
   region.clear();
   for (size_t i = 0; i < cap; ++i) region.push_back(ranked[i].second);
   std::sort(region.begin(), region.end());
@@ -424,13 +497,15 @@ Status ExperienceMap::SetState(State state) {
   RATSLAM_RETURN_IF_ERROR(ValidateState(state));
   const size_t n_links = state.links.size();
   state_ = std::move(state);
-  link_cos_.resize(n_links);
-  link_sin_.resize(n_links);
+  relax_links_.clear();
+  for (const Link& l : state_.links) relax_links_.push_back(ToRelaxLink(l));
   in_region_.assign(n_links, 0);
   for (uint32_t l : state_.relaxation_pending_links) in_region_[l] = 1;
+  outside_.assign(state_.experiences.size(), 0);
   for (size_t i = 0; i < n_links; ++i) {
-    link_cos_[i] = std::cos(state_.links[i].heading_rad);
-    link_sin_[i] = std::sin(state_.links[i].heading_rad);
+    if (in_region_[i]) continue;
+    ++outside_[state_.links[i].from];
+    ++outside_[state_.links[i].to];
   }
   return Status::Ok();
 }

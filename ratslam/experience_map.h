@@ -230,34 +230,56 @@ class ExperienceMap {
   void RelaxIncremental();
   void RelaxLeastSquares();
   // Moves both ends of link `l` towards agreement, given the cosine and sine of the link's
-  // direction (from's rotation plus heading_rad). Returns the movement of each end: metres
-  // (|dx| + |dy|) and radians.
+  // direction (from's rotation plus heading_rad): the full scheme's update.
+  void UpdateLink(const Link& l, double cos_direction, double sin_direction);
+
+  // Incremental relaxation works on a copy of what a link update reads and writes, laid out for
+  // the scan: per link its ends and measurement with the cos and sin of heading_rad; per
+  // experience its pose (loaded from the map at the first touch in a Relax call, written back at
+  // its end), its rotation's cos and sin as the pass first read them, and its pose when a pass
+  // first touched it.
+  struct RelaxLink {
+    uint32_t from, to;
+    double distance_m, cos_heading, sin_heading, facing_rad;
+  };
+  struct RelaxPose {
+    double x_m, y_m, theta_rad, cos_theta, sin_theta;
+    double trig_theta_rad;  // the rotation cos_theta and sin_theta are of
+    double start_x_m, start_y_m, start_theta_rad;
+    uint64_t pass = 0;  // the pass that last touched it
+    uint64_t call = 0;  // the Relax call that loaded it
+  };
+  static RelaxLink ToRelaxLink(const Link& l);
+  // The incremental scheme's update of link `l` between a and b (the same arithmetic as
+  // UpdateLink). Returns the movement of each end: metres (|dx| + |dy|) and radians.
   struct EndMotion {
     double a_m, a_rad, b_m, b_rad;
   };
-  EndMotion UpdateLink(const Link& l, double cos_direction, double sin_direction);
-  // Records experience `id`'s pose and rotation's cos and sin when first touched in a pass.
-  void Touch(uint32_t id);
+  EndMotion UpdateRelaxLink(const RelaxLink& l, RelaxPose& a, RelaxPose& b, bool a_fixed,
+                            bool b_fixed) const;
+  // Experience `id`'s working pose, loaded at its first touch in this call, with its pose at
+  // its first touch in this pass recorded.
+  RelaxPose& Touch(uint32_t id);
   // Adds `id`'s links with ids from `above` that are not in the region yet to it (and, with
   // `this_pass`, to the links still ahead in this pass). Returns true when the region grew.
   bool GrowRegion(uint32_t id, uint32_t above, bool this_pass);
+  void LeaveRegion(uint32_t link);
   // Shrinks the region to `cap` links after a pass, keeping those whose ends moved most.
   void TrimRegion(size_t cap);
 
   ExperienceMapOptions options_;
   State state_;
-  // Scratch, rebuilt from state_: per link cos and sin of heading_rad; per experience the pass
-  // it was first touched in, its pose then and its rotation's cos and sin; links joining the
-  // region (ahead_: still in this pass).
-  std::vector<double> link_cos_, link_sin_;
-  std::vector<double> experience_cos_, experience_sin_;
-  // The rotation experience_cos_/sin_ were computed from (NaN: never): an experience whose
-  // rotation the last passes left alone needs no new sincos.
-  std::vector<double> experience_trig_rad_;
-  std::vector<Pose2> pass_start_;
-  std::vector<uint64_t> touched_pass_;
-  std::vector<uint32_t> ahead_, grown_, touched_;
+  // Scratch, rebuilt from state_ (see RelaxLink and RelaxPose).
+  std::vector<RelaxLink> relax_links_;
+  std::vector<RelaxPose> relax_poses_;
+  // The cos and sin of an experience's rotation computed when it was last loaded, and that
+  // rotation (NaN: never): an experience whose rotation the last actions left alone needs no new
+  // sincos. Later passes of a call turn the working cos and sin by the rotation since.
+  std::vector<double> experience_cos_, experience_sin_, experience_trig_rad_;
+  std::vector<uint32_t> outside_;  // per experience: how many of its links are not in the region
+  std::vector<uint32_t> ahead_, grown_, touched_, loaded_;
   std::vector<char> in_region_;  // per link: in relaxation_pending_links
+  uint64_t call_ = 0;
   uint64_t pass_ = 0;
   uint64_t link_updates_ = 0;
   uint64_t least_squares_runs_ = 0;

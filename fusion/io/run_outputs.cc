@@ -353,6 +353,9 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
   if (map.options().relaxation_scheme == RelaxationScheme::kIncremental) {
     j["relaxation_capped_passes"] = map.relaxation_capped_passes();
   }
+  if (map.options().relaxation_scheme != RelaxationScheme::kLeastSquares) {
+    j["relaxation_link_updates"] = map.relaxation_link_updates();
+  }
   j["odometry_steps"] = state.trajectory.size();
   j["view_injections"] = slam.counters().injections;
   j["refused_ambiguous_links"] = slam.counters().refused_ambiguous;
@@ -529,6 +532,7 @@ const std::vector<std::string>& SummaryKeys() {
                                                 "odometry_steps",
                                                 "refused_ambiguous_links",
                                                 "relaxation_capped_passes",
+                                                "relaxation_link_updates",
                                                 "resumed_from",
                                                 "run",
                                                 "session_names",
