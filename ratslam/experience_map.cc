@@ -256,47 +256,49 @@ ExperienceMap::RelaxLink ExperienceMap::ToRelaxLink(const Link& l) {
           l.facing_rad};
 }
 
-ExperienceMap::RelaxPose& ExperienceMap::Touch(uint32_t id) {
+void ExperienceMap::LoadPose(uint32_t id) {
   RelaxPose& p = relax_poses_[id];
-  if (p.call != call_) {  // first touch in this call: load the pose from the map
-    p.call = call_;
-    const Experience& e = state_.experiences[id];
-    p.x_m = e.x_m;
-    p.y_m = e.y_m;
-    p.theta_rad = e.theta_rad;
-    if (experience_trig_rad_[id] != e.theta_rad) {  // NaN compares unequal: computed the first time
-      ::sincos(e.theta_rad, &experience_sin_[id], &experience_cos_[id]);  // glibc: both at once
-      experience_trig_rad_[id] = e.theta_rad;
-    }
-    p.cos_theta = experience_cos_[id];
-    p.sin_theta = experience_sin_[id];
-    p.trig_theta_rad = e.theta_rad;
-    loaded_.push_back(id);
+  p.call = call_;
+  const Experience& e = state_.experiences[id];
+  p.x_m = e.x_m;
+  p.y_m = e.y_m;
+  p.theta_rad = e.theta_rad;
+  if (experience_trig_rad_[id] != e.theta_rad) {  // NaN compares unequal: computed the first time
+    ::sincos(e.theta_rad, &experience_sin_[id], &experience_cos_[id]);  // glibc: both at once
+    experience_trig_rad_[id] = e.theta_rad;
   }
-  if (p.pass != pass_) {
-    // A pass reads each experience's rotation once, at its first touch: the cos and sin of the
-    // last pass turned by what the experience rotated since (angle sum formulas), so a pass calls
-    // no trig function per experience.
-    if (p.theta_rad != p.trig_theta_rad) {
-      double sin_turn, cos_turn;
-      SinCosOfSmallAngle(WrapAngleNear(p.theta_rad - p.trig_theta_rad), &sin_turn, &cos_turn);
-      const double c = p.cos_theta, s = p.sin_theta;
-      p.cos_theta = c * cos_turn - s * sin_turn;
-      p.sin_theta = s * cos_turn + c * sin_turn;
-      p.trig_theta_rad = p.theta_rad;
-    }
-    p.pass = pass_;
-    p.start_x_m = p.x_m;
-    p.start_y_m = p.y_m;
-    p.start_theta_rad = p.theta_rad;
-    touched_.push_back(id);
+  p.cos_theta = experience_cos_[id];
+  p.sin_theta = experience_sin_[id];
+  p.trig_theta_rad = e.theta_rad;
+  loaded_.push_back(id);
+}
+
+inline ExperienceMap::RelaxPose& ExperienceMap::Touch(uint32_t id) {
+  RelaxPose& p = relax_poses_[id];
+  if (p.pass == pass_) return p;
+  if (p.call != call_) LoadPose(id);  // first touch in this call
+  // A pass reads each experience's rotation once, at its first touch: the cos and sin of the
+  // last pass turned by what the experience rotated since (angle sum formulas), so a pass calls
+  // no trig function per experience.
+  if (p.theta_rad != p.trig_theta_rad) {
+    double sin_turn, cos_turn;
+    SinCosOfSmallAngle(WrapAngleNear(p.theta_rad - p.trig_theta_rad), &sin_turn, &cos_turn);
+    const double c = p.cos_theta, s = p.sin_theta;
+    p.cos_theta = c * cos_turn - s * sin_turn;
+    p.sin_theta = s * cos_turn + c * sin_turn;
+    p.trig_theta_rad = p.theta_rad;
   }
+  p.pass = pass_;
+  p.start_x_m = p.x_m;
+  p.start_y_m = p.y_m;
+  p.start_theta_rad = p.theta_rad;
+  touched_.push_back(id);
   return p;
 }
 
-ExperienceMap::EndMotion ExperienceMap::UpdateRelaxLink(const RelaxLink& l, RelaxPose& a,
-                                                        RelaxPose& b, bool a_fixed,
-                                                        bool b_fixed) const {
+inline ExperienceMap::EndMotion ExperienceMap::UpdateRelaxLink(const RelaxLink& l, RelaxPose& a,
+                                                               RelaxPose& b, bool a_fixed,
+                                                               bool b_fixed) const {
   const double c = options_.relaxation_correction;
   // The link's direction: a's rotation (as the pass first read it) plus the link's heading.
   const double cos_direction = a.cos_theta * l.cos_heading - a.sin_theta * l.sin_heading;

@@ -52,8 +52,8 @@ struct ExperienceMapOptions {
   double relaxation_correction = 0.5;    // share of a link's error each end absorbs per pass
   bool anchor_first_experience = false;  // keep experience 0 fixed during relaxation
   RelaxationScheme relaxation_scheme = RelaxationScheme::kIncremental;  // see RelaxationScheme
-  double relaxation_tolerance_m = 1e-4;    // kIncremental: movement that grows the region
-  double relaxation_tolerance_rad = 1e-5;  // kIncremental: rotation that grows the region
+  double relaxation_tolerance_m = 1e-3;    // kIncremental: movement that grows the region
+  double relaxation_tolerance_rad = 1e-4;  // kIncremental: rotation that grows the region
   // kIncremental: the region stops growing at this many links (0: no limit), so a loop closure
   // on a large map costs at most relaxation_sweeps passes over this many links per action.
   int relaxation_max_region_links = 5000;
@@ -260,6 +260,8 @@ class ExperienceMap {
   // Experience `id`'s working pose, loaded at its first touch in this call, with its pose at
   // its first touch in this pass recorded.
   RelaxPose& Touch(uint32_t id);
+  // Copies experience `id`'s pose and its rotation's cos and sin into its RelaxPose.
+  void LoadPose(uint32_t id);
   // Adds `id`'s links with ids from `above` that are not in the region yet to it (and, with
   // `this_pass`, to the links still ahead in this pass). Returns true when the region grew.
   bool GrowRegion(uint32_t id, uint32_t above, bool this_pass);

@@ -52,14 +52,22 @@ nlohmann::json Summary(const fs::path& out) {
 }
 
 // Writes `config` (a full printed config) to `out` as map format `format` was made: full
-// relaxation (formats 2-3) and no PDR orientation test (formats 2-4). Such maps resume only
-// under those values. Empty when a key is missing.
+// relaxation (formats 2-3), no PDR orientation test (formats 2-4), and from format 4 the
+// incremental scheme's tolerances of the releases before they became a millimetre and a tenth of
+// a milliradian. Such maps resume only under those values. Empty when a key is missing.
 std::string AsMadeByFormat(int format, const std::string& config, const fs::path& out) {
   std::string text = Slurp(config);
-  std::vector<std::pair<std::string, std::string>> changes = {
-      {"min_orientation_steadiness = 0.85", "min_orientation_steadiness = 0.0"}};
+  std::vector<std::pair<std::string, std::string>> changes;
+  if (format <= 4) {
+    changes.push_back({"min_orientation_steadiness = 0.85", "min_orientation_steadiness = 0.0"});
+  }
   if (format <= 3) {
     changes.push_back({"relaxation_scheme = \"incremental\"", "relaxation_scheme = \"full\""});
+  } else {
+    // Incremental relaxation's tolerances before they were raised to a millimetre and a tenth of
+    // a milliradian (format 3 maps, made under full relaxation, do not carry them).
+    changes.push_back({"relaxation_tolerance_m = 0.001", "relaxation_tolerance_m = 1e-04"});
+    changes.push_back({"relaxation_tolerance_rad = 1e-04", "relaxation_tolerance_rad = 1e-05"});
   }
   for (const auto& [now, then] : changes) {
     const size_t at = text.find(now);
@@ -721,27 +729,36 @@ TEST_F(ReplayEndToEndTest, FormatFourMapResumesWithoutTheOrientationTestOnly) {
 }
 
 // A format-5 map (made by the release before Wi-Fi sequence loop closure, with
-// `ratslam replay --config configs/synthetic.toml --until 75 --save-map`) resumes under today's
-// defaults to exactly the uninterrupted run: its configuration lacks [wifi_sequence], which
-// defaults to off. Turning the loop closer on is refused, naming the key.
+// `ratslam replay --config configs/synthetic.toml --until 75 --save-map`) resumes under the
+// values that made it to exactly the uninterrupted run: its configuration lacks [wifi_sequence],
+// which defaults to off. Turning the loop closer on is refused, naming the key, and so are
+// today's relaxation tolerances.
 TEST_F(ReplayEndToEndTest, FormatFiveMapResumesWithWifiSequenceOffOnly) {
   const fs::path fixture = fs::path(RATSLAM_SOURCE_DIR) / "tests" / "data" / "map-v5-synthetic.map";
+  const std::string then = AsMadeByFormat(5, config_, root_ / "v5-then.toml");
+  ASSERT_FALSE(then.empty());
   auto args = [&](const std::string& c, const fs::path& out) {
     return "replay --quiet --config " + c + " --data " + (root_ / "data").string() + " --out " +
            out.string();
   };
   const fs::path whole = root_ / "whole_v5", rest = root_ / "rest_v5";
-  ASSERT_EQ(RunRatslam(args(config_, whole), root_).exit_code, 0);
-  const Result r = RunRatslam(args(config_, rest) + " --load-map " + fixture.string(), root_);
+  ASSERT_EQ(RunRatslam(args(then, whole), root_).exit_code, 0);
+  const Result r = RunRatslam(args(then, rest) + " --load-map " + fixture.string(), root_);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   ExpectSameRun(whole, rest);
   const fs::path on = root_ / "sequence-on.toml";
-  std::ofstream(on) << Slurp(config_) << "\n[wifi_sequence]\nenabled = true\n";
+  std::ofstream(on) << Slurp(then) << "\n[wifi_sequence]\nenabled = true\n";
   const Result refused = RunRatslam(
       args(on.string(), root_ / "v5_sequence") + " --load-map " + fixture.string(), root_);
   EXPECT_EQ(refused.exit_code, 1);
   EXPECT_NE(refused.err.find("wifi_sequence.enabled: false -> true"), std::string::npos)
       << refused.err;
+  const Result today =
+      RunRatslam(args(config_, root_ / "v5_today") + " --load-map " + fixture.string(), root_);
+  EXPECT_EQ(today.exit_code, 1);
+  EXPECT_NE(today.err.find("experience_map.relaxation_tolerance_m: 1e-04 -> 0.001"),
+            std::string::npos)
+      << today.err;
 }
 
 // A key added after format 2 must be at its default to resume a format-2 map (which was made
