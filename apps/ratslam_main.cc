@@ -425,7 +425,7 @@ int ImportCommand(const Arguments& parsed) {
   std::cerr << MessagePrefix() << "wrote '" << d->name << "' (" << d->odometry.size()
             << " odometry rows, " << d->images.size() << " images, " << d->wifi.size()
             << " Wi-Fi scans, " << d->compass.size() << " compass rows, " << d->ground_truth.size()
-            << " ground-truth rows) to " << args->values.at("--out") << "\n";
+            << " ground-truth rows) to " << args->Shown(out) << "\n";
   return kExitOk;
 }
 

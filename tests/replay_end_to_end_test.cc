@@ -517,6 +517,9 @@ TEST_F(ReplayEndToEndTest, BagReplayGivesTheFolderReplaysMap) {
                      (dir / "loop.bag").string() + " --out " + (dir / "imported").string(),
                  root_);
   ASSERT_EQ(imported.exit_code, 0) << imported.err;
+  // The closing line names the folder the data set ends up in, not the staging folder.
+  EXPECT_NE(imported.err.find(") to " + (dir / "imported").string() + "\n"), std::string::npos)
+      << imported.err;
   EXPECT_TRUE(fs::exists(dir / "imported" / "images" / "000000.png"));
   const Result again = replay(dir / "imported", "from_import");
   ASSERT_EQ(again.exit_code, 0) << again.err;
