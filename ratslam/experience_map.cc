@@ -214,26 +214,42 @@ void ExperienceMap::RelaxLeastSquares() {
   state_.relaxation_pending_links.clear();
 }
 
-void ExperienceMap::UpdateLink(const Link& l, double cos_direction, double sin_direction) {
-  const double c = options_.relaxation_correction;
-  Experience& a = state_.experiences[l.from];
-  Experience& b = state_.experiences[l.to];
+template <typename Pose>
+inline ExperienceMap::EndMotion ExperienceMap::CorrectLink(Pose& a, Pose& b, double distance_m,
+                                                           double facing_rad, double cos_direction,
+                                                           double sin_direction, double c,
+                                                           bool a_fixed, bool b_fixed) {
   // Where the link says b should be, seen from a.
-  const double px = a.x_m + l.distance_m * cos_direction;
-  const double py = a.y_m + l.distance_m * sin_direction;
+  const double px = a.x_m + distance_m * cos_direction;
+  const double py = a.y_m + distance_m * sin_direction;
   const double ex_m = b.x_m - px;
   const double ey_m = b.y_m - py;
-  const double et = WrapAngleNear(b.theta_rad - (a.theta_rad + l.facing_rad));
-  if (!(options_.anchor_first_experience && l.from == 0)) {
+  const double et = WrapAngleNear(b.theta_rad - (a.theta_rad + facing_rad));
+  const double moved_m = (std::abs(ex_m) + std::abs(ey_m)) * c;
+  const double moved_rad = std::abs(et) * c;
+  EndMotion motion{0.0, 0.0, 0.0, 0.0};
+  if (!a_fixed) {
     a.x_m += ex_m * c;
     a.y_m += ey_m * c;
     a.theta_rad = WrapAngleNear(a.theta_rad + et * c);
+    motion.a_m = moved_m;
+    motion.a_rad = moved_rad;
   }
-  if (!(options_.anchor_first_experience && l.to == 0)) {
+  if (!b_fixed) {
     b.x_m -= ex_m * c;
     b.y_m -= ey_m * c;
     b.theta_rad = WrapAngleNear(b.theta_rad - et * c);
+    motion.b_m = moved_m;
+    motion.b_rad = moved_rad;
   }
+  return motion;
+}
+
+void ExperienceMap::UpdateLink(const Link& l, double cos_direction, double sin_direction) {
+  const bool anchor = options_.anchor_first_experience;
+  CorrectLink(state_.experiences[l.from], state_.experiences[l.to], l.distance_m, l.facing_rad,
+              cos_direction, sin_direction, options_.relaxation_correction, anchor && l.from == 0,
+              anchor && l.to == 0);
 }
 
 void ExperienceMap::RelaxFull() {
@@ -299,34 +315,11 @@ inline ExperienceMap::RelaxPose& ExperienceMap::Touch(uint32_t id) {
 inline ExperienceMap::EndMotion ExperienceMap::UpdateRelaxLink(const RelaxLink& l, RelaxPose& a,
                                                                RelaxPose& b, bool a_fixed,
                                                                bool b_fixed) const {
-  const double c = options_.relaxation_correction;
   // The link's direction: a's rotation (as the pass first read it) plus the link's heading.
   const double cos_direction = a.cos_theta * l.cos_heading - a.sin_theta * l.sin_heading;
   const double sin_direction = a.sin_theta * l.cos_heading + a.cos_theta * l.sin_heading;
-  // Where the link says b should be, seen from a.
-  const double px = a.x_m + l.distance_m * cos_direction;
-  const double py = a.y_m + l.distance_m * sin_direction;
-  const double ex_m = b.x_m - px;
-  const double ey_m = b.y_m - py;
-  const double et = WrapAngleNear(b.theta_rad - (a.theta_rad + l.facing_rad));
-  const double moved_m = (std::abs(ex_m) + std::abs(ey_m)) * c;
-  const double moved_rad = std::abs(et) * c;
-  EndMotion motion{0.0, 0.0, 0.0, 0.0};
-  if (!a_fixed) {
-    a.x_m += ex_m * c;
-    a.y_m += ey_m * c;
-    a.theta_rad = WrapAngleNear(a.theta_rad + et * c);
-    motion.a_m = moved_m;
-    motion.a_rad = moved_rad;
-  }
-  if (!b_fixed) {
-    b.x_m -= ex_m * c;
-    b.y_m -= ey_m * c;
-    b.theta_rad = WrapAngleNear(b.theta_rad - et * c);
-    motion.b_m = moved_m;
-    motion.b_rad = moved_rad;
-  }
-  return motion;
+  return CorrectLink(a, b, l.distance_m, l.facing_rad, cos_direction, sin_direction,
+                     options_.relaxation_correction, a_fixed, b_fixed);
 }
 
 void ExperienceMap::LeaveRegion(uint32_t link) {

@@ -229,9 +229,6 @@ class ExperienceMap {
   void RelaxFull();
   void RelaxIncremental();
   void RelaxLeastSquares();
-  // Moves both ends of link `l` towards agreement, given the cosine and sine of the link's
-  // direction (from's rotation plus heading_rad): the full scheme's update.
-  void UpdateLink(const Link& l, double cos_direction, double sin_direction);
 
   // Incremental relaxation works on a copy of what a link update reads and writes, laid out for
   // the scan: per link its ends and measurement with the cos and sin of heading_rad; per
@@ -250,11 +247,22 @@ class ExperienceMap {
     uint64_t call = 0;  // the Relax call that loaded it
   };
   static RelaxLink ToRelaxLink(const Link& l);
-  // The incremental scheme's update of link `l` between a and b (the same arithmetic as
-  // UpdateLink). Returns the movement of each end: metres (|dx| + |dy|) and radians.
+  // Movement of each end of a link by one update: metres (|dx| + |dy|) and radians.
   struct EndMotion {
     double a_m, a_rad, b_m, b_rad;
   };
+  // Moves a and b (poses with x_m, y_m, theta_rad) towards agreement with a link of
+  // `distance_m` and `facing_rad` whose direction has the given cosine and sine, each end by the
+  // share `correction` of the error unless fixed: the one link update of both schemes.
+  template <typename Pose>
+  static EndMotion CorrectLink(Pose& a, Pose& b, double distance_m, double facing_rad,
+                               double cos_direction, double sin_direction, double correction,
+                               bool a_fixed, bool b_fixed);
+  // The full scheme's update of link `l`, given the cosine and sine of its direction (from's
+  // rotation plus heading_rad).
+  void UpdateLink(const Link& l, double cos_direction, double sin_direction);
+  // The incremental scheme's update of link `l` between a and b, its direction from a's cos and
+  // sin as the pass first read them.
   EndMotion UpdateRelaxLink(const RelaxLink& l, RelaxPose& a, RelaxPose& b, bool a_fixed,
                             bool b_fixed) const;
   // Experience `id`'s working pose, loaded at its first touch in this call, with its pose at
