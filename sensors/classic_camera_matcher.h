@@ -12,6 +12,7 @@
 #define RATSLAM_SENSORS_CLASSIC_CAMERA_MATCHER_H_
 
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -99,13 +100,18 @@ class ClassicCameraMatcher {
 
   // Builds the template of an image (row-padded 8-bit layout) without storing it.
   StatusOr<std::vector<uint8_t>> MakeTemplate(const GrayImageView& image) const;
-  // Compares a template (from MakeTemplate) with every stored one. Templates whose exact lower
-  // bound (column sums) cannot beat the best so far are skipped: the result is the full scan's.
-  // `hint`, a template likely to be close (Observe passes the last frame's), is compared first
-  // so that the bound skips more; the result does not depend on it.
-  TemplateComparison Compare(const std::vector<uint8_t>& query, int64_t hint = -1) const;
+  // The stored template of the smallest difference to a template (from MakeTemplate), the lowest
+  // id among equals, if that difference is at most `cutoff`; template_id -1 otherwise. Templates
+  // whose exact lower bound (column sums) cannot beat the best so far are skipped, and with a
+  // finite cutoff only templates whose column-sum total lies near the query's are visited at
+  // all: the result is the full scan's. `hint`, a template likely to be close (Observe passes the
+  // last frame's), is compared first so that fewer are visited; the result does not depend on it.
+  TemplateComparison Compare(const std::vector<uint8_t>& query, int64_t hint = -1,
+                             double cutoff = std::numeric_limits<double>::infinity()) const;
   // Templates Compare has compared in full (not skipped by the bound), since construction.
   uint64_t full_comparisons() const { return full_comparisons_; }
+  // Templates whose lower bound Compare has evaluated, since construction.
+  uint64_t bounds_checked() const { return bounds_checked_; }
   // Tests: use the portable SSE2 kernel even where AVX2 exists.
   void set_force_portable(bool portable) { force_portable_ = portable; }
   // The smallest mean difference over the shifts to every stored template, by id.
@@ -126,6 +132,26 @@ class ClassicCameraMatcher {
   PreparedQuery PrepareQuery(const std::vector<uint8_t>& query) const;
   template <typename Visit>
   void VisitTemplates(const PreparedQuery& prepared, Visit&& visit) const;
+  // Appends template `id`'s column sums and files it in the total index.
+  void Index(uint32_t id);
+  // The ids (ascending) of every template that may be within `radius` of the query by the
+  // total-over-overlap bound at some shift; false (and nothing) when that is about all of them.
+  bool CandidatesWithin(const PreparedQuery& prepared, const std::vector<double>& scale,
+                        double radius, std::vector<uint32_t>* out) const;
+
+  // Per distinct overlap [first, last) of the shifts: template ids in buckets of their column-sum
+  // total over it (bucket b holds totals in [b, b + 1) * bucket_width), each with its sums over
+  // runs of the overlap's columns (a fixed number per id, when they fit 32 bits).
+  struct TotalBuckets {
+    struct Bucket {
+      std::vector<uint32_t> ids;
+      std::vector<int32_t> runs;
+    };
+    int first = 0, last = 0;
+    int64_t bucket_width = 1;
+    std::vector<Bucket> buckets;
+  };
+  static constexpr int64_t kTotalBuckets = 1024;
 
   ClassicCameraOptions options_;
   int row_stride_;  // template width rounded up to a multiple of 32 bytes
@@ -135,7 +161,10 @@ class ClassicCameraMatcher {
   // Per stored template: column sums (width) and their running sums (width + 1); rebuilt from
   // state_.
   std::vector<int32_t> column_sums_;
+  std::vector<TotalBuckets> total_buckets_;  // rebuilt from state_
+  std::vector<int> shift_overlap_;           // per shift: its entry in total_buckets_
   mutable uint64_t full_comparisons_ = 0;
+  mutable uint64_t bounds_checked_ = 0;
   int64_t last_template_ = -1;  // Observe's last decision: the next Compare's hint
   bool force_portable_ = false;
 };

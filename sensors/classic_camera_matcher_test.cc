@@ -226,8 +226,10 @@ std::vector<Image> RouteViews(int width, int height, int count, uint32_t seed) {
 
 // The full scan as the reference: the first template of the smallest difference (Differences
 // visits every template without the bound).
+// `thorough`: every cutoff and hint below; otherwise a tie at the cutoff and just below it.
 void ExpectBoundedScanEqualsFullScan(ClassicCameraOptions options, const std::vector<Image>& stored,
-                                     const std::vector<Image>& queries, bool portable) {
+                                     const std::vector<Image>& queries, bool portable,
+                                     bool thorough = true) {
   ClassicCameraMatcher matcher(options);
   matcher.set_force_portable(portable);
   for (const Image& s : stored) matcher.Add(matcher.MakeTemplate(s.view()).value());
@@ -242,6 +244,28 @@ void ExpectBoundedScanEqualsFullScan(ClassicCameraOptions options, const std::ve
       const TemplateComparison got = matcher.Compare(query, hint);
       ASSERT_EQ(got.template_id, first_min - all.begin()) << "hint " << hint;
       ASSERT_EQ(got.mean_difference, *first_min) << "hint " << hint;  // bit for bit
+    }
+    // With a cutoff: the same answer when it is within (a tie at the cutoff counts), none when
+    // not. The cutoffs straddle the answer and a range of other templates' differences.
+    std::vector<double> sorted = all;
+    std::sort(sorted.begin(), sorted.end());
+    std::vector<double> cutoffs = {*first_min, std::nextafter(*first_min, 0.0)};
+    std::vector<int64_t> hints = {-1};
+    if (thorough) {
+      cutoffs.insert(cutoffs.end(), {*first_min * 2.0, sorted[sorted.size() / 10],
+                                     sorted[sorted.size() / 2], 0.0, 1.0});
+      hints.insert(hints.end(), {first_min - all.begin(), count / 2});
+    }
+    for (double cutoff : cutoffs) {
+      for (int64_t hint : hints) {
+        const TemplateComparison got = matcher.Compare(query, hint, cutoff);
+        if (*first_min <= cutoff) {
+          ASSERT_EQ(got.template_id, first_min - all.begin()) << "cutoff " << cutoff;
+          ASSERT_EQ(got.mean_difference, *first_min) << "cutoff " << cutoff;
+        } else {
+          ASSERT_EQ(got.template_id, -1) << "cutoff " << cutoff << " hint " << hint;
+        }
+      }
     }
   }
 }
@@ -270,6 +294,15 @@ TEST(ClassicCameraBoundTest, BoundedScanEqualsFullScanOnRandomTemplatesWithTies)
   std::vector<Image> queries;  // half of them equal to stored images: exact ties at 0
   for (uint32_t i = 0; i < 40; ++i)
     queries.push_back(RandomImage(120, 40, i % 2 ? 100 + i : 900 + i));
+  // Stored images made uniformly brighter: their difference equals the column-sum total bound
+  // exactly, so a cutoff at the answer leaves the index no slack.
+  for (uint32_t i = 0; i < 10; ++i) {
+    Image lifted = stored[i * 7];
+    for (uint8_t& p : lifted.pixels) p = static_cast<uint8_t>(p * 200 / 255 + 5 + i);
+    queries.push_back(lifted);
+    for (uint8_t& p : lifted.pixels) p = static_cast<uint8_t>(p - 2 * (5 + i));  // and darker
+    queries.push_back(lifted);
+  }
   for (bool portable : {false, true}) {
     ExpectBoundedScanEqualsFullScan({}, stored, queries, portable);
   }
@@ -283,7 +316,66 @@ TEST(ClassicCameraBoundTest, BoundedScanEqualsFullScanOnHugeTemplates) {
   options.shift_px = 1;
   std::vector<Image> stored;
   for (uint32_t i = 0; i < 2; ++i) stored.push_back(RandomImage(4096, 2060, 40 + i));
-  ExpectBoundedScanEqualsFullScan(options, stored, {stored[1], RandomImage(4096, 2060, 7)}, false);
+  ExpectBoundedScanEqualsFullScan(options, stored, {stored[1], RandomImage(4096, 2060, 7)}, false,
+                                  /*thorough=*/false);
+}
+
+// Cutoffs that admit nothing (zero with no exact copy, negative, NaN) give no template, and do
+// not upset the index.
+TEST(ClassicCameraBoundTest, CutoffThatAdmitsNothingGivesNoTemplate) {
+  ClassicCameraMatcher matcher({});
+  for (uint32_t i = 0; i < 50; ++i)
+    matcher.Add(matcher.MakeTemplate(RandomImage(120, 40, i).view()).value());
+  const std::vector<uint8_t> query = matcher.MakeTemplate(RandomImage(120, 40, 99).view()).value();
+  for (double cutoff : {0.0, -1.0, -1e300, std::nan("")}) {
+    EXPECT_EQ(matcher.Compare(query, -1, cutoff).template_id, -1) << cutoff;
+    EXPECT_EQ(matcher.Compare(query, 3, cutoff).template_id, -1) << cutoff;
+  }
+  EXPECT_GE(matcher.Compare(query, -1, 1.0).template_id, 0);
+}
+
+// A matcher reloaded from its state answers as the one that stored the templates (the total
+// index is rebuilt, not saved).
+TEST(ClassicCameraBoundTest, RestoredMatcherAnswersAsTheOriginal) {
+  const std::vector<Image> views = RouteViews(120, 40, 300, 8);
+  ClassicCameraOptions options;
+  options.match_threshold = 0.02;
+  ClassicCameraMatcher original(options);
+  for (int i = 0; i < 250; ++i) ASSERT_TRUE(original.Observe(views[i].view(), i).ok());
+  ClassicCameraMatcher restored(options);
+  ASSERT_TRUE(restored.SetState(original.state()).ok());
+  ASSERT_TRUE(restored.SetState(original.state()).ok());  // twice: no stale index entries
+  for (int i = 250; i < 300; ++i) {
+    const std::vector<uint8_t> query = original.MakeTemplate(views[i].view()).value();
+    for (double cutoff : {0.005, 0.02, 0.1}) {
+      const TemplateComparison a = original.Compare(query, -1, cutoff);
+      const TemplateComparison b = restored.Compare(query, -1, cutoff);
+      ASSERT_EQ(a.template_id, b.template_id);
+      ASSERT_EQ(a.mean_difference, b.mean_difference);
+      ASSERT_EQ(a.shift_px, b.shift_px);
+    }
+  }
+}
+
+// A tight cutoff visits only templates whose column-sum total is near the query's: on views of
+// many brightnesses, far fewer than all, and fewer than the scan without a cutoff compares.
+TEST(ClassicCameraBoundTest, CutoffVisitsFewTemplatesOfOtherBrightness) {
+  std::vector<Image> views;
+  for (int i = 0; i < 400; ++i) {
+    Image image = RandomImage(120, 40, 300 + i);
+    const int lift = (i * 37) % 200 - 100;  // brightness offsets spread over -100..99
+    for (uint8_t& p : image.pixels)
+      p = static_cast<uint8_t>(std::clamp(p / 2 + 64 + lift / 2, 0, 255));
+    views.push_back(image);
+  }
+  ClassicCameraMatcher matcher({});
+  for (int i = 0; i < 300; ++i) matcher.Add(matcher.MakeTemplate(views[i].view()).value());
+  for (int i = 300; i < 400; ++i) {
+    matcher.Compare(matcher.MakeTemplate(views[i].view()).value(), -1, 0.01);
+  }
+  // The totals of 300 templates spread over ~100 grey levels; a 0.01 cutoff is 2.55 levels
+  // either side (a few per cent), so well under a tenth should be visited.
+  EXPECT_LT(matcher.bounds_checked(), 100u * 300u / 10) << matcher.bounds_checked();
 }
 
 TEST(ClassicCameraBoundTest, BoundSkipsMostTemplatesOnRouteViews) {
