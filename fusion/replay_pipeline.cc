@@ -1,6 +1,8 @@
 #include "fusion/replay_pipeline.h"
 
 #include <cmath>
+#include <map>
+#include <set>
 #include <stdexcept>
 
 #include "common/circular.h"
@@ -269,6 +271,33 @@ Pose2 Inverse(const Pose2& p) {
 
 Pose2 Then(const Pose2& a, const Pose2& b) { return Compose(a, b.x_m, b.y_m, b.theta_rad); }
 
+// Whether the map already joins experiences `from` and `to` by links other than sequence
+// closure's (odometry and the front end's loop closures) shorter than `within_m` in all: then
+// the front end has closed this loop already.
+bool JoinedWithin(const ExperienceMap& map, uint32_t from, uint32_t to, double within_m) {
+  // Dijkstra from `from`, bounded by within_m; the region is small (a few links around a closure).
+  std::map<uint32_t, double> reached{{from, 0.0}};
+  std::set<std::pair<double, uint32_t>> frontier{{0.0, from}};
+  while (!frontier.empty()) {
+    const auto [d, u] = *frontier.begin();
+    frontier.erase(frontier.begin());
+    if (u == to) return true;
+    for (uint32_t link_id : map.experience(u).link_ids) {
+      const Link& l = map.links()[link_id];
+      if (l.wifi_sequence) continue;
+      const uint32_t v = l.from == u ? l.to : l.from;
+      const double dv = d + l.distance_m;
+      if (dv >= within_m) continue;
+      auto it = reached.find(v);
+      if (it != reached.end() && it->second <= dv) continue;
+      if (it != reached.end()) frontier.erase({it->second, v});
+      reached[v] = dv;
+      frontier.insert({dv, v});
+    }
+  }
+  return false;
+}
+
 }  // namespace
 
 Status ReplayPipeline::AddSequencePose(const WifiScan& scan) {
@@ -299,11 +328,22 @@ Status ReplayPipeline::AddSequencePose(const WifiScan& scan) {
 Status ReplayPipeline::LinkLoop(const std::optional<SequenceLoop>& loop, double time_s) {
   if (!loop || !loop->accepted) return Status::Ok();
   bool added = false;
+  size_t joined = 0, inliers = 0;
   for (const SequenceCorrespondence& c : loop->correspondences) {
     if (!c.inlier) continue;
     const SequencePose& now = wifi_sequence_->pose(c.current_pose);
     const SequencePose& then = wifi_sequence_->pose(c.past_pose);
     if (now.anchor < 0 || then.anchor < 0) continue;
+    // Where the front end has already joined the two places, a second, differently measured
+    // link only pulls against its own (on the IPIN routes such links made b_out's maps worse).
+    // Poses this close are never loop candidates, so without a front end's closures nothing is
+    // skipped.
+    ++inliers;
+    if (JoinedWithin(slam_->experience_map(), static_cast<uint32_t>(then.anchor),
+                     static_cast<uint32_t>(now.anchor), options_.wifi_sequence.min_loop_travel_m)) {
+      ++joined;
+      continue;
+    }
     // The current pose seen from the past one (the verified fit), carried to their anchors:
     // anchor_now in anchor_then's frame = offset_then * relative * offset_now^-1.
     const Pose2 relative = wifi_sequence_->RelativePose(*loop, c.current_pose, c.past_pose);
@@ -312,6 +352,11 @@ Status ReplayPipeline::LinkLoop(const std::optional<SequenceLoop>& loop, double 
                                                  static_cast<uint32_t>(now.anchor), link, time_s);
     if (!linked.ok()) return linked.status();
     added |= linked.value();
+  }
+  if (joined > 0) {
+    wifi_sequence_->SetOutcome(loop->id, "accepted; " + std::to_string(joined) + " of " +
+                                             std::to_string(inliers) +
+                                             " links left out: the map already joins those places");
   }
   if (added && finished()) {
     for (int i = 0; i < 100; ++i) slam_->RelaxExperienceMap();

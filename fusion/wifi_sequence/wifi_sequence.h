@@ -289,6 +289,13 @@ class WifiSequenceLoopCloser {
   size_t size() const { return state_.poses.size(); }
   const SequencePose& pose(size_t i) const { return state_.poses[i]; }
   const std::vector<SequenceLoop>& loops() const { return state_.loops; }
+  // Replaces loop `id`'s outcome (what became of an accepted loop's links); unknown ids are
+  // ignored.
+  void SetOutcome(uint32_t id, std::string outcome) {
+    for (SequenceLoop& l : state_.loops) {
+      if (l.id == id) l.outcome = std::move(outcome);
+    }
+  }
   const SmoothedSignalMatrix& similarity() const { return matrix_; }
   const WifiSequenceOptions& options() const { return options_; }
   const State& state() const { return state_; }
