@@ -71,6 +71,9 @@ Status WriteWifiSequenceImages(SceneRenderer* renderer, const ReplayPipeline& pi
       pairs.pairs.push_back({c.current_pose, c.past_pose, loop.accepted && c.inlier});
     }
   }
+  pairs.links_made = 0;
+  for (const Link& l : pipeline.slam().experience_map().links())
+    *pairs.links_made += l.wifi_sequence;
   return write(
       [&](int width_px) {
         return SequencePairsScene(pairs, "Wi-Fi sequence correspondences on the map", width_px);

@@ -144,6 +144,7 @@ TEST(FigureOutputTest, NoTextRunsOffAFigureLaidOutForAPage) {
   SequencePairsData pairs;
   for (int i = 0; i < 40; ++i) pairs.positions.push_back({0.5 * i, std::sin(0.3 * i)});
   pairs.pairs = {{30, 2, true}, {31, 3, false}};
+  pairs.links_made = 1;
   std::vector<float> matrix(100, 0.5f);
   std::vector<double> times(10);
   for (int i = 0; i < 10; ++i) times[i] = 100.0 * i;

@@ -155,6 +155,9 @@ struct SequencePairsData {
     bool verified = false;
   };
   std::vector<Pair> pairs;
+  // Links the verified pairs made in the map, when known (fewer than the verified pairs where
+  // the map already joined the places), shown beside the verified count.
+  std::optional<size_t> links_made;
 };
 // Two panels over the same view: every pair (left) and the verified ones (right); the scans'
 // track in grey. The panels are square and `width_px` wide together (0: 1600).
