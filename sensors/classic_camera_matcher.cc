@@ -41,6 +41,37 @@ namespace {
 // fill one 256-bit register.
 constexpr int kIndexRuns = 8;
 
+// The template columns [first, last) a shift overlaps: all of them in a panorama. Prepare (query
+// side) and the index (template side) must agree on it.
+std::pair<int, int> OverlapOf(int shift, int width, bool panoramic) {
+  if (panoramic) return {0, width};
+  return {std::max(0, -shift), std::min(width, width - shift)};
+}
+
+// Sums of `columns` over the kIndexRuns runs that cut [first, last), appended to `out`: the same
+// cut on the query's side and the templates'.
+template <typename Sum>
+void AppendRunSums(const int32_t* columns, int first, int last, std::vector<Sum>* out) {
+  const int span = last - first;
+  for (int j = 0; j < kIndexRuns; ++j) {
+    Sum sum = 0;
+    for (int u = first + span * j / kIndexRuns; u < first + span * (j + 1) / kIndexRuns; ++u) {
+      sum += columns[u];
+    }
+    out->push_back(sum);
+  }
+}
+
+// Whether the AVX2 kernels can run here (asked once).
+bool HaveAvx2() {
+#if defined(RATSLAM_HAVE_X86_SIMD)
+  static const bool kAvx2 = __builtin_cpu_supports("avx2");
+  return kAvx2;
+#else
+  return false;
+#endif
+}
+
 // Marks in `marked` (a bitmap by id) the records whose sums over runs of columns, kIndexRuns
 // per record, are within `limit` of the query's in L1 (each sum and the query's < 2^31).
 void MarkRunsWithinPortable(const int32_t* runs, const uint32_t* ids, size_t count,
@@ -135,8 +166,9 @@ ClassicCameraMatcher::PreparedQuery Prepare(const std::vector<uint8_t>& query,
       }
     }
     p.overlap_columns.push_back(overlap);
-    p.first_column.push_back(panoramic ? 0 : std::max(0, -s));
-    p.last_column.push_back(panoramic ? width : std::min(width, width - s));
+    const auto [first, last] = OverlapOf(s, width, panoramic);
+    p.first_column.push_back(first);
+    p.last_column.push_back(last);
   }
   p.column_sums.assign(shifts.size() * width, 0);
   for (size_t k = 0; k < shifts.size(); ++k) {
@@ -150,14 +182,8 @@ ClassicCameraMatcher::PreparedQuery Prepare(const std::vector<uint8_t>& query,
     for (int u = p.first_column[k]; u < p.last_column[k]; ++u)
       overlap += p.column_sums[k * width + u];
     p.overlap_sums.push_back(overlap);
-    const int first = p.first_column[k], span = p.last_column[k] - first;
-    for (int j = 0; j < kIndexRuns; ++j) {
-      int64_t sum = 0;
-      for (int u = first + span * j / kIndexRuns; u < first + span * (j + 1) / kIndexRuns; ++u) {
-        sum += p.column_sums[k * width + u];
-      }
-      p.run_sums.push_back(sum);
-    }
+    AppendRunSums(p.column_sums.data() + k * width, p.first_column[k], p.last_column[k],
+                  &p.run_sums);
   }
   return p;
 }
@@ -405,8 +431,7 @@ ClassicCameraMatcher::ClassicCameraMatcher(const ClassicCameraOptions& options)
   // overlap: a panorama has one, a shift range one per shift.
   const int w = options.template_width_px;
   for (int s : shifts_) {
-    const int first = options.panoramic ? 0 : std::max(0, -s);
-    const int last = options.panoramic ? w : std::min(w, w - s);
+    const auto [first, last] = OverlapOf(s, w, options.panoramic);
     size_t entry = 0;
     while (entry < total_buckets_.size() &&
            (total_buckets_[entry].first != first || total_buckets_[entry].last != last)) {
@@ -528,8 +553,7 @@ void ClassicCameraMatcher::VisitTemplates(const PreparedQuery& prepared, Visit&&
   }
   const uint8_t* base = state_.templates.data();
 #if defined(RATSLAM_HAVE_X86_SIMD)
-  static const bool kAvx2 = __builtin_cpu_supports("avx2");
-  if (kAvx2) {
+  if (HaveAvx2()) {
     ForEachTemplate<MaskedSadAvx2>(base, state_.template_count, bytes_per_template_, prepared,
                                    scale, shifts_, h, row_stride_, visit);
     return;
@@ -570,6 +594,7 @@ bool ClassicCameraMatcher::CandidatesWithin(const PreparedQuery& prepared,
   // order) leave the few templates the full bound must look at. Union in id order through a
   // bitmap.
   std::vector<uint64_t> marked((state_.template_count + 63) / 64, 0);
+  [[maybe_unused]] const bool use_avx2 = HaveAvx2() && !force_portable_;
   for (const Window& window : windows) {
     const TotalBuckets& index = total_buckets_[static_cast<size_t>(shift_overlap_[window.shift])];
     const int64_t limit = LimitFor(radius, scale[window.shift]);
@@ -586,8 +611,7 @@ bool ClassicCameraMatcher::CandidatesWithin(const PreparedQuery& prepared,
       const uint32_t limit32 =
           static_cast<uint32_t>(std::min<int64_t>(limit, std::numeric_limits<uint32_t>::max()));
 #if defined(RATSLAM_HAVE_X86_SIMD)
-      static const bool kAvx2 = __builtin_cpu_supports("avx2");
-      if (kAvx2 && !force_portable_) {
+      if (use_avx2) {
         MarkRunsWithinAvx2(bucket.runs.data(), bucket.ids.data(), bucket.ids.size(), query_runs,
                            limit32, marked.data());
         continue;
@@ -640,8 +664,7 @@ TemplateComparison ClassicCameraMatcher::Compare(const std::vector<uint8_t>& que
     bounds_checked_ += narrowed ? candidates.size() : state_.template_count;
   };
 #if defined(RATSLAM_HAVE_X86_SIMD)
-  static const bool kAvx2 = __builtin_cpu_supports("avx2");
-  if (kAvx2 && !force_portable_) {
+  if (HaveAvx2() && !force_portable_) {
     search.template operator()<MaskedSadAvx2>();
   } else {
     search.template operator()<MaskedSadPortable>();
@@ -697,16 +720,7 @@ void ClassicCameraMatcher::Index(uint32_t id) {
         std::min(static_cast<size_t>(total / index.bucket_width), index.buckets.size() - 1);
     TotalBuckets::Bucket& bucket = index.buckets[b];
     bucket.ids.push_back(id);
-    if (!fits_32) continue;
-    const int span = index.last - index.first;
-    for (int j = 0; j < kIndexRuns; ++j) {
-      int32_t run = 0;
-      for (int u = index.first + span * j / kIndexRuns;
-           u < index.first + span * (j + 1) / kIndexRuns; ++u) {
-        run += columns[u];
-      }
-      bucket.runs.push_back(run);
-    }
+    if (fits_32) AppendRunSums(columns, index.first, index.last, &bucket.runs);
   }
 }
 
