@@ -1,8 +1,6 @@
 #include "fusion/replay_pipeline.h"
 
 #include <cmath>
-#include <map>
-#include <set>
 #include <stdexcept>
 
 #include "common/circular.h"
@@ -271,33 +269,6 @@ Pose2 Inverse(const Pose2& p) {
 
 Pose2 Then(const Pose2& a, const Pose2& b) { return Compose(a, b.x_m, b.y_m, b.theta_rad); }
 
-// Whether the map already joins experiences `from` and `to` by links other than sequence
-// closure's (odometry and the front end's loop closures) shorter than `within_m` in all: then
-// the front end has closed this loop already.
-bool JoinedWithin(const ExperienceMap& map, uint32_t from, uint32_t to, double within_m) {
-  // Dijkstra from `from`, bounded by within_m; the region is small (a few links around a closure).
-  std::map<uint32_t, double> reached{{from, 0.0}};
-  std::set<std::pair<double, uint32_t>> frontier{{0.0, from}};
-  while (!frontier.empty()) {
-    const auto [d, u] = *frontier.begin();
-    frontier.erase(frontier.begin());
-    if (u == to) return true;
-    for (uint32_t link_id : map.experience(u).link_ids) {
-      const Link& l = map.links()[link_id];
-      if (l.wifi_sequence) continue;
-      const uint32_t v = l.from == u ? l.to : l.from;
-      const double dv = d + l.distance_m;
-      if (dv >= within_m) continue;
-      auto it = reached.find(v);
-      if (it != reached.end() && it->second <= dv) continue;
-      if (it != reached.end()) frontier.erase({it->second, v});
-      reached[v] = dv;
-      frontier.insert({dv, v});
-    }
-  }
-  return false;
-}
-
 }  // namespace
 
 Status ReplayPipeline::AddSequencePose(const WifiScan& scan) {
@@ -339,8 +310,9 @@ Status ReplayPipeline::LinkLoop(const std::optional<SequenceLoop>& loop, double 
     // Poses this close are never loop candidates, so without a front end's closures nothing is
     // skipped.
     ++inliers;
-    if (JoinedWithin(slam_->experience_map(), static_cast<uint32_t>(then.anchor),
-                     static_cast<uint32_t>(now.anchor), options_.wifi_sequence.min_loop_travel_m)) {
+    if (slam_->experience_map().JoinedWithin(static_cast<uint32_t>(then.anchor),
+                                             static_cast<uint32_t>(now.anchor),
+                                             options_.wifi_sequence.min_loop_travel_m)) {
       ++joined;
       continue;
     }

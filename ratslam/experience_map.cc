@@ -6,6 +6,8 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <map>
+#include <set>
 #include <stdexcept>
 
 #include "common/circular.h"
@@ -484,6 +486,32 @@ std::vector<uint32_t> ExperienceMap::ShortestPath(uint32_t from, uint32_t to) co
     if (v == from) break;
   }
   return {path.rbegin(), path.rend()};
+}
+
+bool ExperienceMap::JoinedWithin(uint32_t from, uint32_t to, double within_m) const {
+  const size_t n = state_.experiences.size();
+  if (from >= n || to >= n) return false;
+  // Dijkstra bounded by within_m: around a closure the region is a few links.
+  std::map<uint32_t, double> reached{{from, 0.0}};
+  std::set<std::pair<double, uint32_t>> frontier{{0.0, from}};
+  while (!frontier.empty()) {
+    const auto [d, u] = *frontier.begin();
+    frontier.erase(frontier.begin());
+    if (u == to) return true;
+    for (uint32_t link_id : state_.experiences[u].link_ids) {
+      const Link& l = state_.links[link_id];
+      if (l.wifi_sequence) continue;
+      const uint32_t v = l.from == u ? l.to : l.from;
+      const double dv = d + l.distance_m;
+      if (dv >= within_m) continue;
+      auto it = reached.find(v);
+      if (it != reached.end() && it->second <= dv) continue;
+      if (it != reached.end()) frontier.erase({it->second, v});
+      reached[v] = dv;
+      frontier.insert({dv, v});
+    }
+  }
+  return false;
 }
 
 Status ExperienceMap::SetState(State state) {

@@ -204,6 +204,10 @@ class ExperienceMap {
   // Experience ids along the shortest path (by link distance) from `from` to `to`, both
   // included; empty when they are not connected or an id does not exist.
   std::vector<uint32_t> ShortestPath(uint32_t from, uint32_t to) const;
+  // Whether links other than Wi-Fi sequence closure's (odometry and the front end's loop
+  // closures) join `from` and `to` by a path shorter than `within_m`; the search stays within
+  // that distance of `from`. An id that does not exist is joined to nothing.
+  bool JoinedWithin(uint32_t from, uint32_t to, double within_m) const;
 
   size_t num_experiences() const { return state_.experiences.size(); }
   size_t num_links() const { return state_.links.size(); }

@@ -127,6 +127,22 @@ TEST(ExperienceMapTest, AConstraintClosesTheLoopLikeALinkAndKeepsTheCurrentExper
   EXPECT_EQ(map.links().size(), 40u);  // 39 odometry links and the constraint
 }
 
+// The square's 40 experiences are a chain of 39 one-metre links: 0 and 39 are joined by 39 m of
+// links, and a sequence-closure constraint between them does not count.
+TEST(ExperienceMapTest, JoinedWithinFollowsLinksOtherThanSequenceClosures) {
+  ExperienceMap map = DriveBiasedSquare({});
+  ASSERT_EQ(map.num_experiences(), 40u);
+  EXPECT_TRUE(map.JoinedWithin(0, 39, 39.5));
+  EXPECT_FALSE(map.JoinedWithin(0, 39, 38.5));
+  EXPECT_TRUE(map.JoinedWithin(39, 0, 39.5));  // either way
+  EXPECT_TRUE(map.JoinedWithin(5, 8, 3.5));
+  EXPECT_FALSE(map.JoinedWithin(5, 8, 2.5));
+  EXPECT_TRUE(map.JoinedWithin(7, 7, 0.1));
+  EXPECT_FALSE(map.JoinedWithin(0, 999, 1e9));
+  ASSERT_TRUE(map.AddConstraint(39, 0, {1.0, 0.0, kPi / 2}, 40.0).value());
+  EXPECT_FALSE(map.JoinedWithin(0, 39, 5.0));
+}
+
 TEST(ExperienceMapCompassTest, AConstraintTakesTheCompassFacing) {
   ExperienceMap map({});
   map.CreateExperience(0, {}, 0.0, 0.3);
