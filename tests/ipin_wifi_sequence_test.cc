@@ -43,15 +43,22 @@ nlohmann::json Replay(const std::string& config, const std::vector<fs::path>& lo
   return s;
 }
 
-class IpinWifiSequenceTest : public testing::TestWithParam<const char*> {};
-
-TEST_P(IpinWifiSequenceTest, VerifiedSequencesCloseLoopsOnRealWalks) {
+// The four repetitions of an IPIN 2023 training route, in order.
+std::vector<fs::path> RouteLogs(const std::string& route) {
   const fs::path data = fs::path(RATSLAM_SHARED_DATA_DIR) / "ipin2023-t3";
   std::vector<fs::path> logs;
   for (const char* rep : {"01", "02", "03", "04"}) {
-    logs.push_back(data / (std::string("IPIN2023_T3_TrainingTrial") + GetParam() + "_repetition" +
-                           rep + ".txt"));
-    if (!fs::exists(logs.back())) GTEST_SKIP() << "missing " << logs.back();
+    logs.push_back(data / ("IPIN2023_T3_TrainingTrial" + route + "_repetition" + rep + ".txt"));
+  }
+  return logs;
+}
+
+class IpinWifiSequenceTest : public testing::TestWithParam<const char*> {};
+
+TEST_P(IpinWifiSequenceTest, VerifiedSequencesCloseLoopsOnRealWalks) {
+  const std::vector<fs::path> logs = RouteLogs(GetParam());
+  for (const fs::path& log : logs) {
+    if (!fs::exists(log)) GTEST_SKIP() << "missing " << log;
   }
   const fs::path out =
       fs::temp_directory_path() /
@@ -156,12 +163,9 @@ INSTANTIATE_TEST_SUITE_P(Routes, IpinWifiSequenceTest, testing::Values("21", "02
 class IpinSequenceBesideBoutTest : public testing::TestWithParam<const char*> {};
 
 TEST_P(IpinSequenceBesideBoutTest, NeverWorseThanBoutAlone) {
-  const fs::path data = fs::path(RATSLAM_SHARED_DATA_DIR) / "ipin2023-t3";
-  std::vector<fs::path> logs;
-  for (const char* rep : {"01", "02", "03", "04"}) {
-    logs.push_back(data / (std::string("IPIN2023_T3_TrainingTrial") + GetParam() + "_repetition" +
-                           rep + ".txt"));
-    if (!fs::exists(logs.back())) GTEST_SKIP() << "missing " << logs.back();
+  const std::vector<fs::path> logs = RouteLogs(GetParam());
+  for (const fs::path& log : logs) {
+    if (!fs::exists(log)) GTEST_SKIP() << "missing " << log;
   }
   const fs::path out =
       fs::temp_directory_path() /
