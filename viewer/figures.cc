@@ -737,9 +737,14 @@ Scene SequencePairsScene(const SequencePairsData& data, const std::string& title
                  WithAlpha(p == 1 ? kWifiSequence : kLoopClosure, 200));
       scene.Disc(to_image(a.x, a.y), 2.5f, kInk, 8);
     }
+    // The long caption where the panel has room for it, a short one on a narrow page.
     std::string caption =
         (p == 0 ? "DP pairs before verification: " : "verified: ") + std::to_string(drawn);
     if (p == 1 && data.links_made) caption += ", links made: " + std::to_string(*data.links_made);
+    if (TextWidthPx(caption, 15) > panel - 30) {
+      caption = (p == 0 ? "DP pairs: " : "verified: ") + std::to_string(drawn);
+      if (p == 1 && data.links_made) caption += ", links: " + std::to_string(*data.links_made);
+    }
     scene.Text({p * panel + 20.0f, 58}, caption, 15, kInk);
   }
   scene.Line({static_cast<float>(panel), static_cast<float>(top)},
