@@ -95,9 +95,11 @@ std::vector<EvaluationNode> CaptureNodes(const std::vector<LabelledScan>& rows,
 StatusOr<std::vector<EvaluationNode>> UjiNodes(const std::string& path, bool lenient) {
   auto rows = ReadUjiIndoorLoc(path, lenient);
   if (!rows.ok()) return rows.status();
-  return CaptureNodes(*rows, [](const LabelledScan& s) {
+  auto nodes = CaptureNodes(*rows, [](const LabelledScan& s) {
     return std::pair(s.building * 100 + s.floor, s.user * 100 + s.phone);
   });
+  for (EvaluationNode& n : nodes) n.building = n.floor / 100;
+  return nodes;
 }
 
 // A long-term UJI library set (db/<month>/<set>rss.csv and its siblings): the session is 100 x

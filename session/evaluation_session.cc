@@ -276,6 +276,7 @@ Status EvaluationSession::Localise() {
   if (!localiser_) return Status::Error("evaluation session: Localise before Prepare");
   const bool vision = fabmap::UsesVision(mode());
   result_.matches.clear();
+  result_.answers.clear();
   result_.match_probability.clear();
   result_.new_place_probability.clear();
   result_.best_mapped_place.clear();
@@ -296,6 +297,18 @@ Status EvaluationSession::Localise() {
       r.best_probability = accept ? r.best_mapped_probability : r.new_place_probability;
     }
     result_.matches.push_back(r.best_place);
+    fabmap::Estimate answer;
+    if (r.best_place >= 0) {
+      const fabmap::EvaluationOptions& e = options_.pipeline.evaluation;
+      if (e.answer == fabmap::AnswerRule::kPosterior) {
+        answer = fabmap::PosteriorEstimate(result_.map, r.place_probability, e.answer_places,
+                                           e.answer_temperature);
+      } else {
+        const fabmap::EvaluationNode& p = result_.map[static_cast<size_t>(r.best_place)];
+        answer = {true, p.x_m, p.y_m, p.floor};
+      }
+    }
+    result_.answers.push_back(answer);
     result_.match_probability.push_back(r.best_probability);
     result_.new_place_probability.push_back(r.new_place_probability);
     result_.best_mapped_place.push_back(r.best_mapped_place);
@@ -306,8 +319,7 @@ Status EvaluationSession::Localise() {
   progress_->Finish();
   result_.query_time_ms =
       1000.0 * (clock_->Seconds() - start) / static_cast<double>(result_.queries.size());
-  result_.metrics =
-      fabmap::ComputeMetrics(result_.map, result_.queries, result_.matches, kDistancesM);
+  result_.metrics = fabmap::ComputeMetrics(result_.queries, result_.answers, kDistancesM);
   {
     // The best mapped place's error (infinity on another floor) and posterior (NaN: no place).
     const fabmap::EvaluationMetrics best = fabmap::ComputeMetrics(
@@ -437,9 +449,8 @@ Status EvaluationSession::WriteOutputs() {
     const int64_t match = result_.matches[i];
     csv << i << ',' << ShortestNumber(q.x_m) << ',' << ShortestNumber(q.y_m) << ',' << q.floor
         << ',' << match;
-    if (match >= 0) {
-      const auto& p = result_.map[match];
-      csv << ',' << ShortestNumber(p.x_m) << ',' << ShortestNumber(p.y_m) << ',' << p.floor;
+    if (const fabmap::Estimate& a = result_.answers[i]; a.located) {
+      csv << ',' << ShortestNumber(a.x_m) << ',' << ShortestNumber(a.y_m) << ',' << a.floor;
     } else {
       csv << ",,,";
     }

@@ -40,6 +40,9 @@ struct EvaluationSessionOptions {
 struct EvaluationResult {
   std::vector<fabmap::EvaluationNode> map, queries;
   std::vector<int64_t> matches;  // per query: map index, or -1 for a new place (rejection)
+  // Per query, the answer's position: the match's, or with [evaluation] answer = "posterior" the
+  // vote of the most probable places (not located: a rejection).
+  std::vector<fabmap::Estimate> answers;
   // Per query, FABMAP's posteriors: of the chosen hypothesis (the match, or the new place), of
   // the new place, and the best mapped place (-1: none) with its posterior.
   std::vector<double> match_probability, new_place_probability;

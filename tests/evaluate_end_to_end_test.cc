@@ -39,6 +39,33 @@ fs::path Scratch(const std::string& name) {
   return fs::temp_directory_path() / ("ratslam_" + name + "_" + std::to_string(::getpid()));
 }
 
+// A copy of `config` in `dir` (created) with the line `from` replaced by `to`; "" when `config`
+// has no such line.
+std::string ConfigWith(const std::string& config, const std::string& from, const std::string& to,
+                       const fs::path& dir) {
+  std::ifstream base(config);
+  std::stringstream text;
+  text << base.rdbuf();
+  std::string toml = text.str();
+  if (toml.find(from) == std::string::npos) return "";
+  toml.replace(toml.find(from), from.size(), to);
+  fs::create_directories(dir);
+  const fs::path path = dir / "input.toml";
+  std::ofstream(path) << toml;
+  return path.string();
+}
+
+// `ratslam evaluate` with one data set as map and queries; its evaluation.json.
+nlohmann::json EvaluateOneSet(const std::string& config, const fs::path& data,
+                              const fs::path& dir) {
+  const std::string command =
+      std::string(RATSLAM_BINARY) + " evaluate --quiet --overwrite --config " + config + " --map " +
+      data.string() + " --query " + data.string() + " --out " + dir.string() + " > /dev/null";
+  EXPECT_EQ(std::system(command.c_str()), 0) << command;
+  std::ifstream in(dir / "evaluation.json");
+  return nlohmann::json::parse(in);
+}
+
 TEST(EvaluateEndToEndTest, MicrosoftWalksWifiOnly) {
   const fs::path data = fs::path(RATSLAM_SHARED_DATA_DIR) / "msft-ilc20-site1";
   if (!fs::exists(data)) GTEST_SKIP() << "missing " << data;
@@ -256,28 +283,11 @@ TEST(EvaluateEndToEndTest, UjiByUserSplitsByUserAndLearntThresholdCutsFloorMista
   const fs::path argmax = Scratch("evaluate_uji_by_user_argmax");
   const std::string config =
       RATSLAM_SOURCE_DIR + std::string("/configs/ujiindoorloc-wifi-by-user.toml");
-  {
-    std::ifstream base(config);
-    std::stringstream text;
-    text << base.rdbuf();
-    std::string toml = text.str();
-    const std::string key = "calibrate_new_place = true";
-    ASSERT_NE(toml.find(key), std::string::npos);
-    toml.replace(toml.find(key), key.size(), "calibrate_new_place = false");
-    fs::create_directories(argmax);
-    std::ofstream(argmax / "argmax.toml") << toml;
-  }
-  const auto run = [&](const std::string& config_path, const fs::path& dir) {
-    const std::string command = std::string(RATSLAM_BINARY) +
-                                " evaluate --quiet --overwrite --config " + config_path +
-                                " --map " + data.string() + " --query " + data.string() +
-                                " --out " + dir.string() + " > /dev/null";
-    EXPECT_EQ(std::system(command.c_str()), 0) << command;
-    std::ifstream in(dir / "evaluation.json");
-    return nlohmann::json::parse(in);
-  };
-  const nlohmann::json j = run(config, out);
-  const nlohmann::json a = run((argmax / "argmax.toml").string(), argmax);
+  const std::string argmax_config =
+      ConfigWith(config, "calibrate_new_place = true", "calibrate_new_place = false", argmax);
+  ASSERT_FALSE(argmax_config.empty());
+  const nlohmann::json j = EvaluateOneSet(config, data, out);
+  const nlohmann::json a = EvaluateOneSet(argmax_config, data, argmax);
   EXPECT_EQ(j["map_nodes"].get<size_t>(), expected_map);
   const nlohmann::json& calibration = j["new_place_calibration"];
   ASSERT_TRUE(calibration["calibrated"].get<bool>());
@@ -300,6 +310,61 @@ TEST(EvaluateEndToEndTest, UjiByUserSplitsByUserAndLearntThresholdCutsFloorMista
   }
   fs::remove_all(out);
   fs::remove_all(argmax);
+}
+
+// UJIIndoorLoc split by reference point (the shipped by-position config): no query stands where
+// a map row does, as in the data set's own validation file. There the vote of the five most
+// probable rows (answer = "posterior") must beat the single best row's position within 10 m by a
+// point (measured: 65.0 % against 62.4 %) and be at least k-NN's of the same run (64.2 %), with
+// no more floor mistakes than the arg-max (4.4 % against 5.0 %).
+TEST(EvaluateEndToEndTest, UjiByPositionPosteriorVoteBeatsTheBestPlace) {
+  const fs::path data = fs::path(RATSLAM_SHARED_DATA_DIR) / "ujiindoorloc" / "trainingData.csv";
+  if (!fs::exists(data)) GTEST_SKIP() << "missing " << data;
+  const std::string config =
+      RATSLAM_SOURCE_DIR + std::string("/configs/ujiindoorloc-wifi-by-position.toml");
+  const fs::path vote = Scratch("evaluate_uji_by_position");
+  const fs::path best = Scratch("evaluate_uji_by_position_best");
+  const std::string best_config =
+      ConfigWith(config, "answer = \"posterior\"", "answer = \"best_place\"", best);
+  ASSERT_FALSE(best_config.empty());
+  const nlohmann::json v = EvaluateOneSet(config, data, vote);
+  const nlohmann::json b = EvaluateOneSet(best_config, data, best);
+  const auto within10 = [](const nlohmann::json& j) {
+    return j["correct_within_m"]["10"].get<double>();
+  };
+  EXPECT_GE(within10(v), within10(b) + 0.01);
+  EXPECT_GE(within10(v), within10(v["baselines"]["knn"]));
+  EXPECT_LE(v["floor_mistake_rate"].get<double>(), b["floor_mistake_rate"].get<double>());
+  EXPECT_EQ(v["rejection_rate"].get<double>(), b["rejection_rate"].get<double>());
+  // No query stands on a map row's position. The best place answers with map rows' positions
+  // (at most the map's 373 points); the vote averages rows, so its answers lie between them.
+  const auto answers = [&](const fs::path& dir, size_t* rows) {
+    std::ifstream csv(dir / "queries.csv");
+    std::string line;
+    std::getline(csv, line);
+    const std::vector<std::string> header = Fields(line);
+    const auto column = [&](const std::string& name) {
+      return static_cast<size_t>(std::find(header.begin(), header.end(), name) - header.begin());
+    };
+    const size_t nearest = column("nearest_place_m"), x = column("match_x_m");
+    std::set<std::pair<std::string, std::string>> distinct;
+    for (*rows = 0; std::getline(csv, line); ++*rows) {
+      const std::vector<std::string> f = Fields(line);
+      EXPECT_GT(f.size(), nearest) << line;
+      if (f.size() <= nearest) break;
+      EXPECT_GT(std::stod(f[nearest]), 0.0) << line;
+      if (!f[x].empty()) distinct.insert({f[x], f[x + 1]});
+    }
+    return distinct.size();
+  };
+  size_t vote_rows = 0, best_rows = 0;
+  const size_t vote_answers = answers(vote, &vote_rows), best_answers = answers(best, &best_rows);
+  EXPECT_EQ(vote_rows, v["queries"].get<size_t>());
+  EXPECT_EQ(best_rows, vote_rows);
+  EXPECT_LE(best_answers, 373u);
+  EXPECT_GT(vote_answers, 10 * best_answers);
+  fs::remove_all(vote);
+  fs::remove_all(best);
 }
 
 // UJIIndoorLoc rows are single captures with no travel between them. The Wi-Fi tree must learn

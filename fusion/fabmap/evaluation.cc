@@ -8,6 +8,8 @@
 #include <map>
 #include <set>
 #include <system_error>
+#include <tuple>
+#include <utility>
 
 namespace ratslam::fabmap {
 
@@ -19,6 +21,8 @@ std::string ToString(SplitUnit unit) {
       return "session";
     case SplitUnit::kFirstSession:
       return "first_session";
+    case SplitUnit::kPosition:
+      return "position";
   }
   return "?";
 }
@@ -27,7 +31,25 @@ StatusOr<SplitUnit> SplitUnitFromString(const std::string& name) {
   if (name == "node") return SplitUnit::kNode;
   if (name == "session") return SplitUnit::kSession;
   if (name == "first_session") return SplitUnit::kFirstSession;
-  return Status::Error("unknown split '" + name + "' (expected node, session or first_session)");
+  if (name == "position") return SplitUnit::kPosition;
+  return Status::Error("unknown split '" + name +
+                       "' (expected node, session, first_session or position)");
+}
+
+std::string ToString(AnswerRule rule) {
+  switch (rule) {
+    case AnswerRule::kBestPlace:
+      return "best_place";
+    case AnswerRule::kPosterior:
+      return "posterior";
+  }
+  return "?";
+}
+
+StatusOr<AnswerRule> AnswerRuleFromString(const std::string& name) {
+  if (name == "best_place") return AnswerRule::kBestPlace;
+  if (name == "posterior") return AnswerRule::kPosterior;
+  return Status::Error("unknown answer '" + name + "' (expected best_place or posterior)");
 }
 
 std::string ToString(NewPlaceRule rule) {
@@ -191,18 +213,24 @@ MapDistanceReport ByMapDistance(const EvaluationMetrics& metrics,
 
 SplitNodes SplitEvaluationNodes(const std::vector<EvaluationNode>& nodes,
                                 const EvaluationOptions& options) {
-  // Sessions by id, in the order of their first node: a session whose nodes interleave in time
-  // with another's (UJIIndoorLoc's users and phones took turns) stays whole on one side.
-  std::map<int, size_t> index_of;
-  for (const auto& n : nodes) index_of.emplace(n.session, index_of.size());
-  const bool by_session = options.split == SplitUnit::kSession;
+  // Groups (sessions by id, or positions) in the order of their first node: a session whose nodes
+  // interleave in time with another's (UJIIndoorLoc's users and phones took turns) stays whole
+  // on one side, as do the captures at one position.
+  std::map<std::tuple<int, double, double>, size_t> index_of;
+  auto key = [&](const EvaluationNode& n) {
+    return options.split == SplitUnit::kPosition ? std::tuple(n.floor, n.x_m, n.y_m)
+                                                 : std::tuple(n.session, 0.0, 0.0);
+  };
+  for (const auto& n : nodes) index_of.emplace(key(n), index_of.size());
+  const bool by_group =
+      options.split == SplitUnit::kSession || options.split == SplitUnit::kPosition;
   const std::vector<bool> split =
-      InterleavedSplit(by_session ? index_of.size() : nodes.size(), options.map_fraction);
+      InterleavedSplit(by_group ? index_of.size() : nodes.size(), options.map_fraction);
   SplitNodes out;
   for (size_t i = 0; i < nodes.size(); ++i) {
-    const size_t session_index = index_of.at(nodes[i].session);
-    const bool in_map = options.split == SplitUnit::kFirstSession ? session_index == 0
-                        : by_session                              ? split[session_index]
+    const size_t group = index_of.at(key(nodes[i]));
+    const bool in_map = options.split == SplitUnit::kFirstSession ? group == 0
+                        : by_group                                ? split[group]
                                                                   : split[i];
     (in_map ? out.map : out.queries).push_back(nodes[i]);
   }
@@ -215,6 +243,59 @@ std::vector<bool> InterleavedSplit(size_t count, double map_fraction) {
     in_map[i] = std::floor((i + 1) * map_fraction) > std::floor(i * map_fraction);
   }
   return in_map;
+}
+
+Estimate PosteriorEstimate(const std::vector<EvaluationNode>& map,
+                           const std::vector<double>& place_probability, int places,
+                           double temperature) {
+  // The most probable places, highest first (ties: the lower index).
+  std::vector<std::pair<double, size_t>> top;
+  const size_t n = std::min(map.size(), place_probability.size());
+  for (size_t i = 0; i < n; ++i) {
+    if (place_probability[i] > 0.0) top.push_back({place_probability[i], i});
+  }
+  Estimate e;
+  if (top.empty() || places < 1) return e;
+  const size_t keep = std::min(top.size(), static_cast<size_t>(places));
+  std::partial_sort(top.begin(), top.begin() + static_cast<std::ptrdiff_t>(keep), top.end(),
+                    [](const auto& a, const auto& b) {
+                      return a.first > b.first || (a.first == b.first && a.second < b.second);
+                    });
+  top.resize(keep);
+  // Weights relative to the best place, in logs, so that posteriors far below it stay finite.
+  const double best_log = std::log(top.front().first);
+  for (auto& [p, i] : top) p = std::exp((std::log(p) - best_log) / temperature);
+  // Building first, then a floor in it; ties go to the more probable place's.
+  const auto vote = [&](auto&& label, auto&& in_race) {
+    std::map<int, double> total;
+    for (const auto& [w, i] : top) {
+      if (in_race(map[i])) total[label(map[i])] += w;
+    }
+    int winner = 0;
+    double most = -1.0;
+    for (const auto& [w, i] : top) {  // most probable first: the first of equals wins
+      if (in_race(map[i]) && total[label(map[i])] > most) {
+        most = total[label(map[i])];
+        winner = label(map[i]);
+      }
+    }
+    return winner;
+  };
+  const int building = vote([](const EvaluationNode& m) { return m.building; },
+                            [](const EvaluationNode&) { return true; });
+  e.floor = vote([](const EvaluationNode& m) { return m.floor; },
+                 [&](const EvaluationNode& m) { return m.building == building; });
+  double total = 0.0;
+  for (const auto& [w, i] : top) {
+    if (map[i].building != building || map[i].floor != e.floor) continue;
+    e.x_m += w * map[i].x_m;
+    e.y_m += w * map[i].y_m;
+    total += w;
+  }
+  e.x_m /= total;
+  e.y_m /= total;
+  e.located = true;
+  return e;
 }
 
 EvaluationMetrics ComputeMetrics(const std::vector<EvaluationNode>& map,

@@ -20,7 +20,8 @@ namespace ratslam::fabmap {
 // A place of the benchmark: where it is and what was sensed there.
 struct EvaluationNode {
   double x_m = 0.0, y_m = 0.0;
-  int floor = 0;
+  int floor = 0;     // another building's floors are other floors (UJIIndoorLoc: 100 b + f)
+  int building = 0;  // 0 where a data set has one building
   double time_s = 0.0;
   double travelled_m = 0.0;  // along its session (Wi-Fi tree spacing); NaN: not recorded
   int session = 0;
@@ -28,8 +29,10 @@ struct EvaluationNode {
   std::optional<std::vector<WifiReading>> wifi;  // scan, if any
 };
 
-// kFirstSession: the first session makes the map, every other one queries it.
-enum class SplitUnit { kNode, kSession, kFirstSession };
+// kFirstSession: the first session makes the map, every other one queries it. kPosition: the
+// nodes at one position (floor, x, y) stay together, so every query stands where no map node
+// does (UJIIndoorLoc's reference points: the queries of its validation file stand anywhere).
+enum class SplitUnit { kNode, kSession, kFirstSession, kPosition };
 std::string ToString(SplitUnit unit);
 StatusOr<SplitUnit> SplitUnitFromString(const std::string& name);
 
@@ -43,6 +46,16 @@ enum class NewPlaceRule { kNearRecall, kYouden };
 std::string ToString(NewPlaceRule rule);
 StatusOr<NewPlaceRule> NewPlaceRuleFromString(const std::string& name);
 
+// How a query's answer is read from FABMAP's posterior over the mapped places.
+// kBestPlace: the arg-max place's position (eq. 5; the paper's protocol).
+// kPosterior: the `answer_places` most probable mapped places, weighted by their posterior
+// tempered by `answer_temperature` (weight exp((log p_i - log p_best) / T)), vote for a building,
+// then for a floor in it; the answer is their weighted mean position on that floor. The
+// new-place decision is the same as kBestPlace's.
+enum class AnswerRule { kBestPlace, kPosterior };
+std::string ToString(AnswerRule rule);
+StatusOr<AnswerRule> AnswerRuleFromString(const std::string& name);
+
 struct EvaluationOptions {
   SplitUnit split =
       SplitUnit::kNode;          // when map and query are one data set: split by node or session
@@ -54,17 +67,21 @@ struct EvaluationOptions {
   bool calibrate_new_place = false;    // learn the new-place threshold from held-out map sessions
   int calibration_folds = 4;           // map sessions held out in this many interleaved groups
   NewPlaceRule new_place_rule = NewPlaceRule::kYouden;  // how the threshold is chosen
-  double new_place_near_recall = 0.95;  // kNearRecall: share of near held-out nodes accepted
-  bool online_rssi_offset = false;      // remove each query session's RSSI offset, online
-  int rssi_offset_min_common_aps = 5;   // APs a query shares with a map scan for an estimate
-  int rssi_offset_min_estimates = 10;   // estimates before a session's offset is removed
+  double new_place_near_recall = 0.95;         // kNearRecall: share of near held-out nodes accepted
+  AnswerRule answer = AnswerRule::kBestPlace;  // a query's position from FABMAP's posterior
+  int answer_places = 5;                       // kPosterior: the most probable places that vote
+  double answer_temperature = 10.0;            // kPosterior: posteriors tempered by this
+  bool online_rssi_offset = false;             // remove each query session's RSSI offset, online
+  int rssi_offset_min_common_aps = 5;          // APs a query shares with a map scan for an estimate
+  int rssi_offset_min_estimates = 10;          // estimates before a session's offset is removed
 
   bool IsValid(std::string* error) const;
   template <typename Visitor>
   void VisitFields(Visitor&& v) {
     v("split", split,
-      "one data set for map and queries: split by node, session, or first_session (map = the "
-      "first session, queries = the others)",
+      "one data set for map and queries: split by node, session, first_session (map = the "
+      "first session, queries = the others), or position (the nodes at one floor and position "
+      "all on one side: every query stands where no map node does)",
       schema::Any());
     v("map_fraction", map_fraction, "share of nodes (or sessions) in the map; the rest query",
       schema::Unit("").Above(0).Below(1));
@@ -102,6 +119,19 @@ struct EvaluationOptions {
       "new_place_rule = near_recall: share of the held-out nodes near the rest of the map that "
       "the threshold accepts",
       schema::Unit("").Above(0).AtMost(1));
+    v("answer", answer,
+      "a query's answer from FABMAP's posterior: best_place (the arg-max place's position, the "
+      "paper's protocol) or posterior (the answer_places most probable mapped places, weighted "
+      "by their tempered posterior, vote for a building, then a floor in it; the answer is "
+      "their weighted mean position on that floor); the new-place decision is the same",
+      schema::Any());
+    v("answer_places", answer_places, "answer = posterior: the most probable places that vote",
+      schema::Unit("places").Within(1, 1000));
+    v("answer_temperature", answer_temperature,
+      "answer = posterior: a place's weight is exp((log p - log p_best) / this); FABMAP's "
+      "posteriors are overconfident (the runner-up is often 1e-10 of the best or less), so 1 is "
+      "nearly the arg-max and larger values let the runners-up count",
+      schema::Unit("").AtLeast(1));
     v("online_rssi_offset", online_rssi_offset,
       "estimate each query session's RSSI offset to the map's scans from its own scans, in time "
       "order as a phone would online, and remove it once known (every method sees the "
@@ -149,6 +179,14 @@ SplitNodes SplitEvaluationNodes(const std::vector<EvaluationNode>& nodes,
 // stretch of 1/f items has one in the map. Returns true for map items.
 std::vector<bool> InterleavedSplit(size_t count, double map_fraction);
 
+// A localiser's answer to a query as a position: a map place's, or any position (k-NN averages
+// its neighbours), or none (a rejection).
+struct Estimate {
+  bool located = false;
+  double x_m = 0.0, y_m = 0.0;
+  int floor = 0;
+};
+
 struct EvaluationMetrics {
   size_t queries = 0;
   std::vector<double> distances_m;       // the d of the rates below
@@ -158,6 +196,14 @@ struct EvaluationMetrics {
   double floor_mistake_rate = 0.0;
   std::vector<double> errors_m;  // per query; infinity: other floor; NaN: rejected
 };
+
+// The kPosterior answer (AnswerRule) from a query's posterior over the map's places:
+// `place_probability[i]` is map node i's posterior (entries past the map and places at
+// probability 0 take no part; ties: the lower index). No place with a positive posterior: not
+// located. Building and floor votes break ties toward the most probable place's.
+Estimate PosteriorEstimate(const std::vector<EvaluationNode>& map,
+                           const std::vector<double>& place_probability, int places,
+                           double temperature);
 
 // `matches[i]` is the map index matched by query i, or -1 for a rejection.
 EvaluationMetrics ComputeMetrics(const std::vector<EvaluationNode>& map,
@@ -180,13 +226,6 @@ double ShareOnMappedFloors(const std::vector<EvaluationNode>& map,
 double FloorAccuracy(const std::vector<EvaluationNode>& queries,
                      const std::vector<std::optional<int>>& floors);
 
-// A localiser's answer to a query as a position: a map place's, or any position (k-NN averages
-// its neighbours), or none (a rejection).
-struct Estimate {
-  bool located = false;
-  double x_m = 0.0, y_m = 0.0;
-  int floor = 0;
-};
 // Answers grouped by how far the query is from the map: `near` queries have a map place on their
 // floor within `near_m` (a localiser should locate them), `far` ones none within `far_m` (places
 // the map never saw: the right answer is a rejection). Queries in between are in neither.

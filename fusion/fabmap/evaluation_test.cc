@@ -156,6 +156,86 @@ TEST(EvaluationTest, SplitBySessionKeepsInterleavedSessionsWhole) {
   for (const auto& n : first.map) EXPECT_EQ(n.session, 7);
 }
 
+TEST(EvaluationTest, SplitByPositionKeepsEveryPositionOnOneSide) {
+  // Positions (floor, x, y) first seen in the order A, B, C, D, E; A and C repeat, and (1, 0, 0)
+  // differs from A = (0, 0, 0) by its floor only.
+  std::vector<EvaluationNode> nodes = {At(0, 0, 0), At(5, 0, 0), At(0, 0, 0), At(0, 5, 0),
+                                       At(0, 5, 0), At(0, 0, 1), At(9, 9, 2), At(5, 0, 0)};
+  EvaluationOptions options;
+  options.split = SplitUnit::kPosition;
+  options.map_fraction = 0.4;  // the 3rd and 5th of five positions: (0, 5, 0) and (9, 9, 2)
+  const SplitNodes split = SplitEvaluationNodes(nodes, options);
+  ASSERT_EQ(split.map.size(), 3u);
+  for (const auto& n : split.map) {
+    EXPECT_TRUE((n.x_m == 0 && n.y_m == 5 && n.floor == 0) || (n.x_m == 9 && n.floor == 2));
+  }
+  ASSERT_EQ(split.queries.size(), 5u);
+  for (const auto& q : split.queries) {  // no query stands where a map node does
+    for (const auto& m : split.map) {
+      EXPECT_FALSE(q.x_m == m.x_m && q.y_m == m.y_m && q.floor == m.floor);
+    }
+  }
+}
+
+TEST(PosteriorEstimateTest, OnePlaceIsTheArgMax) {
+  const std::vector<EvaluationNode> map = {At(0, 0, 0), At(10, 0, 0), At(20, 0, 1)};
+  const Estimate e = PosteriorEstimate(map, {0.2, 0.7, 0.1}, 1, 1.0);
+  ASSERT_TRUE(e.located);
+  EXPECT_EQ(e.x_m, 10.0);
+  EXPECT_EQ(e.y_m, 0.0);
+  EXPECT_EQ(e.floor, 0);
+}
+
+TEST(PosteriorEstimateTest, WeightsAreTemperedPosteriorsOnTheWinningFloor) {
+  // Posteriors 1 and e^-10 at x = 0 and 10; temperature 10 makes the weights 1 and e^-1. The
+  // third place (floor 1) is below both and loses the floor vote.
+  const std::vector<EvaluationNode> map = {At(0, 0, 0), At(10, 4, 0), At(50, 50, 1)};
+  const std::vector<double> p = {1.0 / (1 + std::exp(-10.0) + 1e-9),
+                                 std::exp(-10.0) / (1 + std::exp(-10.0) + 1e-9), 1e-9};
+  const Estimate e = PosteriorEstimate(map, p, 3, 10.0);
+  ASSERT_TRUE(e.located);
+  EXPECT_EQ(e.floor, 0);
+  const double w = std::exp(-1.0);
+  EXPECT_NEAR(e.x_m, 10 * w / (1 + w), 1e-9);
+  EXPECT_NEAR(e.y_m, 4 * w / (1 + w), 1e-9);
+  // Temperature 1: the runner-up weighs e^-10 and the answer is nearly the best place.
+  const double v = std::exp(-10.0);
+  EXPECT_NEAR(PosteriorEstimate(map, p, 3, 1.0).x_m, 10 * v / (1 + v), 1e-12);
+  // Equal posteriors: the midpoint.
+  const Estimate mid = PosteriorEstimate(map, {0.4, 0.4, 0.2}, 2, 1.0);
+  EXPECT_DOUBLE_EQ(mid.x_m, 5.0);
+  EXPECT_DOUBLE_EQ(mid.y_m, 2.0);
+}
+
+TEST(PosteriorEstimateTest, BuildingIsVotedBeforeTheFloor) {
+  // Building 1 holds the best place (0.4) but building 0's two places weigh 0.6 together; in
+  // building 0, floor 2 (0.35) beats floor 1 (0.25). The answer is floor 2's place alone, though
+  // floor 1 of building 1 would have won a vote of floors alone.
+  std::vector<EvaluationNode> map = {At(0, 0, 1), At(10, 0, 2), At(30, 30, 101)};
+  map[2].building = 1;
+  const Estimate e = PosteriorEstimate(map, {0.25, 0.35, 0.4}, 3, 1.0);
+  ASSERT_TRUE(e.located);
+  EXPECT_EQ(e.floor, 2);
+  EXPECT_EQ(e.x_m, 10.0);
+  // Only the most probable places vote: with two, building 1 (0.4) beats building 0 (0.35).
+  const Estimate two = PosteriorEstimate(map, {0.25, 0.35, 0.4}, 2, 1.0);
+  EXPECT_EQ(two.floor, 101);
+  EXPECT_EQ(two.x_m, 30.0);
+}
+
+TEST(PosteriorEstimateTest, NoPositivePosteriorIsNoAnswer) {
+  const std::vector<EvaluationNode> map = {At(0, 0, 0), At(10, 0, 0)};
+  EXPECT_FALSE(PosteriorEstimate(map, {0.0, 0.0}, 5, 1.0).located);
+  EXPECT_FALSE(PosteriorEstimate(map, {}, 5, 1.0).located);
+  EXPECT_FALSE(PosteriorEstimate(map, {0.5, 0.5}, 0, 1.0).located);
+  // A posterior past the map's end takes no part; a NaN is not positive.
+  const Estimate e = PosteriorEstimate(map, {0.0, std::nan(""), 0.9}, 5, 1.0);
+  EXPECT_FALSE(e.located);
+  const Estimate f = PosteriorEstimate(map, {0.3, std::nan(""), 0.9}, 5, 1.0);
+  ASSERT_TRUE(f.located);
+  EXPECT_EQ(f.x_m, 0.0);
+}
+
 // Hand-worked: five queries, best-place posteriors 0.9, 0.8, 0.8, 0.3 and none; errors 1, 30, 4,
 // 3 m; the last query has no map place on its floor. Equal posteriors are accepted together.
 TEST(PrecisionRecallTest, HandWorkedCurve) {

@@ -44,6 +44,9 @@ struct TomlCodec<fabmap::WifiEncoding>
 template <>
 struct TomlCodec<fabmap::SplitUnit> : EnumCodec<fabmap::SplitUnit, fabmap::SplitUnitFromString> {};
 template <>
+struct TomlCodec<fabmap::AnswerRule> : EnumCodec<fabmap::AnswerRule, fabmap::AnswerRuleFromString> {
+};
+template <>
 struct TomlCodec<fabmap::NewPlaceRule>
     : EnumCodec<fabmap::NewPlaceRule, fabmap::NewPlaceRuleFromString> {};
 template <>
@@ -361,6 +364,9 @@ constexpr AddedKey kKeysAddedAfter[] = {
     {7, "fabmap_front_end.online_rssi_offset"},
     {7, "fabmap_front_end.rssi_offset_min_common_aps"},
     {7, "fabmap_front_end.rssi_offset_min_estimates"},
+    {9, "evaluation.answer"},
+    {9, "evaluation.answer_places"},
+    {9, "evaluation.answer_temperature"},
 };
 
 // Whole sections added after a map format version: older maps resume only with every key at its
