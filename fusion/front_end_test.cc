@@ -438,6 +438,36 @@ TEST(FusedFrontEndTest, OnlineRssiOffsetBridgesTwoPhones) {
   EXPECT_FALSE(CreateFrontEnd(settings)->DecodeState(state).ok());
 }
 
+// Localising on a saved map, the map's templates are the reference: a scan that matches one of
+// them is that place, even when a template made since (a place the map does not hold, here the
+// same corridor spot read 8 dB lower before any offset was known) matches it better. While
+// mapping, the better match wins as eq. 9 says.
+TEST(FusedFrontEndTest, LocalisingPrefersTheMapsTemplates) {
+  for (bool localising : {false, true}) {
+    FrontEndSettings settings;
+    settings.front_end.kind = FrontEndKind::kFused;
+    settings.fused.use_camera = false;
+    settings.fused.recency_s = 0.0;
+    std::unique_ptr<FrontEnd> f = CreateFrontEnd(settings);
+    auto at = [&](double t, double offset_db) {
+      WifiScan scan = CorridorScan(t, 20.0, 0.0);
+      for (WifiReading& r : scan.readings) r.rssi_dbm += offset_db;
+      const auto d = f->OnWifi(scan);
+      EXPECT_TRUE(d.ok() && d->has_value());
+      return d->value_or(FrameDecision{});
+    };
+    ASSERT_TRUE(at(0.0, 0.0).view.is_new);  // the map: template 0
+    if (localising) f->SettleForLocalisation();
+    const FrameDecision quieter = at(10.0, -8.0);
+    ASSERT_TRUE(quieter.view.is_new) << "8 dB must be too far for a match";
+    ASSERT_EQ(quieter.view.template_id, 1u);
+    const FrameDecision between = at(20.0, -5.0);  // 5 dB from template 0, 3 dB from template 1
+    EXPECT_FALSE(between.view.is_new);
+    EXPECT_EQ(between.source, DecisionSource::kWifi);
+    EXPECT_EQ(between.view.template_id, localising ? 0u : 1u) << "localising " << localising;
+  }
+}
+
 // The FABMAP front end with the same two phones: the second walk reads 15 dB lower, about two of
 // the eight RSSI bins, so its scans are other words. With the online offset (estimated from the
 // scans against the first walk's places, no ground truth) the second walk's scans become the

@@ -219,17 +219,42 @@ class FusedFrontEnd : public FrontEnd {
     std::vector<uint8_t> agrees;
     if (floors) agrees = floors_.BeginFrame(n);
     const std::vector<uint8_t>* allowed = floors ? &agrees : nullptr;
+    // Localising on a saved map (SettleForLocalisation): its templates are the reference, and a
+    // template made since only stands for a place the map does not hold. A map template that
+    // matches wins over one of those, which would otherwise keep the views of a place first seen
+    // before it was recognised (e.g. before the phone's RSSI offset was known).
+    std::vector<uint8_t> mapped;
+    if (settled_ > 0 && n > settled_) {
+      mapped = floors ? agrees : std::vector<uint8_t>(n, 1);
+      std::fill(mapped.begin() + settled_, mapped.end(), 0);
+    }
     if (view) {
-      const KernelCameraMatch best = camera_.Best(*view, allowed);  // eq. 8
+      const double threshold = camera_.options().match_threshold;
+      KernelCameraMatch best;
+      if (!mapped.empty()) {
+        best = camera_.Best(*view, &mapped);
+        camera_verdict = Judge(best.id, best.similarity, threshold, time_s);
+      }
+      if (camera_verdict != Verdict::kMatch) {
+        best = camera_.Best(*view, allowed);  // eq. 8
+        camera_verdict = Judge(best.id, best.similarity, threshold, time_s);
+      }
       camera_best = best.id;
-      camera_verdict = Judge(best.id, best.similarity, camera_.options().match_threshold, time_s);
     }
     if (scan && !scan->empty()) {
       // Eq. 9; a best below t_wifi would be novel anyway, so the matcher may prune by it.
-      const WifiMatch best = wifi_.Best(*scan, allowed, wifi_.options().match_threshold);
+      const double threshold = wifi_.options().match_threshold;
+      WifiMatch best;
+      if (!mapped.empty()) {
+        best = wifi_.Best(*scan, &mapped, threshold);
+        wifi_verdict = Judge(best.id, best.weight, threshold, time_s);
+      }
+      if (wifi_verdict != Verdict::kMatch) {
+        best = wifi_.Best(*scan, allowed, threshold);
+        wifi_verdict = Judge(best.id, best.weight, threshold, time_s);
+      }
       wifi_best = best.id;
       wifi_best_weight = best.weight;
-      wifi_verdict = Judge(best.id, best.weight, wifi_.options().match_threshold, time_s);
     }
     if (floors && camera_verdict == Verdict::kNovel && wifi_verdict == Verdict::kNovel) {
       // Would a template on another (or an unknown) floor have matched? Then the rule made this

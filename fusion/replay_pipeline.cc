@@ -353,7 +353,7 @@ Status ReplayPipeline::Apply(const FrameDecision& decision) {
     r.time_s = frame.time_s;
     r.experience_id = frame.experience_id;
     map.CurrentPose(&r.x_m, &r.y_m, &r.theta_rad);
-    r.lost = !current || std::hypot(map.offset().forward_m, map.offset().left_m) > lost_after_m_;
+    r.lost = slam_->Lost(lost_after_m_);
     localisation_.push_back(r);
   }
   return Status::Ok();
@@ -412,7 +412,7 @@ Status ReplayPipeline::AdoptMap(const State& map, double lost_after_m) {
   start.front_end = map.front_end;
   start.events_total = events_.size();
   RATSLAM_RETURN_IF_ERROR(Restore(start));
-  slam_->FreezeMap(events_.empty() ? 0.0 : events_.front().time_s);
+  slam_->FreezeMap(events_.empty() ? 0.0 : events_.front().time_s, lost_after_m);
   front_end_->SettleForLocalisation();
   localisation_.clear();
   lost_after_m_ = lost_after_m;

@@ -158,7 +158,8 @@ class ReplayPipeline {
   // templates, experiences or links join the map, Wi-Fi sequence loop closure is off, and every
   // view frame adds a LocalisationRecord, lost when no place has been recognised yet or when dead
   // reckoning has gone further than `lost_after_m` (straight line) from the last one. The pose
-  // cells keep the map's final activity; views of known places pull them to the right place.
+  // cells keep the map's final activity; views of known places pull them to the right place,
+  // and a view of a known place while lost puts the robot there at once (relocalisation).
   Status AdoptMap(const State& map, double lost_after_m);
   bool localising() const { return slam_->frozen(); }
   const std::vector<LocalisationRecord>& localisation() const { return localisation_; }

@@ -407,6 +407,7 @@ class Session {
     if (pipeline_->localising()) {
       d["recognitions"] = slam.localisation_counters().recognitions;
       d["unmapped_views"] = slam.localisation_counters().unmapped_views;
+      d["relocalisations"] = slam.localisation_counters().relocalisations;
     }
     return d;
   }

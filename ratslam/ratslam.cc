@@ -2,7 +2,10 @@
 
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <stdexcept>
+
+#include "common/circular.h"
 
 namespace ratslam {
 
@@ -45,11 +48,42 @@ Status Ratslam::OnView(const ViewDecision& decision) {
     ++localisation_counters_.unmapped_views;
     return Status::Ok();
   }
+  if (frozen_templates_ && relocalise_after_m_ && Lost(*relocalise_after_m_)) {
+    // Lost on a frozen map, and viewing one of its templates: back to its experience at once.
+    const ViewTemplate& view = local_view_.at(decision.template_id);
+    const PoseCellPosition best = pose_cells_.BestPosition();
+    std::optional<uint32_t> nearest;
+    double nearest_distance = std::numeric_limits<double>::infinity();
+    for (uint32_t id : view.experience_ids) {
+      const double d =
+          PoseCellDistance(experience_map_.experience(id).pose_cells, best,
+                           options_.pose_cells.dim_xy_cells, options_.pose_cells.dim_theta_cells);
+      if (d < nearest_distance) nearest_distance = d, nearest = id;
+    }
+    if (nearest) {
+      // Facing as the view says (a compass's change since the template), as an injection would.
+      PoseCellPosition at = experience_map_.experience(*nearest).pose_cells;
+      const double theta_cells = options_.pose_cells.dim_theta_cells;
+      at.theta = WrapCoordinate(
+          at.theta + decision.heading_change_rad / (2.0 * std::numbers::pi) * theta_cells,
+          theta_cells);
+      pose_cells_.Reset(at);
+      experience_map_.MoveTo(*nearest, decision.time_s, compass_heading_rad_);
+      ++localisation_counters_.recognitions;
+      ++localisation_counters_.relocalisations;
+      return Status::Ok();
+    }
+  }
   if (injection.value()) {
     pose_cells_.Inject(injection.value()->position, injection.value()->energy);
     ++counters_.injections;
   }
   return Status::Ok();
+}
+
+bool Ratslam::Lost(double after_m) const {
+  const LocalOffset& o = experience_map_.offset();
+  return !experience_map_.current() || std::hypot(o.forward_m, o.left_m) > after_m;
 }
 
 StatusOr<ActionKind> Ratslam::OnOdometry(const OdometryStep& step) {
@@ -62,8 +96,9 @@ StatusOr<ActionKind> Ratslam::OnOdometry(const OdometryStep& step) {
   return Act(step.time_s);
 }
 
-void Ratslam::FreezeMap(double start_time_s) {
+void Ratslam::FreezeMap(double start_time_s, std::optional<double> relocalise_after_m) {
   frozen_templates_ = local_view_.size();
+  relocalise_after_m_ = relocalise_after_m;
   local_view_.SettleForLocalisation(start_time_s);
   current_template_.reset();
   experience_map_.Forget();

@@ -72,8 +72,9 @@ class Ratslam {
   };
   // Of a frozen map (FreezeMap), not saved.
   struct LocalisationCounters {
-    uint64_t recognitions = 0;    // moves to an experience the pose cells agree with
-    uint64_t unmapped_views = 0;  // view frames of templates made after the freeze
+    uint64_t recognitions = 0;     // moves to an experience the pose cells agree with
+    uint64_t unmapped_views = 0;   // view frames of templates made after the freeze
+    uint64_t relocalisations = 0;  // of the recognitions, those made while lost (FreezeMap)
   };
 
   // `options` must be valid (IsValid); throws std::invalid_argument otherwise.
@@ -104,8 +105,15 @@ class Ratslam {
   // on. The current experience is forgotten: the robot is lost until it recognises a place. The
   // templates are rested for data starting at `start_time_s`
   // (LocalViewCells::SettleForLocalisation). Not part of State: a frozen spine is never saved.
-  void FreezeMap(double start_time_s);
+  // With `relocalise_after_m`, a robot that is lost (no current experience, or dead reckoned
+  // further than that from it) and views a template of the map is put back there at once: the
+  // pose cells reset to a single packet at the template's experience nearest them and that
+  // experience becomes current (a recognition, counted as a relocalisation too). Without it the
+  // pose cells must first be moved there by the view's injections.
+  void FreezeMap(double start_time_s, std::optional<double> relocalise_after_m = std::nullopt);
   bool frozen() const { return frozen_templates_.has_value(); }
+  // No current experience, or dead reckoned further than `after_m` from it.
+  bool Lost(double after_m) const;
 
   const PoseCellNetwork& pose_cells() const { return pose_cells_; }
   const LocalViewCells& local_view() const { return local_view_; }
@@ -138,7 +146,8 @@ class Ratslam {
   std::optional<uint32_t> current_template_;
   Counters counters_;
   std::optional<double> compass_heading_rad_;
-  std::optional<size_t> frozen_templates_;  // templates of the frozen map
+  std::optional<size_t> frozen_templates_;    // templates of the frozen map
+  std::optional<double> relocalise_after_m_;  // FreezeMap's
   LocalisationCounters localisation_counters_;
 };
 

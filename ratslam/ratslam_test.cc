@@ -112,6 +112,65 @@ TEST(RatslamTest, FrozenMapRecognisesPlacesAndNeverGrows) {
   EXPECT_NEAR(slam.experience_map().offset().forward_m, 0.0, 1e-9);
 }
 
+// Relocalisation on a frozen map: a lost robot that views place 17 of the line is at place 17's
+// experience at once (no injections needed), with its pose cells there; it stays there while
+// dead reckoning is within the lost distance, and is relocalised again once it is beyond. Without
+// a lost distance the same view leaves it lost (the injections have not moved the packet yet).
+TEST(RatslamTest, LostRobotIsRelocalisedByAViewOfTheMap) {
+  Ratslam slam(LineOptions());
+  double t = 0.0;
+  MapLine(&slam, &t);
+  Ratslam plain = slam;
+  slam.FreezeMap(t, 5.0);
+  plain.FreezeMap(t);
+  const auto experience_of = [](const Ratslam& r, uint32_t place) {
+    for (uint32_t id : r.local_view().at(place).experience_ids) return id;
+    return UINT32_MAX;
+  };
+  const uint32_t e17 = experience_of(slam, 17);
+  ASSERT_NE(e17, UINT32_MAX);
+  EXPECT_TRUE(slam.Lost(5.0));
+  ASSERT_TRUE(slam.OnView({t, 17, false, 0.0}).ok());
+  ASSERT_TRUE(plain.OnView({t, 17, false, 0.0}).ok());
+  ASSERT_TRUE(slam.experience_map().current().has_value());
+  EXPECT_EQ(*slam.experience_map().current(), e17);
+  EXPECT_FALSE(slam.Lost(5.0));
+  EXPECT_EQ(slam.localisation_counters().relocalisations, 1u);
+  EXPECT_EQ(slam.localisation_counters().recognitions, 1u);
+  EXPECT_EQ(slam.counters().injections, 0u);
+  const PoseCellPosition cells = slam.pose_cells().BestPosition();
+  const PoseCellPosition stored = slam.experience_map().experience(e17).pose_cells;
+  EXPECT_LT(PoseCellDistance(cells, stored, LineOptions().pose_cells.dim_xy_cells,
+                             LineOptions().pose_cells.dim_theta_cells),
+            0.5);
+  EXPECT_FALSE(plain.experience_map().current().has_value());
+  EXPECT_TRUE(plain.Lost(5.0));
+  // Three metres on, seeing place 17 again: not lost, so no relocalisation.
+  for (int k = 0; k < 3; ++k) ASSERT_TRUE(slam.OnOdometry({t += 1.0, 1.0, 0.0}).ok());
+  ASSERT_TRUE(slam.OnView({t, 17, false, 0.0}).ok());
+  EXPECT_EQ(slam.localisation_counters().relocalisations, 1u);
+  // Three more (six from place 17): lost; a view of place 5 puts it there.
+  for (int k = 0; k < 3; ++k) ASSERT_TRUE(slam.OnOdometry({t += 1.0, 1.0, 0.0}).ok());
+  EXPECT_TRUE(slam.Lost(5.0));
+  // This time the compass says the robot faces a quarter turn from when place 5 was stored:
+  // the packet faces that way too, as an injection would.
+  ASSERT_TRUE(slam.OnView({t, 5, false, std::numbers::pi / 2}).ok());
+  EXPECT_EQ(slam.localisation_counters().relocalisations, 2u);
+  EXPECT_EQ(*slam.experience_map().current(), experience_of(slam, 5));
+  const int theta_cells = LineOptions().pose_cells.dim_theta_cells;
+  const PoseCellPosition turned =
+      slam.experience_map().experience(experience_of(slam, 5)).pose_cells;
+  EXPECT_NEAR(PoseCellDistance(slam.pose_cells().BestPosition(),
+                               {turned.x, turned.y, turned.theta + theta_cells / 4.0},
+                               LineOptions().pose_cells.dim_xy_cells, theta_cells),
+              0.0, 0.5);
+  // A view of a place the map does not hold never relocalises.
+  for (int k = 0; k < 6; ++k) ASSERT_TRUE(slam.OnOdometry({t += 1.0, 1.0, 0.0}).ok());
+  ASSERT_TRUE(slam.OnView({t, 30, true, 0.0}).ok());
+  EXPECT_EQ(slam.localisation_counters().relocalisations, 2u);
+  EXPECT_TRUE(slam.Lost(5.0));
+}
+
 TEST(RatslamTest, StateRoundTripContinuesIdentically) {
   Ratslam a({});
   for (uint32_t i = 0; i < 20; ++i) {

@@ -455,6 +455,7 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
     l["lost_fraction"] = *s.lost_fraction;
     l["lost_after_m"] = info.lost_after_m;
     l["recognitions"] = slam.localisation_counters().recognitions;
+    l["relocalisations"] = slam.localisation_counters().relocalisations;
     l["experiences_recognised"] = visited.size();
     l["unmapped_views"] = slam.localisation_counters().unmapped_views;
     if (!dataset.ground_truth.empty()) {

@@ -183,6 +183,8 @@ class RatslamModuleTest(unittest.TestCase):
                                     float(row["turn_rate_rad_per_s"]))
         self.assertEqual(localising.summary()["experiences"], experiences)
         self.assertGreater(localising.summary()["recognitions"], 0)
+        self.assertLessEqual(localising.summary()["relocalisations"],
+                             localising.summary()["recognitions"])
         lost = localising.localisation()["lost"]
         self.assertEqual(len(lost), 200)
         self.assertLess(lost.mean(), 0.5)
