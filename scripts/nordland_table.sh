@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Nordland winter queries against the summer route (../shared/data/nordland-64x32): recall@1,
 # recall@5, PR AUC and recall at 100 % precision of the sequence matcher for several sequence
-# lengths and frame tolerances, with the single-frame baseline of the same run. Prints a markdown
+# lengths and frame tolerances, the online search (each query by the frames ending at it) beside
+# the centred one ([sequence] centred), with the single-frame baseline of the same run. Prints a markdown
 # table (docs/results/nordland.md holds its last output).
 # Usage: scripts/nordland_table.sh [build dir] [out dir] [data dir]
 set -euo pipefail
@@ -14,17 +15,23 @@ py=/usr/bin/python3
 field() { "$py" -c "import json,sys; j=json.load(open(sys.argv[1])); v=j
 for k in sys.argv[2].split('.'): v=v[k]
 print(f'{100*v:.1f}' if sys.argv[3]=='%' else f'{v:.3f}')" "$@"; }
-echo "| sequence length | tolerance (frames) | recall@1 | recall@5 | PR AUC | recall at 100 % precision | single frame recall@1 | matching (s) |"
-echo "|---|---|---|---|---|---|---|---|"
+echo "| sequence length | tolerance (frames) | recall@1 | recall@5 | PR AUC | recall at 100 % precision | centred: recall@1 | recall at 100 % precision | single frame recall@1 | matching (s) |"
+echo "|---|---|---|---|---|---|---|---|---|---|"
 for tolerance in 0 1 2; do
   for length in 5 10 20; do
     tag="len$length-tol$tolerance"
     printf "[sequence]\nsequence_length = %d\n" "$length" > "$out/$tag.toml"
     "$ratslam" evaluate --quiet --overwrite --config "$out/$tag.toml" --frame-tolerance "$tolerance" \
       --map "$data/summer" --query "$data/winter" --out "$out/$tag" > /dev/null
+    printf "[sequence]\nsequence_length = %d\ncentred = true\n" "$length" > "$out/$tag-centred.toml"
+    "$ratslam" evaluate --quiet --overwrite --config "$out/$tag-centred.toml" \
+      --frame-tolerance "$tolerance" --map "$data/summer" --query "$data/winter" \
+      --out "$out/$tag-centred" > /dev/null
     j="$out/$tag/evaluation.json"
+    c="$out/$tag-centred/evaluation.json"
     echo "| $length | $tolerance | $(field "$j" recall_at_1 %) % | $(field "$j" recall_at_5 %) % |" \
          "$(field "$j" pr_auc x) | $(field "$j" recall_at_100_precision %) % |" \
+         "$(field "$c" recall_at_1 %) % | $(field "$c" recall_at_100_precision %) % |" \
          "$(field "$j" baselines.single_frame.recall_at_1 %) % | $(field "$j" match_seconds x) |"
   done
 done

@@ -119,6 +119,9 @@ bool SequenceMatcherOptions::IsValid(std::string* error) const {
   if ((image_width_px == 0) != (image_height_px == 0)) {
     return fail("image_width_px and image_height_px are both set or both 0");
   }
+  if (centred && recognise_views) {
+    return fail("centred needs the frames after a query: evaluate only, not recognise_views");
+  }
   if (!(min_confidence >= 0)) return fail("min_confidence must not be negative");
   if (recency_frames < 0 || min_references < 0) {
     return fail("recency_frames and min_references must not be negative");
@@ -355,15 +358,27 @@ StatusOr<SequenceMatcher::Result> SequenceMatcher::AddQuery(const PreparedFrame&
     }
     result.single = MatchOf(score, candidates, options_.exclusion_window);
   }
-  // Sequence: for each end reference, the best straight line back through the stored rows; the
-  // score is the mean enhanced difference over the non-blank query rows. A line's term at a blank
-  // reference or before the route's start is neutral (the row's mean: 0 once enhanced), so that
-  // every line averages as many terms: a line through a tunnel is neither favoured nor barred.
-  std::vector<double> score(n, inf);
-  if (!frame.blank) {
+  result.sequence = Search(0, answers, candidates);
+  return result;
+}
+
+SequenceMatch SequenceMatcher::MatchAt(int back, int candidates) const {
+  return Search(back, static_cast<int>(references_.size()), candidates);
+}
+
+// For each reference i, the best straight line through the stored rows that passes reference i
+// at the row `back` frames before the newest (0: the newest, SeqSLAM's online search); the score
+// is the mean enhanced difference over the non-blank query rows. A line's term at a blank
+// reference, before the route's start or past its end (or past the references a row has seen)
+// is neutral (the row's mean: 0 once enhanced), so that every line averages as many terms: a
+// line through a tunnel is neither favoured nor barred. Only references below `answers` are
+// answers.
+SequenceMatch SequenceMatcher::Search(int back, int answers, int candidates) const {
+  const int rows = static_cast<int>(rows_.size());
+  std::vector<double> score(answers, std::numeric_limits<double>::infinity());
+  if (back >= 0 && back < rows && !rows_[rows - 1 - back].blank) {
     const int steps = options_.velocity_steps;
-    std::vector<float> sum(n);
-    const int rows = static_cast<int>(rows_.size());
+    std::vector<float> sum(answers);
     int used = 0;
     for (const Row& r : rows_) used += !r.blank;
     for (int s = 0; s < steps; ++s) {
@@ -373,15 +388,18 @@ StatusOr<SequenceMatcher::Result> SequenceMatcher::AddQuery(const PreparedFrame&
                                  (options_.max_velocity - options_.min_velocity) * s / (steps - 1);
       std::fill(sum.begin(), sum.end(), 0.0f);
       for (int k = 0; k < rows; ++k) {
-        const Row& back = rows_[rows - 1 - k];  // query frame newest - k
-        if (back.blank) continue;
-        const int offset = std::min(answers, static_cast<int>(std::lround(v * k)));
-        // References added after this row was made are unseen by it: neutral.
-        const int known = std::min(answers, offset + static_cast<int>(back.enhanced.size()));
-        const float* e = back.enhanced.data();
-        for (int i = 0; i < offset; ++i) sum[i] += back.neutral;
-        for (int i = offset; i < known; ++i) sum[i] += e[i - offset];
-        for (int i = known; i < answers; ++i) sum[i] += back.neutral;
+        const Row& row = rows_[rows - 1 - k];  // query frame newest - k
+        if (row.blank) continue;
+        // The line meets reference i - offset at this row (offset < 0 for rows newer than the
+        // one it is reported at).
+        const long offset = std::lround(v * (k - back));
+        const int size = static_cast<int>(row.enhanced.size());
+        const int lo = static_cast<int>(std::clamp<long>(offset, 0, answers));
+        const int hi = static_cast<int>(std::clamp<long>(offset + size, lo, answers));
+        const float* e = row.enhanced.data();
+        for (int i = 0; i < lo; ++i) sum[i] += row.neutral;
+        for (int i = lo; i < hi; ++i) sum[i] += e[i - offset];
+        for (int i = hi; i < answers; ++i) sum[i] += row.neutral;
       }
       for (int i = 0; i < answers; ++i) {
         if (references_[i].blank) continue;
@@ -389,8 +407,7 @@ StatusOr<SequenceMatcher::Result> SequenceMatcher::AddQuery(const PreparedFrame&
       }
     }
   }
-  result.sequence = MatchOf(score, candidates, options_.exclusion_window);
-  return result;
+  return MatchOf(score, candidates, options_.exclusion_window);
 }
 
 }  // namespace ratslam

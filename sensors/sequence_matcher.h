@@ -35,6 +35,9 @@ struct SequenceMatcherOptions {
   double blank_contrast = 8.0;  // grey levels, 5th to 95th percentile, under which: blank
   int image_width_px = 0;       // frames are resized to this width first (area average); 0: keep
   int image_height_px = 0;      // and to this height; 0: keep
+  // Evaluate: a query's place from the sequence centred on it (OpenSeqSLAM's offline search)
+  // instead of the one ending at it; online recognition (recognise_views) cannot use it.
+  bool centred = false;
   // Replay (sequence recognition in the classic camera and fused front ends): a camera frame
   // whose sequence matches an earlier stretch of the route with at least min_confidence re-uses
   // the template of the frame it matched; a blank frame gives no view; otherwise the front end
@@ -75,6 +78,12 @@ struct SequenceMatcherOptions {
       schema::Unit("px").Within(0, 4096));
     v("image_height_px", image_height_px, "and to this height (0: as read)",
       schema::Unit("px").Within(0, 4096));
+    v("centred", centred,
+      "evaluate: place a query by the best line through the sequence_length frames centred on "
+      "it ((sequence_length - 1) / 2 of them after it; the last ones by the route's last "
+      "frames), as OpenSeqSLAM's offline search does, instead of the frames ending at it; not "
+      "with recognise_views (online)",
+      schema::Any());
     v("recognise_views", recognise_views,
       "replay with the classic camera or fused (use_camera) front end: a camera frame whose "
       "sequence of the newest sequence_length frames matches an earlier stretch of the route "
@@ -158,6 +167,13 @@ class SequenceMatcher {
   // Only references below `searchable` (all when negative) can be answers.
   StatusOr<Result> AddQuery(const PreparedFrame& frame, int candidates = 5, int searchable = -1);
 
+  // The place of the query `back` frames before the newest (0 <= back < queries_in_sequence())
+  // by the best line through all the stored query frames, newer ones included: with back about
+  // sequence_length / 2, the sequence centred on that query (OpenSeqSLAM's offline search),
+  // which an online matcher cannot use. Declined for a blank query or an out-of-range `back`.
+  // Every reference can be the answer.
+  SequenceMatch MatchAt(int back, int candidates = 5) const;
+
   // Query frames in the current sequence (at most sequence_length).
   size_t queries_in_sequence() const { return rows_.size(); }
   // Forgets the queries (a new query route starts); the references stay.
@@ -179,6 +195,8 @@ class SequenceMatcher {
   Status SetState(State state);
 
  private:
+  SequenceMatch Search(int back, int answers, int candidates) const;
+
   SequenceMatcherOptions options_;
   std::vector<PreparedFrame> references_;  // in route order
   std::deque<Row> rows_;                   // the newest sequence_length query rows, newest last

@@ -94,6 +94,49 @@ TEST(SequenceMatcherTest, SequencesResolveWhatSingleFramesCannot) {
   EXPECT_EQ(single_right, 0);
 }
 
+// MatchAt reports the best line at any of the stored query frames: at the newest it is exactly
+// the online search, and in the aliased half (every frame has an identical twin elsewhere) the
+// line through the last sequence_length frames places each of them at its own reference. A blank
+// query, or a frame not stored, is declined.
+TEST(SequenceMatcherTest, MatchAtPlacesEveryFrameOfTheSequence) {
+  std::vector<int> order(100);
+  std::iota(order.begin(), order.end(), 0);
+  std::vector<int> shuffled = order;
+  Random random(11);
+  for (int i = 99; i > 0; --i) std::swap(shuffled[i], shuffled[random.NextU64() % (i + 1)]);
+  order.insert(order.end(), shuffled.begin(), shuffled.end());
+  SequenceMatcherOptions options;
+  SequenceMatcher matcher(options);
+  for (int place : order) ASSERT_TRUE(matcher.AddReference(Prepare(Texture(place))).ok());
+  const int length = options.sequence_length;
+  for (int j = 0; j < static_cast<int>(order.size()); ++j) {
+    const auto r = matcher.AddQuery(Prepare(Noisy(Texture(order[j]), 12, &random)));
+    ASSERT_TRUE(r.ok());
+    const SequenceMatch newest = matcher.MatchAt(0);
+    EXPECT_EQ(newest.reference, r->sequence.reference);
+    EXPECT_EQ(newest.confidence, r->sequence.confidence);
+    ASSERT_EQ(newest.candidates.size(), r->sequence.candidates.size());
+    for (size_t c = 0; c < newest.candidates.size(); ++c) {
+      EXPECT_EQ(newest.candidates[c].reference, r->sequence.candidates[c].reference);
+      EXPECT_EQ(newest.candidates[c].score, r->sequence.candidates[c].score);
+    }
+    if (j - length + 1 < 100) continue;
+    for (int back = 0; back < length; ++back) {
+      EXPECT_EQ(matcher.MatchAt(back).reference, j - back) << j << " back " << back;
+    }
+  }
+  EXPECT_TRUE(matcher.MatchAt(length).declined);
+  EXPECT_TRUE(matcher.MatchAt(-1).declined);
+  const std::vector<uint8_t> black(kW * kH, 0);
+  ASSERT_TRUE(matcher.AddQuery(Prepare(black)).ok());
+  EXPECT_TRUE(matcher.MatchAt(0).declined);
+  EXPECT_FALSE(matcher.MatchAt(1).declined);
+  SequenceMatcherOptions online_only;
+  online_only.centred = true;
+  online_only.recognise_views = true;
+  EXPECT_FALSE(online_only.IsValid(nullptr));
+}
+
 // A query route driven 1.2 times as fast as the reference route (every 6 reference frames in 5
 // query frames) is followed within a frame once a sequence is full; a blank query is declined and
 // a blank reference is never an answer.

@@ -221,6 +221,9 @@ StatusOr<ImageSequenceEvaluation> EvaluateImageSequences(
   e.load_seconds = Seconds(start);
 
   const auto matching = std::chrono::steady_clock::now();
+  // Centred: query q is placed once the (sequence_length - 1) / 2 frames after it are in, the
+  // route's last ones by its last sequence.
+  const size_t lag = o.centred ? static_cast<size_t>(o.sequence_length - 1) / 2 : 0;
   for (size_t q = 0; q < query_frames.size(); ++q) {
     if (stop && stop->load()) return Status::Error("stopped");
     StatusOr<SequenceMatcher::Result> r = matcher.AddQuery(query_frames[q]);
@@ -229,9 +232,14 @@ StatusOr<ImageSequenceEvaluation> EvaluateImageSequences(
                            r.status().message());
     }
     e.sequence.push_back({e.truth[q], std::move(r->sequence)});
+    if (lag > 0 && q >= lag) e.sequence[q - lag].match = matcher.MatchAt(static_cast<int>(lag));
     e.single.push_back({e.truth[q], std::move(r->single)});
     e.differences.push_back(std::move(r->differences));
     if (progress) progress(q + 1, query_frames.size());
+  }
+  const size_t n = query_frames.size();
+  for (size_t q = n - std::min(n, lag); lag > 0 && q < n; ++q) {
+    e.sequence[q].match = matcher.MatchAt(static_cast<int>(n - 1 - q));
   }
   e.match_seconds = Seconds(matching);
   e.sequence_metrics = MetricsOf(e.sequence, options.frame_tolerance);
@@ -254,6 +262,7 @@ Status WriteImageSequenceOutputs(const ImageSequenceEvaluationOptions& options,
   j["blank_queries"] = e.blank_queries;
   j["frame_tolerance"] = options.frame_tolerance;
   j["sequence_length"] = options.matcher.sequence_length;
+  j["centred"] = options.matcher.centred;
   const nlohmann::ordered_json sequence = MetricsJson(e.sequence_metrics);
   for (const auto& [key, value] : sequence.items()) j[key] = value;
   j["baselines"]["single_frame"] = MetricsJson(e.single_metrics);

@@ -119,6 +119,14 @@ TEST_F(ImageFoldersTest, PlacesEveryQueryByNameAndNamesABadFile) {
   // A sequence is full from the tenth query on; from there every answer is exact.
   for (size_t q = 9; q < e->sequence.size(); ++q) EXPECT_EQ(e->sequence[q].match.reference, int(q));
   EXPECT_EQ(e->blank_references, 0u);
+  // Centred, each query is placed with the frames after it too, the last ones by the route's last
+  // sequence: every answer is exact, the first nine and the last four included.
+  options.matcher.centred = true;
+  StatusOr<ImageSequenceEvaluation> centred = EvaluateImageSequences(options, &loader, {}, nullptr);
+  ASSERT_TRUE(centred.ok()) << centred.status().message();
+  ASSERT_EQ(centred->sequence.size(), 40u);
+  for (size_t q = 0; q < 40; ++q) EXPECT_EQ(centred->sequence[q].match.reference, int(q)) << q;
+  options.matcher.centred = false;
 
   std::ofstream(root_ / "query" / "frame-020.png") << "not a PNG";
   e = EvaluateImageSequences(options, &loader, {}, nullptr);

@@ -367,6 +367,7 @@ constexpr AddedKey kKeysAddedAfter[] = {
     {9, "evaluation.answer"},
     {9, "evaluation.answer_places"},
     {9, "evaluation.answer_temperature"},
+    {9, "sequence.centred"},
 };
 
 // Whole sections added after a map format version: older maps resume only with every key at its
