@@ -66,15 +66,21 @@ TEST(FrameDifferenceTest, EqualsThePlainMeanAbsoluteDifference) {
 }
 
 // Perceptual aliasing: the route shows 100 places, then the same places again in another order.
-// A frame of the second half looks exactly like one of the first, so a single frame cannot tell
-// them apart; ten frames in order can. Every query from the tenth on is placed exactly.
-TEST(SequenceMatcherTest, SequencesResolveWhatSingleFramesCannot) {
+std::vector<int> AliasedRoute(Random* random) {
   std::vector<int> order(100);
   std::iota(order.begin(), order.end(), 0);
   std::vector<int> shuffled = order;
-  Random random(7);
-  for (int i = 99; i > 0; --i) std::swap(shuffled[i], shuffled[random.NextU64() % (i + 1)]);
+  for (int i = 99; i > 0; --i) std::swap(shuffled[i], shuffled[random->NextU64() % (i + 1)]);
   order.insert(order.end(), shuffled.begin(), shuffled.end());
+  return order;
+}
+
+// Perceptual aliasing: the route shows 100 places, then the same places again in another order.
+// A frame of the second half looks exactly like one of the first, so a single frame cannot tell
+// them apart; ten frames in order can. Every query from the tenth on is placed exactly.
+TEST(SequenceMatcherTest, SequencesResolveWhatSingleFramesCannot) {
+  Random random(7);
+  const std::vector<int> order = AliasedRoute(&random);
   SequenceMatcherOptions options;
   SequenceMatcher matcher(options);
   for (int place : order) ASSERT_TRUE(matcher.AddReference(Prepare(Texture(place))).ok());
@@ -99,12 +105,8 @@ TEST(SequenceMatcherTest, SequencesResolveWhatSingleFramesCannot) {
 // line through the last sequence_length frames places each of them at its own reference. A blank
 // query, or a frame not stored, is declined.
 TEST(SequenceMatcherTest, MatchAtPlacesEveryFrameOfTheSequence) {
-  std::vector<int> order(100);
-  std::iota(order.begin(), order.end(), 0);
-  std::vector<int> shuffled = order;
   Random random(11);
-  for (int i = 99; i > 0; --i) std::swap(shuffled[i], shuffled[random.NextU64() % (i + 1)]);
-  order.insert(order.end(), shuffled.begin(), shuffled.end());
+  const std::vector<int> order = AliasedRoute(&random);
   SequenceMatcherOptions options;
   SequenceMatcher matcher(options);
   for (int place : order) ASSERT_TRUE(matcher.AddReference(Prepare(Texture(place))).ok());
