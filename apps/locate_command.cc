@@ -28,8 +28,7 @@
 #include "fusion/phone_localisation/wifi_gp_map.h"
 #include "render/renderer.h"
 #include "sensors/dataset/dataset_loader.h"
-#include "sensors/dataset/ipin_log.h"
-#include "session/evaluation_baselines.h"
+#include "session/locate_session.h"
 #include "sim/world.h"
 #include "viewer/figures.h"
 #include "viewer/localisation_figure.h"
@@ -49,41 +48,6 @@ std::optional<LocateOptions> LoadLocateOptions(const Arguments& args, const char
   return *o;
 }
 
-// Loads data sets in one frame: IPIN logs share the first one's geographic origin (or the given
-// one). Returns the origin used, if any log had one.
-StatusOr<std::vector<Dataset>> LoadInOneFrame(const std::vector<std::string>& paths,
-                                              PhoneLogOptions phone,
-                                              std::optional<std::pair<double, double>>* origin) {
-  if (*origin) phone.reference = GeoReference{(*origin)->first, (*origin)->second};
-  std::vector<Dataset> out;
-  for (const std::string& path : paths) {
-    StatusOr<DatasetFormat> format = DetectDatasetFormat(path);
-    if (!format.ok()) return format.status();
-    if (format.value() == DatasetFormat::kIpinLog) {
-      PhoneLogReport report;
-      StatusOr<Dataset> d = ReadIpinLog(path, phone, &report);
-      if (!d.ok()) return d.status();
-      if (!phone.reference) {
-        phone.reference = report.reference;
-        *origin = std::make_pair(report.reference.latitude_deg, report.reference.longitude_deg);
-      }
-      out.push_back(std::move(d.value()));
-    } else {
-      StatusOr<Dataset> d = LoadDataset(path, phone);
-      if (!d.ok()) return d.status();
-      out.push_back(std::move(d.value()));
-    }
-  }
-  return out;
-}
-
-std::vector<std::pair<std::string, double>> Readings(const WifiScan& scan) {
-  std::vector<std::pair<std::string, double>> r;
-  for (const WifiReading& w : scan.readings) r.emplace_back(w.bssid, w.rssi_dbm);
-  return r;
-}
-
-// Percentiles of the errors on the right floor; a wrong floor (infinite error) is counted apart.
 // "2.3 m": a JSON number in metres to a tenth, for the terminal.
 std::string Metres(const nlohmann::ordered_json& value) {
   char text[32];
@@ -91,110 +55,11 @@ std::string Metres(const nlohmann::ordered_json& value) {
   return text;
 }
 
-nlohmann::ordered_json ErrorSummary(std::vector<double> all) {
-  nlohmann::ordered_json j;
-  std::vector<double> errors;
-  for (double e : all) {
-    if (std::isfinite(e)) errors.push_back(e);
-  }
-  std::sort(errors.begin(), errors.end());
-  j["count"] = errors.size();
-  j["wrong_floor"] = all.size() - errors.size();
-  if (errors.empty()) return j;
-  auto at = [&](double q) {
-    return errors[std::min(errors.size() - 1, static_cast<size_t>(q * (errors.size() - 1) + 0.5))];
-  };
-  double sum = 0.0;
-  for (double e : errors) sum += e;
-  j["mean_error_m"] = sum / errors.size();
-  j["median_error_m"] = at(0.5);
-  j["p75_error_m"] = at(0.75);
-  j["p90_error_m"] = at(0.9);
-  return j;
-}
-
-// A point of the Wi-Fi map's frame in the ground truth's frame (the same unless the map is a
-// run's), and back.
-Point2 MapToTruth(const WifiGpMap& map, const Point2& p) {
-  return map.truth_from_map() ? Apply(*map.truth_from_map(), p) : p;
-}
-Point2 TruthToMap(const WifiGpMap& map, const Point2& p) {
-  return map.truth_from_map() ? ApplyInverse(*map.truth_from_map(), p) : p;
-}
-
-// What locate and call share: options, the Wi-Fi map and the phone log read in its frame.
-struct PhoneSetup {
-  LocateOptions options;
-  WifiGpMap map;
-  Dataset data;
-};
-
+// The session's SetUpPhone with the command's options, map and log.
 StatusOr<PhoneSetup> SetUpPhone(const Arguments& args, const char* command) {
   const std::optional<LocateOptions> options = LoadLocateOptions(args, command);
   if (!options) return Status::Error("");  // already reported
-  PhoneSetup setup;
-  setup.options = *options;
-  StatusOr<WifiGpMap> map = WifiGpMap::Load(args.values.at("--wifi-map"));
-  if (!map.ok()) return map.status();
-  setup.map = std::move(map).value();
-  PhoneLogOptions phone;
-  phone.lenient = args.lenient;
-  phone.pdr = options->pdr;
-  std::optional<std::pair<double, double>> origin = setup.map.geo_reference_deg();
-  StatusOr<std::vector<Dataset>> data = LoadInOneFrame({args.values.at("--data")}, phone, &origin);
-  if (!data.ok()) return data.status();
-  setup.data = std::move(data.value().front());
-  if (setup.data.wifi.empty()) {
-    return Status::Error(args.values.at("--data") + ": no Wi-Fi scan to locate the phone by");
-  }
-  // The filter's time is about particles x scans x 4 us (measured: 1e6 particles over the 77
-  // scans of IPIN route 22, repetition 03, took 318 s on this project's 2-core machine, 1e5 took
-  // 28 s): a count that would take over half an hour is refused before it starts (10 million
-  // particles once ran for most of an hour on a walk of a minute).
-  constexpr double kSecondsPerParticleScan = 4.1e-6;
-  constexpr double kMostSeconds = 1800.0;
-  const double estimate = kSecondsPerParticleScan * options->particle_filter.particles *
-                          static_cast<double>(setup.data.wifi.size());
-  if (estimate > kMostSeconds) {
-    return Status::Error(
-        "[particle_filter] particles = " + std::to_string(options->particle_filter.particles) +
-        " would take about " + std::to_string(static_cast<long long>(estimate / 60)) +
-        " minutes over " + std::to_string(setup.data.wifi.size()) +
-        " scans (at most 30 are allowed): use fewer particles");
-  }
-  return setup;
-}
-
-// Replays a phone log through the filter in time order up to `until_s`: PDR steps (heading from
-// the compass, turned into the map's frame, or integrated turn rate), a random walk between
-// scans without odometry, and a weight update per scan, after which `on_scan` runs with the
-// number of readings the map knew.
-void FilterPhoneLog(const Dataset& d, const WifiGpMap& map, ParticleFilter* filter, double until_s,
-                    const std::function<void(const WifiScan&, size_t)>& on_scan) {
-  const bool compass = !d.compass.empty();
-  std::optional<double> heading, last_time, last_odometry;
-  double integrated_heading = 0.0;
-  for (const Event& e : MergeEvents(d)) {
-    if (e.time_s > until_s) break;
-    if (e.type == EventType::kCompass) {
-      heading = d.compass[e.index].heading_rad;
-    } else if (e.type == EventType::kOdometry) {
-      const OdometryRow& row = d.odometry[e.index];
-      const double dt = last_odometry ? row.time_s - *last_odometry : 0.0;
-      last_odometry = row.time_s;
-      integrated_heading += row.turn_rate_rad_per_s * dt;
-      const double forward = row.forward_speed_m_per_s * dt;
-      if (forward != 0.0) {
-        filter->Step(forward,
-                     compass && heading ? *heading + map.compass_to_map_rad() : integrated_heading);
-      }
-    } else if (e.type == EventType::kWifi) {
-      const WifiScan& scan = d.wifi[e.index];
-      if (d.odometry.empty() && last_time) filter->Diffuse(scan.time_s - *last_time);
-      last_time = scan.time_s;
-      on_scan(scan, filter->Update(Readings(scan)));
-    }
-  }
+  return SetUpPhone(*options, args.values.at("--wifi-map"), args.values.at("--data"), args.lenient);
 }
 
 // The walls of the simulated worlds among `paths` (a replay folder holding the world.toml that
@@ -242,7 +107,7 @@ Status SamplesFromRun(const std::string& run_folder, const std::vector<std::stri
     ++*scans;
     const auto pose = InterpolateGroundTruth(*trajectory, scan.time_s);
     if (!pose || scan.readings.empty()) continue;
-    samples->push_back({{pose->x_m, pose->y_m}, 0, Readings(scan)});
+    samples->push_back({{pose->x_m, pose->y_m}, 0, ScanReadings(scan)});
   }
   // The compass's offset: circular mean of map heading minus compass heading.
   double sum_sin = 0.0, sum_cos = 0.0;
@@ -306,7 +171,7 @@ int WifiMapCommand(const Arguments& parsed) {
         ++scans;
         const auto truth = GroundTruthAt(d, scan.time_s);
         if (!truth || scan.readings.empty()) continue;
-        samples.push_back({{truth->x_m, truth->y_m}, truth->floor, Readings(scan)});
+        samples.push_back({{truth->x_m, truth->y_m}, truth->floor, ScanReadings(scan)});
       }
     }
   }
@@ -377,115 +242,22 @@ int LocateCommand(const Arguments& parsed) {
   StatusOr<PhoneSetup> setup = SetUpPhone(*args, "locate");
   if (!setup.ok()) return fail(setup.status());
   const std::string map_path = args->values.at("--wifi-map");
-  const WifiGpMap* map = &setup->map;
   const LocateOptions* options = &setup->options;
   const Dataset& d = setup->data;
-  ParticleFilter filter(*map, options->particle_filter);
-  const bool compass = !d.compass.empty();
-  Status initialised = filter.Initialise(compass);
-  if (!initialised.ok()) return fail(initialised);
-
-  // Replay odometry (PDR steps), compass and scans in time order.
-  std::ostringstream tum, errors, candidates;
-  tum << "# timestamp tx ty tz qx qy qz qw (particle filter estimate at each Wi-Fi scan)\n";
-  errors << "time_s,x_m,y_m,floor,known_aps,true_x_m,true_y_m,true_floor,error_m,"
-            "knn_error_m\n";
-  candidates << "time_s,rank,x_m,y_m,weight\n";
-  std::vector<double> filter_errors, knn_errors;
-  size_t unknown_scans = 0;
-  // Fingerprint baseline on the map's own training scans (weighted 3-NN, session/).
-  std::vector<fabmap::EvaluationNode> map_nodes;
-  for (const WifiMapSample& s : map->training_samples()) {
-    fabmap::EvaluationNode n;
-    n.x_m = s.position.x;
-    n.y_m = s.position.y;
-    n.floor = s.floor;
-    std::vector<WifiReading> r;
-    for (const auto& [b, v] : s.readings) r.push_back({b, v});
-    n.wifi = r;
-    map_nodes.push_back(std::move(n));
-  }
-  std::vector<fabmap::EvaluationNode> queries;
-  for (const WifiScan& scan : d.wifi) {
-    fabmap::EvaluationNode q;
-    q.wifi = scan.readings;
-    queries.push_back(std::move(q));
-  }
-  const std::vector<fabmap::Estimate> knn = KnnEstimates(map_nodes, queries);
-  size_t scan_index = 0;
-  FilterPhoneLog(
-      d, *map, &filter, std::numeric_limits<double>::infinity(),
-      [&](const WifiScan& scan, size_t known) {
-        unknown_scans += known == 0;
-        const LocationEstimate est = filter.Estimate();
-        tum << ShortestNumber(scan.time_s) << ' ' << ShortestNumber(est.x_m) << ' '
-            << ShortestNumber(est.y_m) << " 0 0 0 0 1\n";
-        const auto found = filter.Candidates();
-        for (size_t k = 0; k < found.size(); ++k) {
-          candidates << ShortestNumber(scan.time_s) << ',' << k << ','
-                     << ShortestNumber(found[k].first.x) << ',' << ShortestNumber(found[k].first.y)
-                     << ',' << ShortestNumber(found[k].second) << '\n';
-        }
-        errors << ShortestNumber(scan.time_s) << ',' << ShortestNumber(est.x_m) << ','
-               << ShortestNumber(est.y_m) << ',' << est.floor << ',' << known;
-        const auto truth = GroundTruthAt(d, scan.time_s);
-        if (truth) {
-          // A map made from a run is in the run's frame and has one floor: its estimates are
-          // scored after its alignment onto the truth, on position alone.
-          auto to_truth = [&](double x, double y) { return MapToTruth(*map, {x, y}); };
-          auto floor_differs = [&](int floor) {
-            return !map->truth_from_map() && floor != truth->floor;
-          };
-          const Point2 e = to_truth(est.x_m, est.y_m);
-          const double error = floor_differs(est.floor)
-                                   ? std::numeric_limits<double>::infinity()
-                                   : std::hypot(e.x - truth->x_m, e.y - truth->y_m);
-          filter_errors.push_back(error);
-          const fabmap::Estimate& k = knn[scan_index];
-          const Point2 ke = to_truth(k.x_m, k.y_m);
-          const double knn_error = !k.located || floor_differs(k.floor)
-                                       ? std::numeric_limits<double>::infinity()
-                                       : std::hypot(ke.x - truth->x_m, ke.y - truth->y_m);
-          knn_errors.push_back(knn_error);
-          errors << ',' << ShortestNumber(truth->x_m) << ',' << ShortestNumber(truth->y_m) << ','
-                 << truth->floor << ',' << ShortestNumber(error) << ',' << ShortestNumber(knn_error)
-                 << '\n';
-        } else {
-          errors << ",,,,,\n";
-        }
-        ++scan_index;
-      });
-  nlohmann::ordered_json j;
-  j["data"] = args->values.at("--data");
-  j["wifi_map"] = map_path;
-  j["scans"] = d.wifi.size();
-  j["scans_without_known_ap"] = unknown_scans;
-  j["steps_from"] = d.odometry.empty() ? "random walk" : "pedestrian dead reckoning";
-  j["heading_from"] = compass ? "compass" : "integrated turn rate";
-  j["likelihood"] = ToString(options->particle_filter.likelihood);
-  j["particles"] = options->particle_filter.particles;
-  j["resamplings"] = filter.resamplings();
-  j["walls"] = map->walls().size();
-  j["wall_crossings"] = filter.wall_crossings();
-  if (options->particle_filter.online_rssi_offset) j["rssi_offset_db"] = filter.rssi_offset_db();
-  if (map->truth_from_map()) {
-    j["errors_after_map_alignment"] = true;  // the map is a run's: scored in the truth's frame
-    j["map_to_truth_rmse_m"] = map->truth_from_map()->rmse_m;
-  }
-  if (!filter_errors.empty()) {
-    nlohmann::ordered_json f = ErrorSummary(filter_errors);
-    for (auto& [key, value] : f.items()) j[key] = value;
-    j["knn_baseline"] = ErrorSummary(knn_errors);
-  }
+  StatusOr<LocateResult> located = Locate(*setup, args->values.at("--data"), map_path);
+  if (!located.ok()) return fail(located.status());
+  const std::vector<double>& filter_errors = located->filter_errors_m;
+  const std::vector<double>& knn_errors = located->knn_errors_m;
+  nlohmann::ordered_json& j = located->summary;
   j["run"] = RunObject(args->Provenance(),
                        {args->values.at("--wifi-map"), args->values.at("--data")}, std::nullopt, 0);
   const std::string summary = j.dump(2) + "\n";
   StatusOr<std::unique_ptr<DiskFolder>> folder = DiskFolder::Open(args->values.at("--out"));
   if (!folder.ok()) return fail(folder.status());
   Status written = folder.value()->Write({{"config.toml", PrintLocateConfig(*options)},
-                                          {"trajectory_tum.txt", tum.str()},
-                                          {"errors.csv", errors.str()},
-                                          {"candidates.csv", candidates.str()},
+                                          {"trajectory_tum.txt", located->TrajectoryTum()},
+                                          {"errors.csv", located->ErrorsCsv()},
+                                          {"candidates.csv", located->CandidatesCsv()},
                                           {"summary.json", summary}});
   if (!written.ok()) return fail(written);
   if (!filter_errors.empty()) {
@@ -505,8 +277,8 @@ int LocateCommand(const Arguments& parsed) {
   }
   std::string human = MessagePrefix() + std::to_string(d.wifi.size()) + " scans";
   if (!filter_errors.empty()) {
-    const nlohmann::ordered_json f = ErrorSummary(filter_errors);
-    const nlohmann::ordered_json k = ErrorSummary(knn_errors);
+    const nlohmann::ordered_json f = LocationErrorSummary(filter_errors);
+    const nlohmann::ordered_json k = LocationErrorSummary(knn_errors);
     human += ", " + std::to_string(filter_errors.size()) + " with ground truth";
     if (f.contains("median_error_m")) {
       human += ": median error " + Metres(f["median_error_m"]) + ", 90 % within " +

@@ -29,6 +29,7 @@
 #include "fusion/replay_pipeline.h"
 #include "sensors/dataset/csv.h"
 #include "session/evaluation_session.h"
+#include "session/locate_session.h"
 #include "session/replay_session.h"
 
 namespace py = pybind11;
@@ -501,6 +502,40 @@ py::dict Evaluate(const std::string& map, const std::string& query, const std::s
   return run;
 }
 
+// ratslam.locate: what `ratslam locate` does (the particle filter on a phone log in a Wi-Fi map,
+// scored beside weighted 3-NN), without writing files: the summary and a row per scan.
+py::dict LocatePhone(const std::string& wifi_map, const std::string& data,
+                     const std::optional<std::string>& config, bool lenient) {
+  const LocateOptions options = config ? Take(LoadLocateConfigFile(*config)) : LocateOptions();
+  const PhoneSetup setup = Take(SetUpPhone(options, wifi_map, data, lenient));
+  StatusOr<LocateResult> result = [&] {
+    py::gil_scoped_release release;
+    return Locate(setup, data, wifi_map);
+  }();
+  Check(result.status());
+  const std::vector<LocatedScan>& scans = result->scans;
+  py::dict c;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  Column<double>(&c, "time_s", scans, [](const LocatedScan& s) { return s.time_s; });
+  Column<double>(&c, "x_m", scans, [](const LocatedScan& s) { return s.estimate.x_m; });
+  Column<double>(&c, "y_m", scans, [](const LocatedScan& s) { return s.estimate.y_m; });
+  Column<int32_t>(&c, "floor", scans, [](const LocatedScan& s) { return s.estimate.floor; });
+  Column<int64_t>(&c, "known_aps", scans,
+                  [](const LocatedScan& s) { return static_cast<int64_t>(s.known_aps); });
+  Column<double>(&c, "true_x_m", scans,
+                 [&](const LocatedScan& s) { return s.truth ? s.truth->x_m : nan; });
+  Column<double>(&c, "true_y_m", scans,
+                 [&](const LocatedScan& s) { return s.truth ? s.truth->y_m : nan; });
+  Column<double>(&c, "error_m", scans,
+                 [&](const LocatedScan& s) { return s.truth ? s.error_m : nan; });
+  Column<double>(&c, "knn_error_m", scans,
+                 [&](const LocatedScan& s) { return s.truth ? s.knn_error_m : nan; });
+  py::dict run;
+  run["summary"] = py::module_::import("json").attr("loads")(result->summary.dump());
+  run["scans"] = std::move(c);
+  return run;
+}
+
 }  // namespace
 }  // namespace ratslam::python
 
@@ -536,6 +571,14 @@ PYBIND11_MODULE(ratslam, m) {
         "its figures). Returns {'evaluation': dict (evaluation.json), 'map': columns of the "
         "mapped places, 'queries': columns with 'match' (map index, -1: rejected as a new "
         "place), the posteriors and the best mapped place}.");
+
+  m.def("locate", &LocatePhone, py::arg("wifi_map"), py::arg("data"),
+        py::arg("config") = std::nullopt, py::arg("lenient") = false,
+        "Locates a phone log (`data`) in a Wi-Fi map (`ratslam wifi-map`) with the particle "
+        "filter, as `ratslam locate` does, without writing files. `config`: a locate TOML file. "
+        "Returns {'summary': dict (summary.json without 'run'), 'scans': columns per Wi-Fi scan "
+        "(estimate, known_aps, truth and errors: NaN without ground truth, inf on the wrong "
+        "floor)}.");
 
   py::class_<Session>(m, "Session",
                       "A RatSLAM session fed frame by frame: odometry, grey images, Wi-Fi scans "

@@ -333,6 +333,35 @@ class RatslamModuleTest(unittest.TestCase):
         timer.join()
         self.assertFalse(os.path.exists(os.path.join(stopped, "evaluation.json")))
 
+    def test_locate_equals_the_command_line(self):
+        data = os.path.join(SOURCE, "..", "shared", "data", "ipin2023-t3")
+        walks = [os.path.join(data, f"IPIN2023_T3_TrainingTrial22_repetition{r}.txt")
+                 for r in ("01", "03")]
+        for walk in walks:
+            if not os.path.exists(walk):
+                self.skipTest(f"missing {walk}")
+        wifi_map = os.path.join(self.root, "route22.wifimap")
+        subprocess.run([BINARY, "wifi-map", "--data", walks[0], "--out", wifi_map], check=True,
+                       capture_output=True)
+        cli = os.path.join(self.root, "locate_cli")
+        subprocess.run([BINARY, "locate", "--quiet", "--wifi-map", wifi_map, "--data", walks[1],
+                        "--out", cli], check=True, capture_output=True)
+        result = ratslam.locate(wifi_map, walks[1])
+        with open(os.path.join(cli, "summary.json")) as f:
+            expected = json.load(f)
+        del expected["run"]
+        self.assertEqual(result["summary"], expected)
+        rows = read_csv(os.path.join(cli, "errors.csv"))
+        scans = result["scans"]
+        self.assertEqual(len(scans["time_s"]), expected["scans"])
+        np.testing.assert_array_equal(scans["x_m"], [float(r["x_m"]) for r in rows])
+        np.testing.assert_array_equal(scans["known_aps"], [int(r["known_aps"]) for r in rows])
+        np.testing.assert_array_equal(
+            scans["error_m"], [float(r["error_m"]) if r["error_m"] else np.nan for r in rows])
+        self.assertEqual(int(np.sum(np.isfinite(scans["error_m"]))), expected["count"])
+        with self.assertRaisesRegex(ratslam.Error, "no_such.wifimap"):
+            ratslam.locate(os.path.join(self.root, "no_such.wifimap"), walks[1])
+
 
 if __name__ == "__main__":
     unittest.main()
