@@ -2,10 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <stdexcept>
 
-#include "common/circular.h"
 #include "ratslam/experience_map.h"
 
 namespace ratslam {
@@ -100,9 +98,7 @@ StatusOr<std::optional<Injection>> LocalViewCells::Observe(const ViewDecision& d
   Injection injection;
   injection.position = t.pose_cells;
   injection.position.theta =
-      WrapCoordinate(t.pose_cells.theta +
-                         decision.heading_change_rad / (2.0 * std::numbers::pi) * dim_theta_cells_,
-                     dim_theta_cells_);
+      TurnedTheta(t.pose_cells.theta, decision.heading_change_rad, dim_theta_cells_);
   injection.energy = energy;
   return std::optional<Injection>(injection);
 }

@@ -68,6 +68,10 @@ bool PoseCellOptions::IsValid(std::string* error) const {
   return true;
 }
 
+double TurnedTheta(double theta, double turn_rad, int dim_theta) {
+  return WrapCoordinate(theta + turn_rad / (2.0 * std::numbers::pi) * dim_theta, dim_theta);
+}
+
 double PoseCellDistance(const PoseCellPosition& a, const PoseCellPosition& b, int dim_xy,
                         int dim_theta) {
   const double dx = CircularDifference(a.x, b.x, dim_xy);

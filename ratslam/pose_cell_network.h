@@ -75,6 +75,9 @@ struct PoseCellPosition {
 double PoseCellDistance(const PoseCellPosition& a, const PoseCellPosition& b, int dim_xy,
                         int dim_theta);
 
+// A theta coordinate (cells) turned by `turn_rad`, wrapped into [0, dim_theta).
+double TurnedTheta(double theta, double turn_rad, int dim_theta);
+
 class PoseCellNetwork {
  public:
   // Everything needed to restore the network exactly (see GetState / SetState).

@@ -2,10 +2,7 @@
 
 #include <cmath>
 #include <limits>
-#include <numbers>
 #include <stdexcept>
-
-#include "common/circular.h"
 
 namespace ratslam {
 
@@ -63,10 +60,8 @@ Status Ratslam::OnView(const ViewDecision& decision) {
     if (nearest) {
       // Facing as the view says (a compass's change since the template), as an injection would.
       PoseCellPosition at = experience_map_.experience(*nearest).pose_cells;
-      const double theta_cells = options_.pose_cells.dim_theta_cells;
-      at.theta = WrapCoordinate(
-          at.theta + decision.heading_change_rad / (2.0 * std::numbers::pi) * theta_cells,
-          theta_cells);
+      at.theta =
+          TurnedTheta(at.theta, decision.heading_change_rad, options_.pose_cells.dim_theta_cells);
       pose_cells_.Reset(at);
       experience_map_.MoveTo(*nearest, decision.time_s, compass_heading_rad_);
       ++localisation_counters_.recognitions;
