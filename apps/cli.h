@@ -174,15 +174,6 @@ int LocateCommand(const Arguments& args);
 int CallCommand(const Arguments& args);
 int RouteCommand(const Arguments& args);
 
-// A robot's map for `call` and `route`: a replay's run folder (experiences.csv, links.csv; the
-// robot is at summary.json's current_experience, or else at the experience of frames.csv's last
-// frame that had one) or a saved map file (its current experience). locate_command.cc.
-struct RobotMap {
-  std::vector<Experience> experiences;
-  std::vector<Link> links;
-  std::optional<uint32_t> current;
-};
-StatusOr<RobotMap> LoadRobotMap(const std::string& path);
 int SimulateCommand(const Arguments& args);
 // `action`: plan, run, task, collect or submit.
 int SweepCommand(const std::string& action, const Arguments& args);

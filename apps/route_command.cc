@@ -16,6 +16,7 @@
 #include "common/output_folder.h"
 #include "fusion/phone_localisation/robot_call.h"
 #include "render/image.h"
+#include "session/call_session.h"
 #include "viewer/figures.h"
 
 namespace ratslam {

@@ -1,4 +1,5 @@
-// The `ratslam` Python module: configurations, replays and localisation runs on data sets, and
+// The `ratslam` Python module: configurations, replays, evaluations, Wi-Fi maps, phone location
+// and robot calls on data sets, and
 // sessions stepped frame by frame with the caller's own inputs, over the same library sessions
 // and pipeline the command line uses. Results come back as a dict (the summary) and columns of
 // NumPy arrays (experiences, links, trajectory, frames, localisation). Errors raise
@@ -9,6 +10,7 @@
 
 #include <atomic>
 #include <cmath>
+#include <filesystem>
 #include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -28,9 +30,11 @@
 #include "fusion/io/run_outputs.h"
 #include "fusion/replay_pipeline.h"
 #include "sensors/dataset/csv.h"
+#include "session/call_session.h"
 #include "session/evaluation_session.h"
 #include "session/locate_session.h"
 #include "session/replay_session.h"
+#include "session/wifi_map_session.h"
 
 namespace py = pybind11;
 
@@ -45,7 +49,8 @@ struct Error : std::runtime_error {
 std::string InPythonTerms(std::string message) {
   for (const auto& [flag, keyword] :
        {std::pair<std::string, std::string>{"--overwrite", "overwrite=True"},
-        {"--save-map", "save_map"}}) {
+        {"--save-map", "save_map"},
+        {"--at", "at"}}) {
     for (size_t at = message.find(flag); at != std::string::npos;
          at = message.find(flag, at + keyword.size())) {
       message.replace(at, flag.size(), keyword);
@@ -536,6 +541,56 @@ py::dict LocatePhone(const std::string& wifi_map, const std::string& data,
   return run;
 }
 
+// ratslam.wifi_map: what `ratslam wifi-map` does (the Gaussian-process Wi-Fi map of data sets
+// with ground truth, or of a replay's run), written to the file `out`; returns the summary.
+py::dict WifiMap(const std::vector<std::string>& data, const std::string& out,
+                 const std::optional<std::string>& run, const std::optional<std::string>& config,
+                 bool lenient, bool overwrite) {
+  const LocateOptions options = config ? Take(LoadLocateConfigFile(*config)) : LocateOptions();
+  Check(CheckReplaceable(out, overwrite, "out"));
+  const WifiMapInput input{data, run, lenient};
+  StatusOr<BuiltWifiMap> built = [&] {
+    py::gil_scoped_release release;
+    return BuildWifiMap(options, input);
+  }();
+  Check(built.status());
+  const std::filesystem::path path = out;
+  std::unique_ptr<DiskFolder> folder =
+      Take(DiskFolder::Open(path.has_parent_path() ? path.parent_path().string() : "."));
+  Check(folder->Write(path.filename().string(), built->map.Encode()));
+  nlohmann::ordered_json j;
+  j["wifi_map"] = out;
+  for (const auto& [key, value] : built->summary.items()) j[key] = value;
+  return py::module_::import("json").attr("loads")(j.dump());
+}
+
+// ratslam.call: what `ratslam call` does (the phone located up to `at`, the robot's tour to its
+// candidates over the experience graph), without writing files: call.json and the route.
+py::dict Call(const std::string& map, const std::string& wifi_map, const std::string& data,
+              double at, const std::optional<std::string>& config, bool lenient) {
+  const LocateOptions options = config ? Take(LoadLocateConfigFile(*config)) : LocateOptions();
+  const RobotMap robot = Take(LoadRobotMap(map));
+  const PhoneSetup setup = Take(SetUpPhone(options, wifi_map, data, lenient));
+  StatusOr<CallResult> result = [&] {
+    py::gil_scoped_release release;
+    return CallRobot(setup, robot, at, {data, map, wifi_map});
+  }();
+  Check(result.status());
+  const std::vector<uint32_t>& route = result->plan.route;
+  const std::vector<Point2>& nodes = result->graph.nodes;
+  std::vector<size_t> steps(route.size());
+  for (size_t k = 0; k < steps.size(); ++k) steps[k] = k;
+  py::dict r;
+  Column<int64_t>(&r, "experience_id", steps,
+                  [&](size_t k) { return static_cast<int64_t>(route[k]); });
+  Column<double>(&r, "x_m", steps, [&](size_t k) { return nodes[route[k]].x; });
+  Column<double>(&r, "y_m", steps, [&](size_t k) { return nodes[route[k]].y; });
+  py::dict out;
+  out["call"] = py::module_::import("json").attr("loads")(result->summary.dump());
+  out["route"] = std::move(r);
+  return out;
+}
+
 }  // namespace
 }  // namespace ratslam::python
 
@@ -579,6 +634,20 @@ PYBIND11_MODULE(ratslam, m) {
         "Returns {'summary': dict (summary.json without 'run'), 'scans': columns per Wi-Fi scan "
         "(estimate, known_aps, truth and errors: NaN without ground truth, inf on the wrong "
         "floor)}.");
+
+  m.def("wifi_map", &WifiMap, py::arg("data"), py::arg("out"), py::arg("run") = std::nullopt,
+        py::arg("config") = std::nullopt, py::arg("lenient") = false, py::arg("overwrite") = false,
+        "Builds a Gaussian-process Wi-Fi map from data sets (a list of paths) with ground truth, "
+        "or from a replay's run folder `run` of them (positions from the run's map), and writes "
+        "it to the file `out`, as `ratslam wifi-map` does. `config`: a locate TOML file. Returns "
+        "the summary (`--json`'s, without 'seconds' and 'run').");
+
+  m.def("call", &Call, py::arg("map"), py::arg("wifi_map"), py::arg("data"), py::arg("at"),
+        py::arg("config") = std::nullopt, py::arg("lenient") = false,
+        "Calls the robot of `map` (a run folder or a saved map) to the phone of `data` as located "
+        "in `wifi_map` by time `at` (s), as `ratslam call` does, without writing files. Returns "
+        "{'call': dict (call.json without 'run'), 'route': columns per step of the robot's route "
+        "(experience_id, x_m, y_m)}.");
 
   py::class_<Session>(m, "Session",
                       "A RatSLAM session fed frame by frame: odometry, grey images, Wi-Fi scans "

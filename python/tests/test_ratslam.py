@@ -363,5 +363,56 @@ class RatslamModuleTest(unittest.TestCase):
             ratslam.locate(os.path.join(self.root, "no_such.wifimap"), walks[1])
 
 
+    def test_wifi_map_and_call_equal_the_command_line(self):
+        data = os.path.join(SOURCE, "..", "shared", "data", "ipin2023-t3")
+        walks = [os.path.join(data, f"IPIN2023_T3_TrainingTrial22_repetition{r}.txt")
+                 for r in ("01", "03")]
+        for walk in walks:
+            if not os.path.exists(walk):
+                self.skipTest(f"missing {walk}")
+        run = os.path.join(self.root, "run")
+        subprocess.run([BINARY, "replay", "--quiet", "--config",
+                        os.path.join(SOURCE, "configs", "ipin2023-wifi-compass.toml"),
+                        "--data", walks[0], "--out", run], check=True, capture_output=True)
+        cli_map = os.path.join(self.root, "cli.wifimap")
+        printed = subprocess.run([BINARY, "wifi-map", "--json", "--run", run, "--data", walks[0],
+                                  "--out", cli_map], check=True, capture_output=True, text=True)
+        expected = json.loads(printed.stdout)
+        py_map = os.path.join(self.root, "py.wifimap")
+        summary = ratslam.wifi_map([walks[0]], py_map, run=run)
+        self.assertEqual(summary["wifi_map"], py_map)
+        for key in ("wifi_map", "seconds", "run"):
+            del expected[key]
+            summary.pop(key, None)
+        self.assertEqual(summary, expected)
+        self.assertEqual(summary["positions_from"], "run trajectory")
+        with open(cli_map, "rb") as a, open(py_map, "rb") as b:
+            self.assertEqual(a.read(), b.read())
+        with self.assertRaisesRegex(ratslam.Error, "overwrite=True"):
+            ratslam.wifi_map([walks[0]], py_map)
+
+        cli = os.path.join(self.root, "call_cli")
+        subprocess.run([BINARY, "call", "--quiet", "--map", run, "--wifi-map", py_map, "--data",
+                        walks[1], "--at", "100", "--out", cli], check=True, capture_output=True)
+        called = ratslam.call(run, py_map, walks[1], 100)
+        with open(os.path.join(cli, "call.json")) as f:
+            expected = json.load(f)
+        del expected["run"]
+        self.assertEqual(called["call"], expected)
+        rows = read_csv(os.path.join(cli, "route.csv"))
+        route = called["route"]
+        self.assertEqual(len(route["experience_id"]), expected["route_experiences"])
+        np.testing.assert_array_equal(route["experience_id"],
+                                      [int(r["experience_id"]) for r in rows])
+        np.testing.assert_array_equal(route["x_m"], [float(r["x_m"]) for r in rows])
+        np.testing.assert_array_equal(route["y_m"], [float(r["y_m"]) for r in rows])
+        # The route starts where the robot is and passes every stop in order.
+        self.assertEqual(route["experience_id"][0], expected["robot_experience"])
+        stops = [e for e in route["experience_id"] if e in expected["stops"]]
+        self.assertEqual(list(dict.fromkeys(stops)), expected["stops"])
+        with self.assertRaisesRegex(ratslam.Error, "before at -5 s"):
+            ratslam.call(run, py_map, walks[1], -5)
+
+
 if __name__ == "__main__":
     unittest.main()

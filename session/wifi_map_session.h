@@ -1,0 +1,40 @@
+// Building a Gaussian-process Wi-Fi map (Kudo and Miura, section III) as a library session: the
+// scans of data sets with ground truth placed where the truth says, or the scans of a replay
+// placed where the run's final map puts the robot (the run's frame, with the compass's offset
+// to it and the map's alignment onto the truth). `ratslam wifi-map` and Python drive it.
+#ifndef RATSLAM_SESSION_WIFI_MAP_SESSION_H_
+#define RATSLAM_SESSION_WIFI_MAP_SESSION_H_
+
+#include <cstddef>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "common/status.h"
+#include "fusion/phone_localisation/locate_options.h"
+#include "fusion/phone_localisation/wifi_gp_map.h"
+
+namespace ratslam {
+
+struct WifiMapInput {
+  std::vector<std::string> data;   // data sets (IPIN logs in the first one's frame)
+  std::optional<std::string> run;  // a replay's run folder of `data`: positions from its map
+  bool lenient = false;            // skip bad lines of phone logs
+};
+
+struct BuiltWifiMap {
+  WifiGpMap map;
+  size_t scans = 0;    // Wi-Fi scans read
+  size_t samples = 0;  // of which placed on the map
+  // summary.json of `ratslam wifi-map` without `wifi_map`, `seconds` and `run`.
+  nlohmann::ordered_json summary;
+};
+
+// Fails when no scan could be placed (no ground truth at any scan's time, or none within the
+// run's trajectory), or when the run replayed other data.
+StatusOr<BuiltWifiMap> BuildWifiMap(const LocateOptions& options, const WifiMapInput& input);
+
+}  // namespace ratslam
+
+#endif  // RATSLAM_SESSION_WIFI_MAP_SESSION_H_
