@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "common/provenance.h"
-#include "fusion/io/config.h"
+#include "io/config.h"
 #include "ratslam/experience_map.h"
 #include "render/renderer.h"
 #include "viewer/figure_output.h"

@@ -6,8 +6,8 @@
 
 #include <string>
 
+#include "dataset/synthetic_dataset.h"
 #include "fusion/replay_pipeline.h"
-#include "sensors/dataset/synthetic_dataset.h"
 
 namespace ratslam {
 

@@ -5,7 +5,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "fusion/io/config.h"
+#include "io/config.h"
 
 namespace ratslam {
 namespace {

@@ -12,9 +12,9 @@
 #include <memory>
 
 #include "common/scratch_dir.h"
-#include "fusion/io/config.h"
+#include "dataset/synthetic_dataset.h"
 #include "fusion/replay_pipeline.h"
-#include "sensors/dataset/synthetic_dataset.h"
+#include "io/config.h"
 
 namespace ratslam {
 namespace {

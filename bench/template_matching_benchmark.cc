@@ -11,9 +11,9 @@
 
 #include "common/random.h"
 #include "common/scratch_dir.h"
+#include "dataset/image_loader.h"
+#include "dataset/synthetic_dataset.h"
 #include "sensors/classic_camera_matcher.h"
-#include "sensors/dataset/image_loader.h"
-#include "sensors/dataset/synthetic_dataset.h"
 
 namespace ratslam {
 namespace {

@@ -11,9 +11,9 @@
 
 #include "common/byte_buffer.h"
 #include "common/scratch_dir.h"
+#include "dataset/synthetic_dataset.h"
 #include "fusion/front_end.h"
 #include "fusion/replay_pipeline.h"
-#include "sensors/dataset/synthetic_dataset.h"
 
 namespace ratslam {
 namespace {

@@ -1,6 +1,6 @@
 // Place descriptors computed outside this program, one per camera image of a data set, for the
 // descriptor front end (front_end.h, kDescriptors). The file formats are in
-// sensors/dataset/descriptor_file.h; fusion/io/descriptor_resources.h finds a data set's files.
+// dataset/descriptor_file.h; io/front_end_resources.h finds a data set's files.
 #ifndef RATSLAM_FUSION_DESCRIPTOR_TABLE_H_
 #define RATSLAM_FUSION_DESCRIPTOR_TABLE_H_
 
@@ -12,13 +12,13 @@
 
 #include "common/schema.h"
 #include "common/status.h"
-#include "sensors/dataset/dataset.h"
-#include "sensors/dataset/descriptor_file.h"
+#include "dataset/dataset.h"
+#include "dataset/descriptor_file.h"
 
 namespace ratslam {
 
 struct DescriptorOptions {
-  // The data set's descriptor file (.npy or .csv, sensors/dataset/descriptor_file.h): a relative
+  // The data set's descriptor file (.npy or .csv, dataset/descriptor_file.h): a relative
   // name is looked up in each session's folder (beside a bag, video or phone log), so a
   // multi-session run finds one file per session; an absolute path serves a single session.
   std::string file = "descriptors.npy";

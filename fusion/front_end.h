@@ -19,14 +19,14 @@
 
 #include "common/schema.h"
 #include "common/status.h"
+#include "dataset/dataset.h"
+#include "dataset/image_loader.h"
 #include "fusion/descriptor_table.h"
 #include "fusion/fabmap_front_end_options.h"
 #include "fusion/fused_options.h"
 #include "ratslam/local_view_cells.h"
 #include "ratslam/records.h"
 #include "sensors/classic_camera_matcher.h"
-#include "sensors/dataset/dataset.h"
-#include "sensors/dataset/image_loader.h"
 #include "sensors/kernel_camera_matcher.h"
 #include "sensors/sequence_matcher.h"
 #include "sensors/wifi_fingerprint_matcher.h"
@@ -161,7 +161,7 @@ struct FrontEndResources {
 };
 
 // The FABMAP front end's models for `dataset`: `visual` (required when the mode uses vision;
-// fusion/io/visual_model_file.h loads or trains it) and the Wi-Fi words and tree from an
+// io/visual_model_file.h loads or trains it) and the Wi-Fi words and tree from an
 // exploration of every scan (with odometry travel) when the mode uses Wi-Fi. Reads no file.
 // Fails on invalid settings, a missing visual model or an unusable mode.
 StatusOr<std::shared_ptr<const FabmapResources>> PrepareFabmapResources(

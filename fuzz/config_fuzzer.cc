@@ -2,8 +2,8 @@
 // that reads back to the same config.
 #include <string>
 
-#include "fusion/io/config.h"
 #include "fuzz/fuzz_support.h"
+#include "io/config.h"
 
 namespace ratslam::fuzz {
 

@@ -7,9 +7,9 @@
 #include <filesystem>
 #include <string>
 
+#include "dataset/dataset.h"
+#include "dataset/ipin_log.h"
 #include "fuzz/fuzz_support.h"
-#include "sensors/dataset/dataset.h"
-#include "sensors/dataset/ipin_log.h"
 
 namespace ratslam::fuzz {
 

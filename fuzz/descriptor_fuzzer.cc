@@ -6,9 +6,9 @@
 #include <cstring>
 #include <string>
 
+#include "dataset/descriptor_file.h"
 #include "fusion/front_end.h"
 #include "fuzz/fuzz_support.h"
-#include "sensors/dataset/descriptor_file.h"
 
 namespace ratslam::fuzz {
 

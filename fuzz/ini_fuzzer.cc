@@ -2,8 +2,8 @@
 // through our TOML.
 #include <string>
 
-#include "fusion/io/config.h"
 #include "fuzz/fuzz_support.h"
+#include "io/config.h"
 
 namespace ratslam::fuzz {
 

@@ -2,10 +2,10 @@
 // `ratslam import` can write and read back, and its barometer readings give floors.
 #include <string>
 
+#include "dataset/ipin_log.h"
 #include "fuzz/dataset_round_trip.h"
 #include "fuzz/fuzz_support.h"
 #include "sensors/barometer.h"
-#include "sensors/dataset/ipin_log.h"
 
 namespace ratslam::fuzz {
 

@@ -9,9 +9,9 @@
 #include <numbers>
 #include <string>
 
-#include "fusion/io/map_file.h"
-#include "fusion/io/run_outputs.h"
 #include "fuzz/fuzz_support.h"
+#include "io/map_file.h"
+#include "io/run_outputs.h"
 
 namespace ratslam::fuzz {
 namespace {

@@ -2,9 +2,9 @@
 // set that `ratslam import` can write and read back.
 #include <string>
 
+#include "dataset/msft_log.h"
 #include "fuzz/dataset_round_trip.h"
 #include "fuzz/fuzz_support.h"
-#include "sensors/dataset/msft_log.h"
 
 namespace ratslam::fuzz {
 

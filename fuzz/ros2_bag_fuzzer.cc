@@ -1,8 +1,8 @@
 // ROS 2 bags as MCAP files: any bytes are read into a data set or an error naming the file, and
 // every image of an accepted file decodes or fails with a message.
+#include "dataset/rosbag2.h"
 #include "fuzz/fuzz_support.h"
 #include "fuzz/ros2_seeds.h"
-#include "sensors/dataset/rosbag2.h"
 
 namespace ratslam::fuzz {
 

@@ -1,8 +1,8 @@
 // ROS 2 CDR messages: any bytes decode as each message type or fail with an error naming the
 // field; a decoded image holds no more bytes than the input.
+#include "dataset/ros2_messages.h"
 #include "fuzz/fuzz_support.h"
 #include "fuzz/ros2_seeds.h"
-#include "sensors/dataset/ros2_messages.h"
 
 namespace ratslam::fuzz {
 

@@ -5,8 +5,8 @@
 #include <iterator>
 #include <string>
 
+#include "dataset/rosbag.h"
 #include "fuzz/fuzz_support.h"
-#include "sensors/dataset/rosbag.h"
 
 namespace ratslam::fuzz {
 

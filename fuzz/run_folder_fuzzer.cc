@@ -10,9 +10,9 @@
 #include <set>
 #include <string>
 
-#include "fusion/io/run_reader.h"
 #include "fusion/phone_localisation/robot_call.h"
 #include "fuzz/fuzz_support.h"
+#include "io/run_reader.h"
 
 namespace ratslam::fuzz {
 namespace {

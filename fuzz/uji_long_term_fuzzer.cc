@@ -5,8 +5,8 @@
 #include <cmath>
 #include <string>
 
+#include "dataset/uji_long_term.h"
 #include "fuzz/fuzz_support.h"
-#include "sensors/dataset/uji_long_term.h"
 
 namespace ratslam::fuzz {
 

@@ -2,8 +2,8 @@
 #include <cmath>
 #include <string>
 
+#include "dataset/ujiindoorloc.h"
 #include "fuzz/fuzz_support.h"
-#include "sensors/dataset/ujiindoorloc.h"
 
 namespace ratslam::fuzz {
 

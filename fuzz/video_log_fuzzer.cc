@@ -3,8 +3,8 @@
 #include <fstream>
 #include <string>
 
+#include "dataset/video.h"
 #include "fuzz/fuzz_support.h"
-#include "sensors/dataset/video.h"
 
 namespace ratslam::fuzz {
 

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "common/status.h"
-#include "sensors/dataset/image_loader.h"
+#include "dataset/image_loader.h"
 
 namespace ratslam {
 

@@ -8,8 +8,8 @@
 
 #include "common/file_util.h"
 #include "common/number_text.h"
-#include "fusion/io/map_file.h"
-#include "fusion/io/run_reader.h"
+#include "io/map_file.h"
+#include "io/run_reader.h"
 
 namespace ratslam {
 

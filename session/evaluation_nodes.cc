@@ -11,10 +11,10 @@
 #include <unordered_map>
 #include <utility>
 
-#include "fusion/io/visual_model_file.h"
-#include "sensors/dataset/dataset_loader.h"
-#include "sensors/dataset/uji_long_term.h"
-#include "sensors/dataset/ujiindoorloc.h"
+#include "dataset/dataset_loader.h"
+#include "dataset/uji_long_term.h"
+#include "dataset/ujiindoorloc.h"
+#include "io/visual_model_file.h"
 #include "sensors/rssi_offset.h"
 
 namespace ratslam {

@@ -8,10 +8,10 @@
 #include <vector>
 
 #include "common/status.h"
+#include "dataset/ipin_log.h"
+#include "dataset/rosbag.h"
+#include "dataset/video.h"
 #include "fusion/fabmap/evaluation.h"
-#include "sensors/dataset/ipin_log.h"
-#include "sensors/dataset/rosbag.h"
-#include "sensors/dataset/video.h"
 
 namespace ratslam {
 

@@ -13,9 +13,9 @@
 #include <utility>
 
 #include "common/number_text.h"
-#include "fusion/io/config.h"
-#include "fusion/io/provenance_json.h"
-#include "fusion/io/visual_model_file.h"
+#include "io/config.h"
+#include "io/provenance_json.h"
+#include "io/visual_model_file.h"
 #include "session/evaluation_baselines.h"
 #include "session/evaluation_nodes.h"
 

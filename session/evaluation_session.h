@@ -19,11 +19,11 @@
 #include "common/progress.h"
 #include "common/provenance.h"
 #include "common/status.h"
+#include "dataset/image_loader.h"
 #include "fusion/fabmap/evaluation.h"
 #include "fusion/fabmap/localiser.h"
 #include "fusion/fabmap/visual_model.h"
 #include "fusion/replay_pipeline.h"
-#include "sensors/dataset/image_loader.h"
 #include "session/evaluation_nodes.h"
 
 namespace ratslam {

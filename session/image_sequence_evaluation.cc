@@ -10,8 +10,8 @@
 
 #include "common/file_util.h"
 #include "common/number_text.h"
-#include "fusion/io/provenance_json.h"
-#include "sensors/dataset/csv.h"
+#include "dataset/csv.h"
+#include "io/provenance_json.h"
 
 namespace ratslam {
 namespace {

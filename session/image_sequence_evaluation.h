@@ -14,7 +14,7 @@
 #include "common/output_folder.h"
 #include "common/provenance.h"
 #include "common/status.h"
-#include "sensors/dataset/image_loader.h"
+#include "dataset/image_loader.h"
 #include "sensors/sequence_matcher.h"
 
 namespace ratslam {

@@ -6,8 +6,8 @@
 #include <sstream>
 
 #include "common/number_text.h"
-#include "sensors/dataset/dataset_loader.h"
-#include "sensors/dataset/ipin_log.h"
+#include "dataset/dataset_loader.h"
+#include "dataset/ipin_log.h"
 #include "session/evaluation_baselines.h"
 
 namespace ratslam {

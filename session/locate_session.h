@@ -16,11 +16,11 @@
 #include <vector>
 
 #include "common/status.h"
+#include "dataset/dataset.h"
+#include "dataset/phone_log.h"
 #include "fusion/phone_localisation/locate_options.h"
 #include "fusion/phone_localisation/particle_filter.h"
 #include "fusion/phone_localisation/wifi_gp_map.h"
-#include "sensors/dataset/dataset.h"
-#include "sensors/dataset/phone_log.h"
 
 namespace ratslam {
 

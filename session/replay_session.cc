@@ -4,11 +4,11 @@
 #include <stdexcept>
 #include <utility>
 
-#include "fusion/io/config.h"
-#include "fusion/io/front_end_resources.h"
-#include "fusion/io/map_file.h"
-#include "sensors/dataset/dataset_loader.h"
-#include "sensors/dataset/visual_odometry_source.h"
+#include "dataset/dataset_loader.h"
+#include "dataset/visual_odometry_source.h"
+#include "io/config.h"
+#include "io/front_end_resources.h"
+#include "io/map_file.h"
 
 namespace ratslam {
 Status CheckSameConfiguration(const MapFile& map, const PipelineOptions& now) {

@@ -23,11 +23,11 @@
 #include "common/progress.h"
 #include "common/provenance.h"
 #include "common/status.h"
-#include "fusion/io/map_file.h"
-#include "fusion/io/run_outputs.h"
+#include "dataset/dataset.h"
+#include "dataset/image_loader.h"
 #include "fusion/replay_pipeline.h"
-#include "sensors/dataset/dataset.h"
-#include "sensors/dataset/image_loader.h"
+#include "io/map_file.h"
+#include "io/run_outputs.h"
 
 namespace ratslam {
 

@@ -10,8 +10,8 @@
 #include <set>
 
 #include "common/scratch_dir.h"
-#include "fusion/io/map_file.h"
-#include "sensors/dataset/synthetic_dataset.h"
+#include "dataset/synthetic_dataset.h"
+#include "io/map_file.h"
 
 namespace ratslam {
 namespace {

@@ -6,9 +6,9 @@
 
 #include "common/file_util.h"
 #include "common/geometry.h"
-#include "fusion/io/config.h"
-#include "fusion/io/run_reader.h"
-#include "sensors/dataset/dataset_loader.h"
+#include "dataset/dataset_loader.h"
+#include "io/config.h"
+#include "io/run_reader.h"
 #include "session/locate_session.h"
 #include "sim/world.h"
 

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "common/random.h"
-#include "sensors/dataset/dataset.h"
+#include "dataset/dataset.h"
 #include "sim/world.h"
 
 namespace ratslam::sim {

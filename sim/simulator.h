@@ -18,8 +18,8 @@
 #include <vector>
 
 #include "common/status.h"
+#include "dataset/dataset.h"
 #include "render/view_renderer.h"
-#include "sensors/dataset/dataset.h"
 #include "sim/world.h"
 
 namespace ratslam::sim {

@@ -28,8 +28,8 @@
 #include "common/random.h"
 #include "common/text_file.h"
 #include "common/toml_binder.h"
-#include "fusion/io/config.h"
-#include "fusion/io/run_outputs.h"
+#include "io/config.h"
+#include "io/run_outputs.h"
 #include "session/evaluation_session.h"
 #include "sweep/sweep_internal.h"
 

@@ -17,9 +17,9 @@
 
 #include "common/output_guard.h"
 #include "common/scratch_dir.h"
-#include "fusion/io/config.h"
-#include "fusion/io/run_outputs.h"
-#include "sensors/dataset/dataset.h"
+#include "dataset/dataset.h"
+#include "io/config.h"
+#include "io/run_outputs.h"
 
 extern char** environ;
 

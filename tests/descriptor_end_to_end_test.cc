@@ -13,8 +13,8 @@
 #include <nlohmann/json.hpp>
 
 #include "common/random.h"
-#include "sensors/dataset/descriptor_file.h"
-#include "sensors/dataset/synthetic_dataset.h"
+#include "dataset/descriptor_file.h"
+#include "dataset/synthetic_dataset.h"
 #include "tests/run_ratslam.h"
 
 namespace ratslam {

@@ -17,8 +17,8 @@
 
 #include "apps/demo_config.h"
 #include "common/scratch_dir.h"
-#include "fusion/io/map_file.h"
-#include "sensors/dataset/synthetic_dataset.h"
+#include "dataset/synthetic_dataset.h"
+#include "io/map_file.h"
 #include "tests/run_ratslam.h"
 
 extern char** environ;

@@ -11,7 +11,7 @@
 #include <string>
 
 #include "common/scratch_dir.h"
-#include "fusion/io/map_file.h"
+#include "io/map_file.h"
 #include "tests/run_ratslam.h"
 
 namespace ratslam {

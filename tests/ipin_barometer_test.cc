@@ -14,8 +14,8 @@
 #include <iostream>
 #include <string>
 
+#include "dataset/ipin_log.h"
 #include "sensors/barometer.h"
-#include "sensors/dataset/ipin_log.h"
 
 namespace ratslam {
 namespace {

@@ -22,7 +22,7 @@
 #include <utility>
 
 #include "common/median.h"
-#include "sensors/dataset/dataset_loader.h"
+#include "dataset/dataset_loader.h"
 #include "tests/documented_keys.h"
 #include "tests/run_ratslam.h"
 

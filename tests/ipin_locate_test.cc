@@ -21,8 +21,8 @@
 #include <string>
 
 #include "common/text_file.h"
+#include "dataset/csv.h"
 #include "fusion/phone_localisation/wifi_gp_map.h"
-#include "sensors/dataset/csv.h"
 #include "tests/documented_keys.h"
 #include "tests/run_ratslam.h"
 

@@ -21,8 +21,8 @@
 #include <string>
 #include <vector>
 
-#include "sensors/dataset/csv.h"
-#include "sensors/dataset/dataset_loader.h"
+#include "dataset/csv.h"
+#include "dataset/dataset_loader.h"
 #include "tests/documented_keys.h"
 
 namespace ratslam {

@@ -1,5 +1,5 @@
 // A small synthetic library in the long-term UJI data set's layout (db/<month>/<set>{rss,crd,tms,
-// ids}.csv; sensors/dataset/uji_long_term.h), for tests: two floors (3 and 5) of a 69 m corridor,
+// ids}.csv; dataset/uji_long_term.h), for tests: two floors (3 and 5) of a 69 m corridor,
 // 24 places per floor 3 m apart, three scans per place. Twelve access points (six per floor, on
 // the corridor every 14 m) follow a log-distance model with 18 dB per storey between floors and
 // +-3 dB of seeded noise; below -100 dBm they are not detected (100).

@@ -6,9 +6,9 @@
 #include <string>
 
 #include "common/status.h"
+#include "dataset/dataset.h"
 #include "ratslam/records.h"
 #include "render/renderer.h"
-#include "sensors/dataset/dataset.h"
 #include "viewer/figure_output.h"
 #include "viewer/figures.h"
 

@@ -5,9 +5,9 @@
 #include <vector>
 
 #include "common/status.h"
+#include "dataset/dataset.h"
+#include "dataset/image_loader.h"
 #include "sensors/classic_camera_matcher.h"
-#include "sensors/dataset/dataset.h"
-#include "sensors/dataset/image_loader.h"
 #include "sensors/wifi_fingerprint_matcher.h"
 
 namespace ratslam {

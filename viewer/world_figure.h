@@ -3,8 +3,8 @@
 #ifndef RATSLAM_VIEWER_WORLD_FIGURE_H_
 #define RATSLAM_VIEWER_WORLD_FIGURE_H_
 
+#include "dataset/dataset.h"
 #include "render/scene.h"
-#include "sensors/dataset/dataset.h"
 #include "sim/world.h"
 
 namespace ratslam::sim {

@@ -13,7 +13,7 @@
 
 #include "common/schema.h"
 #include "common/status.h"
-#include "sensors/dataset/dataset.h"
+#include "dataset/dataset.h"
 
 namespace ratslam::fabmap {
 

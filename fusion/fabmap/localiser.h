@@ -27,10 +27,10 @@
 
 #include "common/schema.h"
 #include "common/status.h"
+#include "dataset/dataset.h"
 #include "fusion/fabmap/chow_liu.h"
 #include "fusion/fabmap/fabmap.h"
 #include "fusion/fabmap/wifi_words.h"
-#include "sensors/dataset/dataset.h"
 
 namespace ratslam::fabmap {
 

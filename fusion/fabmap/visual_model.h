@@ -10,9 +10,9 @@
 
 #include "common/schema.h"
 #include "common/status.h"
+#include "dataset/image_loader.h"
 #include "fusion/fabmap/localiser.h"
 #include "fusion/fabmap/vocabulary.h"
-#include "sensors/dataset/image_loader.h"
 
 namespace ratslam::fabmap {
 
@@ -40,7 +40,7 @@ struct TrainedVisualModel {
 };
 
 // Trains on `images` (read through `loader`); `progress` (optional) gets (done, total) per
-// image. Loading a saved model or listing a folder is fusion/io/visual_model_file.h's job.
+// image. Loading a saved model or listing a folder is io/visual_model_file.h's job.
 StatusOr<TrainedVisualModel> TrainVisualModel(const std::vector<std::string>& images,
                                               const FeatureOptions& features,
                                               const VocabularyOptions& vocabulary,

@@ -15,8 +15,8 @@
 
 #include "common/schema.h"
 #include "common/status.h"
+#include "dataset/image_loader.h"
 #include "fusion/fabmap/chow_liu.h"
-#include "sensors/dataset/image_loader.h"
 
 namespace ratslam::fabmap {
 

@@ -21,8 +21,8 @@
 
 #include "common/schema.h"
 #include "common/status.h"
+#include "dataset/dataset.h"
 #include "fusion/fabmap/chow_liu.h"
-#include "sensors/dataset/dataset.h"
 
 namespace ratslam::fabmap {
 

@@ -1,5 +1,5 @@
 // What `ratslam wifi-map` and `ratslam locate` are configured by; one TOML section per member
-// (fusion/io/config.h reads and prints it like the replay's configuration).
+// (io/config.h reads and prints it like the replay's configuration).
 #ifndef RATSLAM_FUSION_PHONE_LOCALISATION_LOCATE_OPTIONS_H_
 #define RATSLAM_FUSION_PHONE_LOCALISATION_LOCATE_OPTIONS_H_
 

@@ -28,7 +28,7 @@
 #include "common/geometry.h"
 #include "common/schema.h"
 #include "common/status.h"
-#include "sensors/dataset/dataset.h"
+#include "dataset/dataset.h"
 
 namespace ratslam {
 
