@@ -14,7 +14,7 @@
 #include "apps/progress.h"
 #include "common/number_text.h"
 #include "common/output_folder.h"
-#include "fusion/phone_localisation/robot_call.h"
+#include "phone/robot_call.h"
 #include "render/image.h"
 #include "session/call_session.h"
 #include "viewer/figures.h"

@@ -16,9 +16,9 @@
 #include <vector>
 
 #include "common/random.h"
-#include "fusion/phone_localisation/particle_filter.h"
-#include "fusion/phone_localisation/robot_call.h"
-#include "fusion/phone_localisation/wifi_gp_map.h"
+#include "phone/particle_filter.h"
+#include "phone/robot_call.h"
+#include "phone/wifi_gp_map.h"
 
 namespace ratslam {
 namespace {

@@ -10,9 +10,9 @@
 #include <set>
 #include <string>
 
-#include "fusion/phone_localisation/robot_call.h"
 #include "fuzz/fuzz_support.h"
 #include "io/run_reader.h"
+#include "phone/robot_call.h"
 
 namespace ratslam::fuzz {
 namespace {

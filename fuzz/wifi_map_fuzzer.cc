@@ -5,9 +5,9 @@
 #include <cmath>
 #include <string>
 
-#include "fusion/phone_localisation/particle_filter.h"
-#include "fusion/phone_localisation/wifi_gp_map.h"
 #include "fuzz/fuzz_support.h"
+#include "phone/particle_filter.h"
+#include "phone/wifi_gp_map.h"
 
 namespace ratslam::fuzz {
 

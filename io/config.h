@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "common/status.h"
-#include "fusion/phone_localisation/locate_options.h"
 #include "fusion/replay_pipeline.h"
+#include "phone/locate_options.h"
 
 namespace ratslam {
 

@@ -16,8 +16,8 @@
 
 #include "common/geometry.h"
 #include "common/status.h"
-#include "fusion/phone_localisation/particle_filter.h"
-#include "fusion/phone_localisation/robot_call.h"
+#include "phone/particle_filter.h"
+#include "phone/robot_call.h"
 #include "ratslam/experience_map.h"
 #include "session/locate_session.h"
 

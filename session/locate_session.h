@@ -18,9 +18,9 @@
 #include "common/status.h"
 #include "dataset/dataset.h"
 #include "dataset/phone_log.h"
-#include "fusion/phone_localisation/locate_options.h"
-#include "fusion/phone_localisation/particle_filter.h"
-#include "fusion/phone_localisation/wifi_gp_map.h"
+#include "phone/locate_options.h"
+#include "phone/particle_filter.h"
+#include "phone/wifi_gp_map.h"
 
 namespace ratslam {
 

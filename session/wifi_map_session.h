@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "common/status.h"
-#include "fusion/phone_localisation/locate_options.h"
-#include "fusion/phone_localisation/wifi_gp_map.h"
+#include "phone/locate_options.h"
+#include "phone/wifi_gp_map.h"
 
 namespace ratslam {
 

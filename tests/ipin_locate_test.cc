@@ -22,7 +22,7 @@
 
 #include "common/text_file.h"
 #include "dataset/csv.h"
-#include "fusion/phone_localisation/wifi_gp_map.h"
+#include "phone/wifi_gp_map.h"
 #include "tests/documented_keys.h"
 #include "tests/run_ratslam.h"
 

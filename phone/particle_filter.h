@@ -34,8 +34,8 @@
 // Floors: at each scan a particle moves to another floor the map knows (same x, y) with a small
 // probability, so the filter follows a phone up the stairs without a stairs model; the scan's
 // weight then decides.
-#ifndef RATSLAM_FUSION_PHONE_LOCALISATION_PARTICLE_FILTER_H_
-#define RATSLAM_FUSION_PHONE_LOCALISATION_PARTICLE_FILTER_H_
+#ifndef RATSLAM_PHONE_PARTICLE_FILTER_H_
+#define RATSLAM_PHONE_PARTICLE_FILTER_H_
 
 #include <cstdint>
 #include <map>
@@ -49,7 +49,7 @@
 #include "common/random.h"
 #include "common/schema.h"
 #include "common/status.h"
-#include "fusion/phone_localisation/wifi_gp_map.h"
+#include "phone/wifi_gp_map.h"
 #include "sensors/rssi_offset.h"
 
 namespace ratslam {
@@ -239,4 +239,4 @@ std::vector<std::pair<Point2, double>> WeightedKMeans(const std::vector<Point2>&
 
 }  // namespace ratslam
 
-#endif  // RATSLAM_FUSION_PHONE_LOCALISATION_PARTICLE_FILTER_H_
+#endif  // RATSLAM_PHONE_PARTICLE_FILTER_H_

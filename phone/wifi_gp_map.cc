@@ -1,4 +1,4 @@
-#include "fusion/phone_localisation/wifi_gp_map.h"
+#include "phone/wifi_gp_map.h"
 
 #include <algorithm>
 #include <cmath>

@@ -3,8 +3,8 @@
 // gaussian_process.h for the choices behind them). The GP is fitted per tile of cells from the
 // training bins within reach (the kernel is negligible beyond a few length scales), so a map of
 // thousands of poses and hundreds of APs builds in seconds and stores only cells near the APs.
-#ifndef RATSLAM_FUSION_PHONE_LOCALISATION_WIFI_GP_MAP_H_
-#define RATSLAM_FUSION_PHONE_LOCALISATION_WIFI_GP_MAP_H_
+#ifndef RATSLAM_PHONE_WIFI_GP_MAP_H_
+#define RATSLAM_PHONE_WIFI_GP_MAP_H_
 
 #include <cstdint>
 #include <map>
@@ -16,7 +16,7 @@
 
 #include "common/geometry.h"
 #include "common/status.h"
-#include "fusion/phone_localisation/gaussian_process.h"
+#include "phone/gaussian_process.h"
 
 namespace ratslam {
 
@@ -126,4 +126,4 @@ class WifiGpMap {
 
 }  // namespace ratslam
 
-#endif  // RATSLAM_FUSION_PHONE_LOCALISATION_WIFI_GP_MAP_H_
+#endif  // RATSLAM_PHONE_WIFI_GP_MAP_H_

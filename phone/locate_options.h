@@ -1,12 +1,12 @@
 // What `ratslam wifi-map` and `ratslam locate` are configured by; one TOML section per member
 // (io/config.h reads and prints it like the replay's configuration).
-#ifndef RATSLAM_FUSION_PHONE_LOCALISATION_LOCATE_OPTIONS_H_
-#define RATSLAM_FUSION_PHONE_LOCALISATION_LOCATE_OPTIONS_H_
+#ifndef RATSLAM_PHONE_LOCATE_OPTIONS_H_
+#define RATSLAM_PHONE_LOCATE_OPTIONS_H_
 
 #include <string>
 
-#include "fusion/phone_localisation/gaussian_process.h"
-#include "fusion/phone_localisation/particle_filter.h"
+#include "phone/gaussian_process.h"
+#include "phone/particle_filter.h"
 #include "sensors/pedestrian_dead_reckoning.h"
 
 namespace ratslam {
@@ -37,4 +37,4 @@ struct LocateOptions {
 
 }  // namespace ratslam
 
-#endif  // RATSLAM_FUSION_PHONE_LOCALISATION_LOCATE_OPTIONS_H_
+#endif  // RATSLAM_PHONE_LOCATE_OPTIONS_H_

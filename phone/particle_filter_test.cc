@@ -1,4 +1,4 @@
-#include "fusion/phone_localisation/particle_filter.h"
+#include "phone/particle_filter.h"
 
 #include <gtest/gtest.h>
 

@@ -11,8 +11,8 @@
 //    dynamic programming over subsets for up to kExactStops stops (the paper's twelve
 //    candidates take 12 x 2^12 states), otherwise nearest neighbour improved by 2-opt until no
 //    reversal shortens it. Ties break by lower index, so a plan is deterministic.
-#ifndef RATSLAM_FUSION_PHONE_LOCALISATION_ROBOT_CALL_H_
-#define RATSLAM_FUSION_PHONE_LOCALISATION_ROBOT_CALL_H_
+#ifndef RATSLAM_PHONE_ROBOT_CALL_H_
+#define RATSLAM_PHONE_ROBOT_CALL_H_
 
 #include <cstdint>
 #include <utility>
@@ -55,4 +55,4 @@ void ShortestPaths(const RouteGraph& graph, uint32_t source, std::vector<double>
 
 }  // namespace ratslam
 
-#endif  // RATSLAM_FUSION_PHONE_LOCALISATION_ROBOT_CALL_H_
+#endif  // RATSLAM_PHONE_ROBOT_CALL_H_

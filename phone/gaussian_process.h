@@ -18,8 +18,8 @@
 //    half a dB) in place of sigma_f^2 in eq. 11's kernel. Eq. 10 with that kernel needs a new
 //    solve per point (F_s changes the whole K'); GaussianProcess2D::Variance scales eq. 10's
 //    posterior share instead: F * (1 - e' (E + N / sigma_f^2)^-1 e), exact when F = sigma_f^2.
-#ifndef RATSLAM_FUSION_PHONE_LOCALISATION_GAUSSIAN_PROCESS_H_
-#define RATSLAM_FUSION_PHONE_LOCALISATION_GAUSSIAN_PROCESS_H_
+#ifndef RATSLAM_PHONE_GAUSSIAN_PROCESS_H_
+#define RATSLAM_PHONE_GAUSSIAN_PROCESS_H_
 
 #include <optional>
 #include <string>
@@ -114,4 +114,4 @@ class GaussianProcess2D {
 
 }  // namespace ratslam
 
-#endif  // RATSLAM_FUSION_PHONE_LOCALISATION_GAUSSIAN_PROCESS_H_
+#endif  // RATSLAM_PHONE_GAUSSIAN_PROCESS_H_

@@ -1,4 +1,4 @@
-#include "fusion/phone_localisation/robot_call.h"
+#include "phone/robot_call.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "fusion/phone_localisation/gaussian_process.h"
+#include "phone/gaussian_process.h"
 
 #include <gtest/gtest.h>
 
