@@ -79,7 +79,7 @@ int WifiMapCommand(const Arguments& parsed) {
   input.data = args->all.at("--data");
   if (args->values.count("--run")) input.run = args->values.at("--run");
   input.lenient = args->lenient;
-  StatusOr<BuiltWifiMap> built = BuildWifiMap(*options, input);
+  StatusOr<BuiltWifiMap> built = BuildWifiMap(*options, input, args->values.at("--out"));
   if (!built.ok()) return fail(built.status());
   const WifiGpMap* map = &built->map;
   const bool from_run = input.run.has_value();
@@ -89,9 +89,7 @@ int WifiMapCommand(const Arguments& parsed) {
   if (!folder.ok()) return fail(folder.status());
   Status written = folder.value()->Write(out.filename().string(), map->Encode());
   if (!written.ok()) return fail(written);
-  nlohmann::ordered_json j;
-  j["wifi_map"] = out.string();
-  for (const auto& [key, value] : built->summary.items()) j[key] = value;
+  nlohmann::ordered_json& j = built->summary;
   j["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   j["run"] = RunObject(args->Provenance(), args->all.at("--data"), std::nullopt, 0);
   char human[256];
@@ -193,8 +191,7 @@ int CallCommand(const Arguments& parsed) {
   const RouteGraph& graph = call->graph;
   const LocationEstimate& estimate = call->estimate;
   const std::optional<Point2>& truth_on_map = call->truth_on_map;
-  std::vector<Point2> candidates;
-  for (const auto& c : call->candidates) candidates.push_back(c.first);
+  const std::vector<std::pair<Point2, double>>& candidates = call->candidates;
   nlohmann::ordered_json& j = call->summary;
 
   // The figure: the experience map, the particles, the estimate, the truth, the candidates
@@ -212,7 +209,7 @@ int CallCommand(const Arguments& parsed) {
     b.max_y_m = std::max(b.max_y_m, p.y + 2);
   };
   for (const Point2& p : graph.nodes) grow(p);
-  for (const Point2& p : candidates) grow(p);
+  for (const auto& c : candidates) grow(c.first);
   options.bounds = b;
   const std::string route_m = ShortestNumber(std::round(plan->length_m * 10) / 10);
   const std::string stops = std::to_string(plan->stops.size());
@@ -240,7 +237,7 @@ int CallCommand(const Arguments& parsed) {
     for (uint32_t e : plan->route) line.push_back(to_image(graph.nodes[e].x, graph.nodes[e].y));
     scene.Polyline(line, 6.0f, {148, 103, 189, 230});  // purple: red marks loop closures
     for (size_t k = 0; k < candidates.size(); ++k) {
-      const ScenePoint c = to_image(candidates[k].x, candidates[k].y);
+      const ScenePoint c = to_image(candidates[k].first.x, candidates[k].first.y);
       const ScenePoint e =
           to_image(graph.nodes[plan->serving_node[k]].x, graph.nodes[plan->serving_node[k]].y);
       // Numbered by rank as call.json numbers them (0 first); two digits get a larger disc.

@@ -551,17 +551,14 @@ py::dict WifiMap(const std::vector<std::string>& data, const std::string& out,
   const WifiMapInput input{data, run, lenient};
   StatusOr<BuiltWifiMap> built = [&] {
     py::gil_scoped_release release;
-    return BuildWifiMap(options, input);
+    return BuildWifiMap(options, input, out);
   }();
   Check(built.status());
   const std::filesystem::path path = out;
   std::unique_ptr<DiskFolder> folder =
       Take(DiskFolder::Open(path.has_parent_path() ? path.parent_path().string() : "."));
   Check(folder->Write(path.filename().string(), built->map.Encode()));
-  nlohmann::ordered_json j;
-  j["wifi_map"] = out;
-  for (const auto& [key, value] : built->summary.items()) j[key] = value;
-  return py::module_::import("json").attr("loads")(j.dump());
+  return py::module_::import("json").attr("loads")(built->summary.dump());
 }
 
 // ratslam.call: what `ratslam call` does (the phone located up to `at`, the robot's tour to its

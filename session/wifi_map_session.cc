@@ -87,7 +87,8 @@ Status SamplesFromRun(const std::string& run_folder, const std::vector<std::stri
 
 }  // namespace
 
-StatusOr<BuiltWifiMap> BuildWifiMap(const LocateOptions& options, const WifiMapInput& input) {
+StatusOr<BuiltWifiMap> BuildWifiMap(const LocateOptions& options, const WifiMapInput& input,
+                                    const std::string& map_label) {
   PhoneLogOptions phone;
   phone.lenient = input.lenient;
   phone.pdr = options.pdr;
@@ -135,6 +136,7 @@ StatusOr<BuiltWifiMap> BuildWifiMap(const LocateOptions& options, const WifiMapI
   BuiltWifiMap built{std::move(map).value(), scans, samples.size(), {}};
   const WifiGpMap& m = built.map;
   nlohmann::ordered_json& j = built.summary;
+  j["wifi_map"] = map_label;
   j["scans"] = scans;
   j["samples"] = samples.size();
   j["access_points"] = m.bssids().size();

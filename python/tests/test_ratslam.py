@@ -66,6 +66,16 @@ def read_csv(path):
 
 
 class RatslamModuleTest(unittest.TestCase):
+    def route22_walks(self, *repetitions):
+        """The IPIN 2023 route 22 phone logs of these repetitions; skips the test without them."""
+        data = os.path.join(SOURCE, "..", "shared", "data", "ipin2023-t3")
+        walks = [os.path.join(data, f"IPIN2023_T3_TrainingTrial22_repetition{r}.txt")
+                 for r in repetitions]
+        for walk in walks:
+            if not os.path.exists(walk):
+                self.skipTest(f"missing {walk}")
+        return walks
+
     @classmethod
     def setUpClass(cls):
         cls.root = tempfile.mkdtemp(prefix="ratslam_python_")
@@ -334,12 +344,7 @@ class RatslamModuleTest(unittest.TestCase):
         self.assertFalse(os.path.exists(os.path.join(stopped, "evaluation.json")))
 
     def test_locate_equals_the_command_line(self):
-        data = os.path.join(SOURCE, "..", "shared", "data", "ipin2023-t3")
-        walks = [os.path.join(data, f"IPIN2023_T3_TrainingTrial22_repetition{r}.txt")
-                 for r in ("01", "03")]
-        for walk in walks:
-            if not os.path.exists(walk):
-                self.skipTest(f"missing {walk}")
+        walks = self.route22_walks("01", "03")
         wifi_map = os.path.join(self.root, "route22.wifimap")
         subprocess.run([BINARY, "wifi-map", "--data", walks[0], "--out", wifi_map], check=True,
                        capture_output=True)
@@ -364,12 +369,7 @@ class RatslamModuleTest(unittest.TestCase):
 
 
     def test_wifi_map_and_call_equal_the_command_line(self):
-        data = os.path.join(SOURCE, "..", "shared", "data", "ipin2023-t3")
-        walks = [os.path.join(data, f"IPIN2023_T3_TrainingTrial22_repetition{r}.txt")
-                 for r in ("01", "03")]
-        for walk in walks:
-            if not os.path.exists(walk):
-                self.skipTest(f"missing {walk}")
+        walks = self.route22_walks("01", "03")
         run = os.path.join(self.root, "run")
         subprocess.run([BINARY, "replay", "--quiet", "--config",
                         os.path.join(SOURCE, "configs", "ipin2023-wifi-compass.toml"),
