@@ -241,13 +241,18 @@ const std::vector<CommandSpec>& Commands() {
        "of Q is placed on M by the sequence matcher ([sequence]) and by single frames, right "
        "within N frames of its true place (same file name, else same position, else "
        "--ground-truth): evaluation.json, queries.csv, pr_curve.csv, pr_curve.png, "
-       "difference_matrix.png.",
+       "difference_matrix.png. --map-descriptors and --query-descriptors add descriptors "
+       "computed elsewhere, matched the same two ways beside the images.",
        {kConfig, Text("--map", "M", "data set to map", true),
         Text("--query", "Q", "data set to localise", true),
         Whole("--frame-tolerance", "N",
               "image-sequence place recognition: right within N reference frames", 0, 1000000),
         Text("--ground-truth", "CSV",
              "with --frame-tolerance: query,reference file-name pairs (default: by name)"),
+        Text("--map-descriptors", "F",
+             "with --frame-tolerance: place descriptors of M's images (.npy or .csv, a row per "
+             "image in file-name order), matched too; needs --query-descriptors"),
+        Text("--query-descriptors", "F", "with --map-descriptors: those of Q's images"),
         Text("--out", "O", "output folder", true), kOverwrite, kLenient, kQuiet, kJson,
         Formats("formats of the figures: png, pdf, svg, comma-separated (default png)"),
         WidthMm("page width of PDF and SVG figures (default 180: two panels)")},

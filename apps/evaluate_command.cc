@@ -34,6 +34,8 @@ int ImageSequenceEvaluate(const Arguments& args, const PipelineOptions& pipeline
   options.ground_truth_csv = args.Value("--ground-truth");
   options.frame_tolerance = std::stoi(args.values.at("--frame-tolerance"));
   options.matcher = pipeline.sensors.sequence;
+  options.reference_descriptors = args.Value("--map-descriptors");
+  options.query_descriptors = args.Value("--query-descriptors");
   for (const std::string& folder : {options.reference_folder, options.query_folder}) {
     if (!IsImageSequenceFolder(folder)) {
       return fail(Status::Error(folder + ": with --frame-tolerance, --map and --query are "
@@ -76,13 +78,21 @@ int ImageSequenceEvaluate(const Arguments& args, const PipelineOptions& pipeline
   const PlaceRecognitionMetrics& single = e->single_metrics;
   const std::string tolerance = " (right within " + std::to_string(options.frame_tolerance) +
                                 (options.frame_tolerance == 1 ? " frame)" : " frames)");
+  const std::string sequences =
+      "sequences of " + std::to_string(options.matcher.sequence_length) + " frames";
+  std::vector<std::pair<std::string, const PlaceRecognitionMetrics*>> rows = {
+      {"sequence", &seq}, {"single frame", &single}};
+  std::vector<std::string> labels = {sequences, "single frames"};
+  if (e->descriptors) {
+    rows.push_back({"desc. sequence", &e->descriptors->sequence_metrics});
+    rows.push_back({"desc. single", &e->descriptors->single_metrics});
+    labels.push_back("descriptors, " + sequences);
+    labels.push_back("descriptors, single frames");
+  }
   {
-    std::vector<std::string> labels = {
-        "sequences of " + std::to_string(options.matcher.sequence_length) + " frames",
-        "single frames"};
-    std::vector<std::vector<double>> recall(2), precision(2);
-    for (size_t k = 0; k < 2; ++k) {
-      for (const PrecisionRecall& p : (k == 0 ? seq : single).curve) {
+    std::vector<std::vector<double>> recall(rows.size()), precision(rows.size());
+    for (size_t k = 0; k < rows.size(); ++k) {
+      for (const PrecisionRecall& p : rows[k].second->curve) {
         recall[k].push_back(p.recall);
         precision[k].push_back(p.precision);
       }
@@ -114,17 +124,16 @@ int ImageSequenceEvaluate(const Arguments& args, const PipelineOptions& pipeline
       return fail(s);
     }
   }
-  char table[512];
-  std::snprintf(table, sizeof table,
-                "%-14s %9s %9s %8s %12s %9s\n"
-                "%-14s %8.1f%% %8.1f%% %8.3f %11.1f%% %9zu\n"
-                "%-14s %8.1f%% %8.1f%% %8.3f %11.1f%% %9zu\n",
-                "matcher", "recall@1", "recall@5", "PR AUC", "R@100%prec", "declined", "sequence",
-                100 * seq.recall_at_1, 100 * seq.recall_at_5, seq.pr_auc,
-                100 * seq.recall_at_100_precision, seq.declined, "single frame",
-                100 * single.recall_at_1, 100 * single.recall_at_5, single.pr_auc,
-                100 * single.recall_at_100_precision, single.declined);
-  std::string text = table;
+  char line[160];
+  std::snprintf(line, sizeof line, "%-14s %9s %9s %8s %12s %9s\n", "matcher", "recall@1",
+                "recall@5", "PR AUC", "R@100%prec", "declined");
+  std::string text = line;
+  for (const auto& [name, m] : rows) {
+    std::snprintf(line, sizeof line, "%-14s %8.1f%% %8.1f%% %8.3f %11.1f%% %9zu\n", name.c_str(),
+                  100 * m->recall_at_1, 100 * m->recall_at_5, m->pr_auc,
+                  100 * m->recall_at_100_precision, m->declined);
+    text += line;
+  }
   text += "(" + std::to_string(seq.queries) + " queries" + tolerance + ", " +
           std::to_string(e->reference_files.size()) + " references; matching " +
           ShortestNumber(std::round(e->match_seconds * 1000) / 1000) + " s)\n";
@@ -145,9 +154,11 @@ int EvaluateCommand(const Arguments& parsed) {
   const auto pipeline = LoadOptions(*args, &options.config_path);
   if (!pipeline) return kExitError;
   if (args->values.count("--frame-tolerance")) return ImageSequenceEvaluate(*args, *pipeline);
-  if (args->values.count("--ground-truth")) {
-    std::cerr << MessagePrefix() << "--ground-truth needs --frame-tolerance\n";
-    return kExitUsage;
+  for (const char* image_only : {"--ground-truth", "--map-descriptors", "--query-descriptors"}) {
+    if (args->values.count(image_only)) {
+      std::cerr << MessagePrefix() << image_only << " needs --frame-tolerance\n";
+      return kExitUsage;
+    }
   }
   options.pipeline = *pipeline;
   options.map_path = args->values.at("--map");

@@ -12,9 +12,7 @@ data=${3:-../shared/data/nordland-64x32}
 ratslam="$build/apps/ratslam"
 mkdir -p "$out"
 py=/usr/bin/python3
-field() { "$py" -c "import json,sys; j=json.load(open(sys.argv[1])); v=j
-for k in sys.argv[2].split('.'): v=v[k]
-print(f'{100*v:.1f}' if sys.argv[3]=='%' else f'{v:.3f}')" "$@"; }
+field() { "$py" "$(dirname "$0")/json_field.py" "$@"; }
 echo "| sequence length | tolerance (frames) | recall@1 | recall@5 | PR AUC | recall at 100 % precision | centred: recall@1 | recall at 100 % precision | single frame recall@1 | matching (s) |"
 echo "|---|---|---|---|---|---|---|---|---|---|"
 for tolerance in 0 1 2; do

@@ -303,16 +303,40 @@ StatusOr<SequenceMatcher::Result> SequenceMatcher::AddQuery(const PreparedFrame&
                          std::to_string(references_[0].width) + "x" +
                          std::to_string(references_[0].height));
   }
-  Result result;
-  result.differences.resize(n);
+  std::vector<float> differences(n);
   for (int r = 0; r < n; ++r) {
-    result.differences[r] = static_cast<float>(FrameDifference(frame, references_[r]));
+    differences[r] = static_cast<float>(FrameDifference(frame, references_[r]));
   }
+  return Match(std::move(differences), frame.blank, candidates, answers);
+}
+
+StatusOr<SequenceMatcher::Result> SequenceMatcher::AddQueryDifferences(
+    std::vector<float> differences, bool blank, int candidates, int searchable) {
+  const int n = static_cast<int>(references_.size());
+  if (differences.size() != references_.size()) {
+    return Status::Error("a query row of " + std::to_string(differences.size()) +
+                         " differences for " + std::to_string(n) + " references");
+  }
+  for (size_t r = 0; r < differences.size(); ++r) {
+    if (!std::isfinite(differences[r]) || differences[r] < 0.0f) {
+      return Status::Error("difference to reference " + std::to_string(r) +
+                           " is negative or not finite");
+    }
+  }
+  return Match(std::move(differences), blank, candidates,
+               searchable < 0 ? n : std::min(n, searchable));
+}
+
+SequenceMatcher::Result SequenceMatcher::Match(std::vector<float> differences, bool blank,
+                                               int candidates, int answers) {
+  const int n = static_cast<int>(references_.size());
+  Result result;
+  result.differences = std::move(differences);
 
   // Contrast enhancement along the references (eq. 1): each difference less the mean of its
   // window, over the window's standard deviation; blank references take no part.
   Row row;
-  row.blank = frame.blank;
+  row.blank = blank;
   row.enhanced.assign(n, 0.0f);
   row.neutral = 0.0f;
   std::vector<double> prefix(n + 1, 0.0), prefix_sq(n + 1, 0.0), prefix_count(n + 1, 0.0);
@@ -351,7 +375,7 @@ StatusOr<SequenceMatcher::Result> SequenceMatcher::AddQuery(const PreparedFrame&
   // Single frame: the raw differences, blank references excluded.
   {
     std::vector<double> score(n, inf);
-    if (!frame.blank) {
+    if (!blank) {
       for (int r = 0; r < answers; ++r) {
         if (!references_[r].blank) score[r] = result.differences[r];
       }

@@ -166,6 +166,13 @@ class SequenceMatcher {
   };
   // Only references below `searchable` (all when negative) can be answers.
   StatusOr<Result> AddQuery(const PreparedFrame& frame, int candidates = 5, int searchable = -1);
+  // The same for a query known only by its row of differences to the references (one per
+  // reference, in their order; lower is more alike, any non-negative finite scale, e.g. 1 - the
+  // cosine similarity of place descriptors computed elsewhere). Such references need no pixels:
+  // a PreparedFrame with only `blank` set stands for one. Fails on a row of the wrong length or
+  // a negative or non-finite difference.
+  StatusOr<Result> AddQueryDifferences(std::vector<float> differences, bool blank,
+                                       int candidates = 5, int searchable = -1);
 
   // The place of the query `back` frames before the newest (0 <= back < queries_in_sequence())
   // by the best line through all the stored query frames, newer ones included: with back about
@@ -196,6 +203,8 @@ class SequenceMatcher {
 
  private:
   SequenceMatch Search(int back, int answers, int candidates) const;
+  // Enhances and stores a query's row (of references_.size() differences) and searches.
+  Result Match(std::vector<float> differences, bool blank, int candidates, int answers);
 
   SequenceMatcherOptions options_;
   std::vector<PreparedFrame> references_;  // in route order

@@ -267,5 +267,40 @@ TEST(SequenceMatcherTest, StateRoundTripsAndBadStateIsRefused) {
   EXPECT_EQ(b.references(), a.references());
 }
 
+// Rows of differences given directly (references without pixels): a route travelled at 1.2
+// reference frames per query frame, every row a noisy dip at the true place over a flat floor
+// with a decoy as deep as the dip at a random place. Single frames are fooled by the decoys
+// about half the time; sequences, which the decoys do not line up for, are within a frame once
+// full. A row of the wrong length, a NaN and a negative difference are errors.
+TEST(SequenceMatcherTest, RowsOfDifferencesFromElsewhere) {
+  SequenceMatcher matcher{SequenceMatcherOptions{}};
+  const int n = 300;
+  for (int r = 0; r < n; ++r) ASSERT_TRUE(matcher.AddReference(PreparedFrame{}).ok());
+  Random random(8);
+  int single_right = 0, queries = 0;
+  for (int j = 0; j < 200; ++j) {
+    const int truth = static_cast<int>(std::lround(10 + 1.2 * j));
+    std::vector<float> row(n);
+    for (int r = 0; r < n; ++r) row[r] = static_cast<float>(1.0 + random.Uniform(0, 0.1));
+    row[truth] = static_cast<float>(random.Uniform(0.3, 0.6));
+    if (random.Uniform(0, 1) < 0.5) row[static_cast<int>(random.Uniform(0, n))] = 0.2f;
+    const auto r = matcher.AddQueryDifferences(row, false);
+    ASSERT_TRUE(r.ok()) << r.status().message();
+    ++queries;
+    single_right += r->single.reference == truth;
+    if (j >= 9) {
+      EXPECT_LE(std::abs(r->sequence.reference - truth), 1) << j;
+    }
+  }
+  EXPECT_LT(single_right, queries * 3 / 4);
+  EXPECT_FALSE(matcher.AddQueryDifferences(std::vector<float>(n - 1, 1.0f), false).ok());
+  std::vector<float> bad(n, 1.0f);
+  bad[7] = std::nanf("");
+  EXPECT_NE(matcher.AddQueryDifferences(bad, false).status().message().find("reference 7"),
+            std::string::npos);
+  bad[7] = -0.5f;
+  EXPECT_FALSE(matcher.AddQueryDifferences(bad, false).ok());
+}
+
 }  // namespace
 }  // namespace ratslam

@@ -1,5 +1,6 @@
 #include "session/image_sequence_evaluation.h"
 
+#include <Eigen/Core>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -11,6 +12,8 @@
 #include "common/file_util.h"
 #include "common/number_text.h"
 #include "dataset/csv.h"
+#include "dataset/descriptor_file.h"
+#include "fusion/descriptor_table.h"
 #include "io/provenance_json.h"
 
 namespace ratslam {
@@ -45,6 +48,64 @@ nlohmann::ordered_json MetricsJson(const PlaceRecognitionMetrics& m) {
   j["pr_auc"] = m.pr_auc;
   j["recall_at_100_precision"] = m.recall_at_100_precision;
   return j;
+}
+
+// Places every query in turn (`add(q)` adds query q to the matcher and returns its result):
+// sequence answers (centred when the options say so) and single-frame answers, and each
+// query's raw differences when `differences` is not null.
+Status MatchQueries(const SequenceMatcherOptions& o, size_t queries,
+                    const std::function<StatusOr<SequenceMatcher::Result>(size_t)>& add,
+                    const std::vector<int>& truth, std::vector<QueryAnswer>* sequence,
+                    std::vector<QueryAnswer>* single, std::vector<std::vector<float>>* differences,
+                    const std::function<void(size_t, size_t)>& progress,
+                    const std::atomic<bool>* stop, SequenceMatcher* matcher) {
+  // Centred: query q is placed once the (sequence_length - 1) / 2 frames after it are in, the
+  // route's last ones by its last sequence.
+  const size_t lag = o.centred ? static_cast<size_t>(o.sequence_length - 1) / 2 : 0;
+  for (size_t q = 0; q < queries; ++q) {
+    if (stop && stop->load()) return Status::Error("stopped");
+    StatusOr<SequenceMatcher::Result> r = add(q);
+    if (!r.ok()) return r.status();
+    sequence->push_back({truth[q], std::move(r->sequence)});
+    if (lag > 0 && q >= lag) (*sequence)[q - lag].match = matcher->MatchAt(static_cast<int>(lag));
+    single->push_back({truth[q], std::move(r->single)});
+    if (differences) differences->push_back(std::move(r->differences));
+    if (progress) progress(q + 1, queries);
+  }
+  for (size_t q = queries - std::min(queries, lag); lag > 0 && q < queries; ++q) {
+    (*sequence)[q].match = matcher->MatchAt(static_cast<int>(queries - 1 - q));
+  }
+  return Status::Ok();
+}
+
+struct DescriptorRows {
+  size_t rows = 0, cols = 0;
+  std::vector<float> unit;  // row-major, each row of unit length
+};
+
+// The descriptors of `path`, one row per image of `folder`, each scaled to unit length.
+StatusOr<DescriptorRows> LoadDescriptorRows(const std::string& path, const std::string& folder,
+                                            size_t images) {
+  StatusOr<DescriptorMatrix> m = ReadDescriptorFile(path);
+  if (!m.ok()) return m.status();
+  if (m->rows != images) {
+    return Status::Error(path + ": " + std::to_string(m->rows) + " rows for the " +
+                         std::to_string(images) + " images of " + folder +
+                         " (one row per image, in file-name order)");
+  }
+  DescriptorRows d;
+  d.rows = m->rows;
+  d.cols = m->cols;
+  d.unit.reserve(m->values.size());
+  std::vector<float> unit;
+  for (size_t r = 0; r < m->rows; ++r) {
+    if (!UnitDescriptor(m->values.data() + r * m->cols, m->cols, &unit)) {
+      return Status::Error(path + ": row " + std::to_string(r + 1) +
+                           " has no direction (all zeros), so no cosine similarity");
+    }
+    d.unit.insert(d.unit.end(), unit.begin(), unit.end());
+  }
+  return d;
 }
 
 }  // namespace
@@ -188,6 +249,26 @@ StatusOr<ImageSequenceEvaluation> EvaluateImageSequences(
       PairQueriesWithReferences(e.reference_files, e.query_files, options.ground_truth_csv);
   if (!truth.ok()) return truth.status();
   e.truth = std::move(*truth);
+  // Descriptor files are read first: a bad one fails before the images are matched.
+  std::optional<DescriptorRows> refs_d, queries_d;
+  if (options.reference_descriptors.empty() != options.query_descriptors.empty()) {
+    return Status::Error("descriptors: give a file for the map and one for the queries, or none");
+  }
+  if (!options.reference_descriptors.empty()) {
+    StatusOr<DescriptorRows> r = LoadDescriptorRows(
+        options.reference_descriptors, options.reference_folder, e.reference_files.size());
+    if (!r.ok()) return r.status();
+    StatusOr<DescriptorRows> q =
+        LoadDescriptorRows(options.query_descriptors, options.query_folder, e.query_files.size());
+    if (!q.ok()) return q.status();
+    if (q->cols != r->cols) {
+      return Status::Error(options.query_descriptors + ": " + std::to_string(q->cols) +
+                           " values per row, " + options.reference_descriptors + " has " +
+                           std::to_string(r->cols));
+    }
+    refs_d = std::move(*r);
+    queries_d = std::move(*q);
+  }
 
   const SequenceMatcherOptions& o = options.matcher;
   auto prepare = [&](const std::string& folder,
@@ -221,29 +302,52 @@ StatusOr<ImageSequenceEvaluation> EvaluateImageSequences(
   e.load_seconds = Seconds(start);
 
   const auto matching = std::chrono::steady_clock::now();
-  // Centred: query q is placed once the (sequence_length - 1) / 2 frames after it are in, the
-  // route's last ones by its last sequence.
-  const size_t lag = o.centred ? static_cast<size_t>(o.sequence_length - 1) / 2 : 0;
-  for (size_t q = 0; q < query_frames.size(); ++q) {
-    if (stop && stop->load()) return Status::Error("stopped");
-    StatusOr<SequenceMatcher::Result> r = matcher.AddQuery(query_frames[q]);
-    if (!r.ok()) {
-      return Status::Error((fs::path(options.query_folder) / e.query_files[q]).string() + ": " +
-                           r.status().message());
-    }
-    e.sequence.push_back({e.truth[q], std::move(r->sequence)});
-    if (lag > 0 && q >= lag) e.sequence[q - lag].match = matcher.MatchAt(static_cast<int>(lag));
-    e.single.push_back({e.truth[q], std::move(r->single)});
-    e.differences.push_back(std::move(r->differences));
-    if (progress) progress(q + 1, query_frames.size());
-  }
-  const size_t n = query_frames.size();
-  for (size_t q = n - std::min(n, lag); lag > 0 && q < n; ++q) {
-    e.sequence[q].match = matcher.MatchAt(static_cast<int>(n - 1 - q));
-  }
+  RATSLAM_RETURN_IF_ERROR(MatchQueries(
+      o, query_frames.size(),
+      [&](size_t q) -> StatusOr<SequenceMatcher::Result> {
+        StatusOr<SequenceMatcher::Result> r = matcher.AddQuery(query_frames[q]);
+        if (!r.ok()) {
+          return Status::Error((fs::path(options.query_folder) / e.query_files[q]).string() + ": " +
+                               r.status().message());
+        }
+        return r;
+      },
+      e.truth, &e.sequence, &e.single, &e.differences, progress, stop, &matcher));
   e.match_seconds = Seconds(matching);
   e.sequence_metrics = MetricsOf(e.sequence, options.frame_tolerance);
   e.single_metrics = MetricsOf(e.single, options.frame_tolerance);
+  if (refs_d) {
+    const auto start_descriptors = std::chrono::steady_clock::now();
+    e.descriptor_dimensions = refs_d->cols;
+    SequenceMatcher by_descriptor(o);
+    for (bool blank : e.reference_blank) {
+      PreparedFrame place;
+      place.blank = blank;
+      RATSLAM_RETURN_IF_ERROR(by_descriptor.AddReference(std::move(place)));
+    }
+    const Eigen::Map<const Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>
+        reference_rows(refs_d->unit.data(), static_cast<Eigen::Index>(refs_d->rows),
+                       static_cast<Eigen::Index>(refs_d->cols));
+    MatcherAnswers d;
+    RATSLAM_RETURN_IF_ERROR(MatchQueries(
+        o, query_frames.size(),
+        [&](size_t q) {
+          const Eigen::Map<const Eigen::VectorXf> query(
+              queries_d->unit.data() + q * queries_d->cols,
+              static_cast<Eigen::Index>(queries_d->cols));
+          const Eigen::VectorXf cosine = reference_rows * query;
+          std::vector<float> row(cosine.size());
+          for (Eigen::Index r = 0; r < cosine.size(); ++r) {
+            row[r] = std::clamp(1.0f - cosine[r], 0.0f, 2.0f);
+          }
+          return by_descriptor.AddQueryDifferences(std::move(row), query_frames[q].blank);
+        },
+        e.truth, &d.sequence, &d.single, nullptr, {}, stop, &by_descriptor));
+    d.sequence_metrics = MetricsOf(d.sequence, options.frame_tolerance);
+    d.single_metrics = MetricsOf(d.single, options.frame_tolerance);
+    e.descriptors = std::move(d);
+    e.descriptor_match_seconds = Seconds(start_descriptors);
+  }
   return e;
 }
 
@@ -266,6 +370,17 @@ Status WriteImageSequenceOutputs(const ImageSequenceEvaluationOptions& options,
   const nlohmann::ordered_json sequence = MetricsJson(e.sequence_metrics);
   for (const auto& [key, value] : sequence.items()) j[key] = value;
   j["baselines"]["single_frame"] = MetricsJson(e.single_metrics);
+  if (e.descriptors) {
+    nlohmann::ordered_json d;
+    d["map_file"] = options.reference_descriptors;
+    d["query_file"] = options.query_descriptors;
+    d["dimensions"] = e.descriptor_dimensions;
+    const nlohmann::ordered_json by_sequence = MetricsJson(e.descriptors->sequence_metrics);
+    for (const auto& [key, value] : by_sequence.items()) d[key] = value;
+    d["single_frame"] = MetricsJson(e.descriptors->single_metrics);
+    d["match_seconds"] = e.descriptor_match_seconds;
+    j["descriptors"] = d;
+  }
   j["load_seconds"] = e.load_seconds;
   j["match_seconds"] = e.match_seconds;
   j["query_time_ms"] =
@@ -274,7 +389,12 @@ Status WriteImageSequenceOutputs(const ImageSequenceEvaluationOptions& options,
                        config_fingerprint);
   std::ostringstream csv;
   csv << "query,file,truth,sequence_match,sequence_confidence,sequence_correct,single_match,"
-         "single_confidence,single_correct\n";
+         "single_confidence,single_correct";
+  if (e.descriptors) {
+    csv << ",descriptor_sequence_match,descriptor_sequence_confidence,descriptor_sequence_correct,"
+           "descriptor_single_match,descriptor_single_confidence,descriptor_single_correct";
+  }
+  csv << '\n';
   for (size_t q = 0; q < e.query_files.size(); ++q) {
     auto cells = [&](const QueryAnswer& a) {
       std::string s;
@@ -285,12 +405,21 @@ Status WriteImageSequenceOutputs(const ImageSequenceEvaluationOptions& options,
     };
     csv << q << ',' << e.query_files[q] << ','
         << (e.truth[q] >= 0 ? std::to_string(e.truth[q]) : std::string()) << ','
-        << cells(e.sequence[q]) << ',' << cells(e.single[q]) << '\n';
+        << cells(e.sequence[q]) << ',' << cells(e.single[q]);
+    if (e.descriptors) {
+      csv << ',' << cells(e.descriptors->sequence[q]) << ',' << cells(e.descriptors->single[q]);
+    }
+    csv << '\n';
   }
   std::ostringstream pr;
   pr << "method,threshold,precision,recall\n";
-  for (const auto& [name, metrics] :
-       {std::pair{"sequence", &e.sequence_metrics}, std::pair{"single_frame", &e.single_metrics}}) {
+  std::vector<std::pair<const char*, const PlaceRecognitionMetrics*>> methods = {
+      {"sequence", &e.sequence_metrics}, {"single_frame", &e.single_metrics}};
+  if (e.descriptors) {
+    methods.push_back({"descriptor_sequence", &e.descriptors->sequence_metrics});
+    methods.push_back({"descriptor_single_frame", &e.descriptors->single_metrics});
+  }
+  for (const auto& [name, metrics] : methods) {
     for (const PrecisionRecall& p : metrics->curve) {
       pr << name << ',' << ShortestNumber(p.threshold) << ',' << ShortestNumber(p.precision) << ','
          << ShortestNumber(p.recall) << '\n';

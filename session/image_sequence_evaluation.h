@@ -8,6 +8,7 @@
 
 #include <atomic>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -63,6 +64,17 @@ struct ImageSequenceEvaluationOptions {
   std::string ground_truth_csv;  // optional
   int frame_tolerance = 1;
   SequenceMatcherOptions matcher;
+  // Place descriptors computed elsewhere (NetVLAD, a ViT, ...; formats in
+  // dataset/descriptor_file.h), one row per image of its folder in file-name order. Both or
+  // neither: given, they are matched too, by single frames and by sequences over 1 - cosine
+  // similarity, beside the images (blank images stay blank).
+  std::string reference_descriptors, query_descriptors;
+};
+
+// One matcher's answers and their metrics: by sequences and by single frames.
+struct MatcherAnswers {
+  std::vector<QueryAnswer> sequence, single;  // per query
+  PlaceRecognitionMetrics sequence_metrics, single_metrics;
 };
 
 struct ImageSequenceEvaluation {
@@ -75,6 +87,10 @@ struct ImageSequenceEvaluation {
   // Every query's raw differences, for the difference-matrix figure (queries x references).
   std::vector<std::vector<float>> differences;
   double load_seconds = 0.0, match_seconds = 0.0;
+  // With descriptor files: the descriptors' answers, their length and matching time.
+  std::optional<MatcherAnswers> descriptors;
+  size_t descriptor_dimensions = 0;
+  double descriptor_match_seconds = 0.0;
 };
 
 // Loads both folders and places every query. `progress` (may be empty) is called with queries

@@ -9,6 +9,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "common/random.h"
+#include "dataset/descriptor_file.h"
 
 namespace ratslam {
 namespace {
@@ -132,6 +133,78 @@ TEST_F(ImageFoldersTest, PlacesEveryQueryByNameAndNamesABadFile) {
   e = EvaluateImageSequences(options, &loader, {}, nullptr);
   ASSERT_FALSE(e.ok());
   EXPECT_NE(e.status().message().find("frame-020.png"), std::string::npos) << e.status().message();
+}
+
+// Descriptors from files are matched by themselves: query i's descriptor is
+// reference (i + 7) % 40's, while its image is reference i's, so the descriptor answers are
+// i + 7 (single frames all, sequences wherever the line does not wrap round the route) and the
+// image answers stay i. Bad files are errors naming the file: a missing one, one without the
+// other, a row count that is not the image count, an all-zero row, two lengths.
+TEST_F(ImageFoldersTest, DescriptorFilesAreMatchedBesideTheImages) {
+  Random noise(4);
+  const int n = 40, shift = 7, dims = 16;
+  DescriptorMatrix refs{size_t(n), size_t(dims), {}}, queries{size_t(n), size_t(dims), {}};
+  Random draw(5);
+  for (int i = 0; i < n; ++i) {
+    char name[32];
+    std::snprintf(name, sizeof name, "frame-%03d.png", i);
+    Write(root_ / "ref" / name, i, 0, &noise);
+    Write(root_ / "query" / name, i, 20, &noise);
+    for (int k = 0; k < dims; ++k) refs.values.push_back(static_cast<float>(draw.Gaussian(0, 1)));
+  }
+  for (int i = 0; i < n; ++i) {
+    const float* row = refs.values.data() + size_t((i + shift) % n) * dims;
+    // Scaled and slightly disturbed: cosine similarity ignores the scale.
+    for (int k = 0; k < dims; ++k) {
+      queries.values.push_back(3.0f * row[k] + static_cast<float>(draw.Gaussian(0, 0.05)));
+    }
+  }
+  ASSERT_TRUE(WriteDescriptorNpy(refs, (root_ / "ref" / "d.npy").string()).ok());
+  ASSERT_TRUE(WriteDescriptorNpy(queries, (root_ / "query" / "d.npy").string()).ok());
+  ImageSequenceEvaluationOptions options;
+  options.reference_folder = (root_ / "ref").string();
+  options.query_folder = (root_ / "query").string();
+  options.frame_tolerance = 0;
+  options.reference_descriptors = (root_ / "ref" / "d.npy").string();
+  options.query_descriptors = (root_ / "query" / "d.npy").string();
+  FileImageLoader loader;
+  StatusOr<ImageSequenceEvaluation> e = EvaluateImageSequences(options, &loader, {}, nullptr);
+  ASSERT_TRUE(e.ok()) << e.status().message();
+  ASSERT_TRUE(e->descriptors.has_value());
+  EXPECT_EQ(e->descriptor_dimensions, size_t(dims));
+  EXPECT_DOUBLE_EQ(e->single_metrics.recall_at_1, 1.0);
+  EXPECT_DOUBLE_EQ(e->descriptors->single_metrics.recall_at_1, 0.0);
+  for (int q = 0; q < n; ++q) {
+    EXPECT_EQ(e->descriptors->single[q].match.reference, (q + shift) % n) << q;
+  }
+  for (int q = 9; q + shift < n; ++q) {
+    EXPECT_EQ(e->descriptors->sequence[q].match.reference, q + shift) << q;
+  }
+
+  auto error_of = [&](const ImageSequenceEvaluationOptions& o) {
+    StatusOr<ImageSequenceEvaluation> bad = EvaluateImageSequences(o, &loader, {}, nullptr);
+    return bad.ok() ? std::string("ok") : bad.status().message();
+  };
+  ImageSequenceEvaluationOptions missing = options;
+  missing.query_descriptors = (root_ / "none.npy").string();
+  EXPECT_NE(error_of(missing).find(missing.query_descriptors), std::string::npos)
+      << error_of(missing);
+  missing.query_descriptors.clear();
+  EXPECT_NE(error_of(missing).find("one for the queries"), std::string::npos) << error_of(missing);
+  DescriptorMatrix short_rows = queries;
+  short_rows.rows = n - 1;
+  short_rows.values.resize(size_t(n - 1) * dims);
+  ASSERT_TRUE(WriteDescriptorNpy(short_rows, (root_ / "query" / "d.npy").string()).ok());
+  EXPECT_NE(error_of(options).find("d.npy: 39 rows for the 40 images"), std::string::npos)
+      << error_of(options);
+  DescriptorMatrix zero = queries;
+  std::fill(zero.values.begin() + 2 * dims, zero.values.begin() + 3 * dims, 0.0f);
+  ASSERT_TRUE(WriteDescriptorNpy(zero, (root_ / "query" / "d.npy").string()).ok());
+  EXPECT_NE(error_of(options).find("d.npy: row 3 has no direction"), std::string::npos)
+      << error_of(options);
+  DescriptorMatrix narrow{size_t(n), 4, std::vector<float>(size_t(n) * 4, 1.0f)};
+  ASSERT_TRUE(WriteDescriptorNpy(narrow, (root_ / "query" / "d.npy").string()).ok());
+  EXPECT_NE(error_of(options).find("4 values per row"), std::string::npos) << error_of(options);
 }
 
 }  // namespace
