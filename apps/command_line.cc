@@ -242,7 +242,8 @@ const std::vector<CommandSpec>& Commands() {
        "within N frames of its true place (same file name, else same position, else "
        "--ground-truth): evaluation.json, queries.csv, pr_curve.csv, pr_curve.png, "
        "difference_matrix.png. --map-descriptors and --query-descriptors add descriptors "
-       "computed elsewhere, matched the same two ways beside the images.",
+       "computed elsewhere, matched the same two ways beside the images; --fabmap adds visual "
+       "FABMAP on single frames.",
        {kConfig, Text("--map", "M", "data set to map", true),
         Text("--query", "Q", "data set to localise", true),
         Whole("--frame-tolerance", "N",
@@ -253,6 +254,10 @@ const std::vector<CommandSpec>& Commands() {
              "with --frame-tolerance: place descriptors of M's images (.npy or .csv, a row per "
              "image in file-name order), matched too; needs --query-descriptors"),
         Text("--query-descriptors", "F", "with --map-descriptors: those of Q's images"),
+        Flag("--fabmap",
+             "with --frame-tolerance: also place single frames by visual FABMAP ([visual_model], "
+             "[visual_words], [vocabulary]; trained on M's images unless a model or training "
+             "images are given)"),
         Text("--out", "O", "output folder", true), kOverwrite, kLenient, kQuiet, kJson,
         Formats("formats of the figures: png, pdf, svg, comma-separated (default png)"),
         WidthMm("page width of PDF and SVG figures (default 180: two panels)")},

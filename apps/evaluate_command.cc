@@ -36,6 +36,8 @@ int ImageSequenceEvaluate(const Arguments& args, const PipelineOptions& pipeline
   options.matcher = pipeline.sensors.sequence;
   options.reference_descriptors = args.Value("--map-descriptors");
   options.query_descriptors = args.Value("--query-descriptors");
+  options.fabmap = args.values.count("--fabmap") > 0;
+  options.fabmap_settings = pipeline.sensors.fabmap;
   for (const std::string& folder : {options.reference_folder, options.query_folder}) {
     if (!IsImageSequenceFolder(folder)) {
       return fail(Status::Error(folder + ": with --frame-tolerance, --map and --query are "
@@ -89,6 +91,10 @@ int ImageSequenceEvaluate(const Arguments& args, const PipelineOptions& pipeline
     labels.push_back("descriptors, " + sequences);
     labels.push_back("descriptors, single frames");
   }
+  if (e->fabmap) {
+    rows.push_back({"FABMAP", &e->fabmap->metrics});
+    labels.push_back("FABMAP (visual words), single frames");
+  }
   {
     std::vector<std::vector<double>> recall(rows.size()), precision(rows.size());
     for (size_t k = 0; k < rows.size(); ++k) {
@@ -103,8 +109,11 @@ int ImageSequenceEvaluate(const Arguments& args, const PipelineOptions& pipeline
                                       [&](int w) {
                                         return PrecisionRecallScene(
                                             labels, recall, precision, title, w,
-                                            "accepted: the answer's margin over the runner-up "
-                                            ">= a threshold");
+                                            e->fabmap ? "accepted: the answer's margin over "
+                                                        "the runner-up (FABMAP: log odds over a "
+                                                        "new place) >= a threshold"
+                                                      : "accepted: the answer's margin over the "
+                                                        "runner-up >= a threshold");
                                       });
         !s.ok()) {
       return fail(s);
@@ -154,7 +163,8 @@ int EvaluateCommand(const Arguments& parsed) {
   const auto pipeline = LoadOptions(*args, &options.config_path);
   if (!pipeline) return kExitError;
   if (args->values.count("--frame-tolerance")) return ImageSequenceEvaluate(*args, *pipeline);
-  for (const char* image_only : {"--ground-truth", "--map-descriptors", "--query-descriptors"}) {
+  for (const char* image_only :
+       {"--ground-truth", "--map-descriptors", "--query-descriptors", "--fabmap"}) {
     if (args->values.count(image_only)) {
       std::cerr << MessagePrefix() << image_only << " needs --frame-tolerance\n";
       return kExitUsage;

@@ -29,3 +29,21 @@ for cells in 4x2 8x4 16x8; do
        "$(field "$j" descriptors.single_frame.recall_at_1 %) % | $(field "$j" recall_at_1 %) % |" \
        "$(field "$j" baselines.single_frame.recall_at_1 %) % | $(field "$j" descriptors.match_seconds x) |"
 done
+# Visual FABMAP on the same benchmark: single frames by visual words, the vocabulary, Chow-Liu
+# tree and unknown world learnt from the summer images.
+echo
+echo "| FABMAP visual words | vocabulary | training images | words per image (summer, winter) | recall@1 | recall@5 | PR AUC |"
+echo "|---|---|---|---|---|---|---|"
+for features in "sift 1000 5" "sift 3000 1" "orb 100 1"; do
+  set -- $features
+  tag="fabmap-$1-$2"
+  printf '[visual_words]\ndescriptor = "%s"\nfast_threshold = 5\n[vocabulary]\nwords = %d\n[visual_model]\ntraining_image_step = %d\n' \
+    "$1" "$2" "$3" > "$out/$tag.toml"
+  "$ratslam" evaluate --quiet --overwrite --config "$out/$tag.toml" --fabmap --frame-tolerance 1 \
+    --map "$data/summer" --query "$data/winter" --out "$out/$tag" > /dev/null
+  j="$out/$tag/evaluation.json"
+  every="every ${3}th"
+  [ "$3" = 1 ] && every="every"
+  echo "| $1 | $2 | $every summer image | $(field "$j" baselines.fabmap.words_per_reference x), $(field "$j" baselines.fabmap.words_per_query x) |" \
+       "$(field "$j" baselines.fabmap.recall_at_1 %) % | $(field "$j" baselines.fabmap.recall_at_5 %) % | $(field "$j" baselines.fabmap.pr_auc x) |"
+done

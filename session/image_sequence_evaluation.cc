@@ -14,7 +14,10 @@
 #include "dataset/csv.h"
 #include "dataset/descriptor_file.h"
 #include "fusion/descriptor_table.h"
+#include "fusion/fabmap/localiser.h"
+#include "fusion/fabmap/visual_model.h"
 #include "io/provenance_json.h"
+#include "io/visual_model_file.h"
 
 namespace ratslam {
 namespace {
@@ -106,6 +109,103 @@ StatusOr<DescriptorRows> LoadDescriptorRows(const std::string& path, const std::
     d.unit.insert(d.unit.end(), unit.begin(), unit.end());
   }
   return d;
+}
+
+// The visual words of every image of `folder` (`names` in it).
+Status WordsOf(const fabmap::TrainedVisualModel& model, const std::string& folder,
+               const std::vector<std::string>& names, ImageLoader* loader,
+               std::vector<fabmap::Observation>* words, double* mean_words,
+               const std::atomic<bool>* stop) {
+  double total = 0.0;
+  for (const std::string& name : names) {
+    if (stop && stop->load()) return Status::Error("stopped");
+    const std::string path = (fs::path(folder) / name).string();
+    StatusOr<GrayImage> image = loader->Load(path);
+    if (!image.ok()) return image.status();
+    StatusOr<fabmap::Observation> w = fabmap::ImageWords(model, *image);
+    if (!w.ok()) return w.status().WithContext(path);
+    total += static_cast<double>(w->size());
+    words->push_back(*std::move(w));
+  }
+  *mean_words = names.empty() ? 0.0 : total / static_cast<double>(names.size());
+  return Status::Ok();
+}
+
+// FABMAP (vision alone) over the references as places: each non-blank query's answer is the
+// most probable non-blank place, its confidence the log odds of that place against the new one;
+// up to five candidates, best first, each outside the others' `exclusion` windows.
+StatusOr<ImageSequenceEvaluation::Fabmap> MatchByFabmap(
+    const ImageSequenceEvaluationOptions& options, const ImageSequenceEvaluation& e,
+    const std::vector<PreparedFrame>& query_frames, ImageLoader* loader,
+    const std::atomic<bool>* stop) {
+  const auto start = std::chrono::steady_clock::now();
+  ImageSequenceEvaluation::Fabmap f;
+  const FabmapSettings& settings = options.fabmap_settings;
+  fabmap::VisualModelOptions model_options = settings.visual_model;
+  f.trained_here = model_options.file.empty();
+  if (model_options.file.empty() && model_options.training_images.empty()) {
+    model_options.training_images = options.reference_folder;
+  }
+  StatusOr<fabmap::TrainedVisualModel> model =
+      LoadOrTrainVisualModel(model_options, settings.features, settings.vocabulary,
+                             settings.localiser.chow_liu, *loader, {});
+  if (!model.ok()) return model.status();
+  f.vocabulary = model->vocabulary.size();
+  std::vector<fabmap::Observation> reference_words, query_words;
+  RATSLAM_RETURN_IF_ERROR(WordsOf(*model, options.reference_folder, e.reference_files, loader,
+                                  &reference_words, &f.words_per_reference, stop));
+  RATSLAM_RETURN_IF_ERROR(WordsOf(*model, options.query_folder, e.query_files, loader, &query_words,
+                                  &f.words_per_query, stop));
+  std::vector<fabmap::MapNode> places(reference_words.size());
+  for (size_t i = 0; i < places.size(); ++i) {
+    places[i].visual = std::move(reference_words[i]);
+    places[i].travelled_m = static_cast<double>(i);
+    places[i].time_s = static_cast<double>(i);
+  }
+  fabmap::LocaliserSettings localiser = settings.localiser;
+  localiser.localiser.mode = fabmap::FabmapMode::kVision;  // images have no Wi-Fi
+  StatusOr<std::unique_ptr<fabmap::Localiser>> built =
+      fabmap::Localiser::Build(localiser, &model->model, places);
+  if (!built.ok()) return built.status();
+  const int exclusion = options.matcher.exclusion_window;
+  for (size_t q = 0; q < query_words.size(); ++q) {
+    if (stop && stop->load()) return Status::Error("stopped");
+    QueryAnswer a;
+    a.truth = e.truth[q];
+    if (!query_frames[q].blank) {
+      const fabmap::LocalisationResult r = (*built)->Localise({query_words[q], std::nullopt});
+      std::vector<size_t> order;
+      for (size_t i = 0; i < r.place_probability.size(); ++i) {
+        if (!e.reference_blank[i]) order.push_back(i);
+      }
+      std::stable_sort(order.begin(), order.end(), [&](size_t x, size_t y) {
+        return r.place_probability[x] > r.place_probability[y];
+      });
+      for (size_t i : order) {
+        if (a.match.candidates.size() == 5) break;
+        const bool apart = std::all_of(
+            a.match.candidates.begin(), a.match.candidates.end(), [&](const PlaceCandidate& c) {
+              return std::abs(c.reference - static_cast<int>(i)) > exclusion;
+            });
+        if (apart) a.match.candidates.push_back({static_cast<int>(i), -r.place_probability[i]});
+      }
+      if (!a.match.candidates.empty()) {
+        a.match.declined = false;
+        a.match.reference = a.match.candidates.front().reference;
+        // Log odds of the answer against the new place, from the two posteriors; a blank
+        // reference that FABMAP preferred leaves the answer's own posterior in the numerator.
+        const double p = r.place_probability[static_cast<size_t>(a.match.reference)];
+        a.match.confidence = a.match.reference == r.best_mapped_place
+                                 ? r.best_mapped_log_odds
+                                 : std::log(std::max(p, 1e-300)) -
+                                       std::log(std::max(r.new_place_probability, 1e-300));
+      }
+    }
+    f.answers.push_back(std::move(a));
+  }
+  f.metrics = MetricsOf(f.answers, options.frame_tolerance);
+  f.seconds = Seconds(start);
+  return f;
 }
 
 }  // namespace
@@ -348,6 +448,12 @@ StatusOr<ImageSequenceEvaluation> EvaluateImageSequences(
     e.descriptors = std::move(d);
     e.descriptor_match_seconds = Seconds(start_descriptors);
   }
+  if (options.fabmap) {
+    StatusOr<ImageSequenceEvaluation::Fabmap> f =
+        MatchByFabmap(options, e, query_frames, loader, stop);
+    if (!f.ok()) return f.status();
+    e.fabmap = std::move(*f);
+  }
   return e;
 }
 
@@ -381,6 +487,16 @@ Status WriteImageSequenceOutputs(const ImageSequenceEvaluationOptions& options,
     d["match_seconds"] = e.descriptor_match_seconds;
     j["descriptors"] = d;
   }
+  if (e.fabmap) {
+    nlohmann::ordered_json f = MetricsJson(e.fabmap->metrics);
+    f["visual_words"] = e.fabmap->vocabulary;
+    f["trained_on_references"] =
+        e.fabmap->trained_here && options.fabmap_settings.visual_model.training_images.empty();
+    f["words_per_reference"] = e.fabmap->words_per_reference;
+    f["words_per_query"] = e.fabmap->words_per_query;
+    f["seconds"] = e.fabmap->seconds;
+    j["baselines"]["fabmap"] = f;
+  }
   j["load_seconds"] = e.load_seconds;
   j["match_seconds"] = e.match_seconds;
   j["query_time_ms"] =
@@ -394,6 +510,7 @@ Status WriteImageSequenceOutputs(const ImageSequenceEvaluationOptions& options,
     csv << ",descriptor_sequence_match,descriptor_sequence_confidence,descriptor_sequence_correct,"
            "descriptor_single_match,descriptor_single_confidence,descriptor_single_correct";
   }
+  if (e.fabmap) csv << ",fabmap_match,fabmap_confidence,fabmap_correct";
   csv << '\n';
   for (size_t q = 0; q < e.query_files.size(); ++q) {
     auto cells = [&](const QueryAnswer& a) {
@@ -409,6 +526,7 @@ Status WriteImageSequenceOutputs(const ImageSequenceEvaluationOptions& options,
     if (e.descriptors) {
       csv << ',' << cells(e.descriptors->sequence[q]) << ',' << cells(e.descriptors->single[q]);
     }
+    if (e.fabmap) csv << ',' << cells(e.fabmap->answers[q]);
     csv << '\n';
   }
   std::ostringstream pr;
@@ -419,6 +537,7 @@ Status WriteImageSequenceOutputs(const ImageSequenceEvaluationOptions& options,
     methods.push_back({"descriptor_sequence", &e.descriptors->sequence_metrics});
     methods.push_back({"descriptor_single_frame", &e.descriptors->single_metrics});
   }
+  if (e.fabmap) methods.push_back({"fabmap", &e.fabmap->metrics});
   for (const auto& [name, metrics] : methods) {
     for (const PrecisionRecall& p : metrics->curve) {
       pr << name << ',' << ShortestNumber(p.threshold) << ',' << ShortestNumber(p.precision) << ','

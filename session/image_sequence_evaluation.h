@@ -16,6 +16,7 @@
 #include "common/provenance.h"
 #include "common/status.h"
 #include "dataset/image_loader.h"
+#include "fusion/fabmap_front_end_options.h"
 #include "sensors/sequence_matcher.h"
 
 namespace ratslam {
@@ -69,6 +70,13 @@ struct ImageSequenceEvaluationOptions {
   // neither: given, they are matched too, by single frames and by sequences over 1 - cosine
   // similarity, beside the images (blank images stay blank).
   std::string reference_descriptors, query_descriptors;
+  // FABMAP over visual words (fusion/fabmap, vision alone) as another single-frame matcher: every
+  // reference image a place, each query placed by the most probable one, its confidence the log
+  // odds of that place against the new place. The vocabulary, tree and unknown world come from
+  // `fabmap_settings.visual_model` (a saved model or training images), else are trained on the
+  // reference images.
+  bool fabmap = false;
+  FabmapSettings fabmap_settings;
 };
 
 // One matcher's answers and their metrics: by sequences and by single frames.
@@ -91,6 +99,18 @@ struct ImageSequenceEvaluation {
   std::optional<MatcherAnswers> descriptors;
   size_t descriptor_dimensions = 0;
   double descriptor_match_seconds = 0.0;
+  // With fabmap: its answers (per query) and metrics, the vocabulary's size, the mean number of
+  // distinct words per reference and per query image, whether the model was trained here, and
+  // the time of training, words and localisation.
+  struct Fabmap {
+    std::vector<QueryAnswer> answers;
+    PlaceRecognitionMetrics metrics;
+    size_t vocabulary = 0;
+    double words_per_reference = 0.0, words_per_query = 0.0;
+    bool trained_here = false;
+    double seconds = 0.0;
+  };
+  std::optional<Fabmap> fabmap;
 };
 
 // Loads both folders and places every query. `progress` (may be empty) is called with queries

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "common/random.h"
 #include "dataset/descriptor_file.h"
@@ -205,6 +206,67 @@ TEST_F(ImageFoldersTest, DescriptorFilesAreMatchedBesideTheImages) {
   DescriptorMatrix narrow{size_t(n), 4, std::vector<float>(size_t(n) * 4, 1.0f)};
   ASSERT_TRUE(WriteDescriptorNpy(narrow, (root_ / "query" / "d.npy").string()).ok());
   EXPECT_NE(error_of(options).find("4 values per row"), std::string::npos) << error_of(options);
+}
+
+// Visual FABMAP as a matcher of single frames: 30 places of 128x96 images of random rectangles
+// (corners for ORB), the queries the same scenes with noise. With a vocabulary learnt from the
+// references, far more than chance (1 in 30) of the queries land on their own place, and the
+// answers and metrics are where the other matchers' are. A visual model file that does not
+// exist is an error naming it.
+TEST_F(ImageFoldersTest, FabmapPlacesSingleFramesFromVisualWords) {
+  Random noise(3);
+  const int n = 30;
+  for (int i = 0; i < n; ++i) {
+    char name[32];
+    std::snprintf(name, sizeof name, "frame-%03d.png", i);
+    Random scene(500 + i);
+    cv::Mat image(96, 128, CV_8UC1, cv::Scalar(128));
+    for (int k = 0; k < 25; ++k) {
+      const int x = static_cast<int>(scene.Uniform(0, 110)),
+                y = static_cast<int>(scene.Uniform(0, 80));
+      const int w = static_cast<int>(scene.Uniform(6, 30)),
+                h = static_cast<int>(scene.Uniform(6, 30));
+      cv::rectangle(image, cv::Rect(x, y, w, h), cv::Scalar(scene.Uniform(0, 255)), cv::FILLED);
+    }
+    ASSERT_TRUE(cv::imwrite((root_ / "ref" / name).string(), image));
+    cv::Mat query = image.clone();
+    for (int y = 0; y < query.rows; ++y) {
+      for (int x = 0; x < query.cols; ++x) {
+        query.at<uint8_t>(y, x) =
+            cv::saturate_cast<uint8_t>(query.at<uint8_t>(y, x) + noise.Gaussian(0, 4));
+      }
+    }
+    ASSERT_TRUE(cv::imwrite((root_ / "query" / name).string(), query));
+  }
+  ImageSequenceEvaluationOptions options;
+  options.reference_folder = (root_ / "ref").string();
+  options.query_folder = (root_ / "query").string();
+  options.frame_tolerance = 0;
+  options.matcher.image_width_px = 64;
+  options.matcher.image_height_px = 32;
+  options.fabmap = true;
+  options.fabmap_settings.vocabulary.words = 200;
+  options.fabmap_settings.visual_model.training_image_step = 1;
+  FileImageLoader loader;
+  StatusOr<ImageSequenceEvaluation> e = EvaluateImageSequences(options, &loader, {}, nullptr);
+  ASSERT_TRUE(e.ok()) << e.status().message();
+  ASSERT_TRUE(e->fabmap.has_value());
+  EXPECT_EQ(e->fabmap->vocabulary, 200u);
+  EXPECT_TRUE(e->fabmap->trained_here);
+  EXPECT_GT(e->fabmap->words_per_query, 5.0);
+  ASSERT_EQ(e->fabmap->answers.size(), size_t(n));
+  EXPECT_EQ(e->fabmap->metrics.queries, size_t(n));
+  EXPECT_GE(e->fabmap->metrics.recall_at_1, 0.8);  // all 30 here; chance 1 in 30
+  EXPECT_GE(e->fabmap->metrics.recall_at_5, e->fabmap->metrics.recall_at_1);
+  for (const QueryAnswer& a : e->fabmap->answers) {
+    ASSERT_FALSE(a.match.declined);
+    EXPECT_TRUE(std::isfinite(a.match.confidence));
+  }
+
+  options.fabmap_settings.visual_model.file = (root_ / "missing.bin").string();
+  e = EvaluateImageSequences(options, &loader, {}, nullptr);
+  ASSERT_FALSE(e.ok());
+  EXPECT_NE(e.status().message().find("missing.bin"), std::string::npos) << e.status().message();
 }
 
 }  // namespace
