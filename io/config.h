@@ -1,4 +1,4 @@
-// Configuration files: TOML with one section per component (see configs/README.md). Unknown
+// Configuration files: TOML with one section per component (keys in docs/config.md). Unknown
 // sections and keys, wrong types and out-of-range values are errors that name the file and line.
 // Also an importer for OpenRatSLAM's INI configuration files.
 #ifndef RATSLAM_IO_CONFIG_H_

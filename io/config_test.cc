@@ -144,50 +144,6 @@ TEST(ConfigTest, PoseCellGridSizeIsBounded) {
   EXPECT_TRUE(ParseConfig("[pose_cells]\ndim_xy_cells = 200\ndim_theta_cells = 36\n", "c").ok());
 }
 
-// Every key the program reads is documented in configs/README.md, in its section's table, with
-// the default the program uses; and the README documents no key the program does not read.
-TEST(ConfigTest, ReadmeDocumentsEveryKeyWithItsDefault) {
-  const std::string readme_path = std::string(RATSLAM_SOURCE_DIR) + "/configs/README.md";
-  std::ifstream in(readme_path);
-  ASSERT_TRUE(in) << readme_path;
-  std::map<std::string, std::string> documented;  // "section.key" -> default as written
-  std::string line, section;
-  while (std::getline(in, line)) {
-    if (line.rfind("### [", 0) == 0) {
-      section = line.substr(5, line.find(']') - 5);
-      continue;
-    }
-    if (line.rfind("## ", 0) == 0) section.clear();
-    if (section.empty() || line.rfind("| `", 0) != 0) continue;
-    const size_t key_end = line.find('`', 3);
-    const size_t default_begin = line.find('`', key_end + 1);
-    const size_t default_end = line.find('`', default_begin + 1);
-    ASSERT_NE(default_end, std::string::npos) << line;
-    documented[section + "." + line.substr(3, key_end - 3)] =
-        line.substr(default_begin + 1, default_end - default_begin - 1);
-  }
-  // The replay's configuration and that of wifi-map and locate (whose [pdr] is the replay's).
-  std::istringstream printed(PrintConfig(PipelineOptions(), false) + "\n" +
-                             PrintLocateConfig(LocateOptions(), false));
-  std::set<std::string> read;
-  while (std::getline(printed, line)) {
-    if (line.empty()) continue;
-    if (line.front() == '[') {
-      section = line.substr(1, line.size() - 2);
-      continue;
-    }
-    const std::string key = section + "." + line.substr(0, line.find(" = "));
-    const std::string value = line.substr(line.find(" = ") + 3);
-    read.insert(key);
-    const auto it = documented.find(key);
-    ASSERT_NE(it, documented.end()) << key << " is not documented in configs/README.md";
-    EXPECT_EQ(it->second, value) << key << ": README default differs from the program's";
-  }
-  for (const auto& [key, value] : documented) {
-    EXPECT_TRUE(read.count(key)) << key << " is documented but not read by the program";
-  }
-}
-
 TEST(ConfigTest, LocateConfigReadsItsSectionsAndRefusesOthers) {
   StatusOr<LocateOptions> o = ParseLocateConfig(
       "[particle_filter]\nlikelihood = \"product\"\nparticles = 500\n[wifi_map]\n"

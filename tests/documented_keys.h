@@ -1,5 +1,6 @@
 // Checks that every key a program writes into its JSON outputs is documented: named as `key` in
-// configs/README.md. A new key without a line of documentation fails the end-to-end tests.
+// configs/README.md (run outputs) or docs/config.md (the sections in more detail). A new key
+// without a line of documentation fails the end-to-end tests.
 #ifndef RATSLAM_TESTS_DOCUMENTED_KEYS_H_
 #define RATSLAM_TESTS_DOCUMENTED_KEYS_H_
 
@@ -12,13 +13,15 @@
 
 namespace ratslam::e2e {
 
-// The keys of `j` (of nested objects and of objects in arrays too) that configs/README.md does
-// not name in backquotes. Keys that are numbers ("2", "5": distances) are values, not names.
+// The keys of `j` (of nested objects and of objects in arrays too) that neither page names in
+// backquotes. Keys that are numbers ("2", "5": distances) are values, not names.
 inline std::set<std::string> UndocumentedKeys(const nlohmann::json& j) {
   static const std::string doc = [] {
-    std::ifstream in(std::string(RATSLAM_SOURCE_DIR) + "/configs/README.md");
     std::stringstream s;
-    s << in.rdbuf();
+    for (const char* page : {"/configs/README.md", "/docs/config.md"}) {
+      std::ifstream in(std::string(RATSLAM_SOURCE_DIR) + page);
+      s << in.rdbuf();
+    }
     return s.str();
   }();
   std::set<std::string> missing;

@@ -78,7 +78,7 @@ TEST(EvaluateEndToEndTest, MicrosoftWalksWifiOnly) {
   std::ifstream in(out / "evaluation.json");
   const nlohmann::json j = nlohmann::json::parse(in);
   EXPECT_TRUE(e2e::UndocumentedKeys(j).empty())
-      << "not in configs/README.md: " << e2e::Join(e2e::UndocumentedKeys(j));
+      << "undocumented: " << e2e::Join(e2e::UndocumentedKeys(j));
   EXPECT_EQ(j["mode"], "wifi");
   EXPECT_GT(j["queries"].get<int>(), 500);
   // --format png,pdf: both figures in both formats; the two-panel curves on a two-column page

@@ -45,7 +45,7 @@ TEST(IpinEndToEndTest, WifiRatslamClosesOutAndBackLoops) {
   std::ifstream in(out / "summary.json");
   const nlohmann::json s = nlohmann::json::parse(in);
   EXPECT_TRUE(e2e::UndocumentedKeys(s).empty())
-      << "not in configs/README.md: " << e2e::Join(e2e::UndocumentedKeys(s));
+      << "undocumented: " << e2e::Join(e2e::UndocumentedKeys(s));
   const double within_10 = s["match_rate_within_m"]["10"];
   const int matches = s["matches"];
 
@@ -220,7 +220,7 @@ TEST(IpinEndToEndTest, BarometerKeepsMatchesOnTheirFloors) {
   const nlohmann::json with = replay(true, 1, "51");
   const nlohmann::json plain = replay(false, 1, "51-plain");
   EXPECT_TRUE(e2e::UndocumentedKeys(with).empty())
-      << "not in configs/README.md: " << e2e::Join(e2e::UndocumentedKeys(with));
+      << "undocumented: " << e2e::Join(e2e::UndocumentedKeys(with));
   EXPECT_GT(plain["floor_mistakes"].get<int>(), 0);  // measured 4 (16 before the stairs rule)
   EXPECT_EQ(with["floor_mistakes"], 0);
   EXPECT_GE(with["barometer"]["floor_changes"].get<int>(), 6);  // the walk changes floor 8 times
@@ -414,7 +414,7 @@ TEST(IpinEndToEndTest, OnlineRssiOffsetFindsTheSecondPhonesOffset) {
     const nlohmann::json& on = summary[true];
     ASSERT_TRUE(on.contains("wifi_rssi_offsets_db")) << on.dump();
     EXPECT_TRUE(e2e::UndocumentedKeys(on).empty())
-        << "not in configs/README.md: " << e2e::Join(e2e::UndocumentedKeys(on));
+        << "undocumented: " << e2e::Join(e2e::UndocumentedKeys(on));
     const std::vector<double> estimated = on["wifi_rssi_offsets_db"];
     ASSERT_EQ(estimated.size(), 4u);
     EXPECT_EQ(estimated[0], 0.0);
@@ -480,7 +480,7 @@ TEST(IpinEndToEndTest, PhoneLogsLocaliseOnASavedMap) {
     std::ifstream in(out / "summary.json");
     const nlohmann::json s = nlohmann::json::parse(in);
     EXPECT_TRUE(e2e::UndocumentedKeys(s).empty())
-        << "not in configs/README.md: " << e2e::Join(e2e::UndocumentedKeys(s));
+        << "undocumented: " << e2e::Join(e2e::UndocumentedKeys(s));
     const nlohmann::json& l = s["localisation"];
     const double lost = l["lost_fraction"];
     RecordProperty("lost_fraction_rep" + std::to_string(k + 1), std::to_string(lost));

@@ -55,7 +55,7 @@ TEST(IpinLocateTest, AParticleFilterLocatesAnotherPhoneInTheWifiMap) {
   std::ifstream in(root / "o" / "summary.json");
   const nlohmann::json s = nlohmann::json::parse(in);
   EXPECT_TRUE(e2e::UndocumentedKeys(s).empty())
-      << "not in configs/README.md: " << e2e::Join(e2e::UndocumentedKeys(s));
+      << "undocumented: " << e2e::Join(e2e::UndocumentedKeys(s));
   ASSERT_GT(s["count"].get<int>(), 30);
   EXPECT_EQ(s["wrong_floor"], 0);
 
@@ -186,7 +186,7 @@ TEST(IpinLocateTest, ARunsMapLocatesThePhoneAndTheRobotIsCalled) {
   std::ifstream in(root / "o" / "summary.json");
   const nlohmann::json s = nlohmann::json::parse(in);
   EXPECT_TRUE(e2e::UndocumentedKeys(s).empty())
-      << "not in configs/README.md: " << e2e::Join(e2e::UndocumentedKeys(s));
+      << "undocumented: " << e2e::Join(e2e::UndocumentedKeys(s));
   EXPECT_TRUE(s["errors_after_map_alignment"].get<bool>());
   EXPECT_GT(fs::file_size(root / "o" / "cumulative_error.png"), 10000u);
   // Chance: a uniform draw over the map's cells, moved into the truth's frame.
@@ -244,7 +244,7 @@ TEST(IpinLocateTest, ARunsMapLocatesThePhoneAndTheRobotIsCalled) {
     EXPECT_EQ(quiet.out, "");
   }
   EXPECT_TRUE(e2e::UndocumentedKeys(c).empty())
-      << "not in configs/README.md: " << e2e::Join(e2e::UndocumentedKeys(c));
+      << "undocumented: " << e2e::Join(e2e::UndocumentedKeys(c));
 
   ASSERT_TRUE(c.is_object());
   EXPECT_GT(fs::file_size(root / "c" / "call.png"), 10000u);

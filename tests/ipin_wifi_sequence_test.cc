@@ -39,7 +39,7 @@ nlohmann::json Replay(const std::string& config, const std::vector<fs::path>& lo
   std::ifstream in(out / "summary.json");
   const nlohmann::json s = nlohmann::json::parse(in);
   EXPECT_TRUE(e2e::UndocumentedKeys(s).empty())
-      << "not in configs/README.md: " << e2e::Join(e2e::UndocumentedKeys(s));
+      << "undocumented: " << e2e::Join(e2e::UndocumentedKeys(s));
   return s;
 }
 

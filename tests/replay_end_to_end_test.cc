@@ -347,7 +347,7 @@ TEST_F(ReplayEndToEndTest, DemoDataClosesLoopsAndBeatsOdometry) {
   ASSERT_EQ(RunRatslam(ReplayArgs(out), root_).exit_code, 0);
   const nlohmann::json s = Summary(out);
   EXPECT_TRUE(e2e::UndocumentedKeys(s).empty())
-      << "not in configs/README.md: " << e2e::Join(e2e::UndocumentedKeys(s));
+      << "undocumented: " << e2e::Join(e2e::UndocumentedKeys(s));
   EXPECT_EQ(s["finished"], true);
   EXPECT_EQ(s["frames"], 3634);
   EXPECT_GT(s["loop_closures"].get<int>(), 10);
@@ -1114,7 +1114,7 @@ TEST_F(ReplayEndToEndTest, RouteIsTheShortestPathOverTheExperienceGraph) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(r.out);
   EXPECT_TRUE(e2e::UndocumentedKeys(j).empty())
-      << "not in configs/README.md: " << e2e::Join(e2e::UndocumentedKeys(j));
+      << "undocumented: " << e2e::Join(e2e::UndocumentedKeys(j));
   EXPECT_EQ(r.out, Slurp(root_ / "route" / "route.json"));
   EXPECT_NEAR(j["length_m"].get<double>(), d[far], 1e-9 * (1 + d[far]));
   const std::vector<size_t> path = j["experiences"].get<std::vector<size_t>>();
@@ -1184,7 +1184,7 @@ TEST_F(ReplayEndToEndTest, LocalisationOnASavedMapFollowsTheNextSession) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json s = Summary(run);
   EXPECT_TRUE(e2e::UndocumentedKeys(s).empty())
-      << "not in configs/README.md: " << e2e::Join(e2e::UndocumentedKeys(s));
+      << "undocumented: " << e2e::Join(e2e::UndocumentedKeys(s));
   EXPECT_EQ(Slurp(run / "experiences.csv"), Slurp(map_run / "experiences.csv"));
   EXPECT_EQ(Slurp(run / "links.csv"), Slurp(map_run / "links.csv"));
   EXPECT_FALSE(s.contains("match_rate_within_m"));
