@@ -29,10 +29,20 @@ inline constexpr int kExitUsage = 2;
 inline constexpr int kExitInternal = 70;  // a bug or an exhausted machine (EX_SOFTWARE)
 inline constexpr int kExitInterrupted = 130;
 
-// A command's options after parsing (apps/command_line.h): "--flag value" pairs and bare flags.
+// An image size from --size.
+struct ImageSize {
+  int width = 0, height = 0;
+};
+
+// A command's options after parsing (apps/command_line.h): "--flag value" pairs and bare flags,
+// and the typed value of each option that is not text, read once by the parser that checked it.
 struct Arguments {
-  std::map<std::string, std::string> values;            // the last value of each flag
-  std::map<std::string, std::vector<std::string>> all;  // every value, for repeatable flags
+  std::map<std::string, std::string> values;                // the last value of each flag
+  std::map<std::string, std::vector<std::string>> all;      // every value, for repeatable flags
+  std::map<std::string, double> numbers;                    // number options
+  std::map<std::string, int64_t> wholes;                    // whole-number options, within range
+  std::map<std::string, ImageSize> sizes;                   // WIDTHxHEIGHT options
+  std::map<std::string, std::vector<double>> number_lists;  // X,Y points and number lists
   std::vector<std::string> positional;
   bool quiet = false;
   bool render = false;
@@ -42,6 +52,10 @@ struct Arguments {
   // named, where the outputs appear at the end (see Shown).
   std::string output_folder;
 
+  bool Has(const std::string& flag) const { return values.count(flag) > 0; }
+  // Typed values of options given (see Has; the option's kind must match).
+  double Number(const std::string& flag) const { return numbers.at(flag); }
+  int64_t Whole(const std::string& flag) const { return wholes.at(flag); }
   // The value of `flag`, or "" when it was not given.
   std::string Value(const std::string& flag) const {
     auto it = values.find(flag);
@@ -129,9 +143,7 @@ inline StatusOr<FigureOptions> FigureOptionsOf(const Arguments& args) {
     if (!formats.ok()) return formats.status().WithContext("--format");
     o.formats = *formats;
   }
-  if (auto it = args.values.find("--width-mm"); it != args.values.end()) {
-    o.width_mm = std::strtod(it->second.c_str(), nullptr);  // checked by the parser
-  }
+  if (args.Has("--width-mm")) o.width_mm = args.Number("--width-mm");
   return o;
 }
 

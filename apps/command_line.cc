@@ -17,11 +17,13 @@ namespace {
 
 // What an option's value must be.
 enum class Kind {
-  kText,    // any text (paths, names)
-  kNumber,  // a finite decimal number
-  kWhole,   // a whole number in [min, max]
-  kSize,    // WIDTHxHEIGHT in pixels
-  kFlag,    // no value
+  kText,     // any text (paths, names)
+  kNumber,   // a finite decimal number
+  kWhole,    // a whole number in [min, max]
+  kSize,     // WIDTHxHEIGHT in pixels
+  kPoint,    // X,Y: two finite numbers
+  kNumbers,  // finite numbers, comma-separated
+  kFlag,     // no value
 };
 
 struct OptionSpec {
@@ -97,6 +99,12 @@ OptionSpec WidthMm(std::string help = "page width of PDF and SVG figures (defaul
   o.min = 20;
   o.max = 2000;
   return o;
+}
+OptionSpec Point(std::string name, std::string help) {
+  return Option(std::move(name), "X,Y", std::move(help), Kind::kPoint);
+}
+OptionSpec Numbers(std::string name, std::string value_name, std::string help) {
+  return Option(std::move(name), std::move(value_name), std::move(help), Kind::kNumbers);
 }
 OptionSpec Size() {
   return Option("--size", "WxH", "image size in pixels (e.g. 1600x1200)", Kind::kSize);
@@ -195,7 +203,7 @@ const std::vector<CommandSpec>& Commands() {
         Text("--out", "F", "image file; default: O/experience_map.png"), Size(),
         Choice("--color", "BY", "colour the experiences by time or by session",
                {"time", "session"}),
-        Text("--sessions", "T1,T2,...", "session start times in seconds, comma-separated"),
+        Numbers("--sessions", "T1,T2,...", "session start times in seconds, comma-separated"),
         Formats(), WidthMm()},
        {}},
       {"render template-graph",
@@ -304,7 +312,7 @@ const std::vector<CommandSpec>& Commands() {
         Whole("--from", "E", "start experience (default: the map's current experience)", 0,
               int64_t{1} << 32),
         Whole("--to", "E", "end experience", 0, int64_t{1} << 32),
-        Text("--to-xy", "X,Y", "end at the reachable experience nearest this point (metres)"),
+        Point("--to-xy", "end at the reachable experience nearest this point (metres)"),
         Text("--out", "O", "output folder"), kOverwrite, kQuiet, kJson,
         Formats("formats of route's figure: png, pdf, svg, comma-separated (default png)"),
         WidthMm()},
@@ -426,6 +434,36 @@ CLI::Validator SizeValidator() {
       "");
 }
 
+// `text` as finite numbers separated by commas: exactly `count` of them when count > 0, at least
+// one otherwise; nothing when an item is not a finite number.
+std::optional<std::vector<double>> FiniteNumbers(const std::string& text, size_t count) {
+  std::vector<double> numbers;
+  std::istringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    char* end = nullptr;
+    const double value = std::strtod(item.c_str(), &end);
+    if (item.empty() || *end != '\0' || !std::isfinite(value)) return std::nullopt;
+    numbers.push_back(value);
+  }
+  if (text.empty() || text.back() == ',' || numbers.empty() ||
+      (count > 0 && numbers.size() != count)) {
+    return std::nullopt;
+  }
+  return numbers;
+}
+
+CLI::Validator NumbersValidator(size_t count) {
+  return CLI::Validator(
+      [count](std::string& text) -> std::string {
+        if (FiniteNumbers(text, count)) return "";
+        return std::string(count == 2 ? "expected X,Y (two finite numbers)"
+                                      : "expected finite numbers separated by commas") +
+               ", got '" + text + "'";
+      },
+      "");
+}
+
 // One of `choices`, or with `list` a comma-separated list of distinct ones.
 CLI::Validator ChoiceValidator(std::vector<std::string> choices, bool list) {
   return CLI::Validator(
@@ -491,6 +529,12 @@ void AddOption(CLI::App* sub, const OptionSpec& spec) {
       break;
     case Kind::kSize:
       option->check(SizeValidator());
+      break;
+    case Kind::kPoint:
+      option->check(NumbersValidator(2));
+      break;
+    case Kind::kNumbers:
+      option->check(NumbersValidator(0));
       break;
     default:
       if (!spec.choices.empty()) option->check(ChoiceValidator(spec.choices, spec.list));
@@ -584,6 +628,30 @@ ParsedCommand Collect(CLI::App* at, const std::string& path) {
     for (const std::string& value : option->results()) {
       parsed.args.values[o.name] = value;
       parsed.args.all[o.name].push_back(value);
+    }
+    // The typed value, from the text the validators accepted (the last one given).
+    const std::string& text = parsed.args.values[o.name];
+    switch (o.kind) {
+      case Kind::kNumber:
+        parsed.args.numbers[o.name] = std::strtod(text.c_str(), nullptr);
+        break;
+      case Kind::kWhole:
+        parsed.args.wholes[o.name] = std::strtoll(text.c_str(), nullptr, 10);
+        break;
+      case Kind::kSize: {
+        ImageSize size;
+        char x = 0;
+        std::istringstream(text) >> size.width >> x >> size.height;
+        parsed.args.sizes[o.name] = size;
+        break;
+      }
+      case Kind::kPoint:
+      case Kind::kNumbers:
+        parsed.args.number_lists[o.name] =
+            FiniteNumbers(text, o.kind == Kind::kPoint ? 2 : 0).value();
+        break;
+      default:
+        break;
     }
   }
   for (const OptionSpec& o : spec.positionals) {

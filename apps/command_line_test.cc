@@ -111,6 +111,31 @@ TEST(CommandLineTest, NestedCommandsPositionalsAndOtherFlags) {
   EXPECT_EQ(p.command().args.positional, std::vector<std::string>{"locate"});
 }
 
+// The parser hands commands typed values, read from the text it checked: numbers, whole numbers,
+// sizes, points and number lists, each the last one given.
+TEST(CommandLineTest, ValuesArriveTyped) {
+  const Outcome replay = Parse("replay --data a --out o --until 12.5 --animate 7");
+  ASSERT_EQ(replay.code(), -1) << replay.err;
+  EXPECT_EQ(replay.command().args.Number("--until"), 12.5);
+  EXPECT_EQ(replay.command().args.Whole("--animate"), 7);
+  EXPECT_FALSE(replay.command().args.Has("--lost-after"));
+  const Outcome seed = Parse("synthesize --out d --seed 9007199254740992 --start-m -2.5e1");
+  ASSERT_EQ(seed.code(), -1) << seed.err;
+  EXPECT_EQ(seed.command().args.Whole("--seed"), int64_t{1} << 53);
+  EXPECT_EQ(seed.command().args.Number("--start-m"), -25.0);
+  const Outcome render =
+      Parse("render experience-map --run r --size 640x480 --sessions 30,0.5,-1 --width-mm 120");
+  ASSERT_EQ(render.code(), -1) << render.err;
+  EXPECT_EQ(render.command().args.sizes.at("--size").width, 640);
+  EXPECT_EQ(render.command().args.sizes.at("--size").height, 480);
+  EXPECT_EQ(render.command().args.number_lists.at("--sessions"),
+            (std::vector<double>{30, 0.5, -1}));
+  EXPECT_EQ(render.command().args.Number("--width-mm"), 120.0);
+  const Outcome route = Parse("route --map m --out o --to-xy -1.5,2e-1");
+  ASSERT_EQ(route.code(), -1) << route.err;
+  EXPECT_EQ(route.command().args.number_lists.at("--to-xy"), (std::vector<double>{-1.5, 0.2}));
+}
+
 // Each bad line, and a piece of the message it must give; all are usage errors (exit 2).
 TEST(CommandLineTest, UsageErrorsSayWhatIsWrong) {
   const std::vector<std::pair<std::string, std::string>> cases = {
@@ -125,6 +150,11 @@ TEST(CommandLineTest, UsageErrorsSayWhatIsWrong) {
       {"render experience-map --run r --size 100", "--size: expected WIDTHxHEIGHT"},
       {"render experience-map --run r --size 32x32", "--size: expected WIDTHxHEIGHT"},
       {"render experience-map --run r --color sesion", "(did you mean 'session'?)"},
+      {"render experience-map --run r --sessions 0,x", "--sessions: expected finite numbers"},
+      {"render experience-map --run r --sessions 1,", "--sessions: expected finite numbers"},
+      {"route --map m --out o --to-xy 3", "--to-xy: expected X,Y (two finite numbers), got '3'"},
+      {"route --map m --out o --to-xy 1,2,3", "--to-xy: expected X,Y"},
+      {"route --map m --out o --to-xy 1,inf", "--to-xy: expected X,Y"},
       {"print-config --render", "ratslam print-config: unknown option '--render'"},
       {"print-config --quiet", "unknown option '--quiet'"},
       {"replay --dta x --out y", "unknown option '--dta' (did you mean '--data'?)"},

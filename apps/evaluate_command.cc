@@ -32,7 +32,7 @@ int ImageSequenceEvaluate(const Arguments& args, const PipelineOptions& pipeline
   options.reference_folder = args.values.at("--map");
   options.query_folder = args.values.at("--query");
   options.ground_truth_csv = args.Value("--ground-truth");
-  options.frame_tolerance = std::stoi(args.values.at("--frame-tolerance"));
+  options.frame_tolerance = static_cast<int>(args.Whole("--frame-tolerance"));
   options.matcher = pipeline.sensors.sequence;
   options.reference_descriptors = args.Value("--map-descriptors");
   options.query_descriptors = args.Value("--query-descriptors");

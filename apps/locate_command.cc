@@ -172,8 +172,7 @@ int CallCommand(const Arguments& parsed) {
     if (!s.message().empty()) std::cerr << MessagePrefix() << s.message() << "\n";
     return kExitError;
   };
-  const std::optional<double> at = ParseNumber("--at", args->values.at("--at"));
-  if (!at) return kExitUsage;
+  const double at = args->Number("--at");
   StatusOr<RobotMap> robot = LoadRobotMap(args->values.at("--map"));
   if (!robot.ok()) return fail(robot.status());
   StatusOr<PhoneSetup> setup = SetUpPhone(*args, "call");
@@ -184,7 +183,7 @@ int CallCommand(const Arguments& parsed) {
                  "only if the map was drawn in the truth's frame (make it with wifi-map --run)\n";
   }
   StatusOr<CallResult> call = CallRobot(
-      *setup, *robot, *at,
+      *setup, *robot, at,
       {args->values.at("--data"), args->values.at("--map"), args->values.at("--wifi-map")});
   if (!call.ok()) return fail(call.status());
   const CallPlan* plan = &call->plan;
@@ -222,9 +221,9 @@ int CallCommand(const Arguments& parsed) {
       o.height_px = width_px * 3 / 4;
     }
     o.title = o.width_px >= 1000
-                  ? "calling the robot at " + ShortestNumber(*at) + " s: route " + route_m +
+                  ? "calling the robot at " + ShortestNumber(at) + " s: route " + route_m +
                         " m through " + stops + " stops for " + candidate_count + " candidates"
-                  : "call at " + ShortestNumber(*at) + " s: route " + route_m + " m, " + stops +
+                  : "call at " + ShortestNumber(at) + " s: route " + route_m + " m, " + stops +
                         " stops, " + candidate_count + " candidates";
     WorldToImage to_image;
     Scene scene = ExperienceMapScene(image, o, &to_image);

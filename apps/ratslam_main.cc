@@ -258,21 +258,10 @@ int Replay(const Arguments& parsed) {
     std::cerr << MessagePrefix() << "--lost-after applies only with --localise\n";
     return kExitUsage;
   }
-  if (args->values.count("--lost-after")) {
-    auto lost = ParseNumber("--lost-after", args->values.at("--lost-after"));
-    if (!lost) return kExitUsage;
-    request.session.lost_after_m = *lost;
-  }
-  if (args->values.count("--until")) {
-    auto until = ParseNumber("--until", args->values.at("--until"));
-    if (!until) return kExitUsage;
-    request.session.until_s = *until;
-  }
-  if (args->values.count("--animate")) {
-    auto every = ParseInteger("--animate", args->values.at("--animate"), 1, int64_t{1} << 53);
-    if (!every) return kExitUsage;
-    request.animate_every = static_cast<uint64_t>(*every);
-  }
+  if (args->Has("--lost-after")) request.session.lost_after_m = args->Number("--lost-after");
+  if (args->Has("--until")) request.session.until_s = args->Number("--until");
+  if (args->Has("--animate"))
+    request.animate_every = static_cast<uint64_t>(args->Whole("--animate"));
   request.quiet = args->quiet;
   request.render = args->render;
   request.json = args->values.count("--json") > 0;
@@ -432,26 +421,12 @@ int ImportCommand(const Arguments& parsed) {
 int SynthesizeCommand(const Arguments& parsed) {
   const Arguments* args = &parsed;
   SyntheticOptions options = DemoSyntheticOptions();
-  if (args->values.count("--seed")) {
-    auto seed = ParseInteger("--seed", args->values.at("--seed"), 0, int64_t{1} << 53);
-    if (!seed) return kExitUsage;
-    options.seed = static_cast<uint64_t>(*seed);
+  if (args->Has("--seed")) options.seed = static_cast<uint64_t>(args->Whole("--seed"));
+  if (args->Has("--laps")) options.laps = static_cast<int>(args->Whole("--laps"));
+  if (args->Has("--noise-seed")) {
+    options.noise_seed = static_cast<uint64_t>(args->Whole("--noise-seed"));
   }
-  if (args->values.count("--laps")) {
-    auto laps = ParseInteger("--laps", args->values.at("--laps"), 1, 1000);
-    if (!laps) return kExitUsage;
-    options.laps = static_cast<int>(*laps);
-  }
-  if (args->values.count("--noise-seed")) {
-    auto seed = ParseInteger("--noise-seed", args->values.at("--noise-seed"), 1, int64_t{1} << 53);
-    if (!seed) return kExitUsage;
-    options.noise_seed = static_cast<uint64_t>(*seed);
-  }
-  if (args->values.count("--start-m")) {
-    auto start = ParseNumber("--start-m", args->values.at("--start-m"));
-    if (!start) return kExitUsage;
-    options.start_m = *start;
-  }
+  if (args->Has("--start-m")) options.start_m = args->Number("--start-m");
   return Synthesize(options, args->values.at("--out"), args->Shown(args->values.at("--out")),
                     args->Value("--bag"), args->Value("--video"));
 }

@@ -28,31 +28,12 @@ int Fail(const std::string& message) {
   return kExitError;
 }
 
-bool ParseSize(const Arguments& args, int* width, int* height) {
-  auto it = args.values.find("--size");
-  if (it == args.values.end()) return true;
-  char x = 0;
-  std::istringstream in(it->second);
-  if (!(in >> *width >> x >> *height) || x != 'x' || *width < 64 || *height < 64 ||
-      *width > 16384 || *height > 16384) {
-    std::cerr << MessagePrefix() << "--size must be WxH with 64..16384 pixels each, not '"
-              << it->second << "'\n";
-    return false;
+// --size (checked by the parser), when given.
+void TakeSize(const Arguments& args, int* width, int* height) {
+  if (auto it = args.sizes.find("--size"); it != args.sizes.end()) {
+    *width = it->second.width;
+    *height = it->second.height;
   }
-  return true;
-}
-
-std::optional<std::vector<double>> ParseTimes(const std::string& text) {
-  std::vector<double> times;
-  std::istringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ',')) {
-    auto t = ParseNumber("--sessions", item);
-    if (!t) return std::nullopt;
-    times.push_back(*t);
-  }
-  std::sort(times.begin(), times.end());
-  return times;
 }
 
 std::optional<std::vector<TimeSpan>> ParseSpans(const std::string& text) {
@@ -138,7 +119,7 @@ int RenderExperienceMap(const Arguments& args) {
     figure = ExperienceMapFigureOf(std::move(data), *dataset, until_s);
   }
   ExperienceMapImageOptions& options = figure.options;
-  if (!ParseSize(args, &options.width_px, &options.height_px)) return kExitUsage;
+  TakeSize(args, &options.width_px, &options.height_px);
   if (auto it = args.values.find("--color"); it != args.values.end()) {
     if (it->second == "time") {
       options.coloring = MapColoring::kTime;
@@ -148,10 +129,9 @@ int RenderExperienceMap(const Arguments& args) {
       return Fail("--color must be time or session, not '" + it->second + "'");
     }
   }
-  if (auto it = args.values.find("--sessions"); it != args.values.end()) {
-    auto times = ParseTimes(it->second);
-    if (!times) return kExitUsage;
-    options.session_start_times_s = *times;
+  if (auto it = args.number_lists.find("--sessions"); it != args.number_lists.end()) {
+    options.session_start_times_s = it->second;
+    std::sort(options.session_start_times_s.begin(), options.session_start_times_s.end());
   } else if (options.coloring == MapColoring::kSession && options.session_start_times_s.empty()) {
     options.session_start_times_s = {run->experiences.empty() ? 0.0 : run->experiences[0].time_s};
   }
@@ -173,7 +153,7 @@ int RenderTemplateGraph(const Arguments& args) {
   StatusOr<RunFolder> run = ReadRunFolder(run_folder);
   if (!run.ok()) return Fail(run.status().message());
   TemplateGraphImageOptions options;
-  if (!ParseSize(args, &options.width_px, &options.height_px)) return kExitUsage;
+  TakeSize(args, &options.width_px, &options.height_px);
   if (auto it = args.values.find("--spans"); it != args.values.end()) {
     auto spans = ParseSpans(it->second);
     if (!spans) return kExitUsage;
@@ -231,12 +211,7 @@ int RenderPoseCells(const Arguments& args) {
 int RenderSimilarity(const Arguments& args) {
   auto options = LoadOptions(args);
   if (!options) return kExitError;
-  int frames = 600;
-  if (auto it = args.values.find("--frames"); it != args.values.end()) {
-    auto n = ParseInteger("--frames", it->second, 2, 5000);
-    if (!n) return kExitUsage;
-    frames = static_cast<int>(*n);
-  }
+  const int frames = args.Has("--frames") ? static_cast<int>(args.Whole("--frames")) : 600;
   PhoneLogOptions phone;
   phone.pdr = options->pdr;
   StatusOr<Dataset> dataset =
@@ -293,11 +268,7 @@ int RenderWifiMap(const Arguments& args) {
   const auto& grids = map->grids(ap);
   if (grids.empty()) return Fail(path + ": access point " + map->bssids()[ap] + " has no grid");
   int floor = grids.front().floor;
-  if (args.values.count("--floor")) {
-    auto f = ParseInteger("--floor", args.values.at("--floor"), -1000, 1000);
-    if (!f) return kExitUsage;
-    floor = static_cast<int>(*f);
-  }
+  if (args.Has("--floor")) floor = static_cast<int>(args.Whole("--floor"));
   const auto grid = std::find_if(grids.begin(), grids.end(),
                                  [floor](const WifiGpMap::Grid& g) { return g.floor == floor; });
   if (grid == grids.end()) {

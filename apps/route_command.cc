@@ -20,23 +20,7 @@
 #include "viewer/figures.h"
 
 namespace ratslam {
-namespace {
-
-// "X,Y" in metres; nothing (after a message) when it is not two finite numbers.
-std::optional<Point2> ParsePoint(const std::string& flag, const std::string& text) {
-  const size_t comma = text.find(',');
-  if (comma != std::string::npos) {
-    const std::optional<double> x = ParseNumber(flag, text.substr(0, comma));
-    if (!x) return std::nullopt;
-    const std::optional<double> y = ParseNumber(flag, text.substr(comma + 1));
-    if (!y) return std::nullopt;
-    return Point2{*x, *y};
-  }
-  std::cerr << MessagePrefix() << flag << ": expected X,Y in metres, got '" << text << "'\n";
-  return std::nullopt;
-}
-
-}  // namespace
+namespace {}  // namespace
 
 int RouteCommand(const Arguments& args) {
   auto fail = [](const Status& s) {
@@ -54,15 +38,13 @@ int RouteCommand(const Arguments& args) {
   if (!map.ok()) return fail(map.status());
   const int64_t n = static_cast<int64_t>(map->experiences.size());
   auto experience = [&](const char* flag) -> std::optional<uint32_t> {
-    const std::optional<int64_t> id =
-        ParseInteger(flag, args.values.at(flag), 0, std::numeric_limits<uint32_t>::max());
-    if (!id) return std::nullopt;
-    if (*id >= n) {
-      std::cerr << MessagePrefix() << flag << ": no experience " << *id << " in " << map_path
+    const int64_t id = args.Whole(flag);  // >= 0 by the parser; below n by this check
+    if (id >= n) {
+      std::cerr << MessagePrefix() << flag << ": no experience " << id << " in " << map_path
                 << " (it has 0.." << n - 1 << ")\n";
       return std::nullopt;
     }
-    return static_cast<uint32_t>(*id);
+    return static_cast<uint32_t>(id);
   };
   uint32_t from = *map->current;
   if (args.values.count("--from")) {
@@ -88,8 +70,8 @@ int RouteCommand(const Arguments& args) {
                                 std::to_string(from) + " over the links of " + map_path));
     }
   } else {
-    point = ParsePoint("--to-xy", args.values.at("--to-xy"));
-    if (!point) return kExitUsage;
+    const std::vector<double>& xy = args.number_lists.at("--to-xy");
+    point = Point2{xy[0], xy[1]};
     // The nearest experience the robot can reach (ties: the lower id).
     double best = std::numeric_limits<double>::infinity();
     for (uint32_t k = 0; k < graph.nodes.size(); ++k) {

@@ -64,11 +64,7 @@ Status SimulateWorld(const sim::World& world, uint64_t seed, const std::string& 
 int SimulateCommand(const Arguments& parsed) {
   const Arguments* args = &parsed;
   uint64_t seed = 1;
-  if (args->values.count("--seed")) {
-    const auto s = ParseInteger("--seed", args->values.at("--seed"), 0, int64_t{1} << 53);
-    if (!s) return kExitUsage;
-    seed = static_cast<uint64_t>(*s);
-  }
+  if (args->Has("--seed")) seed = static_cast<uint64_t>(args->Whole("--seed"));
   auto world = LoadWorld(args->values.at("--world"));
   if (!world.ok()) {
     std::cerr << MessagePrefix() << world.status().message() << "\n";

@@ -96,11 +96,7 @@ int SweepCommand(const std::string& action, const Arguments& parsed) {
   if (action == "run") {
     sweep::RunOptions options;
     options.program = ThisProgram();
-    if (args->values.count("--jobs")) {
-      auto jobs = ParseInteger("--jobs", args->values.at("--jobs"), 1, 1024);
-      if (!jobs) return kExitUsage;
-      options.jobs = static_cast<int>(*jobs);
-    }
+    if (args->Has("--jobs")) options.jobs = static_cast<int>(args->Whole("--jobs"));
     ProgressPrinter progress(stderr, args->quiet);
     options.progress = &progress;
     options.stop_requested = &g_sweep_stop;
@@ -119,10 +115,8 @@ int SweepCommand(const std::string& action, const Arguments& parsed) {
   }
   if (action == "task") {
     int64_t index = -1;
-    if (args->values.count("--index")) {
-      auto i = ParseInteger("--index", args->values.at("--index"), 0, 1 << 30);
-      if (!i) return kExitUsage;
-      index = *i;
+    if (args->Has("--index")) {
+      index = args->Whole("--index");
     } else {
       for (const char* variable : {"SLURM_ARRAY_TASK_ID", "PBS_ARRAY_INDEX", "SGE_TASK_ID"}) {
         const char* value = std::getenv(variable);
@@ -139,12 +133,7 @@ int SweepCommand(const std::string& action, const Arguments& parsed) {
         return kExitUsage;
       }
     }
-    int64_t chunk = 1;
-    if (args->values.count("--chunk")) {
-      auto c = ParseInteger("--chunk", args->values.at("--chunk"), 1, 1 << 20);
-      if (!c) return kExitUsage;
-      chunk = *c;
-    }
+    const int64_t chunk = args->Has("--chunk") ? args->Whole("--chunk") : 1;
     StatusOr<std::vector<sweep::TaskOutcome>> outcomes = sweep::RunTasks(
         target, static_cast<int>(index * chunk), static_cast<int>(chunk), ThisProgram());
     if (!outcomes.ok()) return Fail(outcomes.status());
@@ -169,16 +158,10 @@ int SweepCommand(const std::string& action, const Arguments& parsed) {
     options.time = args->Value("--time");
     options.mem = args->Value("--mem");
     if (args->all.count("--sbatch-arg")) options.sbatch_args = args->all.at("--sbatch-arg");
-    if (args->values.count("--max-parallel")) {
-      auto k = ParseInteger("--max-parallel", args->values.at("--max-parallel"), 1, 1 << 20);
-      if (!k) return kExitUsage;
-      options.max_parallel = static_cast<int>(*k);
+    if (args->Has("--max-parallel")) {
+      options.max_parallel = static_cast<int>(args->Whole("--max-parallel"));
     }
-    if (args->values.count("--chunk")) {
-      auto c = ParseInteger("--chunk", args->values.at("--chunk"), 1, 1 << 20);
-      if (!c) return kExitUsage;
-      options.chunk = static_cast<int>(*c);
-    }
+    if (args->Has("--chunk")) options.chunk = static_cast<int>(args->Whole("--chunk"));
     StatusOr<sweep::SlurmJobs> jobs = sweep::WriteSlurmScripts(target, options);
     if (!jobs.ok()) return Fail(jobs.status());
     if (dry_run) {
