@@ -77,7 +77,7 @@ struct Arguments {
 };
 
 // SIGINT and SIGTERM while a command that writes into --out runs (ratslam_main.cc installs the
-// handler). A command that stops cleanly calls StopCooperatively() and then polls StopFlag(); any
+// handler with StopOnSignalsGuarded, stop_signals.cc). A command that stops cleanly calls StopCooperatively() and then polls StopFlag(); any
 // other command ends at once with exit 130, and its output folder is as it was (its files were
 // only staged).
 std::atomic<bool>& StopFlag();
@@ -177,18 +177,37 @@ inline Status WriteCommandFigure(const Arguments& args, const std::string& png_p
   return WriteNaturalFigure(figure->renderer.get(), build, figure->targets, figure->width_mm);
 }
 
-// `ratslam render ...` (render_command.cc).
-// `what`: experience-map, template-graph, pose-cells, similarity or wifi-map.
-int RenderCommand(const std::string& what, const Arguments& args);
-int EvaluateCommand(const Arguments& args);
-int WifiMapCommand(const Arguments& args);
+// Installs the handlers of SIGINT and SIGTERM: StopOnSignals sets StopFlag (a command that
+// stops cleanly); StopOnSignalsGuarded, for a command under an OutputGuard, also ends one that
+// does not poll it at once (exit 130), and any command at a second signal.
+void StopOnSignals();
+void StopOnSignalsGuarded();
+
+// The commands: each runs with its parsed arguments and returns the exit code. The command
+// table (command_line.cc) names each one's handler beside its options.
+using CommandHandler = int (*)(const Arguments&);
+int ReplayCommand(const Arguments& args);  // replay_command.cc
+int DemoCommand(const Arguments& args);
+int PrintConfigCommand(const Arguments& args);
+int ImportOpenRatslamCommand(const Arguments& args);
+int ImportCommand(const Arguments& args);
+int SynthesizeCommand(const Arguments& args);
+int EvaluateCommand(const Arguments& args);  // evaluate_command.cc
+int WifiMapCommand(const Arguments& args);   // locate_command.cc
 int LocateCommand(const Arguments& args);
 int CallCommand(const Arguments& args);
-int RouteCommand(const Arguments& args);
-
-int SimulateCommand(const Arguments& args);
-// `action`: plan, run, task, collect or submit.
-int SweepCommand(const std::string& action, const Arguments& args);
+int RouteCommand(const Arguments& args);                // route_command.cc
+int SimulateCommand(const Arguments& args);             // simulate_command.cc
+int RenderExperienceMapCommand(const Arguments& args);  // render_command.cc
+int RenderTemplateGraphCommand(const Arguments& args);
+int RenderPoseCellsCommand(const Arguments& args);
+int RenderSimilarityCommand(const Arguments& args);
+int RenderWifiMapCommand(const Arguments& args);
+int SweepPlanCommand(const Arguments& args);  // sweep_command.cc
+int SweepRunCommand(const Arguments& args);
+int SweepTaskCommand(const Arguments& args);
+int SweepCollectCommand(const Arguments& args);
+int SweepSubmitCommand(const Arguments& args);
 // Simulates `world` into the replay data set `out` (with world.toml, simulation.json and
 // ground_truth.png); `dataset` receives it.
 namespace sim {

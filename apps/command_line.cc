@@ -44,6 +44,10 @@ struct CommandSpec {
   std::string description;  // more than the summary, for --help; may be empty
   std::vector<OptionSpec> options;
   std::vector<OptionSpec> positionals;
+  CommandHandler handler = nullptr;  // none for a group ("render") and for completion
+  // --out is a folder written under an OutputGuard (common/output_guard.h); false: the command
+  // writes --out itself (an image, a Wi-Fi map file, a sweep folder).
+  bool guard_out = true;
 };
 
 constexpr int64_t kSeedMax = int64_t{1} << 53;  // exact in a double, as the map files keep it
@@ -144,7 +148,8 @@ const std::vector<CommandSpec>& Commands() {
               kSeedMax),
         Formats("formats of the --render images: png, pdf, svg, comma-separated (default png)"),
         WidthMm(), kLenient, kQuiet, kJson},
-       {}},
+       {},
+       ReplayCommand},
       {"import",
        "convert data sets (ROS bags, phone logs, ...) to the replay format",
        "Converts data sets to the replay format in folder F (one multi-session data set when "
@@ -153,25 +158,29 @@ const std::vector<CommandSpec>& Commands() {
        "configuration.",
        {Text("--data", "D", "data set to convert; repeat to join sessions", true, true),
         Text("--out", "F", "output folder", true), kOverwrite, kConfig, kLenient, kQuiet},
-       {}},
+       {},
+       ImportCommand},
       {"demo",
        "simulate the built-in day_night world and replay it",
        "Simulates the built-in day_night world (camera, Wi-Fi, compass, odometry) into O/data, "
        "replays it into O with the fused front end and renders the images.",
        {Text("--out", "O", "output folder", true), kOverwrite, kQuiet, kJson},
-       {}},
+       {},
+       DemoCommand},
       {"print-config",
        "print the resolved configuration",
        "Prints the resolved configuration (the defaults when no file is given); with `locate`, "
        "that of wifi-map and locate.",
        {kConfig},
        {Choice("WHICH", "WHICH", "`locate` for the configuration of wifi-map and locate",
-               {"locate"})}},
+               {"locate"})},
+       PrintConfigCommand},
       {"import-openratslam",
        "convert an OpenRatSLAM configuration file to ours",
        "Converts an OpenRatSLAM configuration file (INI) to ours; the TOML goes to stdout.",
        {},
-       {Text("FILE", "FILE", "the OpenRatSLAM .ini or config.txt", true)}},
+       {Text("FILE", "FILE", "the OpenRatSLAM .ini or config.txt", true)},
+       ImportOpenRatslamCommand},
       {"synthesize",
        "write the built-in synthetic camera loop",
        "Writes the built-in synthetic camera loop into D (replay it with "
@@ -190,7 +199,8 @@ const std::vector<CommandSpec>& Commands() {
         Text("--video", "F",
              "also write the loop as a Motion-JPEG video F (.avi) with OpenRatSLAM's odometry "
              "log beside it (F's name with .txt)")},
-       {}},
+       {},
+       SynthesizeCommand},
       {"render", "images from a run folder, a saved map, a data set or a Wi-Fi map", "", {}, {}},
       {"render experience-map",
        "the experience map of a run",
@@ -205,7 +215,9 @@ const std::vector<CommandSpec>& Commands() {
                {"time", "session"}),
         Numbers("--sessions", "T1,T2,...", "session start times in seconds, comma-separated"),
         Formats(), WidthMm()},
-       {}},
+       {},
+       RenderExperienceMapCommand,
+       false},
       {"render template-graph",
        "template ids over time, with labelled spans",
        "",
@@ -213,14 +225,18 @@ const std::vector<CommandSpec>& Commands() {
         Text("--out", "F", "image file; default: O/template_graph.png"), Size(),
         Text("--spans", "A-B:label,...", "time spans to shade and label, comma-separated"),
         Formats(), WidthMm()},
-       {}},
+       {},
+       RenderTemplateGraphCommand,
+       false},
       {"render pose-cells",
        "the pose-cell activity of a saved map",
        "Draws the pose-cell network of a saved map with the map's own configuration (maps of "
        "format 2 carry none and need --config).",
        {Text("--map", "F", "saved map (replay --save-map)", true),
         Text("--out", "F", "image file", true), kConfig, Formats(), WidthMm()},
-       {}},
+       {},
+       RenderPoseCellsCommand,
+       false},
       {"render similarity",
        "the frame-by-frame similarity matrix of a data set",
        "",
@@ -228,7 +244,9 @@ const std::vector<CommandSpec>& Commands() {
         Text("--out", "F", "image file", true), kConfig,
         Whole("--frames", "N", "frames to compare (evenly spaced)", 2, 5000),
         Choice("--sensor", "S", "the sensor to compare", {"camera", "wifi"}), Formats(), WidthMm()},
-       {}},
+       {},
+       RenderSimilarityCommand,
+       false},
       {"render wifi-map",
        "one access point's Gaussian-process Wi-Fi map",
        "",
@@ -237,7 +255,9 @@ const std::vector<CommandSpec>& Commands() {
         Text("--ap", "BSSID", "access point; default: the one with the largest grid"),
         Whole("--floor", "N", "floor; default: the AP's first", -1000, 1000), Formats(),
         WidthMm("page width of PDF and SVG figures (default 180: two panels)")},
-       {}},
+       {},
+       RenderWifiMapCommand,
+       false},
       {"evaluate",
        "FABMAP localisation benchmark",
        "Maps M, localises every node of Q and writes evaluation.json, queries.csv, "
@@ -269,7 +289,8 @@ const std::vector<CommandSpec>& Commands() {
         Text("--out", "O", "output folder", true), kOverwrite, kLenient, kQuiet, kJson,
         Formats("formats of the figures: png, pdf, svg, comma-separated (default png)"),
         WidthMm("page width of PDF and SVG figures (default 180: two panels)")},
-       {}},
+       {},
+       EvaluateCommand},
       {"wifi-map",
        "fit Gaussian-process Wi-Fi maps",
        "Fits a Gaussian process per access point (mean and variance grids, [wifi_map] in C) from "
@@ -279,7 +300,9 @@ const std::vector<CommandSpec>& Commands() {
         Text("--out", "W", "Wi-Fi map file to write", true),
         Flag("--overwrite", "replace the file W if it exists (refused without it)"), kConfig,
         Text("--run", "RUN_FOLDER", "take positions from this run's map"), kLenient, kQuiet, kJson},
-       {}},
+       {},
+       WifiMapCommand,
+       false},
       {"locate",
        "locate a phone in a Wi-Fi map with a particle filter",
        "Locates a phone in W with a particle filter ([particle_filter], [pdr]): writes "
@@ -290,7 +313,8 @@ const std::vector<CommandSpec>& Commands() {
         Text("--out", "O", "output folder", true), kOverwrite, kConfig, kLenient, kQuiet, kJson,
         Formats("formats of the figures: png, pdf, svg, comma-separated (default png)"),
         WidthMm("page width of PDF and SVG figures (default 180: two panels)")},
-       {}},
+       {},
+       LocateCommand},
       {"call",
        "locate a phone and plan the robot's route to it",
        "Locates the phone up to time T and plans the robot's route from its current experience "
@@ -302,7 +326,8 @@ const std::vector<CommandSpec>& Commands() {
         Text("--out", "O", "output folder", true), kOverwrite, kConfig, kLenient, kQuiet, kJson,
         Formats("formats of call's figure: png, pdf, svg, comma-separated (default png)"),
         WidthMm("page width of PDF and SVG figures (default 180: a two-column map)")},
-       {}},
+       {},
+       CallCommand},
       {"route",
        "the shortest path between two experiences of a map",
        "Prints the shortest path over the experience graph of RUN from experience --from (default: "
@@ -316,7 +341,8 @@ const std::vector<CommandSpec>& Commands() {
         Text("--out", "O", "output folder"), kOverwrite, kQuiet, kJson,
         Formats("formats of route's figure: png, pdf, svg, comma-separated (default png)"),
         WidthMm()},
-       {}},
+       {},
+       RouteCommand},
       {"simulate",
        "simulate a world into a replay data set",
        "Simulates a world (built in: office, circular, day_night, aliased_floors, apartment; or "
@@ -325,30 +351,39 @@ const std::vector<CommandSpec>& Commands() {
        {Text("--world", "NAME|FILE", "built-in world name or world file", true),
         Text("--out", "D", "output folder", true), kOverwrite,
         Whole("--seed", "S", "random seed", 0, kSeedMax), kQuiet},
-       {}},
+       {},
+       SimulateCommand},
       {"sweep", "parameter sweeps (configs/README.md, \"Sweeps\")", "", {}, {}},
       {"sweep plan",
        "expand a sweep file into a folder's task table",
        "",
        {Text("--out", "DIR", "sweep folder to create", true)},
-       {Text("SWEEP", "SWEEP.toml", "sweep file", true)}},
+       {Text("SWEEP", "SWEEP.toml", "sweep file", true)},
+       SweepPlanCommand,
+       false},
       {"sweep run",
        "run every pending task, N at a time (resumable)",
        "",
        {Whole("--jobs", "N", "tasks at a time", 1, 1024), kQuiet},
-       {Text("DIR", "DIR", "sweep folder", true)}},
+       {Text("DIR", "DIR", "sweep folder", true)},
+       SweepRunCommand,
+       false},
       {"sweep task",
        "run one task of a cluster array",
        "Runs one task (or a chunk of them). The index comes from --index, else from "
        "SLURM_ARRAY_TASK_ID, PBS_ARRAY_INDEX or SGE_TASK_ID.",
        {Whole("--index", "I", "array index", 0, int64_t{1} << 30),
         Whole("--chunk", "C", "tasks per array index", 1, int64_t{1} << 20)},
-       {Text("DIR", "DIR", "sweep folder", true)}},
+       {Text("DIR", "DIR", "sweep folder", true)},
+       SweepTaskCommand,
+       false},
       {"sweep collect",
        "collect results.csv/json, points.csv, best.toml and the plots",
        "",
        {Formats("formats of the plots: png, pdf, svg, comma-separated (default png)"), WidthMm()},
-       {Text("DIR", "DIR", "sweep folder", true)}},
+       {Text("DIR", "DIR", "sweep folder", true)},
+       SweepCollectCommand,
+       false},
       {"sweep submit",
        "submit a Slurm job array over the pending tasks",
        "Writes and submits a Slurm job array over the pending tasks (C tasks per element) and a "
@@ -361,7 +396,9 @@ const std::vector<CommandSpec>& Commands() {
         Whole("--chunk", "C", "tasks per array element", 1, int64_t{1} << 20),
         Text("--sbatch-arg", "A", "extra sbatch argument; repeatable", false, true),
         Flag("--dry-run", "write and print the scripts without submitting")},
-       {Text("DIR", "DIR", "sweep folder", true)}},
+       {Text("DIR", "DIR", "sweep folder", true)},
+       SweepSubmitCommand,
+       false},
       {"completion",
        "print a bash completion script",
        "Prints a bash completion script for ratslam: `source <(ratslam completion)`.",
@@ -609,6 +646,8 @@ ParsedCommand Collect(CLI::App* at, const std::string& path) {
   ParsedCommand parsed;
   parsed.command = path;
   const CommandSpec& spec = SpecOf(path);
+  parsed.handler = spec.handler;
+  parsed.guard_out = spec.guard_out;
   for (const OptionSpec& o : spec.options) {
     const CLI::Option* option = at->get_option(o.name);
     if (option->count() == 0) continue;
@@ -730,6 +769,8 @@ std::variant<ParsedCommand, int> ParseCommandLine(int argc, const char* const* a
   }
   return Collect(at, path);
 }
+
+CommandHandler HandlerOf(const std::string& path) { return SpecOf(path).handler; }
 
 std::vector<std::string> CommandPaths() {
   std::vector<std::string> paths;

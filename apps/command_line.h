@@ -19,6 +19,8 @@ namespace ratslam {
 struct ParsedCommand {
   std::string command;
   Arguments args;
+  CommandHandler handler = nullptr;  // the command's own (never null for a parsed command)
+  bool guard_out = true;             // a given --out is a folder to write under an OutputGuard
 };
 
 // Parses `argv`. Returns the command, or an exit code once the parser has answered by itself:
@@ -29,6 +31,10 @@ std::variant<ParsedCommand, int> ParseCommandLine(int argc, const char* const* a
 
 // Every command path, in the order of the reference.
 std::vector<std::string> CommandPaths();
+
+// The handler the table names for `path`: null for a group ("render", "sweep") and for
+// `completion`, which the parser answers itself.
+CommandHandler HandlerOf(const std::string& path);
 
 // docs/cli.md's command reference: each command's `--help`, in Markdown.
 std::string CommandReference();

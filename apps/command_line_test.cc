@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -49,6 +50,28 @@ TEST(CommandLineTest, EveryCommandHasHelpWithBothSpellings) {
     EXPECT_EQ(help.code(), kExitOk) << path;
     EXPECT_NE(help.out.find("Usage: ratslam " + path), std::string::npos) << path;
   }
+}
+
+// One table names each command's handler: every command that runs has one, no two share one
+// (a copied line would run the wrong command), and a parsed command carries its own.
+TEST(CommandLineTest, EveryCommandHasItsOwnHandler) {
+  std::set<CommandHandler> seen;
+  for (const std::string& path : CommandPaths()) {
+    const bool group = path == "render" || path == "sweep";
+    if (group || path == "completion") {
+      EXPECT_EQ(HandlerOf(path), nullptr) << path;
+      continue;
+    }
+    ASSERT_NE(HandlerOf(path), nullptr) << path;
+    EXPECT_TRUE(seen.insert(HandlerOf(path)).second) << path << " shares a handler";
+  }
+  EXPECT_EQ(seen.size(), 22u);
+  const Outcome o = Parse("render pose-cells --map m --out o.png");
+  ASSERT_EQ(o.code(), -1) << o.err;
+  EXPECT_EQ(o.command().handler, HandlerOf("render pose-cells"));
+  EXPECT_FALSE(o.command().guard_out);  // an image file
+  EXPECT_FALSE(Parse("wifi-map --data d --out w.bin").command().guard_out);
+  EXPECT_TRUE(Parse("replay --data d --out o").command().guard_out);
 }
 
 TEST(CommandLineTest, HelpIsNotTakenForAFileName) {

@@ -72,7 +72,9 @@ Status Write(const Arguments& args, const std::string& out, const SceneBuilder& 
   return Status::Ok();
 }
 
-int RenderExperienceMap(const Arguments& args) {
+}  // namespace
+
+int RenderExperienceMapCommand(const Arguments& args) {
   const std::string run_folder = args.values.at("--run");
   StatusOr<RunFolder> run = ReadRunFolder(run_folder);
   if (!run.ok()) return Fail(run.status().message());
@@ -148,7 +150,7 @@ int RenderExperienceMap(const Arguments& args) {
   return status.ok() ? kExitOk : Fail(status.message());
 }
 
-int RenderTemplateGraph(const Arguments& args) {
+int RenderTemplateGraphCommand(const Arguments& args) {
   const std::string run_folder = args.values.at("--run");
   StatusOr<RunFolder> run = ReadRunFolder(run_folder);
   if (!run.ok()) return Fail(run.status().message());
@@ -174,7 +176,7 @@ int RenderTemplateGraph(const Arguments& args) {
   return status.ok() ? kExitOk : Fail(status.message());
 }
 
-int RenderPoseCells(const Arguments& args) {
+int RenderPoseCellsCommand(const Arguments& args) {
   const std::string& map_path = args.values.at("--map");
   StatusOr<MapFile> map = LoadMapFile(map_path);
   if (!map.ok()) return Fail(map.status().message());
@@ -208,7 +210,7 @@ int RenderPoseCells(const Arguments& args) {
   return status.ok() ? kExitOk : Fail(status.message());
 }
 
-int RenderSimilarity(const Arguments& args) {
+int RenderSimilarityCommand(const Arguments& args) {
   auto options = LoadOptions(args);
   if (!options) return kExitError;
   const int frames = args.Has("--frames") ? static_cast<int>(args.Whole("--frames")) : 600;
@@ -246,7 +248,7 @@ int RenderSimilarity(const Arguments& args) {
 }
 
 // The GP mean and variance of one AP (Kudo and Miura, fig. 15), with the training scans.
-int RenderWifiMap(const Arguments& args) {
+int RenderWifiMapCommand(const Arguments& args) {
   const std::string path = args.values.at("--wifi-map");
   StatusOr<WifiGpMap> map = WifiGpMap::Load(path);
   if (!map.ok()) return Fail(map.status().message());
@@ -296,19 +298,6 @@ int RenderWifiMap(const Arguments& args) {
       },
       natural.width(), natural.height(), kTwoColumnMm);
   return status.ok() ? kExitOk : Fail(status.message());
-}
-
-}  // namespace
-
-int RenderCommand(const std::string& what, const Arguments& parsed) {
-  const Arguments* args = &parsed;
-  if (what == "experience-map") return RenderExperienceMap(*args);
-  if (what == "template-graph") return RenderTemplateGraph(*args);
-  if (what == "pose-cells") return RenderPoseCells(*args);
-  if (what == "similarity") return RenderSimilarity(*args);
-  if (what == "wifi-map") return RenderWifiMap(*args);
-  std::cerr << MessagePrefix() << "internal error: unknown image '" << what << "'\n";
-  return kExitInternal;
 }
 
 }  // namespace ratslam

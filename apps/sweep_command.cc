@@ -77,106 +77,118 @@ int Fail(const Status& s) {
 
 }  // namespace
 
-int SweepCommand(const std::string& action, const Arguments& parsed) {
+int SweepPlanCommand(const Arguments& parsed) {
   const Arguments* args = &parsed;
-  const bool slurm = args->values.count("--slurm") > 0;
-  const bool dry_run = args->values.count("--dry-run") > 0;
   const std::string& target = args->positional[0];
-  if (action == "plan") {
-    StatusOr<sweep::SweepSpec> spec = sweep::LoadSweepFile(target);
-    if (!spec.ok()) return Fail(spec.status());
-    StatusOr<sweep::Plan> plan = sweep::MakePlan(*spec);
-    if (!plan.ok()) return Fail(plan.status());
-    Status written = sweep::WritePlan(*plan, args->values.at("--out"));
-    if (!written.ok()) return Fail(written);
-    std::cout << plan->tasks.size() << " tasks (" << plan->points << " points x "
-              << spec->datasets.size() << " data sets) in " << args->values.at("--out") << "\n";
-    return kExitOk;
+  StatusOr<sweep::SweepSpec> spec = sweep::LoadSweepFile(target);
+  if (!spec.ok()) return Fail(spec.status());
+  StatusOr<sweep::Plan> plan = sweep::MakePlan(*spec);
+  if (!plan.ok()) return Fail(plan.status());
+  Status written = sweep::WritePlan(*plan, args->values.at("--out"));
+  if (!written.ok()) return Fail(written);
+  std::cout << plan->tasks.size() << " tasks (" << plan->points << " points x "
+            << spec->datasets.size() << " data sets) in " << args->values.at("--out") << "\n";
+  return kExitOk;
+}
+
+int SweepRunCommand(const Arguments& parsed) {
+  const Arguments* args = &parsed;
+  const std::string& target = args->positional[0];
+  sweep::RunOptions options;
+  options.program = ThisProgram();
+  if (args->Has("--jobs")) options.jobs = static_cast<int>(args->Whole("--jobs"));
+  ProgressPrinter progress(stderr, args->quiet);
+  options.progress = &progress;
+  options.stop_requested = &g_sweep_stop;
+  std::signal(SIGINT, OnSweepSignal);
+  std::signal(SIGTERM, OnSweepSignal);
+  StatusOr<sweep::RunReport> report = sweep::RunSweep(target, options);
+  std::signal(SIGINT, SIG_DFL);
+  std::signal(SIGTERM, SIG_DFL);
+  if (!report.ok()) return Fail(report.status());
+  if (!args->quiet) {
+    std::cout << report->done << " run, " << report->skipped << " already done, " << report->failed
+              << " failed, " << report->pending << " pending\n";
   }
-  if (action == "run") {
-    sweep::RunOptions options;
-    options.program = ThisProgram();
-    if (args->Has("--jobs")) options.jobs = static_cast<int>(args->Whole("--jobs"));
-    ProgressPrinter progress(stderr, args->quiet);
-    options.progress = &progress;
-    options.stop_requested = &g_sweep_stop;
-    std::signal(SIGINT, OnSweepSignal);
-    std::signal(SIGTERM, OnSweepSignal);
-    StatusOr<sweep::RunReport> report = sweep::RunSweep(target, options);
-    std::signal(SIGINT, SIG_DFL);
-    std::signal(SIGTERM, SIG_DFL);
-    if (!report.ok()) return Fail(report.status());
-    if (!args->quiet) {
-      std::cout << report->done << " run, " << report->skipped << " already done, "
-                << report->failed << " failed, " << report->pending << " pending\n";
+  if (report->pending > 0) return kExitInterrupted;
+  return report->failed > 0 ? kExitError : kExitOk;
+}
+
+int SweepTaskCommand(const Arguments& parsed) {
+  const Arguments* args = &parsed;
+  const std::string& target = args->positional[0];
+  int64_t index = -1;
+  if (args->Has("--index")) {
+    index = args->Whole("--index");
+  } else {
+    for (const char* variable : {"SLURM_ARRAY_TASK_ID", "PBS_ARRAY_INDEX", "SGE_TASK_ID"}) {
+      const char* value = std::getenv(variable);
+      if (!value) continue;
+      auto i = ParseInteger(variable, value, 0, 1 << 30);
+      if (!i) return kExitUsage;
+      index = *i;
+      break;
     }
-    if (report->pending > 0) return kExitInterrupted;
-    return report->failed > 0 ? kExitError : kExitOk;
-  }
-  if (action == "task") {
-    int64_t index = -1;
-    if (args->Has("--index")) {
-      index = args->Whole("--index");
-    } else {
-      for (const char* variable : {"SLURM_ARRAY_TASK_ID", "PBS_ARRAY_INDEX", "SGE_TASK_ID"}) {
-        const char* value = std::getenv(variable);
-        if (!value) continue;
-        auto i = ParseInteger(variable, value, 0, 1 << 30);
-        if (!i) return kExitUsage;
-        index = *i;
-        break;
-      }
-      if (index < 0) {
-        std::cerr << MessagePrefix()
-                  << "no --index and no scheduler array index in the "
-                     "environment\n";
-        return kExitUsage;
-      }
-    }
-    const int64_t chunk = args->Has("--chunk") ? args->Whole("--chunk") : 1;
-    StatusOr<std::vector<sweep::TaskOutcome>> outcomes = sweep::RunTasks(
-        target, static_cast<int>(index * chunk), static_cast<int>(chunk), ThisProgram());
-    if (!outcomes.ok()) return Fail(outcomes.status());
-    bool all_ok = true;
-    for (const sweep::TaskOutcome& o : *outcomes) {
-      std::cout << "task " << o.index << ": " << o.status
-                << (o.error.empty() ? "" : " (" + o.error + ")") << "\n";
-      all_ok = all_ok && o.status == "ok";
-    }
-    return all_ok ? kExitOk : kExitError;
-  }
-  if (action == "submit") {
-    if (!slurm) {
+    if (index < 0) {
       std::cerr << MessagePrefix()
-                << "only --slurm is supported (see configs/README.md for a "
-                   "GNU parallel recipe)\n";
+                << "no --index and no scheduler array index in the "
+                   "environment\n";
       return kExitUsage;
     }
-    sweep::SlurmOptions options;
-    options.program = ThisProgram();
-    options.partition = args->Value("--partition");
-    options.time = args->Value("--time");
-    options.mem = args->Value("--mem");
-    if (args->all.count("--sbatch-arg")) options.sbatch_args = args->all.at("--sbatch-arg");
-    if (args->Has("--max-parallel")) {
-      options.max_parallel = static_cast<int>(args->Whole("--max-parallel"));
+  }
+  const int64_t chunk = args->Has("--chunk") ? args->Whole("--chunk") : 1;
+  StatusOr<std::vector<sweep::TaskOutcome>> outcomes = sweep::RunTasks(
+      target, static_cast<int>(index * chunk), static_cast<int>(chunk), ThisProgram());
+  if (!outcomes.ok()) return Fail(outcomes.status());
+  bool all_ok = true;
+  for (const sweep::TaskOutcome& o : *outcomes) {
+    std::cout << "task " << o.index << ": " << o.status
+              << (o.error.empty() ? "" : " (" + o.error + ")") << "\n";
+    all_ok = all_ok && o.status == "ok";
+  }
+  return all_ok ? kExitOk : kExitError;
+}
+
+int SweepSubmitCommand(const Arguments& parsed) {
+  const Arguments* args = &parsed;
+  const std::string& target = args->positional[0];
+  const bool slurm = args->values.count("--slurm") > 0;
+  const bool dry_run = args->values.count("--dry-run") > 0;
+  if (!slurm) {
+    std::cerr << MessagePrefix()
+              << "only --slurm is supported (see configs/README.md for a "
+                 "GNU parallel recipe)\n";
+    return kExitUsage;
+  }
+  sweep::SlurmOptions options;
+  options.program = ThisProgram();
+  options.partition = args->Value("--partition");
+  options.time = args->Value("--time");
+  options.mem = args->Value("--mem");
+  if (args->all.count("--sbatch-arg")) options.sbatch_args = args->all.at("--sbatch-arg");
+  if (args->Has("--max-parallel")) {
+    options.max_parallel = static_cast<int>(args->Whole("--max-parallel"));
+  }
+  if (args->Has("--chunk")) options.chunk = static_cast<int>(args->Whole("--chunk"));
+  StatusOr<sweep::SlurmJobs> jobs = sweep::WriteSlurmScripts(target, options);
+  if (!jobs.ok()) return Fail(jobs.status());
+  if (dry_run) {
+    for (const std::string& script : {jobs->array_script, jobs->collect_script}) {
+      std::ifstream in(script);
+      std::cout << "# " << script << "\n" << in.rdbuf() << "\n";
     }
-    if (args->Has("--chunk")) options.chunk = static_cast<int>(args->Whole("--chunk"));
-    StatusOr<sweep::SlurmJobs> jobs = sweep::WriteSlurmScripts(target, options);
-    if (!jobs.ok()) return Fail(jobs.status());
-    if (dry_run) {
-      for (const std::string& script : {jobs->array_script, jobs->collect_script}) {
-        std::ifstream in(script);
-        std::cout << "# " << script << "\n" << in.rdbuf() << "\n";
-      }
-      return kExitOk;
-    }
-    Status submitted = sweep::SubmitSlurm(&*jobs);
-    if (!submitted.ok()) return Fail(submitted);
-    std::cout << "array job " << jobs->array_job << " (--array=" << jobs->array_spec
-              << "), collect job " << jobs->collect_job << "\n";
     return kExitOk;
   }
+  Status submitted = sweep::SubmitSlurm(&*jobs);
+  if (!submitted.ok()) return Fail(submitted);
+  std::cout << "array job " << jobs->array_job << " (--array=" << jobs->array_spec
+            << "), collect job " << jobs->collect_job << "\n";
+  return kExitOk;
+}
+
+int SweepCollectCommand(const Arguments& parsed) {
+  const Arguments* args = &parsed;
+  const std::string& target = args->positional[0];
   StatusOr<sweep::CollectReport> report = sweep::Collect(target);
   if (!report.ok()) return Fail(report.status());
   if (Status drawn = DrawSweepPlots(target, *report, *args); !drawn.ok()) return Fail(drawn);
