@@ -77,9 +77,9 @@ struct Arguments {
 };
 
 // SIGINT and SIGTERM while a command that writes into --out runs (ratslam_main.cc installs the
-// handler with StopOnSignalsGuarded, stop_signals.cc). A command that stops cleanly calls StopCooperatively() and then polls StopFlag(); any
-// other command ends at once with exit 130, and its output folder is as it was (its files were
-// only staged).
+// handler with StopOnSignalsGuarded, stop_signals.cc). A command that stops cleanly calls
+// StopCooperatively() and then polls StopFlag(); any other command ends at once with exit 130, and
+// its output folder is as it was (its files were only staged).
 std::atomic<bool>& StopFlag();
 void StopCooperatively();
 
