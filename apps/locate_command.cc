@@ -34,9 +34,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::optional<LocateOptions> LoadLocateOptions(const Arguments& args, const char* command) {
-  if (!args.values.count("--config")) return LocateOptions();
-  StatusOr<LocateOptions> o = LoadLocateConfigFile(args.values.at("--config"));
+std::optional<phone::LocateOptions> LoadLocateOptions(const Arguments& args, const char* command) {
+  if (!args.values.count("--config")) return phone::LocateOptions();
+  StatusOr<phone::LocateOptions> o = LoadLocateConfigFile(args.values.at("--config"));
   if (!o.ok()) {
     std::cerr << "ratslam " << command << ": " << o.status().message() << "\n";
     return std::nullopt;
@@ -53,16 +53,17 @@ std::string Metres(const nlohmann::ordered_json& value) {
 
 // The session's SetUpPhone with the command's options, map and log.
 StatusOr<PhoneSetup> SetUpPhone(const Arguments& args, const char* command) {
-  const std::optional<LocateOptions> options = LoadLocateOptions(args, command);
+  const std::optional<phone::LocateOptions> options = LoadLocateOptions(args, command);
   if (!options) return Status::Error("");  // already reported
-  return SetUpPhone(*options, args.values.at("--wifi-map"), args.values.at("--data"), args.lenient);
+  return ratslam::SetUpPhone(*options, args.values.at("--wifi-map"), args.values.at("--data"),
+                             args.lenient);
 }
 
 }  // namespace
 
 int WifiMapCommand(const Arguments& parsed) {
   const Arguments* args = &parsed;
-  const std::optional<LocateOptions> options = LoadLocateOptions(*args, "wifi-map");
+  const std::optional<phone::LocateOptions> options = LoadLocateOptions(*args, "wifi-map");
   if (!options) return kExitError;
   auto fail = [](const Status& s) {
     std::cerr << MessagePrefix() << s.message() << "\n";
@@ -81,7 +82,7 @@ int WifiMapCommand(const Arguments& parsed) {
   input.lenient = args->lenient;
   StatusOr<BuiltWifiMap> built = BuildWifiMap(*options, input, args->values.at("--out"));
   if (!built.ok()) return fail(built.status());
-  const WifiGpMap* map = &built->map;
+  const phone::WifiGpMap* map = &built->map;
   const bool from_run = input.run.has_value();
   const fs::path out = args->values.at("--out");
   StatusOr<std::unique_ptr<DiskFolder>> folder =
@@ -112,7 +113,7 @@ int LocateCommand(const Arguments& parsed) {
   StatusOr<PhoneSetup> setup = SetUpPhone(*args, "locate");
   if (!setup.ok()) return fail(setup.status());
   const std::string map_path = args->values.at("--wifi-map");
-  const LocateOptions* options = &setup->options;
+  const phone::LocateOptions* options = &setup->options;
   const Dataset& d = setup->data;
   StatusOr<LocateResult> located = Locate(*setup, args->values.at("--data"), map_path);
   if (!located.ok()) return fail(located.status());
@@ -186,9 +187,9 @@ int CallCommand(const Arguments& parsed) {
       *setup, *robot, at,
       {args->values.at("--data"), args->values.at("--map"), args->values.at("--wifi-map")});
   if (!call.ok()) return fail(call.status());
-  const CallPlan* plan = &call->plan;
-  const RouteGraph& graph = call->graph;
-  const LocationEstimate& estimate = call->estimate;
+  const phone::CallPlan* plan = &call->plan;
+  const phone::RouteGraph& graph = call->graph;
+  const phone::LocationEstimate& estimate = call->estimate;
   const std::optional<Point2>& truth_on_map = call->truth_on_map;
   const std::vector<std::pair<Point2, double>>& candidates = call->candidates;
   nlohmann::ordered_json& j = call->summary;
@@ -227,7 +228,7 @@ int CallCommand(const Arguments& parsed) {
                         " stops, " + candidate_count + " candidates";
     WorldToImage to_image;
     Scene scene = ExperienceMapScene(image, o, &to_image);
-    const std::vector<Particle>& particles = call->particles;
+    const std::vector<phone::Particle>& particles = call->particles;
     const size_t every = std::max<size_t>(1, particles.size() / 3000);
     for (size_t k = 0; k < particles.size(); k += every) {
       scene.Disc(to_image(particles[k].x_m, particles[k].y_m), 1.6f, {120, 120, 120, 110}, 6);

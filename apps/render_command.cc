@@ -250,7 +250,7 @@ int RenderSimilarityCommand(const Arguments& args) {
 // The GP mean and variance of one AP (Kudo and Miura, fig. 15), with the training scans.
 int RenderWifiMapCommand(const Arguments& args) {
   const std::string path = args.values.at("--wifi-map");
-  StatusOr<WifiGpMap> map = WifiGpMap::Load(path);
+  StatusOr<phone::WifiGpMap> map = phone::WifiGpMap::Load(path);
   if (!map.ok()) return Fail(map.status().message());
   if (map->bssids().empty()) return Fail(path + ": the map holds no access point");
   // The AP asked for, or the one with the most stored cells.
@@ -271,8 +271,9 @@ int RenderWifiMapCommand(const Arguments& args) {
   if (grids.empty()) return Fail(path + ": access point " + map->bssids()[ap] + " has no grid");
   int floor = grids.front().floor;
   if (args.Has("--floor")) floor = static_cast<int>(args.Whole("--floor"));
-  const auto grid = std::find_if(grids.begin(), grids.end(),
-                                 [floor](const WifiGpMap::Grid& g) { return g.floor == floor; });
+  const auto grid =
+      std::find_if(grids.begin(), grids.end(),
+                   [floor](const phone::WifiGpMap::Grid& g) { return g.floor == floor; });
   if (grid == grids.end()) {
     return Fail(path + ": access point " + map->bssids()[ap] + " was not heard on floor " +
                 std::to_string(floor));
@@ -283,7 +284,7 @@ int RenderWifiMapCommand(const Arguments& args) {
   GridField variance{"variance (dBm^2), eq. 10", grid->width,        grid->height,       cell,
                      grid->min_x * cell,         grid->min_y * cell, grid->variance_dbm2};
   std::vector<Point2> points;
-  for (const WifiMapSample& s : map->training_samples()) {
+  for (const phone::WifiMapSample& s : map->training_samples()) {
     if (s.floor == floor) points.push_back(s.position);
   }
   const std::string title = "Wi-Fi map of " + map->bssids()[ap] + ", floor " +

@@ -330,9 +330,9 @@ int PrintConfigCommand(const Arguments& parsed) {
   const Arguments* args = &parsed;
   const bool locate = args->positional == std::vector<std::string>{"locate"};
   if (locate) {  // the configuration of wifi-map and locate
-    LocateOptions o;
+    phone::LocateOptions o;
     if (args->values.count("--config")) {
-      StatusOr<LocateOptions> loaded = LoadLocateConfigFile(args->values.at("--config"));
+      StatusOr<phone::LocateOptions> loaded = LoadLocateConfigFile(args->values.at("--config"));
       if (!loaded.ok()) {
         std::cerr << MessagePrefix() << loaded.status().message() << "\n";
         return kExitError;

@@ -52,12 +52,12 @@ int RouteCommand(const Arguments& args) {
     if (!id) return kExitError;
     from = *id;
   }
-  RouteGraph graph;
+  phone::RouteGraph graph;
   for (const Experience& e : map->experiences) graph.nodes.push_back({e.x_m, e.y_m});
   for (const Link& l : map->links) graph.edges.push_back({l.from, l.to});
   std::vector<double> distance;
   std::vector<uint32_t> previous;
-  ShortestPaths(graph, from, &distance, &previous);
+  phone::ShortestPaths(graph, from, &distance, &previous);
 
   uint32_t to = 0;
   std::optional<Point2> point;

@@ -25,7 +25,7 @@ namespace {
 
 struct Floor {
   std::vector<Point2> aps;
-  std::vector<WifiMapSample> samples;
+  std::vector<phone::WifiMapSample> samples;
   Floor() {
     Random r(3);
     for (int a = 0; a < 200; ++a) aps.push_back({r.Uniform(0, 120), r.Uniform(0, 60)});
@@ -40,8 +40,8 @@ struct Floor {
     }
     while (samples.size() < 2000) samples.push_back(At({r.Uniform(0, 120), 30.0}, &r));
   }
-  WifiMapSample At(const Point2& p, Random* r) const {
-    WifiMapSample s{p, 0, {}};
+  phone::WifiMapSample At(const Point2& p, Random* r) const {
+    phone::WifiMapSample s{p, 0, {}};
     for (size_t a = 0; a < aps.size(); ++a) {
       const double d = std::hypot(p.x - aps[a].x, p.y - aps[a].y);
       if (d < 25)
@@ -62,7 +62,7 @@ void BM_WifiMapBuild(benchmark::State& state) {
   size_t readings = 0;
   for (const auto& s : f.samples) readings += s.readings.size();
   for (auto _ : state) {
-    StatusOr<WifiGpMap> map = WifiGpMap::Build(f.samples, WifiGpOptions());
+    StatusOr<phone::WifiGpMap> map = phone::WifiGpMap::Build(f.samples, phone::WifiGpOptions());
     benchmark::DoNotOptimize(map);
     state.counters["cells"] = static_cast<double>(map->stored_cells());
   }
@@ -71,8 +71,8 @@ void BM_WifiMapBuild(benchmark::State& state) {
 }
 BENCHMARK(BM_WifiMapBuild)->Unit(benchmark::kSecond)->Iterations(1);
 
-std::vector<WallSegment> CorridorWalls() {
-  std::vector<WallSegment> walls;
+std::vector<phone::WallSegment> CorridorWalls() {
+  std::vector<phone::WallSegment> walls;
   for (double y = 0; y <= 60; y += 15) {
     for (double x = 0; x < 120; x += 7.5) {
       walls.push_back({0, {x + 1.0, y - 1.2}, {x + 7.5, y - 1.2}});
@@ -84,16 +84,16 @@ std::vector<WallSegment> CorridorWalls() {
 
 void BM_FilterScan(benchmark::State& state) {
   const Floor& f = TheFloor();
-  static const WifiGpMap plain = *WifiGpMap::Build(f.samples, WifiGpOptions());
-  static const WifiGpMap walled = [] {
-    WifiGpMap m = plain;
+  static const phone::WifiGpMap plain = *phone::WifiGpMap::Build(f.samples, phone::WifiGpOptions());
+  static const phone::WifiGpMap walled = [] {
+    phone::WifiGpMap m = plain;
     m.set_walls(CorridorWalls());
     return m;
   }();
-  const WifiGpMap& map = state.range(1) ? walled : plain;
-  ParticleFilterOptions options;
+  const phone::WifiGpMap& map = state.range(1) ? walled : plain;
+  phone::ParticleFilterOptions options;
   options.particles = static_cast<int>(state.range(0));
-  ParticleFilter filter(map, options);
+  phone::ParticleFilter filter(map, options);
   (void)filter.Initialise(true);
   Random r(5);
   std::vector<std::vector<std::pair<std::string, double>>> scans;
@@ -118,7 +118,7 @@ void BM_PlanCall(benchmark::State& state) {
   // Experiences every 0.6 m along the floor's corridors (every 15 m both ways over 120 x 60 m),
   // each linked to its neighbours along the corridor: 1,869 nodes, about one link per node,
   // like an experience map.
-  RouteGraph graph;
+  phone::RouteGraph graph;
   std::map<std::pair<int, int>, uint32_t> id;
   for (int ix = 0; ix <= 200; ++ix) {
     for (int iy = 0; iy <= 100; ++iy) {
@@ -138,7 +138,7 @@ void BM_PlanCall(benchmark::State& state) {
   for (int c = 0; c < state.range(0); ++c)
     candidates.push_back({r.Uniform(0, 120), r.Uniform(0, 60)});
   for (auto _ : state) {
-    StatusOr<CallPlan> plan = PlanCall(graph, 0, candidates);
+    StatusOr<phone::CallPlan> plan = phone::PlanCall(graph, 0, candidates);
     benchmark::DoNotOptimize(plan);
     state.counters["route_m"] = plan->length_m;
   }

@@ -14,7 +14,7 @@ std::vector<std::string> FuzzSeeds() {
   fused.sensors.fused.use_compass = true;
   return {PrintConfig(PipelineOptions()), PrintConfig(fused, false),
           "[front_end]\nkind = \"fabmap\"\n[fabmap]\nmode = \"early\"\n[wifi_words]\nbins = 8\n",
-          PrintLocateConfig(LocateOptions())};
+          PrintLocateConfig(phone::LocateOptions())};
 }
 
 }  // namespace ratslam::fuzz
@@ -23,7 +23,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace ratslam;
   const std::string text(reinterpret_cast<const char*>(data), size);
   // The same text as a wifi-map / locate configuration: the same invariants.
-  StatusOr<LocateOptions> locate = ParseLocateConfig(text, "fuzz.toml");
+  StatusOr<phone::LocateOptions> locate = ParseLocateConfig(text, "fuzz.toml");
   if (!locate.ok() && locate.status().message().rfind("fuzz.toml", 0) != 0) {
     fuzz::InvariantFailed("error does not name the file: " + locate.status().message());
   }
@@ -31,7 +31,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     std::string invalid;
     if (!locate->IsValid(&invalid)) fuzz::InvariantFailed("accepted an invalid config: " + invalid);
     const std::string printed = PrintLocateConfig(*locate);
-    StatusOr<LocateOptions> back = ParseLocateConfig(printed, "printed.toml");
+    StatusOr<phone::LocateOptions> back = ParseLocateConfig(printed, "printed.toml");
     if (!back.ok() || PrintLocateConfig(*back) != printed) {
       fuzz::InvariantFailed("locate config print/parse round trip differs");
     }

@@ -66,12 +66,12 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     return 0;
   }
   if (run->experiences.empty() || run->experiences.size() > 5000) return 0;
-  RouteGraph graph;
+  phone::RouteGraph graph;
   for (const Experience& e : run->experiences) graph.nodes.push_back({e.x_m, e.y_m});
   for (const Link& l : run->links) graph.edges.push_back({l.from, l.to});
   const uint32_t start = run->current_experience.value_or(0);
   const std::vector<Point2> candidates = {{0, 0}, {1.5, -2}, {1e6, 3}, {-7, 7}};
-  StatusOr<CallPlan> plan = PlanCall(graph, start, candidates);
+  StatusOr<phone::CallPlan> plan = phone::PlanCall(graph, start, candidates);
   if (!plan.ok()) return 0;  // e.g. a non-finite position: refused, not planned
   std::set<std::pair<uint32_t, uint32_t>> linked;
   for (const auto& [a, b] : graph.edges) linked.insert({std::min(a, b), std::max(a, b)});

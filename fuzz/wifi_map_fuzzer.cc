@@ -14,11 +14,11 @@ namespace ratslam::fuzz {
 std::vector<std::string> FuzzSeeds() {
   std::vector<std::string> seeds;
   for (int floors : {1, 2}) {
-    std::vector<WifiMapSample> samples;
+    std::vector<phone::WifiMapSample> samples;
     for (int f = 0; f < floors; ++f) {
       for (double x = 0; x <= 12; x += 2) {
         for (double y = 0; y <= 6; y += 3) {
-          WifiMapSample s{{x, y}, f, {}};
+          phone::WifiMapSample s{{x, y}, f, {}};
           for (int a = 0; a < 3; ++a) {
             const double d = std::hypot(x - 6 * a, y - 3);
             if (d < 9)
@@ -28,9 +28,9 @@ std::vector<std::string> FuzzSeeds() {
         }
       }
     }
-    WifiGpOptions options;
+    phone::WifiGpOptions options;
     options.grid_margin_m = 3.0;
-    StatusOr<WifiGpMap> map = WifiGpMap::Build(samples, options);
+    StatusOr<phone::WifiGpMap> map = phone::WifiGpMap::Build(samples, options);
     if (!map.ok()) InvariantFailed("the seed map failed: " + map.status().message());
     if (floors == 2) {
       map->set_geo_reference_deg(std::make_pair(40.3, -3.7));
@@ -53,7 +53,7 @@ namespace {
 
 int DecodeAndUse(const std::string& bytes) {
   using namespace ratslam;
-  StatusOr<WifiGpMap> map = WifiGpMap::Decode(bytes, "w.wifimap");
+  StatusOr<phone::WifiGpMap> map = phone::WifiGpMap::Decode(bytes, "w.wifimap");
   if (!map.ok()) {
     if (map.status().message().rfind("w.wifimap", 0) != 0) {
       fuzz::InvariantFailed("error does not name the file: " + map.status().message());
@@ -63,15 +63,15 @@ int DecodeAndUse(const std::string& bytes) {
   for (size_t ap = 0; ap < map->bssids().size() + 1; ++ap) {
     for (int floor : {-1, 0, 1, 7}) {
       for (const Point2& p : {Point2{0, 0}, Point2{5.5, 2.5}, Point2{-1e6, 1e6}}) {
-        const WifiGpMap::Cell c = map->Predict(ap, floor, p);
+        const phone::WifiGpMap::Cell c = map->Predict(ap, floor, p);
         if (std::isnan(c.mean_dbm)) fuzz::InvariantFailed("a lookup returned NaN");
       }
     }
   }
   if (map->stored_cells() > 200000) return 0;  // a filter over a huge map is not the point here
-  ParticleFilterOptions options;
+  phone::ParticleFilterOptions options;
   options.particles = 50;
-  ParticleFilter filter(*map, options);
+  phone::ParticleFilter filter(*map, options);
   if (!filter.Initialise(true).ok()) return 0;
   std::vector<std::pair<std::string, double>> scan;
   for (const std::string& b : map->bssids()) scan.emplace_back(b, -60.0);
@@ -81,7 +81,7 @@ int DecodeAndUse(const std::string& bytes) {
     filter.Diffuse(2.0);
     filter.Update(scan);
   }
-  const LocationEstimate e = filter.Estimate();
+  const phone::LocationEstimate e = filter.Estimate();
   if (!std::isfinite(e.x_m) || !std::isfinite(e.y_m)) fuzz::InvariantFailed("estimate not finite");
   (void)filter.Candidates();
   return 0;

@@ -58,7 +58,8 @@ struct TomlCodec<ViewMemory> : EnumCodec<ViewMemory, ViewMemoryFromString> {};
 template <>
 struct TomlCodec<FrontEndKind> : EnumCodec<FrontEndKind, FrontEndKindFromString> {};
 template <>
-struct TomlCodec<ScanLikelihood> : EnumCodec<ScanLikelihood, ScanLikelihoodFromString> {};
+struct TomlCodec<phone::ScanLikelihood>
+    : EnumCodec<phone::ScanLikelihood, phone::ScanLikelihoodFromString> {};
 }  // namespace ratslam::schema
 
 namespace ratslam {
@@ -134,11 +135,12 @@ StatusOr<PipelineOptions> ParseConfigOnto(const std::string& text, const std::st
   return ParseSectionsOnto(text, source_name, base);
 }
 
-StatusOr<LocateOptions> ParseLocateConfig(const std::string& text, const std::string& source_name) {
-  return ParseSectionsOnto(text, source_name, LocateOptions());
+StatusOr<phone::LocateOptions> ParseLocateConfig(const std::string& text,
+                                                 const std::string& source_name) {
+  return ParseSectionsOnto(text, source_name, phone::LocateOptions());
 }
 
-StatusOr<LocateOptions> LoadLocateConfigFile(const std::string& path) {
+StatusOr<phone::LocateOptions> LoadLocateConfigFile(const std::string& path) {
   StatusOr<std::string> text = ReadRegularFile(path, "config file", kMaxConfigBytes);
   if (!text.ok()) return text.status();
   return ParseLocateConfig(*text, path);
@@ -234,7 +236,7 @@ std::string PrintConfig(const PipelineOptions& options, bool comments) {
   return PrintSections(options, comments);
 }
 
-std::string PrintLocateConfig(const LocateOptions& options, bool comments) {
+std::string PrintLocateConfig(const phone::LocateOptions& options, bool comments) {
   return PrintSections(options, comments);
 }
 
@@ -276,7 +278,7 @@ std::string ConfigReferenceMarkdown() {
   return "\n## Replay, evaluation and sweeps (`--config`)\n" +
          MarkdownTables(PrintConfig(PipelineOptions(), true)) +
          "\n## `ratslam locate` (`--config`)\n" +
-         MarkdownTables(PrintLocateConfig(LocateOptions(), true));
+         MarkdownTables(PrintLocateConfig(phone::LocateOptions(), true));
 }
 
 namespace {

@@ -30,9 +30,10 @@ std::string PrintConfig(const PipelineOptions& options, bool comments = true);
 std::string ConfigReferenceMarkdown();
 
 // The same for `ratslam wifi-map` and `ratslam locate` ([wifi_map], [particle_filter], [pdr]).
-StatusOr<LocateOptions> ParseLocateConfig(const std::string& text, const std::string& source_name);
-StatusOr<LocateOptions> LoadLocateConfigFile(const std::string& path);
-std::string PrintLocateConfig(const LocateOptions& options, bool comments = true);
+StatusOr<phone::LocateOptions> ParseLocateConfig(const std::string& text,
+                                                 const std::string& source_name);
+StatusOr<phone::LocateOptions> LoadLocateConfigFile(const std::string& path);
+std::string PrintLocateConfig(const phone::LocateOptions& options, bool comments = true);
 
 // A stable 64-bit fingerprint of the resolved configuration (FNV-1a of PrintConfig without
 // comments), stored in map files so that a map is resumed only with the config that made it.

@@ -145,25 +145,26 @@ TEST(ConfigTest, PoseCellGridSizeIsBounded) {
 }
 
 TEST(ConfigTest, LocateConfigReadsItsSectionsAndRefusesOthers) {
-  StatusOr<LocateOptions> o = ParseLocateConfig(
+  StatusOr<phone::LocateOptions> o = ParseLocateConfig(
       "[particle_filter]\nlikelihood = \"product\"\nparticles = 500\n[wifi_map]\n"
       "length_scale_m = 2.0\n",
       "l.toml");
   ASSERT_TRUE(o.ok()) << o.status().message();
-  EXPECT_EQ(o->particle_filter.likelihood, ScanLikelihood::kProduct);
+  EXPECT_EQ(o->particle_filter.likelihood, phone::ScanLikelihood::kProduct);
   EXPECT_EQ(o->particle_filter.particles, 500);
   EXPECT_EQ(o->wifi_map.length_scale_m, 2.0);
-  StatusOr<LocateOptions> back = ParseLocateConfig(PrintLocateConfig(*o), "p.toml");
+  StatusOr<phone::LocateOptions> back = ParseLocateConfig(PrintLocateConfig(*o), "p.toml");
   ASSERT_TRUE(back.ok());
   EXPECT_EQ(PrintLocateConfig(*back), PrintLocateConfig(*o));
   // A replay section, a typo and a bad enum name the file and line.
-  StatusOr<LocateOptions> replay = ParseLocateConfig("[camera]\nshift_px = 3\n", "l.toml");
+  StatusOr<phone::LocateOptions> replay = ParseLocateConfig("[camera]\nshift_px = 3\n", "l.toml");
   ASSERT_FALSE(replay.ok());
   EXPECT_NE(replay.status().message().find("unknown section 'camera'"), std::string::npos);
-  StatusOr<LocateOptions> typo = ParseLocateConfig("[particle_filter]\nparticle = 5\n", "l.toml");
+  StatusOr<phone::LocateOptions> typo =
+      ParseLocateConfig("[particle_filter]\nparticle = 5\n", "l.toml");
   ASSERT_FALSE(typo.ok());
   EXPECT_NE(typo.status().message().find("l.toml:2"), std::string::npos) << typo.status().message();
-  StatusOr<LocateOptions> bad =
+  StatusOr<phone::LocateOptions> bad =
       ParseLocateConfig("[particle_filter]\nlikelihood = \"mean\"\n", "l.toml");
   ASSERT_FALSE(bad.ok());
   EXPECT_NE(bad.status().message().find("sum, product"), std::string::npos);

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <numbers>
 
-namespace ratslam {
+namespace ratslam::phone {
 
 bool WifiGpOptions::IsValid(std::string* error) const { return schema::CheckFields(*this, error); }
 
@@ -112,4 +112,4 @@ double GaussianProcess2D::Variance(const Point2& p, std::optional<double> here) 
   return here.value_or(signal_variance_) * std::max(0.0, 1.0 - share);
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::phone

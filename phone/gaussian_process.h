@@ -29,7 +29,7 @@
 #include "common/schema.h"
 #include "common/status.h"
 
-namespace ratslam {
+namespace ratslam::phone {
 
 struct WifiGpOptions {
   double length_scale_m = 1.5;             // l of eqs. 9 and 11 (the paper's 1.5 m)
@@ -112,6 +112,6 @@ class GaussianProcess2D {
   double prior_mean_ = 0.0, signal_variance_ = 1.0, length_scale_m_ = 1.0;
 };
 
-}  // namespace ratslam
+}  // namespace ratslam::phone
 
 #endif  // RATSLAM_PHONE_GAUSSIAN_PROCESS_H_

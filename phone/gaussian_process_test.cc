@@ -8,7 +8,7 @@
 
 #include "common/random.h"
 
-namespace ratslam {
+namespace ratslam::phone {
 namespace {
 
 TEST(WifiGpOptionsTest, DefaultsAreValidAndFollowThePaper) {
@@ -157,4 +157,4 @@ TEST(GaussianProcess2DTest, RefusesBadInput) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::phone

@@ -9,7 +9,7 @@
 #include "phone/particle_filter.h"
 #include "sensors/pedestrian_dead_reckoning.h"
 
-namespace ratslam {
+namespace ratslam::phone {
 
 struct LocateOptions {
   WifiGpOptions wifi_map;                 // the GP maps (wifi-map)
@@ -35,6 +35,6 @@ struct LocateOptions {
   }
 };
 
-}  // namespace ratslam
+}  // namespace ratslam::phone
 
 #endif  // RATSLAM_PHONE_LOCATE_OPTIONS_H_

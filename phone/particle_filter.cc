@@ -9,7 +9,7 @@
 
 #include "common/circular.h"
 
-namespace ratslam {
+namespace ratslam::phone {
 
 std::string ToString(ScanLikelihood likelihood) {
   return likelihood == ScanLikelihood::kSum ? "sum" : "product";
@@ -479,4 +479,4 @@ std::vector<std::pair<Point2, double>> ParticleFilter::Candidates() {
   return WeightedKMeans(points, weights, options_.candidates, &random_);
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::phone

@@ -52,7 +52,7 @@
 #include "phone/wifi_gp_map.h"
 #include "sensors/rssi_offset.h"
 
-namespace ratslam {
+namespace ratslam::phone {
 
 // How a particle's weight follows from a scan.
 //  - kSum: eq. 13, the sum of eq. 14's per-AP densities (the paper's).
@@ -237,6 +237,6 @@ std::vector<std::pair<Point2, double>> WeightedKMeans(const std::vector<Point2>&
                                                       const std::vector<double>& weights, int k,
                                                       Random* random);
 
-}  // namespace ratslam
+}  // namespace ratslam::phone
 
 #endif  // RATSLAM_PHONE_PARTICLE_FILTER_H_

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-namespace ratslam {
+namespace ratslam::phone {
 namespace {
 
 TEST(ParticleFilterOptionsTest, DefaultsAreValid) {
@@ -469,4 +469,4 @@ TEST(ParticleFilterTest, UnknownApsAndAnEmptyMapLeaveABeliefNotACrash) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::phone

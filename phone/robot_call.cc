@@ -6,7 +6,7 @@
 #include <queue>
 #include <string>
 
-namespace ratslam {
+namespace ratslam::phone {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -220,4 +220,4 @@ StatusOr<CallPlan> PlanCall(const RouteGraph& graph, uint32_t start,
   return plan;
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::phone

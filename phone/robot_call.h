@@ -21,7 +21,7 @@
 #include "common/geometry.h"
 #include "common/status.h"
 
-namespace ratslam {
+namespace ratslam::phone {
 
 struct RouteGraph {
   std::vector<Point2> nodes;                         // positions on the map
@@ -53,6 +53,6 @@ StatusOr<CallPlan> PlanCall(const RouteGraph& graph, uint32_t start,
 void ShortestPaths(const RouteGraph& graph, uint32_t source, std::vector<double>* distance_m,
                    std::vector<uint32_t>* previous);
 
-}  // namespace ratslam
+}  // namespace ratslam::phone
 
 #endif  // RATSLAM_PHONE_ROBOT_CALL_H_

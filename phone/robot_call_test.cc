@@ -10,7 +10,7 @@
 #include <set>
 #include <vector>
 
-namespace ratslam {
+namespace ratslam::phone {
 namespace {
 
 // A w x h lattice of unit spacing, node y * w + x, 4-connected.
@@ -164,4 +164,4 @@ TEST(RobotCallTest, UnreachableNodesDoNotServeAndBadInputFails) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::phone

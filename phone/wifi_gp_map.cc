@@ -9,7 +9,7 @@
 #include "common/checksum.h"
 #include "common/text_file.h"
 
-namespace ratslam {
+namespace ratslam::phone {
 namespace {
 
 constexpr char kMagic[] = "RSWIFIGP";
@@ -628,4 +628,4 @@ StatusOr<WifiGpMap> WifiGpMap::Load(const std::string& path) {
   return Decode(*bytes, path);
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::phone

@@ -18,7 +18,7 @@
 #include "common/status.h"
 #include "phone/gaussian_process.h"
 
-namespace ratslam {
+namespace ratslam::phone {
 
 // A training sample: a position on the map, its floor, and the scan heard there.
 struct WifiMapSample {
@@ -124,6 +124,6 @@ class WifiGpMap {
   std::map<int, std::set<std::pair<int, int>>> coverage_;
 };
 
-}  // namespace ratslam
+}  // namespace ratslam::phone
 
 #endif  // RATSLAM_PHONE_WIFI_GP_MAP_H_

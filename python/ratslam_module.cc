@@ -511,7 +511,8 @@ py::dict Evaluate(const std::string& map, const std::string& query, const std::s
 // scored beside weighted 3-NN), without writing files: the summary and a row per scan.
 py::dict LocatePhone(const std::string& wifi_map, const std::string& data,
                      const std::optional<std::string>& config, bool lenient) {
-  const LocateOptions options = config ? Take(LoadLocateConfigFile(*config)) : LocateOptions();
+  const phone::LocateOptions options =
+      config ? Take(LoadLocateConfigFile(*config)) : phone::LocateOptions();
   const PhoneSetup setup = Take(SetUpPhone(options, wifi_map, data, lenient));
   StatusOr<LocateResult> result = [&] {
     py::gil_scoped_release release;
@@ -546,7 +547,8 @@ py::dict LocatePhone(const std::string& wifi_map, const std::string& data,
 py::dict WifiMap(const std::vector<std::string>& data, const std::string& out,
                  const std::optional<std::string>& run, const std::optional<std::string>& config,
                  bool lenient, bool overwrite) {
-  const LocateOptions options = config ? Take(LoadLocateConfigFile(*config)) : LocateOptions();
+  const phone::LocateOptions options =
+      config ? Take(LoadLocateConfigFile(*config)) : phone::LocateOptions();
   Check(CheckReplaceable(out, overwrite, "out"));
   const WifiMapInput input{data, run, lenient};
   StatusOr<BuiltWifiMap> built = [&] {
@@ -565,7 +567,8 @@ py::dict WifiMap(const std::vector<std::string>& data, const std::string& out,
 // candidates over the experience graph), without writing files: call.json and the route.
 py::dict Call(const std::string& map, const std::string& wifi_map, const std::string& data,
               double at, const std::optional<std::string>& config, bool lenient) {
-  const LocateOptions options = config ? Take(LoadLocateConfigFile(*config)) : LocateOptions();
+  const phone::LocateOptions options =
+      config ? Take(LoadLocateConfigFile(*config)) : phone::LocateOptions();
   const RobotMap robot = Take(LoadRobotMap(map));
   const PhoneSetup setup = Take(SetUpPhone(options, wifi_map, data, lenient));
   StatusOr<CallResult> result = [&] {

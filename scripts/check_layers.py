@@ -6,9 +6,11 @@
   - a header includes a header of a library that the header's own library (the one with the
     deepest folder holding it) does not link;
   - a library in a sub-folder of another library's folder links that parent (a child above its
-    parent: folders should say which way the layers go).
+    parent: folders should say which way the layers go);
+  - a header of a folder listed in NAMESPACES_FILE opens a named namespace at its top level
+    other than the folder's (folder = library = namespace).
 
-Usage: check_layers.py BUILD_DIR SOURCE_DIR [KNOWN_FILE]
+Usage: check_layers.py BUILD_DIR SOURCE_DIR [KNOWN_FILE [NAMESPACES_FILE]]
 BUILD_DIR/ratslam_layers.txt (written by CMakeLists.txt at configure time) gives every target's
 type, folder, direct links and sources. KNOWN_FILE lists violations that are known and still to
 be removed, one per line as printed; a listed one that no longer occurs is an error too, so the
@@ -21,6 +23,7 @@ import sys
 def main():
     build, source = sys.argv[1], os.path.realpath(sys.argv[2])
     known_file = sys.argv[3] if len(sys.argv) > 3 else None
+    namespaces_file = sys.argv[4] if len(sys.argv) > 4 else None
     folder_of, links, sources, libraries = {}, {}, {}, set()
     with open(os.path.join(build, "ratslam_layers.txt")) as f:
         for line in f:
@@ -94,6 +97,24 @@ def main():
                 owner = library_of(path)
                 if owner:
                     check(path, owner)
+    if namespaces_file:
+        with open(namespaces_file) as f:
+            namespaced = dict(l.split() for l in f if l.strip() and not l.startswith("#"))
+        opening = re.compile(r"^namespace\s+([\w:]+)\s*\{")
+        for folder, namespace in namespaced.items():
+            headers = sorted(h for h in os.listdir(os.path.join(source, folder)) if h.endswith(".h"))
+            if not headers:
+                problems.add(f"{folder}: no headers, but listed with namespace {namespace}")
+            for header in headers:
+                path = os.path.join(folder, header)
+                with open(os.path.join(source, path), errors="replace") as f:
+                    opened = [(n, m.group(1)) for n, line in enumerate(f, 1)
+                              if (m := opening.match(line))]
+                if not any(name == namespace for _, name in opened):
+                    problems.add(f"{path}: does not open namespace {namespace}")
+                for number, name in opened:
+                    if name != namespace:
+                        problems.add(f"{path}:{number}: opens namespace {name}, not {namespace}")
     known = set()
     if known_file:
         with open(known_file) as f:

@@ -60,7 +60,7 @@ std::string CallResult::RouteCsv() const {
 
 StatusOr<CallResult> CallRobot(const PhoneSetup& setup, const RobotMap& robot, double at_s,
                                const CallLabels& labels) {
-  const WifiGpMap& map = setup.map;
+  const phone::WifiGpMap& map = setup.map;
   const Dataset& d = setup.data;
   if (d.wifi.empty() || d.wifi.front().time_s > at_s) {
     return Status::Error(
@@ -71,7 +71,7 @@ StatusOr<CallResult> CallRobot(const PhoneSetup& setup, const RobotMap& robot, d
   if (!robot.current || *robot.current >= robot.experiences.size()) {
     return Status::Error(labels.map + ": the robot's experience is not in its map");
   }
-  ParticleFilter filter(map, setup.options.particle_filter);
+  phone::ParticleFilter filter(map, setup.options.particle_filter);
   Status initialised = filter.Initialise(!d.compass.empty());
   if (!initialised.ok()) return initialised;
   CallResult r;
@@ -86,7 +86,7 @@ StatusOr<CallResult> CallRobot(const PhoneSetup& setup, const RobotMap& robot, d
   for (const auto& c : r.candidates) candidates.push_back(c.first);
   for (const Experience& e : robot.experiences) r.graph.nodes.push_back({e.x_m, e.y_m});
   for (const Link& l : robot.links) r.graph.edges.push_back({l.from, l.to});
-  StatusOr<CallPlan> plan = PlanCall(r.graph, *robot.current, candidates);
+  StatusOr<phone::CallPlan> plan = phone::PlanCall(r.graph, *robot.current, candidates);
   if (!plan.ok()) return plan.status();
   r.plan = std::move(plan).value();
 

@@ -41,11 +41,11 @@ struct CallLabels {
 struct CallResult {
   size_t scans_used = 0;     // Wi-Fi scans the filter took, up to the call's time
   double last_scan_s = 0.0;  // the last of them
-  LocationEstimate estimate;
+  phone::LocationEstimate estimate;
   std::vector<std::pair<Point2, double>> candidates;  // the filter's, best first, with weights
-  std::vector<Particle> particles;                    // the filter's at the call
-  RouteGraph graph;                                   // the robot's map as a graph
-  CallPlan plan;
+  std::vector<phone::Particle> particles;             // the filter's at the call
+  phone::RouteGraph graph;                            // the robot's map as a graph
+  phone::CallPlan plan;
   std::optional<Point2> truth_on_map;  // the phone's true place at the last scan, in the map
   // call.json of `ratslam call` without `run`.
   nlohmann::ordered_json summary;

@@ -66,18 +66,19 @@ nlohmann::ordered_json LocationErrorSummary(std::vector<double> all) {
   return j;
 }
 
-Point2 MapToTruth(const WifiGpMap& map, const Point2& p) {
+Point2 MapToTruth(const phone::WifiGpMap& map, const Point2& p) {
   return map.truth_from_map() ? Apply(*map.truth_from_map(), p) : p;
 }
-Point2 TruthToMap(const WifiGpMap& map, const Point2& p) {
+Point2 TruthToMap(const phone::WifiGpMap& map, const Point2& p) {
   return map.truth_from_map() ? ApplyInverse(*map.truth_from_map(), p) : p;
 }
 
-StatusOr<PhoneSetup> SetUpPhone(const LocateOptions& options, const std::string& wifi_map_path,
-                                const std::string& data_path, bool lenient) {
+StatusOr<PhoneSetup> SetUpPhone(const phone::LocateOptions& options,
+                                const std::string& wifi_map_path, const std::string& data_path,
+                                bool lenient) {
   PhoneSetup setup;
   setup.options = options;
-  StatusOr<WifiGpMap> map = WifiGpMap::Load(wifi_map_path);
+  StatusOr<phone::WifiGpMap> map = phone::WifiGpMap::Load(wifi_map_path);
   if (!map.ok()) return map.status();
   setup.map = std::move(map).value();
   PhoneLogOptions phone;
@@ -108,8 +109,8 @@ StatusOr<PhoneSetup> SetUpPhone(const LocateOptions& options, const std::string&
   return setup;
 }
 
-void FilterPhoneLog(const Dataset& d, const WifiGpMap& map, ParticleFilter* filter, double until_s,
-                    const std::function<void(const WifiScan&, size_t)>& on_scan) {
+void FilterPhoneLog(const Dataset& d, const phone::WifiGpMap& map, phone::ParticleFilter* filter,
+                    double until_s, const std::function<void(const WifiScan&, size_t)>& on_scan) {
   const bool compass = !d.compass.empty();
   std::optional<double> heading, last_time, last_odometry;
   double integrated_heading = 0.0;
@@ -139,9 +140,9 @@ void FilterPhoneLog(const Dataset& d, const WifiGpMap& map, ParticleFilter* filt
 namespace {
 
 // The weighted 3-NN fingerprint answer per scan of `d` on the map's own training scans.
-std::vector<fabmap::Estimate> KnnOnTrainingScans(const WifiGpMap& map, const Dataset& d) {
+std::vector<fabmap::Estimate> KnnOnTrainingScans(const phone::WifiGpMap& map, const Dataset& d) {
   std::vector<fabmap::EvaluationNode> map_nodes;
-  for (const WifiMapSample& s : map.training_samples()) {
+  for (const phone::WifiMapSample& s : map.training_samples()) {
     fabmap::EvaluationNode n;
     n.x_m = s.position.x;
     n.y_m = s.position.y;
@@ -164,10 +165,10 @@ std::vector<fabmap::Estimate> KnnOnTrainingScans(const WifiGpMap& map, const Dat
 
 StatusOr<LocateResult> Locate(const PhoneSetup& setup, const std::string& data_label,
                               const std::string& map_label) {
-  const WifiGpMap& map = setup.map;
-  const LocateOptions& options = setup.options;
+  const phone::WifiGpMap& map = setup.map;
+  const phone::LocateOptions& options = setup.options;
   const Dataset& d = setup.data;
-  ParticleFilter filter(map, options.particle_filter);
+  phone::ParticleFilter filter(map, options.particle_filter);
   const bool compass = !d.compass.empty();
   Status initialised = filter.Initialise(compass);
   if (!initialised.ok()) return initialised;

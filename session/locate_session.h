@@ -39,31 +39,32 @@ nlohmann::ordered_json LocationErrorSummary(std::vector<double> errors_m);
 
 // A point of the Wi-Fi map's frame in the ground truth's frame (the same unless the map is a
 // run's), and back.
-Point2 MapToTruth(const WifiGpMap& map, const Point2& p);
-Point2 TruthToMap(const WifiGpMap& map, const Point2& p);
+Point2 MapToTruth(const phone::WifiGpMap& map, const Point2& p);
+Point2 TruthToMap(const phone::WifiGpMap& map, const Point2& p);
 
 // What locate and call share: options, the Wi-Fi map and the phone log read in its frame.
 struct PhoneSetup {
-  LocateOptions options;
-  WifiGpMap map;
+  phone::LocateOptions options;
+  phone::WifiGpMap map;
   Dataset data;
 };
 // Loads the map and the log (which must hold a Wi-Fi scan), and refuses a particle count that
 // would take over half an hour on it.
-StatusOr<PhoneSetup> SetUpPhone(const LocateOptions& options, const std::string& wifi_map_path,
-                                const std::string& data_path, bool lenient);
+StatusOr<PhoneSetup> SetUpPhone(const phone::LocateOptions& options,
+                                const std::string& wifi_map_path, const std::string& data_path,
+                                bool lenient);
 
 // Replays a phone log through the filter in time order up to `until_s`: PDR steps (heading from
 // the compass, turned into the map's frame, or integrated turn rate), a random walk between
 // scans without odometry, and a weight update per scan, after which `on_scan` runs with the
 // number of readings the map knew.
-void FilterPhoneLog(const Dataset& d, const WifiGpMap& map, ParticleFilter* filter, double until_s,
-                    const std::function<void(const WifiScan&, size_t)>& on_scan);
+void FilterPhoneLog(const Dataset& d, const phone::WifiGpMap& map, phone::ParticleFilter* filter,
+                    double until_s, const std::function<void(const WifiScan&, size_t)>& on_scan);
 
 // One scan of the located log.
 struct LocatedScan {
   double time_s = 0.0;
-  LocationEstimate estimate;
+  phone::LocationEstimate estimate;
   size_t known_aps = 0;                               // readings the map knew
   std::vector<std::pair<Point2, double>> candidates;  // the filter's, best first, with weights
   std::optional<GroundTruthRow> truth;

@@ -19,8 +19,8 @@ namespace fs = std::filesystem;
 
 // The walls of the simulated worlds among `paths` (a replay folder holding the world.toml that
 // `ratslam simulate` wrote), in the world's frame, which is the ground truth's.
-StatusOr<std::vector<WallSegment>> WallsOfData(const std::vector<std::string>& paths) {
-  std::vector<WallSegment> walls;
+StatusOr<std::vector<phone::WallSegment>> WallsOfData(const std::vector<std::string>& paths) {
+  std::vector<phone::WallSegment> walls;
   for (const std::string& path : paths) {
     const fs::path world = fs::path(path) / "world.toml";
     if (!IsDirectory(path) || !PathExists(world)) continue;
@@ -39,8 +39,8 @@ StatusOr<std::vector<WallSegment>> WallsOfData(const std::vector<std::string>& p
 // (trajectory_tum.txt); the map's frame is the run's. Also finds the compass's offset to that
 // frame and, with ground truth, the map's alignment onto the truth.
 Status SamplesFromRun(const std::string& run_folder, const std::vector<std::string>& paths,
-                      bool lenient, std::vector<WifiMapSample>* samples, size_t* scans,
-                      WifiGpMap* frame_of) {
+                      bool lenient, std::vector<phone::WifiMapSample>* samples, size_t* scans,
+                      phone::WifiGpMap* frame_of) {
   const fs::path run = run_folder;
   StatusOr<RunFolder> folder = ReadRunFolder(run.string());
   if (!folder.ok()) return folder.status();
@@ -87,15 +87,15 @@ Status SamplesFromRun(const std::string& run_folder, const std::vector<std::stri
 
 }  // namespace
 
-StatusOr<BuiltWifiMap> BuildWifiMap(const LocateOptions& options, const WifiMapInput& input,
+StatusOr<BuiltWifiMap> BuildWifiMap(const phone::LocateOptions& options, const WifiMapInput& input,
                                     const std::string& map_label) {
   PhoneLogOptions phone;
   phone.lenient = input.lenient;
   phone.pdr = options.pdr;
   std::optional<std::pair<double, double>> origin;
-  std::vector<WifiMapSample> samples;
+  std::vector<phone::WifiMapSample> samples;
   size_t scans = 0;
-  WifiGpMap frame;  // carries the run's frame when a run is given
+  phone::WifiGpMap frame;  // carries the run's frame when a run is given
   const bool from_run = input.run.has_value();
   if (input.data.empty()) return Status::Error("a Wi-Fi map needs at least one data set");
   if (from_run) {
@@ -123,18 +123,18 @@ StatusOr<BuiltWifiMap> BuildWifiMap(const LocateOptions& options, const WifiMapI
                   : " Wi-Fi scans and none with ground truth at its time: a Wi-Fi map needs "
                     "positions"));
   }
-  StatusOr<WifiGpMap> map = WifiGpMap::Build(samples, options.wifi_map);
+  StatusOr<phone::WifiGpMap> map = phone::WifiGpMap::Build(samples, options.wifi_map);
   if (!map.ok()) return map.status();
   map->set_geo_reference_deg(origin);
   map->set_compass_to_map_rad(frame.compass_to_map_rad());
   map->set_truth_from_map(frame.truth_from_map());
   if (!from_run) {  // a run's frame is not the world's: its walls would not line up
-    StatusOr<std::vector<WallSegment>> walls = WallsOfData(input.data);
+    StatusOr<std::vector<phone::WallSegment>> walls = WallsOfData(input.data);
     if (!walls.ok()) return walls.status();
     map->set_walls(std::move(walls).value());
   }
   BuiltWifiMap built{std::move(map).value(), scans, samples.size(), {}};
-  const WifiGpMap& m = built.map;
+  const phone::WifiGpMap& m = built.map;
   nlohmann::ordered_json& j = built.summary;
   j["wifi_map"] = map_label;
   j["scans"] = scans;

@@ -24,7 +24,7 @@ struct WifiMapInput {
 };
 
 struct BuiltWifiMap {
-  WifiGpMap map;
+  phone::WifiGpMap map;
   size_t scans = 0;    // Wi-Fi scans read
   size_t samples = 0;  // of which placed on the map
   // The summary of `ratslam wifi-map` without `seconds` and `run`; `wifi_map` is the label given.
@@ -33,7 +33,7 @@ struct BuiltWifiMap {
 
 // Fails when no scan could be placed (no ground truth at any scan's time, or none within the
 // run's trajectory), or when the run replayed other data.
-StatusOr<BuiltWifiMap> BuildWifiMap(const LocateOptions& options, const WifiMapInput& input,
+StatusOr<BuiltWifiMap> BuildWifiMap(const phone::LocateOptions& options, const WifiMapInput& input,
                                     const std::string& map_label);
 
 }  // namespace ratslam

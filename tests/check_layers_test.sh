@@ -18,5 +18,18 @@ fi
 grep -qF "NEW: low/a.h:1: includes high/b.h of ratslam_high, which ratslam_low does not link" <<< "$out" || {
   echo "unexpected report:"; echo "$out"; exit 1; }
 if grep -q "high/b.h:1" <<< "$out"; then echo "flagged the allowed direction: $out"; exit 1; fi
+# A namespaced folder whose header opens the parent namespace instead: reported.
+printf 'namespace low {\n}\n' >> "$tree/src/low/a.h"
+printf 'low low\n' > "$tree/namespaces.txt"
+printf '' > "$tree/known.txt"
+if out=$(/usr/bin/python3 "$source_dir/scripts/check_layers.py" "$tree/build" "$tree/src" \
+  "$tree/known.txt" "$tree/namespaces.txt"); then :; fi
+if grep -q "low/a.h" <<< "$(grep namespace <<< "$out")"; then
+  echo "flagged a header in its own namespace: $out"; exit 1; fi
+printf 'high high\n' > "$tree/namespaces.txt"
+out=$(/usr/bin/python3 "$source_dir/scripts/check_layers.py" "$tree/build" "$tree/src" \
+  "$tree/known.txt" "$tree/namespaces.txt" || true)
+grep -qF "NEW: high/b.h: does not open namespace high" <<< "$out" || {
+  echo "missed a header outside its folder's namespace:"; echo "$out"; exit 1; }
 /usr/bin/python3 "$source_dir/scripts/check_layers.py" "$build_dir" "$source_dir" \
-  "$source_dir/scripts/layers_known.txt"
+  "$source_dir/scripts/layers_known.txt" "$source_dir/scripts/layers_namespaces.txt"

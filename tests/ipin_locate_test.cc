@@ -62,7 +62,7 @@ TEST(IpinLocateTest, AParticleFilterLocatesAnotherPhoneInTheWifiMap) {
   // Chance from the map and the ground truth in errors.csv.
   StatusOr<std::string> bytes = ReadRegularFile(map.string(), "Wi-Fi map", size_t{1} << 30);
   ASSERT_TRUE(bytes.ok());
-  StatusOr<WifiGpMap> wifi = WifiGpMap::Decode(*bytes, map.string());
+  StatusOr<phone::WifiGpMap> wifi = phone::WifiGpMap::Decode(*bytes, map.string());
   ASSERT_TRUE(wifi.ok()) << wifi.status().message();
   ASSERT_EQ(wifi->floors().size(), 1u);
   const std::vector<Point2> cells = wifi->KnownCells(wifi->floors().front());
@@ -176,7 +176,7 @@ TEST(IpinLocateTest, ARunsMapLocatesThePhoneAndTheRobotIsCalled) {
   EXPECT_EQ(wrong.exit_code, 1);
   EXPECT_NE(wrong.err.find("the run replayed data set"), std::string::npos) << wrong.err;
 
-  StatusOr<WifiGpMap> w = WifiGpMap::Load(wifi);
+  StatusOr<phone::WifiGpMap> w = phone::WifiGpMap::Load(wifi);
   ASSERT_TRUE(w.ok()) << w.status().message();
   ASSERT_TRUE(w->truth_from_map().has_value());
   const Result located = RunRatslam("locate --quiet --wifi-map " + wifi + " --data " + log("03") +
