@@ -22,6 +22,81 @@
 namespace ratslam {
 namespace {
 
+// One matcher of the image-sequence benchmark: its name in the table, its label in the figure.
+struct ImageSequenceMatcherRow {
+  std::string name, label;
+  const PlaceRecognitionMetrics* metrics;
+};
+
+std::vector<ImageSequenceMatcherRow> MatcherRows(const ImageSequenceEvaluationOptions& options,
+                                                 const ImageSequenceEvaluation& e) {
+  const std::string sequences =
+      "sequences of " + std::to_string(options.matcher.sequence_length) + " frames";
+  std::vector<ImageSequenceMatcherRow> rows = {
+      {"sequence", sequences, &e.sequence_metrics},
+      {"single frame", "single frames", &e.single_metrics}};
+  if (e.descriptors) {
+    rows.push_back(
+        {"desc. sequence", "descriptors, " + sequences, &e.descriptors->sequence_metrics});
+    rows.push_back({"desc. single", "descriptors, single frames", &e.descriptors->single_metrics});
+  }
+  if (e.fabmap) {
+    rows.push_back({"FABMAP", "FABMAP (visual words), single frames", &e.fabmap->metrics});
+  }
+  return rows;
+}
+
+// pr_curve.png (every matcher) and difference_matrix.png (the images' sequence answers); the
+// difference matrix moves out of `e`.
+Status WriteImageSequenceFigures(const Arguments& args,
+                                 const ImageSequenceEvaluationOptions& options,
+                                 const std::vector<ImageSequenceMatcherRow>& rows,
+                                 const std::string& tolerance, ImageSequenceEvaluation* e,
+                                 OutputFolder* out) {
+  std::vector<std::string> labels;
+  std::vector<std::vector<double>> recall(rows.size()), precision(rows.size());
+  for (size_t k = 0; k < rows.size(); ++k) {
+    labels.push_back(rows[k].label);
+    for (const PrecisionRecall& p : rows[k].metrics->curve) {
+      recall[k].push_back(p.recall);
+      precision[k].push_back(p.precision);
+    }
+  }
+  const std::string title =
+      "place recognition: " + std::to_string(e->sequence_metrics.queries) + " queries" + tolerance;
+  const std::string accepted =
+      e->fabmap ? "accepted: margin over runner-up (FABMAP: log odds) >= threshold"
+                : "accepted: the answer's margin over the runner-up >= a threshold";
+  RATSLAM_RETURN_IF_ERROR(WriteCommandFigure(args, out->Path("pr_curve.png"), [&](int w) {
+    return PrecisionRecallScene(labels, recall, precision, title, w, accepted);
+  }));
+  DifferenceMatrixFigure figure;
+  figure.differences = std::move(e->differences);
+  for (const QueryAnswer& a : e->sequence) figure.answers.push_back(a.match.reference);
+  figure.truth = e->truth;
+  figure.blank_references = e->reference_blank;
+  figure.frame_tolerance = options.frame_tolerance;
+  figure.title = "differences and sequence answers";
+  return WriteCommandFigure(args, out->Path("difference_matrix.png"),
+                            [&](int) { return DifferenceMatrixScene(figure); });
+}
+
+// The terminal's table: a row per matcher.
+std::string MatcherTable(const std::vector<ImageSequenceMatcherRow>& rows) {
+  char line[160];
+  std::snprintf(line, sizeof line, "%-14s %9s %9s %8s %12s %9s\n", "matcher", "recall@1",
+                "recall@5", "PR AUC", "R@100%prec", "declined");
+  std::string text = line;
+  for (const ImageSequenceMatcherRow& row : rows) {
+    const PlaceRecognitionMetrics& m = *row.metrics;
+    std::snprintf(line, sizeof line, "%-14s %8.1f%% %8.1f%% %8.3f %11.1f%% %9zu\n",
+                  row.name.c_str(), 100 * m.recall_at_1, 100 * m.recall_at_5, m.pr_auc,
+                  100 * m.recall_at_100_precision, m.declined);
+    text += line;
+  }
+  return text;
+}
+
 // Place recognition along a route: two image folders, right within N frames.
 int ImageSequenceEvaluate(const Arguments& args, const PipelineOptions& pipeline) {
   auto fail = [](const Status& s) {
@@ -76,74 +151,15 @@ int ImageSequenceEvaluate(const Arguments& args, const PipelineOptions& pipeline
       !s.ok()) {
     return fail(s);
   }
-  const PlaceRecognitionMetrics& seq = e->sequence_metrics;
-  const PlaceRecognitionMetrics& single = e->single_metrics;
+  const std::vector<ImageSequenceMatcherRow> rows = MatcherRows(options, *e);
   const std::string tolerance = " (right within " + std::to_string(options.frame_tolerance) +
                                 (options.frame_tolerance == 1 ? " frame)" : " frames)");
-  const std::string sequences =
-      "sequences of " + std::to_string(options.matcher.sequence_length) + " frames";
-  std::vector<std::pair<std::string, const PlaceRecognitionMetrics*>> rows = {
-      {"sequence", &seq}, {"single frame", &single}};
-  std::vector<std::string> labels = {sequences, "single frames"};
-  if (e->descriptors) {
-    rows.push_back({"desc. sequence", &e->descriptors->sequence_metrics});
-    rows.push_back({"desc. single", &e->descriptors->single_metrics});
-    labels.push_back("descriptors, " + sequences);
-    labels.push_back("descriptors, single frames");
+  if (Status s = WriteImageSequenceFigures(args, options, rows, tolerance, &*e, out->get());
+      !s.ok()) {
+    return fail(s);
   }
-  if (e->fabmap) {
-    rows.push_back({"FABMAP", &e->fabmap->metrics});
-    labels.push_back("FABMAP (visual words), single frames");
-  }
-  {
-    std::vector<std::vector<double>> recall(rows.size()), precision(rows.size());
-    for (size_t k = 0; k < rows.size(); ++k) {
-      for (const PrecisionRecall& p : rows[k].second->curve) {
-        recall[k].push_back(p.recall);
-        precision[k].push_back(p.precision);
-      }
-    }
-    const std::string title =
-        "place recognition: " + std::to_string(seq.queries) + " queries" + tolerance;
-    if (Status s = WriteCommandFigure(args, (*out)->Path("pr_curve.png"),
-                                      [&](int w) {
-                                        return PrecisionRecallScene(
-                                            labels, recall, precision, title, w,
-                                            e->fabmap ? "accepted: the answer's margin over "
-                                                        "the runner-up (FABMAP: log odds over a "
-                                                        "new place) >= a threshold"
-                                                      : "accepted: the answer's margin over the "
-                                                        "runner-up >= a threshold");
-                                      });
-        !s.ok()) {
-      return fail(s);
-    }
-  }
-  {
-    DifferenceMatrixFigure figure;
-    figure.differences = std::move(e->differences);  // the outputs are written; not used again
-    for (const QueryAnswer& a : e->sequence) figure.answers.push_back(a.match.reference);
-    figure.truth = e->truth;
-    figure.blank_references = e->reference_blank;
-    figure.frame_tolerance = options.frame_tolerance;
-    figure.title = "differences and sequence answers";
-    if (Status s = WriteCommandFigure(args, (*out)->Path("difference_matrix.png"),
-                                      [&](int) { return DifferenceMatrixScene(figure); });
-        !s.ok()) {
-      return fail(s);
-    }
-  }
-  char line[160];
-  std::snprintf(line, sizeof line, "%-14s %9s %9s %8s %12s %9s\n", "matcher", "recall@1",
-                "recall@5", "PR AUC", "R@100%prec", "declined");
-  std::string text = line;
-  for (const auto& [name, m] : rows) {
-    std::snprintf(line, sizeof line, "%-14s %8.1f%% %8.1f%% %8.3f %11.1f%% %9zu\n", name.c_str(),
-                  100 * m->recall_at_1, 100 * m->recall_at_5, m->pr_auc,
-                  100 * m->recall_at_100_precision, m->declined);
-    text += line;
-  }
-  text += "(" + std::to_string(seq.queries) + " queries" + tolerance + ", " +
+  std::string text = MatcherTable(rows);
+  text += "(" + std::to_string(e->sequence_metrics.queries) + " queries" + tolerance + ", " +
           std::to_string(e->reference_files.size()) + " references; matching " +
           ShortestNumber(std::round(e->match_seconds * 1000) / 1000) + " s)\n";
   text += MessagePrefix() + "outputs in " + args.Shown(out_path) +

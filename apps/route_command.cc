@@ -20,7 +20,83 @@
 #include "viewer/figures.h"
 
 namespace ratslam {
-namespace {}  // namespace
+namespace {
+
+// A route over a map's experience graph: its nodes' positions, the distances from the start,
+// the experiences from start to end, and the point asked for (--to-xy).
+struct Route {
+  const phone::RouteGraph& graph;
+  const std::vector<double>& distance_m;
+  const std::vector<uint32_t>& path;
+  std::optional<Point2> point;
+};
+
+// The map with the route drawn over it: a purple line, a green start, a ring at the end and an
+// x at the point asked for (kept in view).
+Scene RouteScene(const RobotMap& map, const Route& r, int width_px) {
+  ExperienceMapImageData image;
+  image.experiences = map.experiences;
+  image.links = map.links;
+  ExperienceMapImageOptions o;
+  char title[160];
+  std::snprintf(title, sizeof title, "route from experience %u to %u: %.1f m", r.path.front(),
+                r.path.back(), r.distance_m[r.path.back()]);
+  o.title = title;
+  const std::optional<Point2>& point = r.point;
+  if (point) {  // the point in view, with the map
+    WorldBounds b{point->x - 2, point->y - 2, point->x + 2, point->y + 2};
+    for (const Point2& p : r.graph.nodes) {
+      b.min_x_m = std::min(b.min_x_m, p.x);
+      b.min_y_m = std::min(b.min_y_m, p.y);
+      b.max_x_m = std::max(b.max_x_m, p.x);
+      b.max_y_m = std::max(b.max_y_m, p.y);
+    }
+    o.bounds = b;
+  }
+  if (width_px > 0) {
+    o.width_px = width_px;
+    o.height_px = width_px * 3 / 4;
+  }
+  WorldToImage to_image;
+  Scene scene = ExperienceMapScene(image, o, &to_image);
+  std::vector<ScenePoint> line_px;
+  for (uint32_t e : r.path) line_px.push_back(to_image(r.graph.nodes[e].x, r.graph.nodes[e].y));
+  scene.Polyline(line_px, 6.0f, {148, 103, 189, 230});  // purple: red marks loop closures
+  scene.Disc(line_px.front(), 9.0f, {44, 160, 44, 255}, 20);
+  scene.Ring(line_px.back(), 8.0f, 12.0f, 0.0f, 6.2832f, {148, 103, 189, 255}, 24);
+  if (point) {
+    const ScenePoint p = to_image(point->x, point->y);
+    scene.Line({p.x - 9, p.y - 9}, {p.x + 9, p.y + 9}, 3.0f, kInk);
+    scene.Line({p.x - 9, p.y + 9}, {p.x + 9, p.y - 9}, 3.0f, kInk);
+  }
+  std::string legend = "purple: route   green: start   ring: end";
+  if (point) {
+    const std::string full = legend + "   x: the point asked for";
+    // A one-column page has no room for the long form.
+    legend = TextWidthPx(full, 15.0f) <= o.width_px - 60.0f ? full : legend + "   x: --to-xy";
+  }
+  scene.Text({30, 75}, legend, 15.0f, kInk);
+  return scene;
+}
+
+// route.csv, route.json and route.png into --out.
+Status WriteRouteFiles(const Arguments& args, const RobotMap& map, const Route& r,
+                       const std::string& json) {
+  std::ostringstream csv;
+  csv << "step,experience_id,x_m,y_m,distance_m\n";
+  for (size_t k = 0; k < r.path.size(); ++k) {
+    const Point2& p = r.graph.nodes[r.path[k]];
+    csv << k << ',' << r.path[k] << ',' << ShortestNumber(p.x) << ',' << ShortestNumber(p.y) << ','
+        << ShortestNumber(r.distance_m[r.path[k]]) << '\n';
+  }
+  StatusOr<std::unique_ptr<DiskFolder>> folder = DiskFolder::Open(args.values.at("--out"));
+  if (!folder.ok()) return folder.status();
+  RATSLAM_RETURN_IF_ERROR(folder.value()->Write({{"route.csv", csv.str()}, {"route.json", json}}));
+  return WriteCommandFigure(args, folder.value()->Path("route.png"),
+                            [&](int width_px) { return RouteScene(map, r, width_px); });
+}
+
+}  // namespace
 
 int RouteCommand(const Arguments& args) {
   auto fail = [](const Status& s) {
@@ -114,65 +190,7 @@ int RouteCommand(const Arguments& args) {
   human += MessagePrefix() + "experiences: " + ids + "\n";
 
   if (args.values.count("--out")) {
-    std::ostringstream csv;
-    csv << "step,experience_id,x_m,y_m,distance_m\n";
-    for (size_t k = 0; k < path.size(); ++k) {
-      const Point2& p = graph.nodes[path[k]];
-      csv << k << ',' << path[k] << ',' << ShortestNumber(p.x) << ',' << ShortestNumber(p.y) << ','
-          << ShortestNumber(distance[path[k]]) << '\n';
-    }
-    StatusOr<std::unique_ptr<DiskFolder>> folder = DiskFolder::Open(args.values.at("--out"));
-    if (!folder.ok()) return fail(folder.status());
-    if (Status s = folder.value()->Write({{"route.csv", csv.str()}, {"route.json", json}});
-        !s.ok()) {
-      return fail(s);
-    }
-    ExperienceMapImageData image;
-    image.experiences = map->experiences;
-    image.links = map->links;
-    ExperienceMapImageOptions options;
-    char title[160];
-    std::snprintf(title, sizeof title, "route from experience %u to %u: %.1f m", from, to,
-                  distance[to]);
-    options.title = title;
-    if (point) {  // the point in view, with the map
-      WorldBounds b{point->x - 2, point->y - 2, point->x + 2, point->y + 2};
-      for (const Point2& p : graph.nodes) {
-        b.min_x_m = std::min(b.min_x_m, p.x);
-        b.min_y_m = std::min(b.min_y_m, p.y);
-        b.max_x_m = std::max(b.max_x_m, p.x);
-        b.max_y_m = std::max(b.max_y_m, p.y);
-      }
-      options.bounds = b;
-    }
-    auto build = [&](int width_px) {
-      ExperienceMapImageOptions o = options;
-      if (width_px > 0) {
-        o.width_px = width_px;
-        o.height_px = width_px * 3 / 4;
-      }
-      WorldToImage to_image;
-      Scene scene = ExperienceMapScene(image, o, &to_image);
-      std::vector<ScenePoint> line_px;
-      for (uint32_t e : path) line_px.push_back(to_image(graph.nodes[e].x, graph.nodes[e].y));
-      scene.Polyline(line_px, 6.0f, {148, 103, 189, 230});  // purple: red marks loop closures
-      scene.Disc(line_px.front(), 9.0f, {44, 160, 44, 255}, 20);
-      scene.Ring(line_px.back(), 8.0f, 12.0f, 0.0f, 6.2832f, {148, 103, 189, 255}, 24);
-      if (point) {
-        const ScenePoint p = to_image(point->x, point->y);
-        scene.Line({p.x - 9, p.y - 9}, {p.x + 9, p.y + 9}, 3.0f, kInk);
-        scene.Line({p.x - 9, p.y + 9}, {p.x + 9, p.y - 9}, 3.0f, kInk);
-      }
-      std::string legend = "purple: route   green: start   ring: end";
-      if (point) {
-        const std::string full = legend + "   x: the point asked for";
-        // A one-column page has no room for the long form.
-        legend = TextWidthPx(full, 15.0f) <= o.width_px - 60.0f ? full : legend + "   x: --to-xy";
-      }
-      scene.Text({30, 75}, legend, 15.0f, kInk);
-      return scene;
-    };
-    if (Status s = WriteCommandFigure(args, folder.value()->Path("route.png"), build); !s.ok()) {
+    if (Status s = WriteRouteFiles(args, *map, {graph, distance, path, point}, json); !s.ok()) {
       return fail(s);
     }
     human += MessagePrefix() + "outputs in " + args.Shown(args.values.at("--out")) +

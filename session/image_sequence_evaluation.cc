@@ -111,6 +111,67 @@ StatusOr<DescriptorRows> LoadDescriptorRows(const std::string& path, const std::
   return d;
 }
 
+struct DescriptorPair {
+  DescriptorRows references, queries;
+};
+
+// The options' two descriptor files, when given, checked against the image counts and each
+// other's length.
+StatusOr<std::optional<DescriptorPair>> LoadDescriptorPair(
+    const ImageSequenceEvaluationOptions& options, const ImageSequenceEvaluation& e) {
+  if (options.reference_descriptors.empty() != options.query_descriptors.empty()) {
+    return Status::Error("descriptors: give a file for the map and one for the queries, or none");
+  }
+  if (options.reference_descriptors.empty()) return std::optional<DescriptorPair>();
+  StatusOr<DescriptorRows> r = LoadDescriptorRows(
+      options.reference_descriptors, options.reference_folder, e.reference_files.size());
+  if (!r.ok()) return r.status();
+  StatusOr<DescriptorRows> q =
+      LoadDescriptorRows(options.query_descriptors, options.query_folder, e.query_files.size());
+  if (!q.ok()) return q.status();
+  if (q->cols != r->cols) {
+    return Status::Error(options.query_descriptors + ": " + std::to_string(q->cols) +
+                         " values per row, " + options.reference_descriptors + " has " +
+                         std::to_string(r->cols));
+  }
+  return std::optional<DescriptorPair>(DescriptorPair{std::move(*r), std::move(*q)});
+}
+
+// The descriptors matched as the images are, by sequences and single frames, over 1 - cosine
+// similarity; the images' blank frames stay blank.
+StatusOr<MatcherAnswers> MatchByDescriptors(const ImageSequenceEvaluationOptions& options,
+                                            const DescriptorPair& d,
+                                            const ImageSequenceEvaluation& e,
+                                            const std::vector<PreparedFrame>& query_frames,
+                                            const std::atomic<bool>* stop) {
+  SequenceMatcher matcher(options.matcher);
+  for (bool blank : e.reference_blank) {
+    PreparedFrame place;
+    place.blank = blank;
+    RATSLAM_RETURN_IF_ERROR(matcher.AddReference(std::move(place)));
+  }
+  const Eigen::Map<const Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>
+      reference_rows(d.references.unit.data(), static_cast<Eigen::Index>(d.references.rows),
+                     static_cast<Eigen::Index>(d.references.cols));
+  MatcherAnswers answers;
+  RATSLAM_RETURN_IF_ERROR(MatchQueries(
+      options.matcher, query_frames.size(),
+      [&](size_t q) {
+        const Eigen::Map<const Eigen::VectorXf> query(d.queries.unit.data() + q * d.queries.cols,
+                                                      static_cast<Eigen::Index>(d.queries.cols));
+        const Eigen::VectorXf cosine = reference_rows * query;
+        std::vector<float> row(cosine.size());
+        for (Eigen::Index r = 0; r < cosine.size(); ++r) {
+          row[r] = std::clamp(1.0f - cosine[r], 0.0f, 2.0f);
+        }
+        return matcher.AddQueryDifferences(std::move(row), query_frames[q].blank);
+      },
+      e.truth, &answers.sequence, &answers.single, nullptr, {}, stop, &matcher));
+  answers.sequence_metrics = MetricsOf(answers.sequence, options.frame_tolerance);
+  answers.single_metrics = MetricsOf(answers.single, options.frame_tolerance);
+  return answers;
+}
+
 // The visual words of every image of `folder` (`names` in it).
 Status WordsOf(const fabmap::TrainedVisualModel& model, const std::string& folder,
                const std::vector<std::string>& names, ImageLoader* loader,
@@ -350,25 +411,8 @@ StatusOr<ImageSequenceEvaluation> EvaluateImageSequences(
   if (!truth.ok()) return truth.status();
   e.truth = std::move(*truth);
   // Descriptor files are read first: a bad one fails before the images are matched.
-  std::optional<DescriptorRows> refs_d, queries_d;
-  if (options.reference_descriptors.empty() != options.query_descriptors.empty()) {
-    return Status::Error("descriptors: give a file for the map and one for the queries, or none");
-  }
-  if (!options.reference_descriptors.empty()) {
-    StatusOr<DescriptorRows> r = LoadDescriptorRows(
-        options.reference_descriptors, options.reference_folder, e.reference_files.size());
-    if (!r.ok()) return r.status();
-    StatusOr<DescriptorRows> q =
-        LoadDescriptorRows(options.query_descriptors, options.query_folder, e.query_files.size());
-    if (!q.ok()) return q.status();
-    if (q->cols != r->cols) {
-      return Status::Error(options.query_descriptors + ": " + std::to_string(q->cols) +
-                           " values per row, " + options.reference_descriptors + " has " +
-                           std::to_string(r->cols));
-    }
-    refs_d = std::move(*r);
-    queries_d = std::move(*q);
-  }
+  StatusOr<std::optional<DescriptorPair>> descriptors = LoadDescriptorPair(options, e);
+  if (!descriptors.ok()) return descriptors.status();
 
   const SequenceMatcherOptions& o = options.matcher;
   auto prepare = [&](const std::string& folder,
@@ -416,36 +460,12 @@ StatusOr<ImageSequenceEvaluation> EvaluateImageSequences(
   e.match_seconds = Seconds(matching);
   e.sequence_metrics = MetricsOf(e.sequence, options.frame_tolerance);
   e.single_metrics = MetricsOf(e.single, options.frame_tolerance);
-  if (refs_d) {
+  if (*descriptors) {
     const auto start_descriptors = std::chrono::steady_clock::now();
-    e.descriptor_dimensions = refs_d->cols;
-    SequenceMatcher by_descriptor(o);
-    for (bool blank : e.reference_blank) {
-      PreparedFrame place;
-      place.blank = blank;
-      RATSLAM_RETURN_IF_ERROR(by_descriptor.AddReference(std::move(place)));
-    }
-    const Eigen::Map<const Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>
-        reference_rows(refs_d->unit.data(), static_cast<Eigen::Index>(refs_d->rows),
-                       static_cast<Eigen::Index>(refs_d->cols));
-    MatcherAnswers d;
-    RATSLAM_RETURN_IF_ERROR(MatchQueries(
-        o, query_frames.size(),
-        [&](size_t q) {
-          const Eigen::Map<const Eigen::VectorXf> query(
-              queries_d->unit.data() + q * queries_d->cols,
-              static_cast<Eigen::Index>(queries_d->cols));
-          const Eigen::VectorXf cosine = reference_rows * query;
-          std::vector<float> row(cosine.size());
-          for (Eigen::Index r = 0; r < cosine.size(); ++r) {
-            row[r] = std::clamp(1.0f - cosine[r], 0.0f, 2.0f);
-          }
-          return by_descriptor.AddQueryDifferences(std::move(row), query_frames[q].blank);
-        },
-        e.truth, &d.sequence, &d.single, nullptr, {}, stop, &by_descriptor));
-    d.sequence_metrics = MetricsOf(d.sequence, options.frame_tolerance);
-    d.single_metrics = MetricsOf(d.single, options.frame_tolerance);
-    e.descriptors = std::move(d);
+    StatusOr<MatcherAnswers> d = MatchByDescriptors(options, **descriptors, e, query_frames, stop);
+    if (!d.ok()) return d.status();
+    e.descriptor_dimensions = (*descriptors)->references.cols;
+    e.descriptors = std::move(*d);
     e.descriptor_match_seconds = Seconds(start_descriptors);
   }
   if (options.fabmap) {
