@@ -25,11 +25,12 @@ namespace {
 // One matcher of the image-sequence benchmark: its name in the table, its label in the figure.
 struct ImageSequenceMatcherRow {
   std::string name, label;
-  const PlaceRecognitionMetrics* metrics;
+  const session::PlaceRecognitionMetrics* metrics;
 };
 
-std::vector<ImageSequenceMatcherRow> MatcherRows(const ImageSequenceEvaluationOptions& options,
-                                                 const ImageSequenceEvaluation& e) {
+std::vector<ImageSequenceMatcherRow> MatcherRows(
+    const session::ImageSequenceEvaluationOptions& options,
+    const session::ImageSequenceEvaluation& e) {
   const std::string sequences =
       "sequences of " + std::to_string(options.matcher.sequence_length) + " frames";
   std::vector<ImageSequenceMatcherRow> rows = {
@@ -49,15 +50,15 @@ std::vector<ImageSequenceMatcherRow> MatcherRows(const ImageSequenceEvaluationOp
 // pr_curve.png (every matcher) and difference_matrix.png (the images' sequence answers); the
 // difference matrix moves out of `e`.
 Status WriteImageSequenceFigures(const Arguments& args,
-                                 const ImageSequenceEvaluationOptions& options,
+                                 const session::ImageSequenceEvaluationOptions& options,
                                  const std::vector<ImageSequenceMatcherRow>& rows,
-                                 const std::string& tolerance, ImageSequenceEvaluation* e,
+                                 const std::string& tolerance, session::ImageSequenceEvaluation* e,
                                  OutputFolder* out) {
   std::vector<std::string> labels;
   std::vector<std::vector<double>> recall(rows.size()), precision(rows.size());
   for (size_t k = 0; k < rows.size(); ++k) {
     labels.push_back(rows[k].label);
-    for (const PrecisionRecall& p : rows[k].metrics->curve) {
+    for (const session::PrecisionRecall& p : rows[k].metrics->curve) {
       recall[k].push_back(p.recall);
       precision[k].push_back(p.precision);
     }
@@ -72,7 +73,7 @@ Status WriteImageSequenceFigures(const Arguments& args,
   }));
   DifferenceMatrixFigure figure;
   figure.differences = std::move(e->differences);
-  for (const QueryAnswer& a : e->sequence) figure.answers.push_back(a.match.reference);
+  for (const session::QueryAnswer& a : e->sequence) figure.answers.push_back(a.match.reference);
   figure.truth = e->truth;
   figure.blank_references = e->reference_blank;
   figure.frame_tolerance = options.frame_tolerance;
@@ -88,7 +89,7 @@ std::string MatcherTable(const std::vector<ImageSequenceMatcherRow>& rows) {
                 "recall@5", "PR AUC", "R@100%prec", "declined");
   std::string text = line;
   for (const ImageSequenceMatcherRow& row : rows) {
-    const PlaceRecognitionMetrics& m = *row.metrics;
+    const session::PlaceRecognitionMetrics& m = *row.metrics;
     std::snprintf(line, sizeof line, "%-14s %8.1f%% %8.1f%% %8.3f %11.1f%% %9zu\n",
                   row.name.c_str(), 100 * m.recall_at_1, 100 * m.recall_at_5, m.pr_auc,
                   100 * m.recall_at_100_precision, m.declined);
@@ -103,7 +104,7 @@ int ImageSequenceEvaluate(const Arguments& args, const PipelineOptions& pipeline
     std::cerr << MessagePrefix() << s.message() << "\n";
     return kExitError;
   };
-  ImageSequenceEvaluationOptions options;
+  session::ImageSequenceEvaluationOptions options;
   options.reference_folder = args.values.at("--map");
   options.query_folder = args.values.at("--query");
   options.ground_truth_csv = args.Value("--ground-truth");
@@ -114,7 +115,7 @@ int ImageSequenceEvaluate(const Arguments& args, const PipelineOptions& pipeline
   options.fabmap = args.values.count("--fabmap") > 0;
   options.fabmap_settings = pipeline.sensors.fabmap;
   for (const std::string& folder : {options.reference_folder, options.query_folder}) {
-    if (!IsImageSequenceFolder(folder)) {
+    if (!session::IsImageSequenceFolder(folder)) {
       return fail(Status::Error(folder + ": with --frame-tolerance, --map and --query are "
                                          "folders of images (png, jpg, pgm, ...)"));
     }
@@ -125,7 +126,7 @@ int ImageSequenceEvaluate(const Arguments& args, const PipelineOptions& pipeline
   ProgressPrinter progress(stderr, args.quiet);
   StopCooperatively();
   FileImageLoader loader;
-  StatusOr<ImageSequenceEvaluation> e = EvaluateImageSequences(
+  StatusOr<session::ImageSequenceEvaluation> e = session::EvaluateImageSequences(
       options, &loader,
       [&](size_t done, size_t total) {
         if (done % 100 == 0 || done == total) {
@@ -145,9 +146,9 @@ int ImageSequenceEvaluate(const Arguments& args, const PipelineOptions& pipeline
     }
     return fail(e.status());
   }
-  if (Status s =
-          WriteImageSequenceOutputs(options, *e, PrintConfig(pipeline), ConfigFingerprint(pipeline),
-                                    args.Provenance(), out->get());
+  if (Status s = session::WriteImageSequenceOutputs(options, *e, PrintConfig(pipeline),
+                                                    ConfigFingerprint(pipeline), args.Provenance(),
+                                                    out->get());
       !s.ok()) {
     return fail(s);
   }
@@ -175,7 +176,7 @@ int ImageSequenceEvaluate(const Arguments& args, const PipelineOptions& pipeline
 
 int EvaluateCommand(const Arguments& parsed) {
   const Arguments* args = &parsed;
-  EvaluationSessionOptions options;
+  session::EvaluationSessionOptions options;
   const auto pipeline = LoadOptions(*args, &options.config_path);
   if (!pipeline) return kExitError;
   if (args->values.count("--frame-tolerance")) return ImageSequenceEvaluate(*args, *pipeline);
@@ -199,7 +200,7 @@ int EvaluateCommand(const Arguments& parsed) {
   auto out = DiskFolder::Open(out_path);
   if (!out.ok()) return fail(out.status());
   ProgressPrinter progress(stderr, args->quiet);
-  EvaluationSession session(options, out->get(), nullptr, &progress);
+  session::EvaluationSession session(options, out->get(), nullptr, &progress);
   // Ctrl-C or SIGTERM stops it between steps, nothing written (exit 130).
   session.set_stop_flag(&StopFlag());
   StopCooperatively();
@@ -218,7 +219,7 @@ int EvaluateCommand(const Arguments& parsed) {
   if (Status s = session.Prepare(); !s.ok()) return fail_or_stop(s);
   if (Status s = session.Localise(); !s.ok()) return fail_or_stop(s);
   if (Status s = session.WriteOutputs(); !s.ok()) return fail(s);
-  const EvaluationResult& r = session.result();
+  const session::EvaluationResult& r = session.result();
   const fabmap::EvaluationMetrics& m = r.metrics;
   // The curves cannot show rejections and floor mistakes (neither is within nor beyond any d on
   // the floor): the labels give their rates.

@@ -52,10 +52,10 @@ std::string Metres(const nlohmann::ordered_json& value) {
 }
 
 // The session's SetUpPhone with the command's options, map and log.
-StatusOr<PhoneSetup> SetUpPhone(const Arguments& args, const char* command) {
+StatusOr<session::PhoneSetup> SetUpPhone(const Arguments& args, const char* command) {
   const std::optional<phone::LocateOptions> options = LoadLocateOptions(args, command);
   if (!options) return Status::Error("");  // already reported
-  return ratslam::SetUpPhone(*options, args.values.at("--wifi-map"), args.values.at("--data"),
+  return session::SetUpPhone(*options, args.values.at("--wifi-map"), args.values.at("--data"),
                              args.lenient);
 }
 
@@ -76,11 +76,12 @@ int WifiMapCommand(const Arguments& parsed) {
     return fail(s);
   }
   const auto start = std::chrono::steady_clock::now();
-  WifiMapInput input;
+  session::WifiMapInput input;
   input.data = args->all.at("--data");
   if (args->values.count("--run")) input.run = args->values.at("--run");
   input.lenient = args->lenient;
-  StatusOr<BuiltWifiMap> built = BuildWifiMap(*options, input, args->values.at("--out"));
+  StatusOr<session::BuiltWifiMap> built =
+      session::BuildWifiMap(*options, input, args->values.at("--out"));
   if (!built.ok()) return fail(built.status());
   const phone::WifiGpMap* map = &built->map;
   const bool from_run = input.run.has_value();
@@ -110,12 +111,13 @@ int LocateCommand(const Arguments& parsed) {
     if (!s.message().empty()) std::cerr << MessagePrefix() << s.message() << "\n";
     return kExitError;
   };
-  StatusOr<PhoneSetup> setup = SetUpPhone(*args, "locate");
+  StatusOr<session::PhoneSetup> setup = SetUpPhone(*args, "locate");
   if (!setup.ok()) return fail(setup.status());
   const std::string map_path = args->values.at("--wifi-map");
   const phone::LocateOptions* options = &setup->options;
   const Dataset& d = setup->data;
-  StatusOr<LocateResult> located = Locate(*setup, args->values.at("--data"), map_path);
+  StatusOr<session::LocateResult> located =
+      session::Locate(*setup, args->values.at("--data"), map_path);
   if (!located.ok()) return fail(located.status());
   const std::vector<double>& filter_errors = located->filter_errors_m;
   const std::vector<double>& knn_errors = located->knn_errors_m;
@@ -148,8 +150,8 @@ int LocateCommand(const Arguments& parsed) {
   }
   std::string human = MessagePrefix() + std::to_string(d.wifi.size()) + " scans";
   if (!filter_errors.empty()) {
-    const nlohmann::ordered_json f = LocationErrorSummary(filter_errors);
-    const nlohmann::ordered_json k = LocationErrorSummary(knn_errors);
+    const nlohmann::ordered_json f = session::LocationErrorSummary(filter_errors);
+    const nlohmann::ordered_json k = session::LocationErrorSummary(knn_errors);
     human += ", " + std::to_string(filter_errors.size()) + " with ground truth";
     if (f.contains("median_error_m")) {
       human += ": median error " + Metres(f["median_error_m"]) + ", 90 % within " +
@@ -174,16 +176,16 @@ int CallCommand(const Arguments& parsed) {
     return kExitError;
   };
   const double at = args->Number("--at");
-  StatusOr<RobotMap> robot = LoadRobotMap(args->values.at("--map"));
+  StatusOr<session::RobotMap> robot = session::LoadRobotMap(args->values.at("--map"));
   if (!robot.ok()) return fail(robot.status());
-  StatusOr<PhoneSetup> setup = SetUpPhone(*args, "call");
+  StatusOr<session::PhoneSetup> setup = SetUpPhone(*args, "call");
   if (!setup.ok()) return fail(setup.status());
   if (!setup->map.truth_from_map() && !args->quiet) {
     std::cerr << MessagePrefix() << "note: " << args->values.at("--wifi-map")
               << " was made from ground truth, not from a run: its frame is the robot map's "
                  "only if the map was drawn in the truth's frame (make it with wifi-map --run)\n";
   }
-  StatusOr<CallResult> call = CallRobot(
+  StatusOr<session::CallResult> call = session::CallRobot(
       *setup, *robot, at,
       {args->values.at("--data"), args->values.at("--map"), args->values.at("--wifi-map")});
   if (!call.ok()) return fail(call.status());

@@ -48,7 +48,7 @@ namespace {
 namespace fs = std::filesystem;
 
 struct ReplayRequest {
-  ReplaySessionOptions session;
+  session::ReplaySessionOptions session;
   std::string out;
   bool quiet = false;
   bool render = false;         // write experience_map.png, template_graph.png, pose_cells.png
@@ -117,11 +117,11 @@ int RunReplay(const ReplayRequest& request) {
   // Messages name the folder the outputs end up in, not the staging folder they are written to.
   auto shown = [&](const std::string& path) { return request.session.provenance.Recorded(path); };
   ProgressPrinter progress(stderr, request.quiet);
-  SessionEnvironment environment;
+  session::SessionEnvironment environment;
   environment.out = out->get();
   environment.progress = &progress;
   environment.stop_requested = &StopFlag();
-  ReplaySession session(request.session, environment);
+  session::ReplaySession session(request.session, environment);
   // Ctrl-C stops the replay cleanly; the handler stays until the outputs and the map are saved,
   // so a second signal during the writes cannot lose them.
   StopOnSignals();
@@ -135,7 +135,7 @@ int RunReplay(const ReplayRequest& request) {
   // Animation: a frame of the experience map every `animate_every` events.
   std::unique_ptr<SceneRenderer> animation_renderer;
   std::unique_ptr<AnimationWriter> animation;
-  ReplayCheckpoint checkpoint;
+  session::ReplayCheckpoint checkpoint;
   if (request.animate_every > 0) {
     StatusOr<std::unique_ptr<SceneRenderer>> renderer = CreateOsMesaRenderer();
     if (!renderer.ok()) return fail(renderer.status().WithContext("--animate"));
@@ -171,7 +171,7 @@ int RunReplay(const ReplayRequest& request) {
   }
   (void)session.WriteOutputs();
   (void)session.SaveMap();
-  const ReplayResult& result = session.result();
+  const session::ReplayResult& result = session.result();
 
   int exit_code = kExitOk;
   if (result.summary) {

@@ -33,7 +33,7 @@ struct Route {
 
 // The map with the route drawn over it: a purple line, a green start, a ring at the end and an
 // x at the point asked for (kept in view).
-Scene RouteScene(const RobotMap& map, const Route& r, int width_px) {
+Scene RouteScene(const session::RobotMap& map, const Route& r, int width_px) {
   ExperienceMapImageData image;
   image.experiences = map.experiences;
   image.links = map.links;
@@ -80,7 +80,7 @@ Scene RouteScene(const RobotMap& map, const Route& r, int width_px) {
 }
 
 // route.csv, route.json and route.png into --out.
-Status WriteRouteFiles(const Arguments& args, const RobotMap& map, const Route& r,
+Status WriteRouteFiles(const Arguments& args, const session::RobotMap& map, const Route& r,
                        const std::string& json) {
   std::ostringstream csv;
   csv << "step,experience_id,x_m,y_m,distance_m\n";
@@ -110,7 +110,7 @@ int RouteCommand(const Arguments& args) {
     return kExitUsage;
   }
   const std::string map_path = args.values.at("--map");
-  StatusOr<RobotMap> map = LoadRobotMap(map_path);
+  StatusOr<session::RobotMap> map = session::LoadRobotMap(map_path);
   if (!map.ok()) return fail(map.status());
   const int64_t n = static_cast<int64_t>(map->experiences.size());
   auto experience = [&](const char* flag) -> std::optional<uint32_t> {

@@ -245,7 +245,7 @@ py::dict Replay(const std::vector<std::string>& data, std::string out,
                 const std::string& save_map, bool localise, double lost_after_m,
                 std::optional<double> until_s, bool overwrite) {
   if (data.empty()) throw Error("replay: give at least one data set");
-  ReplaySessionOptions options;
+  session::ReplaySessionOptions options;
   options.pipeline = config ? config->options() : PipelineOptions();
   options.config_path = config ? "(from Python)" : "";
   options.data = data;
@@ -263,13 +263,13 @@ py::dict Replay(const std::vector<std::string>& data, std::string out,
   options.save_map = guard.Staged(save_map);
   options.provenance = {"python: ratslam.replay", UtcNowIso8601(), guard.staging(), out};
   std::unique_ptr<DiskFolder> folder = Take(DiskFolder::Open(guard.staging()));
-  SessionEnvironment environment;
+  session::SessionEnvironment environment;
   environment.out = folder.get();
   InterruptiblePython interrupt;
   environment.progress = &interrupt;
   environment.stop_requested = interrupt.flag();
-  ReplaySession session(std::move(options), environment);
-  StatusOr<ReplayResult> result = [&] {
+  session::ReplaySession session(std::move(options), environment);
+  StatusOr<session::ReplayResult> result = [&] {
     py::gil_scoped_release release;
     return session.Run();
   }();
@@ -315,7 +315,7 @@ class Session {
                                        double lost_after_m) {
     auto session = std::make_unique<Session>(config);
     MapFile map = Take(LoadMapFile(path));
-    Check(CheckSameConfiguration(map, session->options_).WithContext(path));
+    Check(session::CheckSameConfiguration(map, session->options_).WithContext(path));
     if (localise) {
       Check(session->pipeline_->AdoptMap(map.state, lost_after_m).WithContext(path));
     } else {
@@ -468,7 +468,7 @@ py::dict NodeColumns(const std::vector<fabmap::EvaluationNode>& nodes) {
 // folder `out`, returning evaluation.json and the map and queries as columns.
 py::dict Evaluate(const std::string& map, const std::string& query, const std::string& out,
                   const std::optional<Config>& config, bool lenient, bool overwrite) {
-  EvaluationSessionOptions options;
+  session::EvaluationSessionOptions options;
   options.pipeline = config ? config->options() : PipelineOptions();
   options.config_path = config ? "(from Python)" : "";
   options.map_path = map;
@@ -479,9 +479,9 @@ py::dict Evaluate(const std::string& map, const std::string& query, const std::s
   options.provenance = {"python: ratslam.evaluate", UtcNowIso8601(), guard.staging(), out};
   std::unique_ptr<DiskFolder> folder = Take(DiskFolder::Open(guard.staging()));
   InterruptiblePython interrupt;
-  EvaluationSession session(std::move(options), folder.get(), nullptr, &interrupt);
+  session::EvaluationSession session(std::move(options), folder.get(), nullptr, &interrupt);
   session.set_stop_flag(interrupt.flag());
-  StatusOr<EvaluationResult> result = [&] {
+  StatusOr<session::EvaluationResult> result = [&] {
     py::gil_scoped_release release;
     return session.Run();
   }();
@@ -491,7 +491,7 @@ py::dict Evaluate(const std::string& map, const std::string& query, const std::s
     throw py::error_already_set();
   }
   Check(result.status());
-  const EvaluationResult& r = *result;
+  const session::EvaluationResult& r = *result;
   py::dict run;
   run["evaluation"] = py::module_::import("json").attr("loads")(r.json);
   run["map"] = NodeColumns(r.map);
@@ -513,29 +513,30 @@ py::dict LocatePhone(const std::string& wifi_map, const std::string& data,
                      const std::optional<std::string>& config, bool lenient) {
   const phone::LocateOptions options =
       config ? Take(LoadLocateConfigFile(*config)) : phone::LocateOptions();
-  const PhoneSetup setup = Take(SetUpPhone(options, wifi_map, data, lenient));
-  StatusOr<LocateResult> result = [&] {
+  const session::PhoneSetup setup = Take(session::SetUpPhone(options, wifi_map, data, lenient));
+  StatusOr<session::LocateResult> result = [&] {
     py::gil_scoped_release release;
-    return Locate(setup, data, wifi_map);
+    return session::Locate(setup, data, wifi_map);
   }();
   Check(result.status());
-  const std::vector<LocatedScan>& scans = result->scans;
+  const std::vector<session::LocatedScan>& scans = result->scans;
   py::dict c;
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  Column<double>(&c, "time_s", scans, [](const LocatedScan& s) { return s.time_s; });
-  Column<double>(&c, "x_m", scans, [](const LocatedScan& s) { return s.estimate.x_m; });
-  Column<double>(&c, "y_m", scans, [](const LocatedScan& s) { return s.estimate.y_m; });
-  Column<int32_t>(&c, "floor", scans, [](const LocatedScan& s) { return s.estimate.floor; });
+  Column<double>(&c, "time_s", scans, [](const session::LocatedScan& s) { return s.time_s; });
+  Column<double>(&c, "x_m", scans, [](const session::LocatedScan& s) { return s.estimate.x_m; });
+  Column<double>(&c, "y_m", scans, [](const session::LocatedScan& s) { return s.estimate.y_m; });
+  Column<int32_t>(&c, "floor", scans,
+                  [](const session::LocatedScan& s) { return s.estimate.floor; });
   Column<int64_t>(&c, "known_aps", scans,
-                  [](const LocatedScan& s) { return static_cast<int64_t>(s.known_aps); });
+                  [](const session::LocatedScan& s) { return static_cast<int64_t>(s.known_aps); });
   Column<double>(&c, "true_x_m", scans,
-                 [&](const LocatedScan& s) { return s.truth ? s.truth->x_m : nan; });
+                 [&](const session::LocatedScan& s) { return s.truth ? s.truth->x_m : nan; });
   Column<double>(&c, "true_y_m", scans,
-                 [&](const LocatedScan& s) { return s.truth ? s.truth->y_m : nan; });
+                 [&](const session::LocatedScan& s) { return s.truth ? s.truth->y_m : nan; });
   Column<double>(&c, "error_m", scans,
-                 [&](const LocatedScan& s) { return s.truth ? s.error_m : nan; });
+                 [&](const session::LocatedScan& s) { return s.truth ? s.error_m : nan; });
   Column<double>(&c, "knn_error_m", scans,
-                 [&](const LocatedScan& s) { return s.truth ? s.knn_error_m : nan; });
+                 [&](const session::LocatedScan& s) { return s.truth ? s.knn_error_m : nan; });
   py::dict run;
   run["summary"] = py::module_::import("json").attr("loads")(result->summary.dump());
   run["scans"] = std::move(c);
@@ -550,10 +551,10 @@ py::dict WifiMap(const std::vector<std::string>& data, const std::string& out,
   const phone::LocateOptions options =
       config ? Take(LoadLocateConfigFile(*config)) : phone::LocateOptions();
   Check(CheckReplaceable(out, overwrite, "out"));
-  const WifiMapInput input{data, run, lenient};
-  StatusOr<BuiltWifiMap> built = [&] {
+  const session::WifiMapInput input{data, run, lenient};
+  StatusOr<session::BuiltWifiMap> built = [&] {
     py::gil_scoped_release release;
-    return BuildWifiMap(options, input, out);
+    return session::BuildWifiMap(options, input, out);
   }();
   Check(built.status());
   const std::filesystem::path path = out;
@@ -569,11 +570,11 @@ py::dict Call(const std::string& map, const std::string& wifi_map, const std::st
               double at, const std::optional<std::string>& config, bool lenient) {
   const phone::LocateOptions options =
       config ? Take(LoadLocateConfigFile(*config)) : phone::LocateOptions();
-  const RobotMap robot = Take(LoadRobotMap(map));
-  const PhoneSetup setup = Take(SetUpPhone(options, wifi_map, data, lenient));
-  StatusOr<CallResult> result = [&] {
+  const session::RobotMap robot = Take(session::LoadRobotMap(map));
+  const session::PhoneSetup setup = Take(session::SetUpPhone(options, wifi_map, data, lenient));
+  StatusOr<session::CallResult> result = [&] {
     py::gil_scoped_release release;
-    return CallRobot(setup, robot, at, {data, map, wifi_map});
+    return session::CallRobot(setup, robot, at, {data, map, wifi_map});
   }();
   Check(result.status());
   const std::vector<uint32_t>& route = result->plan.route;

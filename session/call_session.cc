@@ -11,7 +11,7 @@
 #include "io/map_file.h"
 #include "io/run_reader.h"
 
-namespace ratslam {
+namespace ratslam::session {
 
 StatusOr<RobotMap> LoadRobotMap(const std::string& path) {
   RobotMap m;
@@ -126,4 +126,4 @@ StatusOr<CallResult> CallRobot(const PhoneSetup& setup, const RobotMap& robot, d
   return r;
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::session

@@ -21,7 +21,7 @@
 #include "ratslam/experience_map.h"
 #include "session/locate_session.h"
 
-namespace ratslam {
+namespace ratslam::session {
 
 // A robot's map: a replay's run folder (experiences.csv, links.csv; the robot is at
 // summary.json's current_experience, or else at the experience of frames.csv's last frame that
@@ -58,6 +58,6 @@ struct CallResult {
 StatusOr<CallResult> CallRobot(const PhoneSetup& setup, const RobotMap& robot, double at_s,
                                const CallLabels& labels);
 
-}  // namespace ratslam
+}  // namespace ratslam::session
 
 #endif  // RATSLAM_SESSION_CALL_SESSION_H_

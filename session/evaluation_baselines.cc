@@ -7,7 +7,7 @@
 #include <unordered_map>
 #include <utility>
 
-namespace ratslam {
+namespace ratslam::session {
 
 using fabmap::Estimate;
 using fabmap::EvaluationNode;
@@ -170,4 +170,4 @@ std::vector<Estimate> FingerprintEstimates(const std::vector<EvaluationNode>& ma
   return out;
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::session

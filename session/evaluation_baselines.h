@@ -21,7 +21,7 @@
 #include "fusion/fabmap/evaluation.h"
 #include "sensors/wifi_fingerprint_matcher.h"
 
-namespace ratslam {
+namespace ratslam::session {
 
 inline constexpr int kKnnNeighbours = 3;
 inline constexpr double kKnnNotHeardDbm = -110.0;
@@ -35,6 +35,6 @@ std::vector<fabmap::Estimate> FingerprintEstimates(
     const std::vector<fabmap::EvaluationNode>& map,
     const std::vector<fabmap::EvaluationNode>& queries, const WifiMatcherOptions& options);
 
-}  // namespace ratslam
+}  // namespace ratslam::session
 
 #endif  // RATSLAM_SESSION_EVALUATION_BASELINES_H_

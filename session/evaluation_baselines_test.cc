@@ -10,7 +10,7 @@
 
 #include "common/random.h"
 
-namespace ratslam {
+namespace ratslam::session {
 namespace {
 
 using fabmap::Estimate;
@@ -139,4 +139,4 @@ TEST(EvaluationBaselinesTest, QueriesWithoutScansAreRejectedAndFingerprintHonour
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::session

@@ -17,7 +17,7 @@
 #include "io/visual_model_file.h"
 #include "sensors/rssi_offset.h"
 
-namespace ratslam {
+namespace ratslam::session {
 
 using fabmap::EvaluationNode;
 using fabmap::EvaluationOptions;
@@ -253,4 +253,4 @@ std::vector<SessionRssiOffset> RemoveQueryRssiOffsets(
   return offsets;
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::session

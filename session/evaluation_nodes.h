@@ -13,7 +13,7 @@
 #include "dataset/video.h"
 #include "fusion/fabmap/evaluation.h"
 
-namespace ratslam {
+namespace ratslam::session {
 
 // Nodes of a data set. `as_map` picks how images get scans: the temporally closest scan for the
 // map, the last scan before the image for queries (the paper's section 5.2). Nodes of data
@@ -39,6 +39,6 @@ std::vector<SessionRssiOffset> RemoveQueryRssiOffsets(
     const std::vector<fabmap::EvaluationNode>& map, std::vector<fabmap::EvaluationNode>* queries,
     int min_common_aps, int min_estimates);
 
-}  // namespace ratslam
+}  // namespace ratslam::session
 
 #endif  // RATSLAM_SESSION_EVALUATION_NODES_H_

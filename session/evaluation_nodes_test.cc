@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-namespace ratslam {
+namespace ratslam::session {
 namespace {
 
 TEST(EvaluationNodesTest, LoadsAnImageFolderWithFloors) {
@@ -90,4 +90,4 @@ TEST(RemoveQueryRssiOffsetsTest, RecoversEachSessionsPlantedOffset) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::session

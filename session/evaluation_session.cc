@@ -19,7 +19,7 @@
 #include "session/evaluation_baselines.h"
 #include "session/evaluation_nodes.h"
 
-namespace ratslam {
+namespace ratslam::session {
 namespace {
 
 std::string Key(double d) {
@@ -498,4 +498,4 @@ StatusOr<EvaluationResult> EvaluationSession::Run() {
   return result_;
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::session

@@ -26,7 +26,7 @@
 #include "fusion/replay_pipeline.h"
 #include "session/evaluation_nodes.h"
 
-namespace ratslam {
+namespace ratslam::session {
 
 struct EvaluationSessionOptions {
   PipelineOptions pipeline;  // [fabmap...] sections, [evaluation], and [pdr] for phone logs
@@ -126,6 +126,6 @@ class EvaluationSession {
   EvaluationResult result_;
 };
 
-}  // namespace ratslam
+}  // namespace ratslam::session
 
 #endif  // RATSLAM_SESSION_EVALUATION_SESSION_H_

@@ -8,7 +8,7 @@
 
 #include "common/scratch_dir.h"
 
-namespace ratslam {
+namespace ratslam::session {
 namespace {
 
 class MemoryFolder : public OutputFolder {
@@ -99,4 +99,4 @@ TEST(EvaluationSessionTest, LenientSkipsMalformedRowsStrictNamesThem) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::session

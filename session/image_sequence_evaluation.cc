@@ -19,7 +19,7 @@
 #include "io/provenance_json.h"
 #include "io/visual_model_file.h"
 
-namespace ratslam {
+namespace ratslam::session {
 namespace {
 
 namespace fs = std::filesystem;
@@ -570,4 +570,4 @@ Status WriteImageSequenceOutputs(const ImageSequenceEvaluationOptions& options,
                      {"pr_curve.csv", pr.str()}});
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::session

@@ -19,7 +19,7 @@
 #include "fusion/fabmap_front_end_options.h"
 #include "sensors/sequence_matcher.h"
 
-namespace ratslam {
+namespace ratslam::session {
 
 // A folder that holds images (and no replay manifest): what `evaluate` reads as an image
 // sequence.
@@ -125,6 +125,6 @@ Status WriteImageSequenceOutputs(const ImageSequenceEvaluationOptions& options,
                                  const std::string& config_toml, uint64_t config_fingerprint,
                                  const RunProvenance& provenance, OutputFolder* out);
 
-}  // namespace ratslam
+}  // namespace ratslam::session
 
 #endif  // RATSLAM_SESSION_IMAGE_SEQUENCE_EVALUATION_H_

@@ -12,7 +12,7 @@
 #include "common/random.h"
 #include "dataset/descriptor_file.h"
 
-namespace ratslam {
+namespace ratslam::session {
 namespace {
 
 QueryAnswer Answer(int truth, int reference, double confidence, std::vector<int> top = {}) {
@@ -270,4 +270,4 @@ TEST_F(ImageFoldersTest, FabmapPlacesSingleFramesFromVisualWords) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::session

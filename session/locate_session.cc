@@ -10,7 +10,7 @@
 #include "dataset/ipin_log.h"
 #include "session/evaluation_baselines.h"
 
-namespace ratslam {
+namespace ratslam::session {
 
 StatusOr<std::vector<Dataset>> LoadInOneFrame(const std::vector<std::string>& paths,
                                               PhoneLogOptions phone,
@@ -274,4 +274,4 @@ std::string LocateResult::CandidatesCsv() const {
   return candidates.str();
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::session

@@ -22,7 +22,7 @@
 #include "phone/particle_filter.h"
 #include "phone/wifi_gp_map.h"
 
-namespace ratslam {
+namespace ratslam::session {
 
 // Loads data sets in one frame: IPIN logs share the first one's geographic origin (or the given
 // one, `*origin`). Sets `*origin` to the origin used, if any log had one.
@@ -86,6 +86,6 @@ struct LocateResult {
 StatusOr<LocateResult> Locate(const PhoneSetup& setup, const std::string& data_label,
                               const std::string& map_label);
 
-}  // namespace ratslam
+}  // namespace ratslam::session
 
 #endif  // RATSLAM_SESSION_LOCATE_SESSION_H_

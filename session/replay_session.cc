@@ -10,7 +10,7 @@
 #include "io/front_end_resources.h"
 #include "io/map_file.h"
 
-namespace ratslam {
+namespace ratslam::session {
 Status CheckSameConfiguration(const MapFile& map, const PipelineOptions& now) {
   if (!map.config.empty()) {
     StatusOr<PipelineOptions> before = ParseMapConfig(map.config, map.format_version);
@@ -196,4 +196,4 @@ StatusOr<ReplayResult> ReplaySession::Run(const ReplayCheckpoint& checkpoint) {
   return result_;
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::session

@@ -29,7 +29,7 @@
 #include "io/map_file.h"
 #include "io/run_outputs.h"
 
-namespace ratslam {
+namespace ratslam::session {
 
 struct ReplaySessionOptions {
   PipelineOptions pipeline;
@@ -118,6 +118,6 @@ class ReplaySession {
   ReplayResult result_;
 };
 
-}  // namespace ratslam
+}  // namespace ratslam::session
 
 #endif  // RATSLAM_SESSION_REPLAY_SESSION_H_

@@ -13,7 +13,7 @@
 #include "dataset/synthetic_dataset.h"
 #include "io/map_file.h"
 
-namespace ratslam {
+namespace ratslam::session {
 namespace {
 namespace fs = std::filesystem;
 
@@ -248,4 +248,4 @@ TEST_F(ReplaySessionTest, CustomFrontEndComesFromTheEnvironment) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::session

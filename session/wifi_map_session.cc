@@ -12,7 +12,7 @@
 #include "session/locate_session.h"
 #include "sim/world.h"
 
-namespace ratslam {
+namespace ratslam::session {
 namespace {
 
 namespace fs = std::filesystem;
@@ -160,4 +160,4 @@ StatusOr<BuiltWifiMap> BuildWifiMap(const phone::LocateOptions& options, const W
   return built;
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::session

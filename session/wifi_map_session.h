@@ -15,7 +15,7 @@
 #include "phone/locate_options.h"
 #include "phone/wifi_gp_map.h"
 
-namespace ratslam {
+namespace ratslam::session {
 
 struct WifiMapInput {
   std::vector<std::string> data;   // data sets (IPIN logs in the first one's frame)
@@ -36,6 +36,6 @@ struct BuiltWifiMap {
 StatusOr<BuiltWifiMap> BuildWifiMap(const phone::LocateOptions& options, const WifiMapInput& input,
                                     const std::string& map_label);
 
-}  // namespace ratslam
+}  // namespace ratslam::session
 
 #endif  // RATSLAM_SESSION_WIFI_MAP_SESSION_H_

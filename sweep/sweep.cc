@@ -501,7 +501,7 @@ StatusOr<SweepSpec> LoadSweepFile(const std::string& path) {
   // their first part against the keys the command's summary can have.
   {
     const std::vector<std::string>& keys =
-        settings.command == "evaluate" ? EvaluationKeys() : SummaryKeys();
+        settings.command == "evaluate" ? session::EvaluationKeys() : SummaryKeys();
     const std::set<std::string> known(keys.begin(), keys.end());
     const std::string file = settings.command == "evaluate" ? "evaluation.json" : "summary.json";
     for (const std::string& m : spec.metrics) {
