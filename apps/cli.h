@@ -133,13 +133,13 @@ inline std::optional<PipelineOptions> LoadOptions(const Arguments& args,
 // --format and --width-mm of the figure commands: the formats asked for (none: the one the
 // output's extension names) and the page width of vector figures.
 struct FigureOptions {
-  std::optional<std::vector<FigureFormat>> formats;
+  std::optional<std::vector<viewer::FigureFormat>> formats;
   double width_mm = kOneColumnMm;
 };
 inline StatusOr<FigureOptions> FigureOptionsOf(const Arguments& args) {
   FigureOptions o;
   if (auto it = args.values.find("--format"); it != args.values.end()) {
-    StatusOr<std::vector<FigureFormat>> formats = ParseFigureFormats(it->second);
+    StatusOr<std::vector<viewer::FigureFormat>> formats = viewer::ParseFigureFormats(it->second);
     if (!formats.ok()) return formats.status().WithContext("--format");
     o.formats = *formats;
   }
@@ -151,7 +151,7 @@ inline StatusOr<FigureOptions> FigureOptionsOf(const Arguments& args) {
 // for; the vector page width (--width-mm, else `default_width_mm`: two-panel figures need two
 // columns); a PNG renderer when a target is a PNG.
 struct CommandFigure {
-  std::vector<FigureTarget> targets;
+  std::vector<viewer::FigureTarget> targets;
   double width_mm = kOneColumnMm;
   std::unique_ptr<SceneRenderer> renderer;
 };
@@ -161,8 +161,8 @@ inline StatusOr<CommandFigure> CommandFigureOf(const Arguments& args, const std:
   if (!figure.ok()) return figure.status();
   CommandFigure c;
   c.width_mm = args.values.count("--width-mm") ? figure->width_mm : default_width_mm;
-  c.targets = FigureTargets(path, figure->formats ? &*figure->formats : nullptr);
-  StatusOr<std::unique_ptr<SceneRenderer>> renderer = RendererFor(c.targets);
+  c.targets = viewer::FigureTargets(path, figure->formats ? &*figure->formats : nullptr);
+  StatusOr<std::unique_ptr<SceneRenderer>> renderer = viewer::RendererFor(c.targets);
   if (!renderer.ok()) return renderer.status();
   c.renderer = std::move(renderer.value());
   return c;
@@ -174,7 +174,8 @@ inline Status WriteCommandFigure(const Arguments& args, const std::string& png_p
                                  double default_width_mm = kOneColumnMm) {
   StatusOr<CommandFigure> figure = CommandFigureOf(args, png_path, default_width_mm);
   if (!figure.ok()) return figure.status();
-  return WriteNaturalFigure(figure->renderer.get(), build, figure->targets, figure->width_mm);
+  return viewer::WriteNaturalFigure(figure->renderer.get(), build, figure->targets,
+                                    figure->width_mm);
 }
 
 // Installs the handlers of SIGINT and SIGTERM: StopOnSignals sets StopFlag (a command that

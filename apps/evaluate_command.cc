@@ -69,9 +69,9 @@ Status WriteImageSequenceFigures(const Arguments& args,
       e->fabmap ? "accepted: margin over runner-up (FABMAP: log odds) >= threshold"
                 : "accepted: the answer's margin over the runner-up >= a threshold";
   RATSLAM_RETURN_IF_ERROR(WriteCommandFigure(args, out->Path("pr_curve.png"), [&](int w) {
-    return PrecisionRecallScene(labels, recall, precision, title, w, accepted);
+    return viewer::PrecisionRecallScene(labels, recall, precision, title, w, accepted);
   }));
-  DifferenceMatrixFigure figure;
+  viewer::DifferenceMatrixFigure figure;
   figure.differences = std::move(e->differences);
   for (const session::QueryAnswer& a : e->sequence) figure.answers.push_back(a.match.reference);
   figure.truth = e->truth;
@@ -79,7 +79,7 @@ Status WriteImageSequenceFigures(const Arguments& args,
   figure.frame_tolerance = options.frame_tolerance;
   figure.title = "differences and sequence answers";
   return WriteCommandFigure(args, out->Path("difference_matrix.png"),
-                            [&](int) { return DifferenceMatrixScene(figure); });
+                            [&](int) { return viewer::DifferenceMatrixScene(figure); });
 }
 
 // The terminal's table: a row per matcher.
@@ -240,7 +240,7 @@ int EvaluateCommand(const Arguments& parsed) {
                     ? " (near recall " + ShortestNumber(e.new_place_near_recall) + ")"
                     : " (Youden's J)";
   }
-  std::vector<LocalisationCurve> curves = {
+  std::vector<viewer::LocalisationCurve> curves = {
       {label("FABMAP " + fabmap::ToString(mode) + decision, m), m.errors_m}};
   for (const auto& [name, b] : r.baselines) {
     curves.push_back({label("baseline " + name, b), b.errors_m});
@@ -250,7 +250,8 @@ int EvaluateCommand(const Arguments& parsed) {
   if (Status s = WriteCommandFigure(
           *args, (*out)->Path("localisation.png"),
           [&](int w) {
-            return LocalisationCurvesScene(curves, title, LocalisationAxisEndM(curves), w);
+            return viewer::LocalisationCurvesScene(curves, title,
+                                                   viewer::LocalisationAxisEndM(curves), w);
           },
           kTwoColumnMm);
       !s.ok()) {
@@ -270,9 +271,11 @@ int EvaluateCommand(const Arguments& parsed) {
       }
     }
     const std::string pr_title = "FABMAP " + fabmap::ToString(mode) + ": precision and recall";
-    if (Status s = WriteCommandFigure(
-            *args, (*out)->Path("pr_curve.png"),
-            [&](int w) { return PrecisionRecallScene(labels, recall, precision, pr_title, w); });
+    if (Status s = WriteCommandFigure(*args, (*out)->Path("pr_curve.png"),
+                                      [&](int w) {
+                                        return viewer::PrecisionRecallScene(labels, recall,
+                                                                            precision, pr_title, w);
+                                      });
         !s.ok()) {
       return fail(s);
     }

@@ -135,7 +135,7 @@ int LocateCommand(const Arguments& parsed) {
   if (!written.ok()) return fail(written);
   if (!filter_errors.empty()) {
     // The paper's fig. 16: the share of scans located within d, beside the 3-NN baseline.
-    const std::vector<LocalisationCurve> curves = {
+    const std::vector<viewer::LocalisationCurve> curves = {
         {"particle filter (" + ToString(options->particle_filter.likelihood) + ")", filter_errors},
         {"weighted 3-NN fingerprints", knn_errors}};
     const std::string title =
@@ -143,7 +143,8 @@ int LocateCommand(const Arguments& parsed) {
     Status drawn = WriteCommandFigure(
         *args, folder.value()->Path("cumulative_error.png"),
         [&](int w) {
-          return LocalisationCurvesScene(curves, title, LocalisationAxisEndM(curves), w);
+          return viewer::LocalisationCurvesScene(curves, title,
+                                                 viewer::LocalisationAxisEndM(curves), w);
         },
         kTwoColumnMm);
     if (!drawn.ok()) return fail(drawn);
@@ -198,12 +199,12 @@ int CallCommand(const Arguments& parsed) {
 
   // The figure: the experience map, the particles, the estimate, the truth, the candidates
   // (numbered by rank) and the robot's route.
-  ExperienceMapImageData image;
+  viewer::ExperienceMapImageData image;
   image.experiences = robot->experiences;
   image.links = robot->links;
   image.current = robot->current;
-  ExperienceMapImageOptions options;
-  WorldBounds b{graph.nodes[0].x, graph.nodes[0].y, graph.nodes[0].x, graph.nodes[0].y};
+  viewer::ExperienceMapImageOptions options;
+  viewer::WorldBounds b{graph.nodes[0].x, graph.nodes[0].y, graph.nodes[0].x, graph.nodes[0].y};
   auto grow = [&](const Point2& p) {
     b.min_x_m = std::min(b.min_x_m, p.x - 2);
     b.max_x_m = std::max(b.max_x_m, p.x + 2);
@@ -218,7 +219,7 @@ int CallCommand(const Arguments& parsed) {
   const std::string candidate_count = std::to_string(candidates.size());
   // Laid out at 1600 x 1200 for PNG, at the page's width for PDF and SVG (4:3 either way).
   auto build = [&](int width_px) {
-    ExperienceMapImageOptions o = options;
+    viewer::ExperienceMapImageOptions o = options;
     if (width_px > 0) {
       o.width_px = width_px;
       o.height_px = width_px * 3 / 4;
@@ -228,8 +229,8 @@ int CallCommand(const Arguments& parsed) {
                         " m through " + stops + " stops for " + candidate_count + " candidates"
                   : "call at " + ShortestNumber(at) + " s: route " + route_m + " m, " + stops +
                         " stops, " + candidate_count + " candidates";
-    WorldToImage to_image;
-    Scene scene = ExperienceMapScene(image, o, &to_image);
+    viewer::WorldToImage to_image;
+    Scene scene = viewer::ExperienceMapScene(image, o, &to_image);
     const std::vector<phone::Particle>& particles = call->particles;
     const size_t every = std::max<size_t>(1, particles.size() / 3000);
     for (size_t k = 0; k < particles.size(); k += every) {
@@ -260,10 +261,10 @@ int CallCommand(const Arguments& parsed) {
     if (o.width_px >= 1000) {
       scene.Text({20, 75},
                  "purple: robot route   orange: candidates (k-means, by weight)   " + particles_etc,
-                 15.0f, kInk);
+                 15.0f, viewer::kInk);
     } else {  // a narrow page: two shorter lines
-      scene.Text({20, 70}, "purple: route   orange: candidates (k-means)", 15.0f, kInk);
-      scene.Text({20, 90}, particles_etc, 15.0f, kInk);
+      scene.Text({20, 70}, "purple: route   orange: candidates (k-means)", 15.0f, viewer::kInk);
+      scene.Text({20, 90}, particles_etc, 15.0f, viewer::kInk);
     }
     return scene;
   };

@@ -36,8 +36,8 @@ void TakeSize(const Arguments& args, int* width, int* height) {
   }
 }
 
-std::optional<std::vector<TimeSpan>> ParseSpans(const std::string& text) {
-  std::vector<TimeSpan> spans;
+std::optional<std::vector<viewer::TimeSpan>> ParseSpans(const std::string& text) {
+  std::vector<viewer::TimeSpan> spans;
   std::istringstream in(text);
   std::string item;
   while (std::getline(in, item, ',')) {
@@ -60,13 +60,13 @@ std::optional<std::vector<TimeSpan>> ParseSpans(const std::string& text) {
 // Writes the figure `build` makes to --out, in the formats --format names (else the one --out's
 // extension names): PNG at width_px x height_px, PDF and SVG laid out for --width-mm.
 // `default_width_mm`: the page width without --width-mm (two-panel figures need two columns).
-Status Write(const Arguments& args, const std::string& out, const SceneBuilder& build, int width_px,
-             int height_px, double default_width_mm = kOneColumnMm) {
+Status Write(const Arguments& args, const std::string& out, const viewer::SceneBuilder& build,
+             int width_px, int height_px, double default_width_mm = kOneColumnMm) {
   StatusOr<CommandFigure> figure = CommandFigureOf(args, out, default_width_mm);
   if (!figure.ok()) return figure.status();
-  RATSLAM_RETURN_IF_ERROR(WriteFigure(figure->renderer.get(), build, width_px, height_px,
-                                      figure->targets, figure->width_mm));
-  for (const FigureTarget& t : figure->targets) {
+  RATSLAM_RETURN_IF_ERROR(viewer::WriteFigure(figure->renderer.get(), build, width_px, height_px,
+                                              figure->targets, figure->width_mm));
+  for (const viewer::FigureTarget& t : figure->targets) {
     std::cerr << MessagePrefix() << "wrote " << t.path << "\n";
   }
   return Status::Ok();
@@ -78,7 +78,7 @@ int RenderExperienceMapCommand(const Arguments& args) {
   const std::string run_folder = args.values.at("--run");
   StatusOr<RunFolder> run = ReadRunFolder(run_folder);
   if (!run.ok()) return Fail(run.status().message());
-  ExperienceMapImageData data;
+  viewer::ExperienceMapImageData data;
   data.experiences = run->experiences;
   data.links = run->links;
   data.current = run->current_experience;
@@ -93,7 +93,7 @@ int RenderExperienceMapCommand(const Arguments& args) {
   } else if (inputs.empty() && !run->dataset_folder.empty()) {
     inputs = {run->dataset_folder};
   }
-  ExperienceMapFigure figure;
+  viewer::ExperienceMapFigure figure;
   if (inputs.empty()) {
     figure.data = std::move(data);
     figure.floors.assign(figure.data.experiences.size(), 0);
@@ -118,15 +118,15 @@ int RenderExperienceMapCommand(const Arguments& args) {
     StatusOr<std::vector<GroundTruthRow>> trajectory =
         ReadTumTrajectory((fs::path(run_folder) / "trajectory_tum.txt").string());
     if (trajectory.ok() && !trajectory->empty()) until_s = trajectory->back().time_s;
-    figure = ExperienceMapFigureOf(std::move(data), *dataset, until_s);
+    figure = viewer::ExperienceMapFigureOf(std::move(data), *dataset, until_s);
   }
-  ExperienceMapImageOptions& options = figure.options;
+  viewer::ExperienceMapImageOptions& options = figure.options;
   TakeSize(args, &options.width_px, &options.height_px);
   if (auto it = args.values.find("--color"); it != args.values.end()) {
     if (it->second == "time") {
-      options.coloring = MapColoring::kTime;
+      options.coloring = viewer::MapColoring::kTime;
     } else if (it->second == "session") {
-      options.coloring = MapColoring::kSession;
+      options.coloring = viewer::MapColoring::kSession;
     } else {
       return Fail("--color must be time or session, not '" + it->second + "'");
     }
@@ -134,18 +134,19 @@ int RenderExperienceMapCommand(const Arguments& args) {
   if (auto it = args.number_lists.find("--sessions"); it != args.number_lists.end()) {
     options.session_start_times_s = it->second;
     std::sort(options.session_start_times_s.begin(), options.session_start_times_s.end());
-  } else if (options.coloring == MapColoring::kSession && options.session_start_times_s.empty()) {
+  } else if (options.coloring == viewer::MapColoring::kSession &&
+             options.session_start_times_s.empty()) {
     options.session_start_times_s = {run->experiences.empty() ? 0.0 : run->experiences[0].time_s};
   }
   const std::string out = args.values.count("--out")
                               ? args.values.at("--out")
                               : (fs::path(run_folder) / "experience_map.png").string();
   Status status = Write(args, out,
-                        Sized(options,
-                              [&](const ExperienceMapImageOptions& o) {
-                                return ExperienceMapFloorsScene(figure.data, figure.floors,
-                                                                figure.truth_floors, o);
-                              }),
+                        viewer::Sized(options,
+                                      [&](const viewer::ExperienceMapImageOptions& o) {
+                                        return viewer::ExperienceMapFloorsScene(
+                                            figure.data, figure.floors, figure.truth_floors, o);
+                                      }),
                         options.width_px, options.height_px);
   return status.ok() ? kExitOk : Fail(status.message());
 }
@@ -154,25 +155,26 @@ int RenderTemplateGraphCommand(const Arguments& args) {
   const std::string run_folder = args.values.at("--run");
   StatusOr<RunFolder> run = ReadRunFolder(run_folder);
   if (!run.ok()) return Fail(run.status().message());
-  TemplateGraphImageOptions options;
+  viewer::TemplateGraphImageOptions options;
   TakeSize(args, &options.width_px, &options.height_px);
   if (auto it = args.values.find("--spans"); it != args.values.end()) {
     auto spans = ParseSpans(it->second);
     if (!spans) return kExitUsage;
     options.shaded_spans = *spans;
   }
-  std::vector<TemplateGraphPoint> points;
+  std::vector<viewer::TemplateGraphPoint> points;
   for (const FrameRecord& f : run->frames) {
     points.push_back({f.time_s, f.template_id, f.experience_id, f.source});
   }
   const std::string out = args.values.count("--out")
                               ? args.values.at("--out")
                               : (fs::path(run_folder) / "template_graph.png").string();
-  Status status = Write(
-      args, out,
-      Sized(options,
-            [&](const TemplateGraphImageOptions& o) { return TemplateGraphScene(points, o); }),
-      options.width_px, options.height_px);
+  Status status = Write(args, out,
+                        viewer::Sized(options,
+                                      [&](const viewer::TemplateGraphImageOptions& o) {
+                                        return viewer::TemplateGraphScene(points, o);
+                                      }),
+                        options.width_px, options.height_px);
   return status.ok() ? kExitOk : Fail(status.message());
 }
 
@@ -200,13 +202,14 @@ int RenderPoseCellsCommand(const Arguments& args) {
     return Fail(args.values.at("--map") + ": " + restored.message() +
                 " (pass the --config the map was made with)");
   }
-  PoseCellImageOptions image_options;
+  viewer::PoseCellImageOptions image_options;
   image_options.title = "pose-cell activity (" + map->dataset_name + ", summed over theta)";
-  Status status =
-      Write(args, args.values.at("--out"),
-            Sized(image_options,
-                  [&](const PoseCellImageOptions& o) { return PoseCellScene(network, o); }),
-            image_options.width_px, image_options.height_px);
+  Status status = Write(args, args.values.at("--out"),
+                        viewer::Sized(image_options,
+                                      [&](const viewer::PoseCellImageOptions& o) {
+                                        return viewer::PoseCellScene(network, o);
+                                      }),
+                        image_options.width_px, image_options.height_px);
   return status.ok() ? kExitOk : Fail(status.message());
 }
 
@@ -220,28 +223,29 @@ int RenderSimilarityCommand(const Arguments& args) {
       LoadSessions(args.all.at("--data"), phone, 1.0, options->bag, options->video);
   if (!dataset.ok()) return Fail(dataset.status().message());
   const std::string sensor = args.values.count("--sensor") ? args.values.at("--sensor") : "camera";
-  SimilarityImageOptions image_options;
-  StatusOr<SimilarityMatrix> m =
+  viewer::SimilarityImageOptions image_options;
+  StatusOr<viewer::SimilarityMatrix> m =
       Status::Error("--sensor must be camera or wifi, not '" + sensor + "'");
   if (sensor == "camera") {
     FileImageLoader images;
-    m = CameraSimilarityMatrix(dataset.value(), &images, options->sensors.classic_camera, frames);
+    m = viewer::CameraSimilarityMatrix(dataset.value(), &images, options->sensors.classic_camera,
+                                       frames);
     image_options.title = "camera template similarity (" + dataset->name + ")";
   } else if (sensor == "wifi") {
-    m = WifiSimilarityMatrix(dataset.value(), options->sensors.wifi, frames);
+    m = viewer::WifiSimilarityMatrix(dataset.value(), options->sensors.wifi, frames);
     image_options.title = "Wi-Fi similarity, eq. 6 (" + dataset->name + ")";
     image_options.value_label = "weight w";
   }
   if (!m.ok()) return Fail(m.status().message());
   // The matrix's side sets the figure's size; the margins around it are fixed.
-  const Scene natural = SimilarityMatrixScene(m->values, m->times_s, image_options);
+  const Scene natural = viewer::SimilarityMatrixScene(m->values, m->times_s, image_options);
   const int margins = natural.width() - image_options.size_px;
   Status status = Write(
       args, args.values.at("--out"),
       [&](int w, int) {
-        SimilarityImageOptions o = image_options;
+        viewer::SimilarityImageOptions o = image_options;
         o.size_px = std::max(100, w - margins);
-        return SimilarityMatrixScene(m->values, m->times_s, o);
+        return viewer::SimilarityMatrixScene(m->values, m->times_s, o);
       },
       natural.width(), natural.height());
   return status.ok() ? kExitOk : Fail(status.message());
@@ -279,23 +283,24 @@ int RenderWifiMapCommand(const Arguments& args) {
                 std::to_string(floor));
   }
   const double cell = map->options().cell_size_m;
-  GridField mean{"mean RSSI (dBm), eq. 8", grid->width,        grid->height,  cell,
-                 grid->min_x * cell,       grid->min_y * cell, grid->mean_dbm};
-  GridField variance{"variance (dBm^2), eq. 10", grid->width,        grid->height,       cell,
-                     grid->min_x * cell,         grid->min_y * cell, grid->variance_dbm2};
+  viewer::GridField mean{"mean RSSI (dBm), eq. 8", grid->width,        grid->height,  cell,
+                         grid->min_x * cell,       grid->min_y * cell, grid->mean_dbm};
+  viewer::GridField variance{
+      "variance (dBm^2), eq. 10", grid->width,        grid->height,       cell,
+      grid->min_x * cell,         grid->min_y * cell, grid->variance_dbm2};
   std::vector<Point2> points;
   for (const phone::WifiMapSample& s : map->training_samples()) {
     if (s.floor == floor) points.push_back(s.position);
   }
   const std::string title = "Wi-Fi map of " + map->bssids()[ap] + ", floor " +
                             std::to_string(floor) + " (dots: training scans)";
-  const Scene natural = GridFieldsScene({mean, variance}, points, title);
+  const Scene natural = viewer::GridFieldsScene({mean, variance}, points, title);
   Status status = Write(
       args, args.values.at("--out"),
       [&](int w, int) {
         // Two panels of `panel` pixels plus fixed margins; the panel follows the width.
         const int panel = std::max(100, 700 - (natural.width() - w) / 2);
-        return GridFieldsScene({mean, variance}, points, title, panel);
+        return viewer::GridFieldsScene({mean, variance}, points, title, panel);
       },
       natural.width(), natural.height(), kTwoColumnMm);
   return status.ok() ? kExitOk : Fail(status.message());

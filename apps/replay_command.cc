@@ -54,7 +54,7 @@ struct ReplayRequest {
   bool render = false;         // write experience_map.png, template_graph.png, pose_cells.png
   uint64_t animate_every = 0;  // events between animation frames; 0: no animation
   bool json = false;           // the summary as JSON on stdout even on a terminal
-  std::vector<FigureFormat> formats{FigureFormat::kPng};  // of the --render images
+  std::vector<viewer::FigureFormat> formats{viewer::FigureFormat::kPng};  // of the --render images
   double width_mm = kOneColumnMm;
 };
 
@@ -134,17 +134,17 @@ int RunReplay(const ReplayRequest& request) {
 
   // Animation: a frame of the experience map every `animate_every` events.
   std::unique_ptr<SceneRenderer> animation_renderer;
-  std::unique_ptr<AnimationWriter> animation;
+  std::unique_ptr<viewer::AnimationWriter> animation;
   session::ReplayCheckpoint checkpoint;
   if (request.animate_every > 0) {
     StatusOr<std::unique_ptr<SceneRenderer>> renderer = CreateOsMesaRenderer();
     if (!renderer.ok()) return fail(renderer.status().WithContext("--animate"));
     animation_renderer = std::move(renderer.value());
-    animation =
-        std::make_unique<AnimationWriter>((fs::path(request.out) / "animation").string(), 10.0);
+    animation = std::make_unique<viewer::AnimationWriter>(
+        (fs::path(request.out) / "animation").string(), 10.0);
     checkpoint.every = request.animate_every;
     checkpoint.callback = [&](const ReplayPipeline& p) -> Status {
-      ExperienceMapImageOptions options;
+      viewer::ExperienceMapImageOptions options;
       options.width_px = 960;
       options.height_px = 720;
       char title[96];
@@ -154,8 +154,8 @@ int RunReplay(const ReplayRequest& request) {
       // One colour scale for the whole animation (each frame used to stretch it over its own
       // experiences, so a colour meant a different time in every frame).
       options.time_range_s = DataTimeSpan(session.dataset());
-      StatusOr<RgbaImage> frame = animation_renderer->Render(
-          ExperienceMapScene(ExperienceMapDataOf(p.View(), session.dataset()), options));
+      StatusOr<RgbaImage> frame = animation_renderer->Render(viewer::ExperienceMapScene(
+          viewer::ExperienceMapDataOf(p.View(), session.dataset()), options));
       if (!frame.ok()) return frame.status();
       return animation->AddFrame(frame.value());
     };
@@ -182,13 +182,14 @@ int RunReplay(const ReplayRequest& request) {
   if (!result.save.ok()) exit_code = fail(result.save);
   if (request.render && result.outputs.ok()) {
     const bool png = std::find(request.formats.begin(), request.formats.end(),
-                               FigureFormat::kPng) != request.formats.end();
+                               viewer::FigureFormat::kPng) != request.formats.end();
     StatusOr<std::unique_ptr<SceneRenderer>> renderer =
         png ? CreateOsMesaRenderer() : StatusOr<std::unique_ptr<SceneRenderer>>(nullptr);
-    Status rendered = renderer.ok() ? WriteRunImages(renderer->get(), session.pipeline().View(),
-                                                     session.dataset(), request.out,
-                                                     request.formats, request.width_mm)
-                                    : renderer.status();
+    Status rendered =
+        renderer.ok()
+            ? viewer::WriteRunImages(renderer->get(), session.pipeline().View(), session.dataset(),
+                                     request.out, request.formats, request.width_mm)
+            : renderer.status();
     if (rendered.ok() && session.pipeline().wifi_sequence().options().enabled) {
       rendered = WriteWifiSequenceImages(renderer->get(), session.pipeline(), request.out,
                                          request.formats, request.width_mm);

@@ -34,17 +34,17 @@ struct Route {
 // The map with the route drawn over it: a purple line, a green start, a ring at the end and an
 // x at the point asked for (kept in view).
 Scene RouteScene(const session::RobotMap& map, const Route& r, int width_px) {
-  ExperienceMapImageData image;
+  viewer::ExperienceMapImageData image;
   image.experiences = map.experiences;
   image.links = map.links;
-  ExperienceMapImageOptions o;
+  viewer::ExperienceMapImageOptions o;
   char title[160];
   std::snprintf(title, sizeof title, "route from experience %u to %u: %.1f m", r.path.front(),
                 r.path.back(), r.distance_m[r.path.back()]);
   o.title = title;
   const std::optional<Point2>& point = r.point;
   if (point) {  // the point in view, with the map
-    WorldBounds b{point->x - 2, point->y - 2, point->x + 2, point->y + 2};
+    viewer::WorldBounds b{point->x - 2, point->y - 2, point->x + 2, point->y + 2};
     for (const Point2& p : r.graph.nodes) {
       b.min_x_m = std::min(b.min_x_m, p.x);
       b.min_y_m = std::min(b.min_y_m, p.y);
@@ -57,8 +57,8 @@ Scene RouteScene(const session::RobotMap& map, const Route& r, int width_px) {
     o.width_px = width_px;
     o.height_px = width_px * 3 / 4;
   }
-  WorldToImage to_image;
-  Scene scene = ExperienceMapScene(image, o, &to_image);
+  viewer::WorldToImage to_image;
+  Scene scene = viewer::ExperienceMapScene(image, o, &to_image);
   std::vector<ScenePoint> line_px;
   for (uint32_t e : r.path) line_px.push_back(to_image(r.graph.nodes[e].x, r.graph.nodes[e].y));
   scene.Polyline(line_px, 6.0f, {148, 103, 189, 230});  // purple: red marks loop closures
@@ -66,8 +66,8 @@ Scene RouteScene(const session::RobotMap& map, const Route& r, int width_px) {
   scene.Ring(line_px.back(), 8.0f, 12.0f, 0.0f, 6.2832f, {148, 103, 189, 255}, 24);
   if (point) {
     const ScenePoint p = to_image(point->x, point->y);
-    scene.Line({p.x - 9, p.y - 9}, {p.x + 9, p.y + 9}, 3.0f, kInk);
-    scene.Line({p.x - 9, p.y + 9}, {p.x + 9, p.y - 9}, 3.0f, kInk);
+    scene.Line({p.x - 9, p.y - 9}, {p.x + 9, p.y + 9}, 3.0f, viewer::kInk);
+    scene.Line({p.x - 9, p.y + 9}, {p.x + 9, p.y - 9}, 3.0f, viewer::kInk);
   }
   std::string legend = "purple: route   green: start   ring: end";
   if (point) {
@@ -75,7 +75,7 @@ Scene RouteScene(const session::RobotMap& map, const Route& r, int width_px) {
     // A one-column page has no room for the long form.
     legend = TextWidthPx(full, 15.0f) <= o.width_px - 60.0f ? full : legend + "   x: --to-xy";
   }
-  scene.Text({30, 75}, legend, 15.0f, kInk);
+  scene.Text({30, 75}, legend, 15.0f, viewer::kInk);
   return scene;
 }
 

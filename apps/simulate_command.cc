@@ -45,7 +45,7 @@ Status SimulateWorld(const sim::World& world, uint64_t seed, const std::string& 
   RATSLAM_RETURN_IF_ERROR(
       WriteFileAtomically((fs::path(out) / "world.toml").string(),
                           "# The simulated world (ratslam simulate).\n" + sim::PrintWorld(world)));
-  RATSLAM_RETURN_IF_ERROR(RenderToPng(sim::WorldMapScene(world, *dataset),
+  RATSLAM_RETURN_IF_ERROR(RenderToPng(viewer::WorldMapScene(world, *dataset),
                                       (fs::path(out) / "ground_truth.png").string()));
   nlohmann::ordered_json j;
   j["world"] = world.name;

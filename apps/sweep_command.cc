@@ -37,13 +37,13 @@ Status DrawSweepPlots(const std::string& dir, const sweep::CollectReport& report
                       const Arguments& args) {
   StatusOr<sweep::Plan> plan = sweep::ReadPlan(dir);
   if (!plan.ok()) return plan.status();
-  SweepFigureData data;
+  viewer::SweepFigureData data;
   data.title = std::filesystem::path(plan->spec.source).filename().string();
   data.objective = plan->spec.aggregate + " " + plan->spec.objective;
   data.minimize = plan->spec.goal == "minimize";
   for (const sweep::Parameter& p : plan->spec.parameters) data.keys.push_back(p.key);
   for (const sweep::PointSummary& p : report.points) {
-    SweepFigurePoint point;
+    viewer::SweepFigurePoint point;
     for (const auto& [key, value] : p.overrides) point.values.push_back(value);
     point.objective = p.objective;
     point.mean_wall_s = p.mean_wall_s;
@@ -60,14 +60,14 @@ Status DrawSweepPlots(const std::string& dir, const sweep::CollectReport& report
     return WriteCommandFigure(args, plots + "/" + name, build);
   };
   if (!data.keys.empty()) {
-    RATSLAM_RETURN_IF_ERROR(
-        draw("objective_by_parameter.png", [&](int w) { return SweepParameterScene(data, w); }));
+    RATSLAM_RETURN_IF_ERROR(draw("objective_by_parameter.png",
+                                 [&](int w) { return viewer::SweepParameterScene(data, w); }));
   }
   if (data.keys.size() >= 2) {
     RATSLAM_RETURN_IF_ERROR(
-        draw("heatmap.png", [&](int w) { return SweepHeatmapScene(data, 0, 1, w); }));
+        draw("heatmap.png", [&](int w) { return viewer::SweepHeatmapScene(data, 0, 1, w); }));
   }
-  return draw("pareto.png", [&](int w) { return SweepParetoScene(data, w); });
+  return draw("pareto.png", [&](int w) { return viewer::SweepParetoScene(data, w); });
 }
 
 int Fail(const Status& s) {

@@ -11,13 +11,14 @@
 namespace ratslam {
 
 Status WriteWifiSequenceImages(SceneRenderer* renderer, const ReplayPipeline& pipeline,
-                               const std::string& folder, const std::vector<FigureFormat>& formats,
-                               double width_mm) {
+                               const std::string& folder,
+                               const std::vector<viewer::FigureFormat>& formats, double width_mm) {
   namespace fs = std::filesystem;
   const WifiSequenceLoopCloser& closer = pipeline.wifi_sequence();
   auto write = [&](const std::function<Scene(int)>& build, const char* name) -> Status {
-    return WriteNaturalFigure(renderer, build,
-                              FigureTargets((fs::path(folder) / name).string(), &formats), width_mm)
+    return viewer::WriteNaturalFigure(
+               renderer, build, viewer::FigureTargets((fs::path(folder) / name).string(), &formats),
+               width_mm)
         .WithContext(name);
   };
   // Fig. 9: every `stride`-th scan, so that long runs stay within 1000 x 1000 cells.
@@ -33,7 +34,7 @@ Status WriteWifiSequenceImages(SceneRenderer* renderer, const ReplayPipeline& pi
       matrix[i * cells + j] = matrix[j * cells + i] = s;
     }
   }
-  SimilarityImageOptions options;
+  viewer::SimilarityImageOptions options;
   options.title = "Wi-Fi similarity of scans (smoothed over travel, eqs. 1-4)";
   // Cosine similarities of signal strengths are mostly high: the colours span the lowest to 1.
   // Rounded down to a hundredth, so that the colour bar's label stays short.
@@ -53,15 +54,15 @@ Status WriteWifiSequenceImages(SceneRenderer* renderer, const ReplayPipeline& pi
   // PNG: a 1000-pixel matrix; PDF and SVG: the matrix fills the page beside its colour bar.
   RATSLAM_RETURN_IF_ERROR(write(
       [&](int width_px) {
-        SimilarityImageOptions o = options;
+        viewer::SimilarityImageOptions o = options;
         if (width_px > 0) o.size_px = std::max(200, width_px - 190);
         if (width_px > 0 && width_px < 900) o.title = "Wi-Fi similarity of scans (eqs. 1-4)";
-        return SimilarityMatrixScene(matrix, times, o);
+        return viewer::SimilarityMatrixScene(matrix, times, o);
       },
       "wifi_sequence_similarity.png"));
 
   // Fig. 10: the pairs on the final map.
-  SequencePairsData pairs;
+  viewer::SequencePairsData pairs;
   for (size_t i = 0; i < n; ++i) {
     const Pose2 p = pipeline.MapPose(closer.pose(i));
     pairs.positions.push_back({p.x_m, p.y_m});
@@ -76,7 +77,8 @@ Status WriteWifiSequenceImages(SceneRenderer* renderer, const ReplayPipeline& pi
     *pairs.links_made += l.wifi_sequence;
   return write(
       [&](int width_px) {
-        return SequencePairsScene(pairs, "Wi-Fi sequence correspondences on the map", width_px);
+        return viewer::SequencePairsScene(pairs, "Wi-Fi sequence correspondences on the map",
+                                          width_px);
       },
       "wifi_sequence_pairs.png");
 }

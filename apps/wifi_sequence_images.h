@@ -18,8 +18,8 @@ namespace ratslam {
 // into `folder`, in each of `formats` (PDF and SVG on a page `width_mm` wide). `renderer` may be
 // null when PNG is not among them.
 Status WriteWifiSequenceImages(SceneRenderer* renderer, const ReplayPipeline& pipeline,
-                               const std::string& folder, const std::vector<FigureFormat>& formats,
-                               double width_mm);
+                               const std::string& folder,
+                               const std::vector<viewer::FigureFormat>& formats, double width_mm);
 
 }  // namespace ratslam
 

@@ -13,11 +13,11 @@
 namespace ratslam {
 namespace {
 
-ExperienceMapImageData LargeMap(int links) {
+viewer::ExperienceMapImageData LargeMap(int links) {
   // Twenty laps of a 5,000-experience city-block route (a rounded square of 1 km sides, one
   // experience per 0.8 m) with lap-to-lap drift; every 50th experience of a lap closes a loop to
   // the same place on the previous lap, as a long multi-lap replay gives.
-  ExperienceMapImageData data;
+  viewer::ExperienceMapImageData data;
   Random rng(3);
   const int per_lap = 5000;
   for (int i = 0; i <= links; ++i) {
@@ -48,16 +48,16 @@ ExperienceMapImageData LargeMap(int links) {
   return data;
 }
 
-ExperienceMapImageOptions Options() {
-  ExperienceMapImageOptions o;
+viewer::ExperienceMapImageOptions Options() {
+  viewer::ExperienceMapImageOptions o;
   o.width_px = 2048;
   o.height_px = 2048;
   return o;
 }
 
 void BM_BuildScene(benchmark::State& state) {
-  const ExperienceMapImageData data = LargeMap(static_cast<int>(state.range(0)));
-  for (auto _ : state) benchmark::DoNotOptimize(ExperienceMapScene(data, Options()));
+  const viewer::ExperienceMapImageData data = LargeMap(static_cast<int>(state.range(0)));
+  for (auto _ : state) benchmark::DoNotOptimize(viewer::ExperienceMapScene(data, Options()));
 }
 BENCHMARK(BM_BuildScene)->Arg(100000)->Unit(benchmark::kMillisecond);
 
@@ -67,7 +67,8 @@ void BM_RenderOsMesa(benchmark::State& state) {
     state.SkipWithError(renderer.status().message().c_str());
     return;
   }
-  const Scene scene = ExperienceMapScene(LargeMap(static_cast<int>(state.range(0))), Options());
+  const Scene scene =
+      viewer::ExperienceMapScene(LargeMap(static_cast<int>(state.range(0))), Options());
   for (auto _ : state) benchmark::DoNotOptimize(renderer.value()->Render(scene));
   state.counters["triangles"] = static_cast<double>(scene.triangles().size() / 3);
 }
@@ -84,7 +85,7 @@ void BM_EncodePng(benchmark::State& state) {
     state.SkipWithError(renderer.status().message().c_str());
     return;
   }
-  const Scene scene = ExperienceMapScene(LargeMap(100000), Options());
+  const Scene scene = viewer::ExperienceMapScene(LargeMap(100000), Options());
   const RgbaImage image = renderer.value()->Render(scene).value();
   const auto path = std::filesystem::temp_directory_path() / "ratslam_render_benchmark.png";
   for (auto _ : state) benchmark::DoNotOptimize(WritePng(image, path.string()));
@@ -101,10 +102,10 @@ void BM_ExperienceMapToPng(benchmark::State& state) {
     state.SkipWithError(renderer.status().message().c_str());
     return;
   }
-  const ExperienceMapImageData data = LargeMap(100000);
+  const viewer::ExperienceMapImageData data = LargeMap(100000);
   const auto path = std::filesystem::temp_directory_path() / "ratslam_render_benchmark_e2e.png";
   for (auto _ : state) {
-    const Scene scene = ExperienceMapScene(data, Options());
+    const Scene scene = viewer::ExperienceMapScene(data, Options());
     benchmark::DoNotOptimize(WritePng(renderer.value()->Render(scene).value(), path.string()));
   }
   std::filesystem::remove(path);
@@ -113,7 +114,7 @@ BENCHMARK(BM_ExperienceMapToPng)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // A new renderer per image: context, shaders and framebuffers made for this one image.
 void BM_RenderOsMesaFirstImage(benchmark::State& state) {
-  const Scene scene = ExperienceMapScene(LargeMap(100000), Options());
+  const Scene scene = viewer::ExperienceMapScene(LargeMap(100000), Options());
   for (auto _ : state) {
     auto renderer = CreateOsMesaRenderer();
     if (!renderer.ok()) {

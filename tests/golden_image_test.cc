@@ -59,8 +59,8 @@ Experience At(uint32_t id, double x, double y, double theta, double t) {
 }
 
 // The golden loop: a 20 m x 10 m loop of 12 experiences with drift, closed back to the start.
-ExperienceMapImageData GoldenLoop() {
-  ExperienceMapImageData data;
+viewer::ExperienceMapImageData GoldenLoop() {
+  viewer::ExperienceMapImageData data;
   for (uint32_t i = 0; i < 12; ++i) {
     const double a = 2 * M_PI * i / 12;
     data.experiences.push_back(
@@ -80,8 +80,8 @@ ExperienceMapImageData GoldenLoop() {
   return data;
 }
 
-ExperienceMapImageOptions GoldenLoopOptions() {
-  ExperienceMapImageOptions options;
+viewer::ExperienceMapImageOptions GoldenLoopOptions() {
+  viewer::ExperienceMapImageOptions options;
   options.width_px = 480;
   options.height_px = 360;
   options.title = "golden";
@@ -89,7 +89,8 @@ ExperienceMapImageOptions GoldenLoopOptions() {
 }
 
 TEST(GoldenImageTest, ExperienceMap) {
-  ExpectMatchesGolden(ExperienceMapScene(GoldenLoop(), GoldenLoopOptions()), "experience_map");
+  ExpectMatchesGolden(viewer::ExperienceMapScene(GoldenLoop(), GoldenLoopOptions()),
+                      "experience_map");
 }
 
 bool HasText(const Scene& scene, const std::string& text) {
@@ -103,9 +104,9 @@ bool HasText(const Scene& scene, const std::string& text) {
 // limit of 1). These checks fail on it: the scene's texts (title, counts, legend) are exact, and
 // along every link of the map the rendered image has ink of the link's kind, loop closures red.
 TEST(GoldenImageTest, ExperienceMapShowsEveryLinkTitleAndLegend) {
-  const ExperienceMapImageData data = GoldenLoop();
-  WorldToImage to_image;
-  const Scene scene = ExperienceMapScene(data, GoldenLoopOptions(), &to_image);
+  const viewer::ExperienceMapImageData data = GoldenLoop();
+  viewer::WorldToImage to_image;
+  const Scene scene = viewer::ExperienceMapScene(data, GoldenLoopOptions(), &to_image);
   EXPECT_TRUE(HasText(scene, "golden"));
   EXPECT_TRUE(HasText(scene, "12 experiences, 12 links, 1 loop closure"));
   EXPECT_TRUE(HasText(scene, "loop closure"));
@@ -114,10 +115,10 @@ TEST(GoldenImageTest, ExperienceMapShowsEveryLinkTitleAndLegend) {
   StatusOr<std::unique_ptr<SceneRenderer>> renderer = CreateOsMesaRenderer();
   if (!renderer.ok()) GTEST_SKIP() << "OSMesa unavailable: " << renderer.status().message();
   // Without the ground truth, whose grey path runs close to the links and could pass for one.
-  ExperienceMapImageData links_only = data;
+  viewer::ExperienceMapImageData links_only = data;
   links_only.ground_truth.clear();
-  StatusOr<RgbaImage> image =
-      renderer.value()->Render(ExperienceMapScene(links_only, GoldenLoopOptions(), &to_image));
+  StatusOr<RgbaImage> image = renderer.value()->Render(
+      viewer::ExperienceMapScene(links_only, GoldenLoopOptions(), &to_image));
   ASSERT_TRUE(image.ok());
   // The darkest pixel within a pixel of `p` (antialiased thin lines cover it partly).
   auto pixel = [&](ScenePoint p) {
@@ -152,9 +153,9 @@ TEST(GoldenImageTest, ExperienceMapShowsEveryLinkTitleAndLegend) {
     }
   }
   // And the check fails on a map with that loop closure removed.
-  ExperienceMapImageData without = links_only;
+  viewer::ExperienceMapImageData without = links_only;
   without.links.pop_back();
-  const Scene fewer = ExperienceMapScene(without, GoldenLoopOptions(), &to_image);
+  const Scene fewer = viewer::ExperienceMapScene(without, GoldenLoopOptions(), &to_image);
   EXPECT_FALSE(HasText(fewer, "12 experiences, 12 links, 1 loop closure"));
   StatusOr<RgbaImage> other = renderer.value()->Render(fewer);
   ASSERT_TRUE(other.ok());
@@ -171,7 +172,7 @@ TEST(GoldenImageTest, ExperienceMapShowsEveryLinkTitleAndLegend) {
 }
 
 TEST(GoldenImageTest, ExperienceMapBySession) {
-  ExperienceMapImageData data;
+  viewer::ExperienceMapImageData data;
   for (uint32_t i = 0; i < 20; ++i) data.experiences.push_back(At(i, i, (i % 10) * 0.5, 0, i));
   for (uint32_t i = 0; i + 1 < 20; ++i) {
     Link l;
@@ -180,19 +181,19 @@ TEST(GoldenImageTest, ExperienceMapBySession) {
     l.to = i + 1;
     data.links.push_back(l);
   }
-  ExperienceMapImageOptions options;
+  viewer::ExperienceMapImageOptions options;
   options.width_px = 480;
   options.height_px = 300;
-  options.coloring = MapColoring::kSession;
+  options.coloring = viewer::MapColoring::kSession;
   options.session_start_times_s = {0, 10};
   options.title = "sessions";
-  ExpectMatchesGolden(ExperienceMapScene(data, options), "experience_map_sessions");
+  ExpectMatchesGolden(viewer::ExperienceMapScene(data, options), "experience_map_sessions");
 }
 
 TEST(GoldenImageTest, TemplateGraph) {
-  std::vector<TemplateGraphPoint> points;
+  std::vector<viewer::TemplateGraphPoint> points;
   for (int i = 0; i < 60; ++i) {
-    TemplateGraphPoint p;
+    viewer::TemplateGraphPoint p;
     p.time_s = i;
     p.template_id = i < 30 ? i : i - 30;
     p.experience_id = i < 30 ? i : i - 28;
@@ -200,12 +201,12 @@ TEST(GoldenImageTest, TemplateGraph) {
         i < 30 ? DecisionSource::kNew : (i % 3 ? DecisionSource::kCamera : DecisionSource::kWifi);
     points.push_back(p);
   }
-  TemplateGraphImageOptions options;
+  viewer::TemplateGraphImageOptions options;
   options.width_px = 640;
   options.height_px = 360;
   options.shaded_spans = {{30, 59, "night"}};
   options.title = "golden";
-  ExpectMatchesGolden(TemplateGraphScene(points, options), "template_graph");
+  ExpectMatchesGolden(viewer::TemplateGraphScene(points, options), "template_graph");
 }
 
 TEST(GoldenImageTest, PoseCells) {
@@ -214,10 +215,10 @@ TEST(GoldenImageTest, PoseCells) {
   PoseCellNetwork network(o);
   network.Reset({5.3, 7.6, 10.0});
   for (int i = 0; i < 10; ++i) network.Step(0.5, 0.1);
-  PoseCellImageOptions options;
+  viewer::PoseCellImageOptions options;
   options.width_px = 800;
   options.height_px = 420;
-  ExpectMatchesGolden(PoseCellScene(network, options), "pose_cells");
+  ExpectMatchesGolden(viewer::PoseCellScene(network, options), "pose_cells");
 }
 
 TEST(GoldenImageTest, SimilarityMatrix) {
@@ -231,9 +232,9 @@ TEST(GoldenImageTest, SimilarityMatrix) {
       m[i * n + j] = static_cast<float>(std::exp(-d * d / 4.0));
     }
   }
-  SimilarityImageOptions options;
+  viewer::SimilarityImageOptions options;
   options.size_px = 300;
-  ExpectMatchesGolden(SimilarityMatrixScene(m, times, options), "similarity_matrix");
+  ExpectMatchesGolden(viewer::SimilarityMatrixScene(m, times, options), "similarity_matrix");
 }
 
 }  // namespace
@@ -245,7 +246,7 @@ namespace {
 // A Wi-Fi sequence link is told apart from RatSLAM's loop closures: its own legend entry, its
 // count in the caption, and black ink (no category colour) along it, not red.
 TEST(GoldenImageTest, WifiSequenceLinksAreMarkedApart) {
-  ExperienceMapImageData data = GoldenLoop();
+  viewer::ExperienceMapImageData data = GoldenLoop();
   data.ground_truth.clear();
   Link across;
   across.id = 12;
@@ -254,12 +255,12 @@ TEST(GoldenImageTest, WifiSequenceLinksAreMarkedApart) {
   across.loop_closure = true;
   across.wifi_sequence = true;
   data.links.push_back(across);
-  WorldToImage to_image;
-  const Scene scene = ExperienceMapScene(data, GoldenLoopOptions(), &to_image);
+  viewer::WorldToImage to_image;
+  const Scene scene = viewer::ExperienceMapScene(data, GoldenLoopOptions(), &to_image);
   EXPECT_TRUE(HasText(scene, "Wi-Fi sequence link"));
   EXPECT_TRUE(HasText(scene, "12 experiences, 13 links, 2 loop closures (1 by Wi-Fi sequences)"));
-  WorldToImage unused;
-  EXPECT_FALSE(HasText(ExperienceMapScene(GoldenLoop(), GoldenLoopOptions(), &unused),
+  viewer::WorldToImage unused;
+  EXPECT_FALSE(HasText(viewer::ExperienceMapScene(GoldenLoop(), GoldenLoopOptions(), &unused),
                        "Wi-Fi sequence link"));
 
   StatusOr<std::unique_ptr<SceneRenderer>> renderer = CreateOsMesaRenderer();

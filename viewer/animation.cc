@@ -5,7 +5,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
-namespace ratslam {
+namespace ratslam::viewer {
 
 struct AnimationWriter::Video {
   cv::VideoWriter writer;
@@ -52,4 +52,4 @@ bool AnimationWriter::Close() {
   return wrote;
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::viewer

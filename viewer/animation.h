@@ -8,7 +8,7 @@
 #include "common/status.h"
 #include "render/image.h"
 
-namespace ratslam {
+namespace ratslam::viewer {
 
 class AnimationWriter {
  public:
@@ -28,6 +28,6 @@ class AnimationWriter {
   std::unique_ptr<Video> video_;
 };
 
-}  // namespace ratslam
+}  // namespace ratslam::viewer
 
 #endif  // RATSLAM_VIEWER_ANIMATION_H_

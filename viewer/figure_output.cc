@@ -7,7 +7,7 @@
 
 #include "render/image.h"
 
-namespace ratslam {
+namespace ratslam::viewer {
 
 StatusOr<std::vector<FigureFormat>> ParseFigureFormats(const std::string& list) {
   std::vector<FigureFormat> formats;
@@ -108,4 +108,4 @@ Status WriteNaturalFigure(SceneRenderer* renderer, const std::function<Scene(int
   return Status::Ok();
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::viewer

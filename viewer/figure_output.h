@@ -15,7 +15,7 @@
 #include "render/scene.h"
 #include "render/vector_figure.h"
 
-namespace ratslam {
+namespace ratslam::viewer {
 
 enum class FigureFormat { kPng, kPdf, kSvg };
 
@@ -72,6 +72,6 @@ Status WriteNaturalFigure(SceneRenderer* renderer, const std::function<Scene(int
 // The vector layout's size for a figure whose PNG is width_px x height_px.
 std::pair<int, int> VectorLayoutSize(int width_px, int height_px, double width_mm);
 
-}  // namespace ratslam
+}  // namespace ratslam::viewer
 
 #endif  // RATSLAM_VIEWER_FIGURE_OUTPUT_H_

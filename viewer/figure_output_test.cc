@@ -16,7 +16,7 @@
 #include "viewer/run_images.h"
 #include "viewer/sweep_figures.h"
 
-namespace ratslam {
+namespace ratslam::viewer {
 namespace {
 
 namespace fs = std::filesystem;
@@ -227,4 +227,4 @@ TEST(LocalisationFigureTest, TheDistanceAxisEndsJustPastTheData) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::viewer

@@ -9,7 +9,7 @@
 
 #include "render/image.h"
 
-namespace ratslam {
+namespace ratslam::viewer {
 namespace {
 
 constexpr Rgba kWhite{255, 255, 255, 255};
@@ -829,4 +829,4 @@ Scene GridFieldsScene(const std::vector<GridField>& fields, const std::vector<Po
   return scene;
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::viewer

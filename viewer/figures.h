@@ -15,7 +15,7 @@
 #include "ratslam/records.h"
 #include "render/scene.h"
 
-namespace ratslam {
+namespace ratslam::viewer {
 
 // The figures' ink (text, axes) and grid lines, shared so that every figure looks alike.
 inline constexpr Rgba kInk{30, 30, 30, 255};
@@ -182,6 +182,6 @@ Scene GridFieldsScene(const std::vector<GridField>& fields, const std::vector<Po
 Scene SimilarityMatrixScene(const std::vector<float>& matrix, const std::vector<double>& times_s,
                             const SimilarityImageOptions& options);
 
-}  // namespace ratslam
+}  // namespace ratslam::viewer
 
 #endif  // RATSLAM_VIEWER_FIGURES_H_

@@ -10,7 +10,7 @@
 #include "render/vector_figure.h"
 #include "viewer/run_images.h"
 
-namespace ratslam {
+namespace ratslam::viewer {
 namespace {
 
 TEST(NiceStepTest, PicksOneTwoFive) {
@@ -317,4 +317,4 @@ TEST(CategoryColorTest, NoCategoryLooksLikeTheLoopClosureRed) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::viewer

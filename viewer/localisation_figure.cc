@@ -8,7 +8,7 @@
 #include "render/image.h"
 #include "viewer/figures.h"
 
-namespace ratslam {
+namespace ratslam::viewer {
 
 double LocalisationAxisEndM(const std::vector<LocalisationCurve>& curves, double at_most_m) {
   double largest = 0.0;
@@ -224,4 +224,4 @@ Scene DifferenceMatrixScene(const DifferenceMatrixFigure& f) {
   return scene;
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::viewer

@@ -8,7 +8,7 @@
 
 #include "render/scene.h"
 
-namespace ratslam {
+namespace ratslam::viewer {
 
 struct LocalisationCurve {
   std::string label;
@@ -49,6 +49,6 @@ struct DifferenceMatrixFigure {
 };
 Scene DifferenceMatrixScene(const DifferenceMatrixFigure& figure);
 
-}  // namespace ratslam
+}  // namespace ratslam::viewer
 
 #endif  // RATSLAM_VIEWER_LOCALISATION_FIGURE_H_

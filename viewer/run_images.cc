@@ -8,7 +8,7 @@
 #include "common/geometry.h"
 #include "render/vector_figure.h"
 
-namespace ratslam {
+namespace ratslam::viewer {
 
 std::vector<Point2> GroundTruthInMapFrame(const std::vector<Experience>& experiences,
                                           const Dataset& dataset, double until_time_s,
@@ -268,4 +268,4 @@ Status WriteRunImages(SceneRenderer* renderer, const RunView& run, const Dataset
       cell_options.width_px, cell_options.height_px, "pose_cells.png");
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::viewer

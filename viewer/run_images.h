@@ -12,7 +12,7 @@
 #include "viewer/figure_output.h"
 #include "viewer/figures.h"
 
-namespace ratslam {
+namespace ratslam::viewer {
 
 // The ground truth up to `until_time_s`, moved into the map's frame by the rigid fit of the
 // experiences to the ground truth at their creation times; empty without ground truth.
@@ -69,6 +69,6 @@ Status WriteRunImages(SceneRenderer* renderer, const RunView& run, const Dataset
                       const std::vector<FigureFormat>& formats = {FigureFormat::kPng},
                       double width_mm = kOneColumnMm);
 
-}  // namespace ratslam
+}  // namespace ratslam::viewer
 
 #endif  // RATSLAM_VIEWER_RUN_IMAGES_H_

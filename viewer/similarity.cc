@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-namespace ratslam {
+namespace ratslam::viewer {
 
 StatusOr<SimilarityMatrix> CameraSimilarityMatrix(const Dataset& dataset, ImageLoader* images,
                                                   const ClassicCameraOptions& options,
@@ -67,4 +67,4 @@ StatusOr<SimilarityMatrix> WifiSimilarityMatrix(const Dataset& dataset,
   return m;
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::viewer

@@ -10,7 +10,7 @@
 #include "sensors/classic_camera_matcher.h"
 #include "sensors/wifi_fingerprint_matcher.h"
 
-namespace ratslam {
+namespace ratslam::viewer {
 
 struct SimilarityMatrix {
   std::vector<double> times_s;  // the sampled frames
@@ -30,6 +30,6 @@ StatusOr<SimilarityMatrix> CameraSimilarityMatrix(const Dataset& dataset, ImageL
 StatusOr<SimilarityMatrix> WifiSimilarityMatrix(const Dataset& dataset,
                                                 const WifiMatcherOptions& options, int max_scans);
 
-}  // namespace ratslam
+}  // namespace ratslam::viewer
 
 #endif  // RATSLAM_VIEWER_SIMILARITY_H_

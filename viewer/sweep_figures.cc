@@ -11,7 +11,7 @@
 #include "render/image.h"
 #include "viewer/figures.h"
 
-namespace ratslam {
+namespace ratslam::viewer {
 namespace {
 
 constexpr Rgba kDot{70, 110, 170, 200};
@@ -312,4 +312,4 @@ Scene SweepParetoScene(const SweepFigureData& data, int width_px) {
   return scene;
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::viewer

@@ -12,7 +12,7 @@
 
 #include "render/scene.h"
 
-namespace ratslam {
+namespace ratslam::viewer {
 
 struct SweepFigurePoint {
   std::vector<std::string> values;  // one per parameter key, as written in the plan
@@ -38,6 +38,6 @@ Scene SweepHeatmapScene(const SweepFigureData& data, int a, int b, int width_px 
 // Objective against mean run time; the points no other point beats in both are the front.
 Scene SweepParetoScene(const SweepFigureData& data, int width_px = 0);
 
-}  // namespace ratslam
+}  // namespace ratslam::viewer
 
 #endif  // RATSLAM_VIEWER_SWEEP_FIGURES_H_

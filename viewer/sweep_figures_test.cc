@@ -4,7 +4,7 @@
 
 #include <algorithm>
 
-namespace ratslam {
+namespace ratslam::viewer {
 namespace {
 
 bool HasText(const Scene& scene, const std::string& text) {
@@ -71,4 +71,4 @@ TEST(SweepFiguresTest, NoTickReadsMinusZero) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::viewer

@@ -7,11 +7,11 @@
 #include "render/image.h"
 #include "viewer/figures.h"
 
-namespace ratslam::sim {
+namespace ratslam::viewer {
 
-Scene WorldMapScene(const World& world, const Dataset& dataset, int panel_px) {
+Scene WorldMapScene(const sim::World& world, const Dataset& dataset, int panel_px) {
   std::set<int> floor_set;
-  for (const Wall& w : world.walls) floor_set.insert(w.floor);
+  for (const sim::Wall& w : world.walls) floor_set.insert(w.floor);
   const std::vector<int> floors(floor_set.begin(), floor_set.end());
   double min_x = 1e300, min_y = 1e300, max_x = -1e300, max_y = -1e300;
   auto grow = [&](double x, double y) {
@@ -20,11 +20,11 @@ Scene WorldMapScene(const World& world, const Dataset& dataset, int panel_px) {
     min_y = std::min(min_y, y);
     max_y = std::max(max_y, y);
   };
-  for (const Wall& w : world.walls) {
+  for (const sim::Wall& w : world.walls) {
     grow(w.from.x_m, w.from.y_m);
     grow(w.to.x_m, w.to.y_m);
   }
-  for (const AccessPoint& a : world.access_points) grow(a.position.x_m, a.position.y_m);
+  for (const sim::AccessPoint& a : world.access_points) grow(a.position.x_m, a.position.y_m);
   const double margin = 0.05 * std::max(max_x - min_x, max_y - min_y) + 1.0;
   min_x -= margin;
   max_x += margin;
@@ -51,7 +51,7 @@ Scene WorldMapScene(const World& world, const Dataset& dataset, int panel_px) {
     to.center_y_px = top + panel_h / 2.0;
     scene.Text({static_cast<float>(left), static_cast<float>(top - 8)},
                "floor " + std::to_string(floors[f]), 15, ink);
-    for (const Wall& w : world.walls) {
+    for (const sim::Wall& w : world.walls) {
       if (w.floor != floors[f]) continue;
       const double db = world.materials_db.at(w.material);
       const uint8_t g = static_cast<uint8_t>(std::clamp(170.0 - 8.0 * db, 0.0, 200.0));
@@ -69,14 +69,14 @@ Scene WorldMapScene(const World& world, const Dataset& dataset, int panel_px) {
       path.push_back(to(g.x_m, g.y_m));
     }
     if (path.size() > 1) scene.Polyline(path, 1.5f, Rgba{40, 90, 200, 200});
-    for (const Disturbance& d : world.disturbances) {
+    for (const sim::Disturbance& d : world.disturbances) {
       if (d.floor == floors[f]) {
         scene.Ring(
             to(d.position.x_m, d.position.y_m), static_cast<float>(d.radius_m * scale) - 1.5f,
             static_cast<float>(d.radius_m * scale), 0.0f, 6.2832f, Rgba{230, 140, 0, 255}, 32);
       }
     }
-    for (const AccessPoint& a : world.access_points) {
+    for (const sim::AccessPoint& a : world.access_points) {
       if (a.floor == floors[f])
         scene.Disc(to(a.position.x_m, a.position.y_m), 5.0f, Rgba{210, 40, 40, 255});
     }
@@ -88,4 +88,4 @@ Scene WorldMapScene(const World& world, const Dataset& dataset, int panel_px) {
   return scene;
 }
 
-}  // namespace ratslam::sim
+}  // namespace ratslam::viewer

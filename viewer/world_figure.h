@@ -7,10 +7,10 @@
 #include "render/scene.h"
 #include "sim/world.h"
 
-namespace ratslam::sim {
+namespace ratslam::viewer {
 
-Scene WorldMapScene(const World& world, const Dataset& dataset, int panel_px = 700);
+Scene WorldMapScene(const sim::World& world, const Dataset& dataset, int panel_px = 700);
 
-}  // namespace ratslam::sim
+}  // namespace ratslam::viewer
 
 #endif  // RATSLAM_VIEWER_WORLD_FIGURE_H_
