@@ -134,7 +134,7 @@ inline std::optional<PipelineOptions> LoadOptions(const Arguments& args,
 // output's extension names) and the page width of vector figures.
 struct FigureOptions {
   std::optional<std::vector<viewer::FigureFormat>> formats;
-  double width_mm = kOneColumnMm;
+  double width_mm = render::kOneColumnMm;
 };
 inline StatusOr<FigureOptions> FigureOptionsOf(const Arguments& args) {
   FigureOptions o;
@@ -152,8 +152,8 @@ inline StatusOr<FigureOptions> FigureOptionsOf(const Arguments& args) {
 // columns); a PNG renderer when a target is a PNG.
 struct CommandFigure {
   std::vector<viewer::FigureTarget> targets;
-  double width_mm = kOneColumnMm;
-  std::unique_ptr<SceneRenderer> renderer;
+  double width_mm = render::kOneColumnMm;
+  std::unique_ptr<render::SceneRenderer> renderer;
 };
 inline StatusOr<CommandFigure> CommandFigureOf(const Arguments& args, const std::string& path,
                                                double default_width_mm) {
@@ -162,7 +162,7 @@ inline StatusOr<CommandFigure> CommandFigureOf(const Arguments& args, const std:
   CommandFigure c;
   c.width_mm = args.values.count("--width-mm") ? figure->width_mm : default_width_mm;
   c.targets = viewer::FigureTargets(path, figure->formats ? &*figure->formats : nullptr);
-  StatusOr<std::unique_ptr<SceneRenderer>> renderer = viewer::RendererFor(c.targets);
+  StatusOr<std::unique_ptr<render::SceneRenderer>> renderer = viewer::RendererFor(c.targets);
   if (!renderer.ok()) return renderer.status();
   c.renderer = std::move(renderer.value());
   return c;
@@ -170,8 +170,8 @@ inline StatusOr<CommandFigure> CommandFigureOf(const Arguments& args, const std:
 
 // Writes a command's figure (natural size, see WriteNaturalFigure) to CommandFigureOf's targets.
 inline Status WriteCommandFigure(const Arguments& args, const std::string& png_path,
-                                 const std::function<Scene(int width_px)>& build,
-                                 double default_width_mm = kOneColumnMm) {
+                                 const std::function<render::Scene(int width_px)>& build,
+                                 double default_width_mm = render::kOneColumnMm) {
   StatusOr<CommandFigure> figure = CommandFigureOf(args, png_path, default_width_mm);
   if (!figure.ok()) return figure.status();
   return viewer::WriteNaturalFigure(figure->renderer.get(), build, figure->targets,

@@ -253,7 +253,7 @@ int EvaluateCommand(const Arguments& parsed) {
             return viewer::LocalisationCurvesScene(curves, title,
                                                    viewer::LocalisationAxisEndM(curves), w);
           },
-          kTwoColumnMm);
+          render::kTwoColumnMm);
       !s.ok()) {
     return fail(s);
   }

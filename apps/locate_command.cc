@@ -146,7 +146,7 @@ int LocateCommand(const Arguments& parsed) {
           return viewer::LocalisationCurvesScene(curves, title,
                                                  viewer::LocalisationAxisEndM(curves), w);
         },
-        kTwoColumnMm);
+        render::kTwoColumnMm);
     if (!drawn.ok()) return fail(drawn);
   }
   std::string human = MessagePrefix() + std::to_string(d.wifi.size()) + " scans";
@@ -230,29 +230,29 @@ int CallCommand(const Arguments& parsed) {
                   : "call at " + ShortestNumber(at) + " s: route " + route_m + " m, " + stops +
                         " stops, " + candidate_count + " candidates";
     viewer::WorldToImage to_image;
-    Scene scene = viewer::ExperienceMapScene(image, o, &to_image);
+    render::Scene scene = viewer::ExperienceMapScene(image, o, &to_image);
     const std::vector<phone::Particle>& particles = call->particles;
     const size_t every = std::max<size_t>(1, particles.size() / 3000);
     for (size_t k = 0; k < particles.size(); k += every) {
       scene.Disc(to_image(particles[k].x_m, particles[k].y_m), 1.6f, {120, 120, 120, 110}, 6);
     }
-    std::vector<ScenePoint> line;
+    std::vector<render::ScenePoint> line;
     for (uint32_t e : plan->route) line.push_back(to_image(graph.nodes[e].x, graph.nodes[e].y));
     scene.Polyline(line, 6.0f, {148, 103, 189, 230});  // purple: red marks loop closures
     for (size_t k = 0; k < candidates.size(); ++k) {
-      const ScenePoint c = to_image(candidates[k].first.x, candidates[k].first.y);
-      const ScenePoint e =
+      const render::ScenePoint c = to_image(candidates[k].first.x, candidates[k].first.y);
+      const render::ScenePoint e =
           to_image(graph.nodes[plan->serving_node[k]].x, graph.nodes[plan->serving_node[k]].y);
       // Numbered by rank as call.json numbers them (0 first); two digits get a larger disc.
       const std::string rank = std::to_string(k);
       scene.Line(c, e, 1.5f, {255, 127, 14, 255});
       scene.Disc(c, rank.size() > 1 ? 12.0f : 9.0f, {255, 127, 14, 255}, 20);
-      scene.Text({c.x, c.y + 4.5f}, rank, 13.0f, {255, 255, 255, 255}, TextAnchor::kCenter);
+      scene.Text({c.x, c.y + 4.5f}, rank, 13.0f, {255, 255, 255, 255}, render::TextAnchor::kCenter);
     }
-    const ScenePoint est = to_image(estimate.x_m, estimate.y_m);
+    const render::ScenePoint est = to_image(estimate.x_m, estimate.y_m);
     scene.Ring(est, 10.0f, 14.0f, 0.0f, 6.2832f, {31, 119, 180, 255}, 24);
     if (truth_on_map) {
-      const ScenePoint t = to_image(truth_on_map->x, truth_on_map->y);
+      const render::ScenePoint t = to_image(truth_on_map->x, truth_on_map->y);
       scene.Line({t.x - 10, t.y - 10}, {t.x + 10, t.y + 10}, 3.0f, {44, 160, 44, 255});
       scene.Line({t.x - 10, t.y + 10}, {t.x + 10, t.y - 10}, 3.0f, {44, 160, 44, 255});
     }
@@ -280,7 +280,8 @@ int CallCommand(const Arguments& parsed) {
                                           {"route.csv", call->RouteCsv()},
                                           {"call.json", summary}});
   if (!written.ok()) return fail(written);
-  Status drawn = WriteCommandFigure(*args, folder.value()->Path("call.png"), build, kTwoColumnMm);
+  Status drawn =
+      WriteCommandFigure(*args, folder.value()->Path("call.png"), build, render::kTwoColumnMm);
   if (!drawn.ok()) return fail(drawn);
   std::string human = MessagePrefix() + "robot at experience " + j["robot_experience"].dump() +
                       ": route " + Metres(j["route_length_m"]) + " through " +

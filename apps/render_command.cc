@@ -61,7 +61,7 @@ std::optional<std::vector<viewer::TimeSpan>> ParseSpans(const std::string& text)
 // extension names): PNG at width_px x height_px, PDF and SVG laid out for --width-mm.
 // `default_width_mm`: the page width without --width-mm (two-panel figures need two columns).
 Status Write(const Arguments& args, const std::string& out, const viewer::SceneBuilder& build,
-             int width_px, int height_px, double default_width_mm = kOneColumnMm) {
+             int width_px, int height_px, double default_width_mm = render::kOneColumnMm) {
   StatusOr<CommandFigure> figure = CommandFigureOf(args, out, default_width_mm);
   if (!figure.ok()) return figure.status();
   RATSLAM_RETURN_IF_ERROR(viewer::WriteFigure(figure->renderer.get(), build, width_px, height_px,
@@ -238,7 +238,7 @@ int RenderSimilarityCommand(const Arguments& args) {
   }
   if (!m.ok()) return Fail(m.status().message());
   // The matrix's side sets the figure's size; the margins around it are fixed.
-  const Scene natural = viewer::SimilarityMatrixScene(m->values, m->times_s, image_options);
+  const render::Scene natural = viewer::SimilarityMatrixScene(m->values, m->times_s, image_options);
   const int margins = natural.width() - image_options.size_px;
   Status status = Write(
       args, args.values.at("--out"),
@@ -294,7 +294,7 @@ int RenderWifiMapCommand(const Arguments& args) {
   }
   const std::string title = "Wi-Fi map of " + map->bssids()[ap] + ", floor " +
                             std::to_string(floor) + " (dots: training scans)";
-  const Scene natural = viewer::GridFieldsScene({mean, variance}, points, title);
+  const render::Scene natural = viewer::GridFieldsScene({mean, variance}, points, title);
   Status status = Write(
       args, args.values.at("--out"),
       [&](int w, int) {
@@ -302,7 +302,7 @@ int RenderWifiMapCommand(const Arguments& args) {
         const int panel = std::max(100, 700 - (natural.width() - w) / 2);
         return viewer::GridFieldsScene({mean, variance}, points, title, panel);
       },
-      natural.width(), natural.height(), kTwoColumnMm);
+      natural.width(), natural.height(), render::kTwoColumnMm);
   return status.ok() ? kExitOk : Fail(status.message());
 }
 

@@ -55,7 +55,7 @@ struct ReplayRequest {
   uint64_t animate_every = 0;  // events between animation frames; 0: no animation
   bool json = false;           // the summary as JSON on stdout even on a terminal
   std::vector<viewer::FigureFormat> formats{viewer::FigureFormat::kPng};  // of the --render images
-  double width_mm = kOneColumnMm;
+  double width_mm = render::kOneColumnMm;
 };
 
 // The first and last time of any stream of the data set: the colour range of animation frames.
@@ -133,11 +133,11 @@ int RunReplay(const ReplayRequest& request) {
   } restore_signals;
 
   // Animation: a frame of the experience map every `animate_every` events.
-  std::unique_ptr<SceneRenderer> animation_renderer;
+  std::unique_ptr<render::SceneRenderer> animation_renderer;
   std::unique_ptr<viewer::AnimationWriter> animation;
   session::ReplayCheckpoint checkpoint;
   if (request.animate_every > 0) {
-    StatusOr<std::unique_ptr<SceneRenderer>> renderer = CreateOsMesaRenderer();
+    StatusOr<std::unique_ptr<render::SceneRenderer>> renderer = render::CreateOsMesaRenderer();
     if (!renderer.ok()) return fail(renderer.status().WithContext("--animate"));
     animation_renderer = std::move(renderer.value());
     animation = std::make_unique<viewer::AnimationWriter>(
@@ -154,7 +154,7 @@ int RunReplay(const ReplayRequest& request) {
       // One colour scale for the whole animation (each frame used to stretch it over its own
       // experiences, so a colour meant a different time in every frame).
       options.time_range_s = DataTimeSpan(session.dataset());
-      StatusOr<RgbaImage> frame = animation_renderer->Render(viewer::ExperienceMapScene(
+      StatusOr<render::RgbaImage> frame = animation_renderer->Render(viewer::ExperienceMapScene(
           viewer::ExperienceMapDataOf(p.View(), session.dataset()), options));
       if (!frame.ok()) return frame.status();
       return animation->AddFrame(frame.value());
@@ -183,8 +183,9 @@ int RunReplay(const ReplayRequest& request) {
   if (request.render && result.outputs.ok()) {
     const bool png = std::find(request.formats.begin(), request.formats.end(),
                                viewer::FigureFormat::kPng) != request.formats.end();
-    StatusOr<std::unique_ptr<SceneRenderer>> renderer =
-        png ? CreateOsMesaRenderer() : StatusOr<std::unique_ptr<SceneRenderer>>(nullptr);
+    StatusOr<std::unique_ptr<render::SceneRenderer>> renderer =
+        png ? render::CreateOsMesaRenderer()
+            : StatusOr<std::unique_ptr<render::SceneRenderer>>(nullptr);
     Status rendered =
         renderer.ok()
             ? viewer::WriteRunImages(renderer->get(), session.pipeline().View(), session.dataset(),

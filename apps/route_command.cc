@@ -33,7 +33,7 @@ struct Route {
 
 // The map with the route drawn over it: a purple line, a green start, a ring at the end and an
 // x at the point asked for (kept in view).
-Scene RouteScene(const session::RobotMap& map, const Route& r, int width_px) {
+render::Scene RouteScene(const session::RobotMap& map, const Route& r, int width_px) {
   viewer::ExperienceMapImageData image;
   image.experiences = map.experiences;
   image.links = map.links;
@@ -58,14 +58,14 @@ Scene RouteScene(const session::RobotMap& map, const Route& r, int width_px) {
     o.height_px = width_px * 3 / 4;
   }
   viewer::WorldToImage to_image;
-  Scene scene = viewer::ExperienceMapScene(image, o, &to_image);
-  std::vector<ScenePoint> line_px;
+  render::Scene scene = viewer::ExperienceMapScene(image, o, &to_image);
+  std::vector<render::ScenePoint> line_px;
   for (uint32_t e : r.path) line_px.push_back(to_image(r.graph.nodes[e].x, r.graph.nodes[e].y));
   scene.Polyline(line_px, 6.0f, {148, 103, 189, 230});  // purple: red marks loop closures
   scene.Disc(line_px.front(), 9.0f, {44, 160, 44, 255}, 20);
   scene.Ring(line_px.back(), 8.0f, 12.0f, 0.0f, 6.2832f, {148, 103, 189, 255}, 24);
   if (point) {
-    const ScenePoint p = to_image(point->x, point->y);
+    const render::ScenePoint p = to_image(point->x, point->y);
     scene.Line({p.x - 9, p.y - 9}, {p.x + 9, p.y + 9}, 3.0f, viewer::kInk);
     scene.Line({p.x - 9, p.y + 9}, {p.x + 9, p.y - 9}, 3.0f, viewer::kInk);
   }
@@ -73,7 +73,8 @@ Scene RouteScene(const session::RobotMap& map, const Route& r, int width_px) {
   if (point) {
     const std::string full = legend + "   x: the point asked for";
     // A one-column page has no room for the long form.
-    legend = TextWidthPx(full, 15.0f) <= o.width_px - 60.0f ? full : legend + "   x: --to-xy";
+    legend =
+        render::TextWidthPx(full, 15.0f) <= o.width_px - 60.0f ? full : legend + "   x: --to-xy";
   }
   scene.Text({30, 75}, legend, 15.0f, viewer::kInk);
   return scene;

@@ -27,7 +27,7 @@ StatusOr<sim::World> LoadWorld(const std::string& name_or_path) {
 Status SimulateWorld(const sim::World& world, uint64_t seed, const std::string& out, bool quiet,
                      Dataset* dataset) {
   const auto started = std::chrono::steady_clock::now();
-  auto renderer = CreateOsMesaViewRenderer();
+  auto renderer = render::CreateOsMesaViewRenderer();
   if (!renderer.ok()) return renderer.status();
   sim::SimulationReport report;
   ProgressPrinter progress(stderr, quiet);
@@ -45,8 +45,8 @@ Status SimulateWorld(const sim::World& world, uint64_t seed, const std::string& 
   RATSLAM_RETURN_IF_ERROR(
       WriteFileAtomically((fs::path(out) / "world.toml").string(),
                           "# The simulated world (ratslam simulate).\n" + sim::PrintWorld(world)));
-  RATSLAM_RETURN_IF_ERROR(RenderToPng(viewer::WorldMapScene(world, *dataset),
-                                      (fs::path(out) / "ground_truth.png").string()));
+  RATSLAM_RETURN_IF_ERROR(render::RenderToPng(viewer::WorldMapScene(world, *dataset),
+                                              (fs::path(out) / "ground_truth.png").string()));
   nlohmann::ordered_json j;
   j["world"] = world.name;
   j["seed"] = seed;

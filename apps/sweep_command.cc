@@ -56,7 +56,7 @@ Status DrawSweepPlots(const std::string& dir, const sweep::CollectReport& report
   std::error_code ec;
   std::filesystem::create_directories(plots, ec);
   if (ec) return Status::Error(plots + ": cannot create folder: " + ec.message());
-  auto draw = [&](const char* name, const std::function<Scene(int)>& build) {
+  auto draw = [&](const char* name, const std::function<render::Scene(int)>& build) {
     return WriteCommandFigure(args, plots + "/" + name, build);
   };
   if (!data.keys.empty()) {

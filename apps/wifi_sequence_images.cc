@@ -10,12 +10,12 @@
 
 namespace ratslam {
 
-Status WriteWifiSequenceImages(SceneRenderer* renderer, const ReplayPipeline& pipeline,
+Status WriteWifiSequenceImages(render::SceneRenderer* renderer, const ReplayPipeline& pipeline,
                                const std::string& folder,
                                const std::vector<viewer::FigureFormat>& formats, double width_mm) {
   namespace fs = std::filesystem;
   const WifiSequenceLoopCloser& closer = pipeline.wifi_sequence();
-  auto write = [&](const std::function<Scene(int)>& build, const char* name) -> Status {
+  auto write = [&](const std::function<render::Scene(int)>& build, const char* name) -> Status {
     return viewer::WriteNaturalFigure(
                renderer, build, viewer::FigureTargets((fs::path(folder) / name).string(), &formats),
                width_mm)
@@ -41,7 +41,7 @@ Status WriteWifiSequenceImages(SceneRenderer* renderer, const ReplayPipeline& pi
   options.value_min =
       matrix.empty() ? 0.0
                      : std::floor(100.0 * *std::min_element(matrix.begin(), matrix.end())) / 100.0;
-  const Rgba verified{220, 50, 32, 255}, rejected{235, 235, 235, 255};
+  const render::Rgba verified{220, 50, 32, 255}, rejected{235, 235, 235, 255};
   options.legend = {{verified, "verified correspondence"},
                     {{170, 170, 170, 255}, "DP pair not verified (light)"}};
   for (const SequenceLoop& loop : closer.loops()) {

@@ -62,12 +62,12 @@ void BM_BuildScene(benchmark::State& state) {
 BENCHMARK(BM_BuildScene)->Arg(100000)->Unit(benchmark::kMillisecond);
 
 void BM_RenderOsMesa(benchmark::State& state) {
-  auto renderer = CreateOsMesaRenderer();
+  auto renderer = render::CreateOsMesaRenderer();
   if (!renderer.ok()) {
     state.SkipWithError(renderer.status().message().c_str());
     return;
   }
-  const Scene scene =
+  const render::Scene scene =
       viewer::ExperienceMapScene(LargeMap(static_cast<int>(state.range(0))), Options());
   for (auto _ : state) benchmark::DoNotOptimize(renderer.value()->Render(scene));
   state.counters["triangles"] = static_cast<double>(scene.triangles().size() / 3);
@@ -80,15 +80,15 @@ BENCHMARK(BM_RenderOsMesa)
     ->UseRealTime();
 
 void BM_EncodePng(benchmark::State& state) {
-  auto renderer = CreateOsMesaRenderer();
+  auto renderer = render::CreateOsMesaRenderer();
   if (!renderer.ok()) {
     state.SkipWithError(renderer.status().message().c_str());
     return;
   }
-  const Scene scene = viewer::ExperienceMapScene(LargeMap(100000), Options());
-  const RgbaImage image = renderer.value()->Render(scene).value();
+  const render::Scene scene = viewer::ExperienceMapScene(LargeMap(100000), Options());
+  const render::RgbaImage image = renderer.value()->Render(scene).value();
   const auto path = std::filesystem::temp_directory_path() / "ratslam_render_benchmark.png";
-  for (auto _ : state) benchmark::DoNotOptimize(WritePng(image, path.string()));
+  for (auto _ : state) benchmark::DoNotOptimize(render::WritePng(image, path.string()));
   std::filesystem::remove(path);
 }
 BENCHMARK(BM_EncodePng)->Unit(benchmark::kMillisecond)->UseRealTime();
@@ -97,7 +97,7 @@ BENCHMARK(BM_EncodePng)->Unit(benchmark::kMillisecond)->UseRealTime();
 // previous image), PNG file. The first image of a size also allocates the framebuffers
 // (BM_RenderOsMesaFirstImage).
 void BM_ExperienceMapToPng(benchmark::State& state) {
-  auto renderer = CreateOsMesaRenderer();
+  auto renderer = render::CreateOsMesaRenderer();
   if (!renderer.ok()) {
     state.SkipWithError(renderer.status().message().c_str());
     return;
@@ -105,8 +105,9 @@ void BM_ExperienceMapToPng(benchmark::State& state) {
   const viewer::ExperienceMapImageData data = LargeMap(100000);
   const auto path = std::filesystem::temp_directory_path() / "ratslam_render_benchmark_e2e.png";
   for (auto _ : state) {
-    const Scene scene = viewer::ExperienceMapScene(data, Options());
-    benchmark::DoNotOptimize(WritePng(renderer.value()->Render(scene).value(), path.string()));
+    const render::Scene scene = viewer::ExperienceMapScene(data, Options());
+    benchmark::DoNotOptimize(
+        render::WritePng(renderer.value()->Render(scene).value(), path.string()));
   }
   std::filesystem::remove(path);
 }
@@ -114,9 +115,9 @@ BENCHMARK(BM_ExperienceMapToPng)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // A new renderer per image: context, shaders and framebuffers made for this one image.
 void BM_RenderOsMesaFirstImage(benchmark::State& state) {
-  const Scene scene = viewer::ExperienceMapScene(LargeMap(100000), Options());
+  const render::Scene scene = viewer::ExperienceMapScene(LargeMap(100000), Options());
   for (auto _ : state) {
-    auto renderer = CreateOsMesaRenderer();
+    auto renderer = render::CreateOsMesaRenderer();
     if (!renderer.ok()) {
       state.SkipWithError(renderer.status().message().c_str());
       return;

@@ -13,7 +13,7 @@
 
 #include "common/file_util.h"
 
-namespace ratslam {
+namespace ratslam::render {
 
 namespace {
 
@@ -191,4 +191,4 @@ void DrawTexts(const Scene& scene, RgbaImage* image) {
   }
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::render

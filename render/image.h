@@ -9,7 +9,7 @@
 #include "common/status.h"
 #include "render/scene.h"
 
-namespace ratslam {
+namespace ratslam::render {
 
 struct RgbaImage {
   int width = 0;
@@ -33,6 +33,6 @@ float TextWidthPx(const std::string& text, float height_px);
 // Draws the scene's texts onto `image` (Hershey fonts, antialiased).
 void DrawTexts(const Scene& scene, RgbaImage* image);
 
-}  // namespace ratslam
+}  // namespace ratslam::render
 
 #endif  // RATSLAM_RENDER_IMAGE_H_

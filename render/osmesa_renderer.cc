@@ -12,7 +12,7 @@
 #include "render/renderer.h"
 #include "render/view_renderer.h"
 
-namespace ratslam {
+namespace ratslam::render {
 namespace {
 
 // The OpenGL entry points we use, resolved through OSMesaGetProcAddress.
@@ -664,4 +664,4 @@ Status RenderToPng(const Scene& scene, const std::string& path) {
   return WritePng(image.value(), path);
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::render

@@ -8,7 +8,7 @@
 #include "render/image.h"
 #include "render/scene.h"
 
-namespace ratslam {
+namespace ratslam::render {
 
 class SceneRenderer {
  public:
@@ -25,6 +25,6 @@ StatusOr<std::unique_ptr<SceneRenderer>> CreateOsMesaRenderer();
 // Renders `scene` with a new OSMesa renderer and writes it as PNG.
 Status RenderToPng(const Scene& scene, const std::string& path);
 
-}  // namespace ratslam
+}  // namespace ratslam::render
 
 #endif  // RATSLAM_RENDER_RENDERER_H_

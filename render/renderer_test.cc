@@ -14,7 +14,7 @@
 
 #include "common/scratch_dir.h"
 
-namespace ratslam {
+namespace ratslam::render {
 namespace {
 
 // One fresh folder per test process (two checkouts testing at once never collide).
@@ -162,4 +162,4 @@ TEST(PngTest, LargeImagesRoundTripThroughAnIndependentDecoder) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::render

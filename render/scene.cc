@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-namespace ratslam {
+namespace ratslam::render {
 
 void Scene::Triangle(ScenePoint a, ScenePoint b, ScenePoint c, Rgba color) {
   SceneShape shape;
@@ -133,4 +133,4 @@ void Scene::Append(const Scene& other, float dx, float dy) {
   }
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::render

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-namespace ratslam {
+namespace ratslam::render {
 
 struct Rgba {
   uint8_t r = 0, g = 0, b = 0, a = 255;
@@ -95,6 +95,6 @@ class Scene {
   std::vector<SceneText> texts_;
 };
 
-}  // namespace ratslam
+}  // namespace ratslam::render
 
 #endif  // RATSLAM_RENDER_SCENE_H_

@@ -14,7 +14,7 @@
 
 #include "common/file_util.h"
 
-namespace ratslam {
+namespace ratslam::render {
 namespace {
 
 constexpr const char* kFontFamily = "DejaVu Sans";
@@ -222,4 +222,4 @@ Status WriteVectorFigure(const Scene& scene, const std::string& path, VectorForm
   return WriteFileAtomically(path, format == VectorFormat::kSvg ? CanonicalSvgIds(bytes) : bytes);
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::render

@@ -15,7 +15,7 @@
 #include "common/status.h"
 #include "render/scene.h"
 
-namespace ratslam {
+namespace ratslam::render {
 
 enum class VectorFormat { kPdf, kSvg };
 
@@ -42,6 +42,6 @@ double TextPoints(float height_px, int scene_width_px, double width_mm);
 Status WriteVectorFigure(const Scene& scene, const std::string& path, VectorFormat format,
                          double width_mm = kOneColumnMm);
 
-}  // namespace ratslam
+}  // namespace ratslam::render
 
 #endif  // RATSLAM_RENDER_VECTOR_FIGURE_H_

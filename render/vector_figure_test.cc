@@ -11,7 +11,7 @@
 
 #include "common/scratch_dir.h"
 
-namespace ratslam {
+namespace ratslam::render {
 namespace {
 
 namespace fs = std::filesystem;
@@ -158,4 +158,4 @@ TEST_F(VectorFigureTest, ErrorsNameTheFile) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::render

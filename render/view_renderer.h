@@ -10,7 +10,7 @@
 #include "common/status.h"
 #include "dataset/image_loader.h"
 
-namespace ratslam {
+namespace ratslam::render {
 
 // One vertex of a textured triangle: (u, v) count texture repeats, `tile` picks the texture in
 // the atlas, `shade` scales the texture's brightness (face orientation).
@@ -55,6 +55,6 @@ class ViewRenderer {
 // OpenGL 3.3 core through OSMesa (see CreateOsMesaRenderer).
 StatusOr<std::unique_ptr<ViewRenderer>> CreateOsMesaViewRenderer();
 
-}  // namespace ratslam
+}  // namespace ratslam::render
 
 #endif  // RATSLAM_RENDER_VIEW_RENDERER_H_

@@ -145,16 +145,16 @@ namespace {
 
 // One floor's static geometry and texture atlas; people are added per frame (PlacePeople).
 struct FloorGeometry {
-  ViewMesh mesh;
+  render::ViewMesh mesh;
   std::map<std::string, int> tiles;  // texture name -> atlas tile
   size_t static_vertices = 0;
   uint64_t static_id = 0;
 };
 
 // Texture v runs top (0) to bottom (1) of the image; walls put v = 0 at their top.
-void AddQuad(const ViewVertex& a, const ViewVertex& b, const ViewVertex& c, const ViewVertex& d,
-             ViewMesh* mesh) {
-  for (const ViewVertex* v : {&a, &b, &c, &a, &c, &d}) mesh->triangles.push_back(*v);
+void AddQuad(const render::ViewVertex& a, const render::ViewVertex& b, const render::ViewVertex& c,
+             const render::ViewVertex& d, render::ViewMesh* mesh) {
+  for (const render::ViewVertex* v : {&a, &b, &c, &a, &c, &d}) mesh->triangles.push_back(*v);
 }
 
 FloorGeometry BuildFloor(const World& world, int floor) {
@@ -175,7 +175,7 @@ FloorGeometry BuildFloor(const World& world, int floor) {
   for (const Person& p : world.people) {
     if (p.floor == floor) tile_of(p.texture);
   }
-  ViewMesh& mesh = g.mesh;
+  render::ViewMesh& mesh = g.mesh;
   mesh.tile_px = kTilePx;
   mesh.tiles_per_side = kTilesPerSide;
   const int atlas_px = kTilePx * kTilesPerSide;
@@ -228,7 +228,8 @@ FloorGeometry BuildFloor(const World& world, int floor) {
     return h;
   };
   mesh.atlas_id = fnv(1469598103934665603ULL, mesh.atlas.data(), mesh.atlas.size());
-  mesh.id = fnv(mesh.atlas_id, mesh.triangles.data(), mesh.triangles.size() * sizeof(ViewVertex));
+  mesh.id =
+      fnv(mesh.atlas_id, mesh.triangles.data(), mesh.triangles.size() * sizeof(render::ViewVertex));
   g.static_vertices = mesh.triangles.size();
   g.static_id = mesh.id;
   return g;
@@ -236,7 +237,7 @@ FloorGeometry BuildFloor(const World& world, int floor) {
 
 // Replaces the people of `g` by their panels at `time_s`; the geometry id follows them.
 void PlacePeople(const World& world, int floor, double time_s, FloorGeometry* g) {
-  ViewMesh& mesh = g->mesh;
+  render::ViewMesh& mesh = g->mesh;
   mesh.triangles.resize(g->static_vertices);
   // The static geometry's id, extended by each person's position.
   uint64_t id = g->static_id;
@@ -286,14 +287,14 @@ std::string SessionName(const World& world, int index) {
 
 }  // namespace
 
-ViewMesh FloorMesh(const World& world, int floor, double time_s) {
+render::ViewMesh FloorMesh(const World& world, int floor, double time_s) {
   FloorGeometry g = BuildFloor(world, floor);
   PlacePeople(world, floor, time_s, &g);
   return std::move(g.mesh);
 }
 
-ViewCamera CameraAt(const World& world, const TruePose& pose) {
-  ViewCamera c;
+render::ViewCamera CameraAt(const World& world, const TruePose& pose) {
+  render::ViewCamera c;
   c.x_m = pose.x_m;
   c.y_m = pose.y_m;
   c.z_m = world.camera.height_m;
@@ -305,8 +306,8 @@ ViewCamera CameraAt(const World& world, const TruePose& pose) {
   return c;
 }
 
-ViewLighting LightingOf(const World& world, int session) {
-  ViewLighting l;
+render::ViewLighting LightingOf(const World& world, int session) {
+  render::ViewLighting l;
   if (world.sessions[session].lighting == "night") {
     l.ambient = 0.12;
     l.headlight_gain = 1.1;
@@ -315,7 +316,7 @@ ViewLighting LightingOf(const World& world, int session) {
   return l;
 }
 
-Status Simulate(const World& world, uint64_t seed, ViewRenderer* renderer,
+Status Simulate(const World& world, uint64_t seed, render::ViewRenderer* renderer,
                 const std::string& image_folder, Dataset* dataset, SimulationReport* report,
                 const std::function<void(double)>& progress) {
   RATSLAM_RETURN_IF_ERROR(world.Validate());

@@ -38,11 +38,11 @@ std::vector<TruePose> TrueTrajectory(const World& world, double step_s);
 
 // Textured triangles of one floor (walls both sides, floor and ceiling), and the people on it
 // at `time_s`. `mesh.id` changes only when the geometry does.
-ViewMesh FloorMesh(const World& world, int floor, double time_s);
+render::ViewMesh FloorMesh(const World& world, int floor, double time_s);
 
 // The camera's view at a pose (before noise).
-ViewCamera CameraAt(const World& world, const TruePose& pose);
-ViewLighting LightingOf(const World& world, int session);
+render::ViewCamera CameraAt(const World& world, const TruePose& pose);
+render::ViewLighting LightingOf(const World& world, int session);
 
 struct SimulationReport {
   size_t images = 0, scans = 0, odometry_rows = 0, compass_rows = 0;
@@ -51,7 +51,7 @@ struct SimulationReport {
 
 // Simulates `world` into `dataset`; images go to `image_folder` (PNG, created) when `renderer`
 // is given, else the data set has no images. `progress` (optional) gets the fraction done.
-Status Simulate(const World& world, uint64_t seed, ViewRenderer* renderer,
+Status Simulate(const World& world, uint64_t seed, render::ViewRenderer* renderer,
                 const std::string& image_folder, Dataset* dataset, SimulationReport* report,
                 const std::function<void(double)>& progress = nullptr);
 

@@ -132,7 +132,7 @@ TEST(PropagationTest, ShadowingIsSpatiallyCorrelated) {
 
 TEST(SimulatorTest, SameSeedSameBytes) {
   const World w = Small();
-  auto renderer = CreateOsMesaViewRenderer();
+  auto renderer = render::CreateOsMesaViewRenderer();
   ASSERT_TRUE(renderer.ok()) << renderer.status().message();
   const fs::path base = fs::temp_directory_path() / ("ratslam_sim_" + std::to_string(::getpid()));
   std::string first_csvs;
@@ -168,14 +168,14 @@ TEST(SimulatorTest, SameSeedSameBytes) {
 
 TEST(SimulatorTest, AWallOfAKnownTextureFillsTheView) {
   World w = Small();
-  auto renderer = CreateOsMesaViewRenderer();
+  auto renderer = render::CreateOsMesaViewRenderer();
   ASSERT_TRUE(renderer.ok());
   // Facing the east wall (brick:2) from 1 m away with a 60 degree field of view.
   TruePose pose;
   pose.x_m = 9.0;
   pose.y_m = 2.0;
   w.camera.horizontal_fov_deg = 60.0;
-  const ViewMesh mesh = FloorMesh(w, 0, 0.0);
+  const render::ViewMesh mesh = FloorMesh(w, 0, 0.0);
   auto view = (*renderer)->Render(mesh, CameraAt(w, pose), LightingOf(w, 0));
   ASSERT_TRUE(view.ok()) << view.status().message();
   const std::vector<uint8_t> texture = MakeTexture("brick:2", 64);

@@ -17,17 +17,17 @@ namespace ratslam {
 namespace {
 namespace fs = std::filesystem;
 
-void ExpectMatchesGolden(const Scene& scene, const std::string& name) {
-  StatusOr<std::unique_ptr<SceneRenderer>> renderer = CreateOsMesaRenderer();
+void ExpectMatchesGolden(const render::Scene& scene, const std::string& name) {
+  StatusOr<std::unique_ptr<render::SceneRenderer>> renderer = render::CreateOsMesaRenderer();
   if (!renderer.ok()) GTEST_SKIP() << "OSMesa unavailable: " << renderer.status().message();
-  StatusOr<RgbaImage> actual = renderer.value()->Render(scene);
+  StatusOr<render::RgbaImage> actual = renderer.value()->Render(scene);
   ASSERT_TRUE(actual.ok()) << actual.status().message();
   const fs::path golden = fs::path(RATSLAM_SOURCE_DIR) / "tests" / "golden" / (name + ".png");
   if (std::getenv("RATSLAM_UPDATE_GOLDEN")) {
-    ASSERT_TRUE(WritePng(actual.value(), golden.string()).ok());
+    ASSERT_TRUE(render::WritePng(actual.value(), golden.string()).ok());
     GTEST_SKIP() << "updated " << golden;
   }
-  StatusOr<RgbaImage> expected = ReadPng(golden.string());
+  StatusOr<render::RgbaImage> expected = render::ReadPng(golden.string());
   ASSERT_TRUE(expected.ok()) << expected.status().message();
   ASSERT_EQ(actual->width, expected->width);
   ASSERT_EQ(actual->height, expected->height);
@@ -42,7 +42,8 @@ void ExpectMatchesGolden(const Scene& scene, const std::string& name) {
   const double large_fraction = static_cast<double>(large) / actual->pixels.size();
   const fs::path written = fs::temp_directory_path() /
                            ("ratslam_actual_" + std::to_string(::getpid()) + "_" + name + ".png");
-  if (mean > 1.0 || large_fraction > 0.005) (void)WritePng(actual.value(), written.string());
+  if (mean > 1.0 || large_fraction > 0.005)
+    (void)render::WritePng(actual.value(), written.string());
   EXPECT_LE(mean, 1.0) << name << ": mean channel difference; actual image in " << written;
   EXPECT_LE(large_fraction, 0.005)
       << name << ": share of very different channels; actual in " << written;
@@ -93,8 +94,8 @@ TEST(GoldenImageTest, ExperienceMap) {
                       "experience_map");
 }
 
-bool HasText(const Scene& scene, const std::string& text) {
-  for (const SceneText& t : scene.texts()) {
+bool HasText(const render::Scene& scene, const std::string& text) {
+  for (const render::SceneText& t : scene.texts()) {
     if (t.text == text) return true;
   }
   return false;
@@ -106,22 +107,22 @@ bool HasText(const Scene& scene, const std::string& text) {
 TEST(GoldenImageTest, ExperienceMapShowsEveryLinkTitleAndLegend) {
   const viewer::ExperienceMapImageData data = GoldenLoop();
   viewer::WorldToImage to_image;
-  const Scene scene = viewer::ExperienceMapScene(data, GoldenLoopOptions(), &to_image);
+  const render::Scene scene = viewer::ExperienceMapScene(data, GoldenLoopOptions(), &to_image);
   EXPECT_TRUE(HasText(scene, "golden"));
   EXPECT_TRUE(HasText(scene, "12 experiences, 12 links, 1 loop closure"));
   EXPECT_TRUE(HasText(scene, "loop closure"));
   EXPECT_TRUE(HasText(scene, "ground truth (rigidly aligned)"));
 
-  StatusOr<std::unique_ptr<SceneRenderer>> renderer = CreateOsMesaRenderer();
+  StatusOr<std::unique_ptr<render::SceneRenderer>> renderer = render::CreateOsMesaRenderer();
   if (!renderer.ok()) GTEST_SKIP() << "OSMesa unavailable: " << renderer.status().message();
   // Without the ground truth, whose grey path runs close to the links and could pass for one.
   viewer::ExperienceMapImageData links_only = data;
   links_only.ground_truth.clear();
-  StatusOr<RgbaImage> image = renderer.value()->Render(
+  StatusOr<render::RgbaImage> image = renderer.value()->Render(
       viewer::ExperienceMapScene(links_only, GoldenLoopOptions(), &to_image));
   ASSERT_TRUE(image.ok());
   // The darkest pixel within a pixel of `p` (antialiased thin lines cover it partly).
-  auto pixel = [&](ScenePoint p) {
+  auto pixel = [&](render::ScenePoint p) {
     std::array<int, 3> best = {255, 255, 255};
     for (int dy = -1; dy <= 1; ++dy) {
       for (int dx = -1; dx <= 1; ++dx) {
@@ -136,11 +137,11 @@ TEST(GoldenImageTest, ExperienceMapShowsEveryLinkTitleAndLegend) {
   for (const Link& l : data.links) {
     const Experience& a = data.experiences[l.from];
     const Experience& b = data.experiences[l.to];
-    const ScenePoint pa = to_image(a.x_m, a.y_m), pb = to_image(b.x_m, b.y_m);
+    const render::ScenePoint pa = to_image(a.x_m, a.y_m), pb = to_image(b.x_m, b.y_m);
     // Midway between the nodes (away from their discs), within a pixel of the line.
     int inked = 0, red = 0;
     for (float f : {0.4f, 0.5f, 0.6f}) {
-      const ScenePoint p{pa.x + f * (pb.x - pa.x), pa.y + f * (pb.y - pa.y)};
+      const render::ScenePoint p{pa.x + f * (pb.x - pa.x), pa.y + f * (pb.y - pa.y)};
       const auto c = pixel(p);
       inked += c[0] + c[1] + c[2] < 3 * 200;  // not the white background
       red += c[0] > c[1] + 60 && c[0] > c[2] + 60;
@@ -155,16 +156,16 @@ TEST(GoldenImageTest, ExperienceMapShowsEveryLinkTitleAndLegend) {
   // And the check fails on a map with that loop closure removed.
   viewer::ExperienceMapImageData without = links_only;
   without.links.pop_back();
-  const Scene fewer = viewer::ExperienceMapScene(without, GoldenLoopOptions(), &to_image);
+  const render::Scene fewer = viewer::ExperienceMapScene(without, GoldenLoopOptions(), &to_image);
   EXPECT_FALSE(HasText(fewer, "12 experiences, 12 links, 1 loop closure"));
-  StatusOr<RgbaImage> other = renderer.value()->Render(fewer);
+  StatusOr<render::RgbaImage> other = renderer.value()->Render(fewer);
   ASSERT_TRUE(other.ok());
   const Link& removed = data.links.back();
-  const ScenePoint pa =
+  const render::ScenePoint pa =
       to_image(data.experiences[removed.from].x_m, data.experiences[removed.from].y_m);
-  const ScenePoint pb =
+  const render::ScenePoint pb =
       to_image(data.experiences[removed.to].x_m, data.experiences[removed.to].y_m);
-  const ScenePoint mid{0.5f * (pa.x + pb.x), 0.5f * (pa.y + pb.y)};
+  const render::ScenePoint mid{0.5f * (pa.x + pb.x), 0.5f * (pa.y + pb.y)};
   const uint8_t* q =
       &other->pixels[(static_cast<size_t>(std::lround(mid.y)) * other->width + std::lround(mid.x)) *
                      4];
@@ -256,19 +257,19 @@ TEST(GoldenImageTest, WifiSequenceLinksAreMarkedApart) {
   across.wifi_sequence = true;
   data.links.push_back(across);
   viewer::WorldToImage to_image;
-  const Scene scene = viewer::ExperienceMapScene(data, GoldenLoopOptions(), &to_image);
+  const render::Scene scene = viewer::ExperienceMapScene(data, GoldenLoopOptions(), &to_image);
   EXPECT_TRUE(HasText(scene, "Wi-Fi sequence link"));
   EXPECT_TRUE(HasText(scene, "12 experiences, 13 links, 2 loop closures (1 by Wi-Fi sequences)"));
   viewer::WorldToImage unused;
   EXPECT_FALSE(HasText(viewer::ExperienceMapScene(GoldenLoop(), GoldenLoopOptions(), &unused),
                        "Wi-Fi sequence link"));
 
-  StatusOr<std::unique_ptr<SceneRenderer>> renderer = CreateOsMesaRenderer();
+  StatusOr<std::unique_ptr<render::SceneRenderer>> renderer = render::CreateOsMesaRenderer();
   if (!renderer.ok()) GTEST_SKIP() << "OSMesa unavailable: " << renderer.status().message();
-  StatusOr<RgbaImage> image = renderer.value()->Render(scene);
+  StatusOr<render::RgbaImage> image = renderer.value()->Render(scene);
   ASSERT_TRUE(image.ok());
-  const ScenePoint a = to_image(data.experiences[3].x_m, data.experiences[3].y_m);
-  const ScenePoint b = to_image(data.experiences[9].x_m, data.experiences[9].y_m);
+  const render::ScenePoint a = to_image(data.experiences[3].x_m, data.experiences[3].y_m);
+  const render::ScenePoint b = to_image(data.experiences[9].x_m, data.experiences[9].y_m);
   for (float f : {0.3f, 0.5f, 0.7f}) {
     const int x = static_cast<int>(std::lround(a.x + f * (b.x - a.x)));
     const int y = static_cast<int>(std::lround(a.y + f * (b.y - a.y)));

@@ -985,7 +985,7 @@ TEST_F(ReplayEndToEndTest, MissingImageKeepsOutputsAndStateThenResumes) {
 // The images a user looks at: written by --render and by `render`, readable, not blank.
 void ExpectPicture(const fs::path& png, int width, int height) {
   ASSERT_TRUE(fs::exists(png)) << png;
-  StatusOr<RgbaImage> image = ReadPng(png.string());
+  StatusOr<render::RgbaImage> image = render::ReadPng(png.string());
   ASSERT_TRUE(image.ok()) << image.status().message();
   EXPECT_EQ(image->width, width) << png;
   EXPECT_EQ(image->height, height) << png;
@@ -995,7 +995,7 @@ void ExpectPicture(const fs::path& png, int width, int height) {
 }
 
 TEST_F(ReplayEndToEndTest, RenderWritesImagesFromRunsAndMaps) {
-  if (!CreateOsMesaRenderer().ok()) GTEST_SKIP() << "OSMesa unavailable";
+  if (!render::CreateOsMesaRenderer().ok()) GTEST_SKIP() << "OSMesa unavailable";
   const fs::path out = root_ / "rendered";
   const Result replay = RunRatslam(
       ReplayArgs(out) + " --render --animate 2000 --save-map " + (out / "m.map").string(), root_);

@@ -17,7 +17,7 @@ AnimationWriter::AnimationWriter(std::string folder, double fps)
 
 AnimationWriter::~AnimationWriter() { Close(); }
 
-Status AnimationWriter::AddFrame(const RgbaImage& frame) {
+Status AnimationWriter::AddFrame(const render::RgbaImage& frame) {
   if (frames_ == 0) {
     std::error_code ec;
     std::filesystem::create_directories(folder_, ec);
@@ -25,7 +25,8 @@ Status AnimationWriter::AddFrame(const RgbaImage& frame) {
   }
   char name[32];
   std::snprintf(name, sizeof name, "frame_%06d.png", frames_);
-  RATSLAM_RETURN_IF_ERROR(WritePng(frame, (std::filesystem::path(folder_) / name).string()));
+  RATSLAM_RETURN_IF_ERROR(
+      render::WritePng(frame, (std::filesystem::path(folder_) / name).string()));
   if (!video_->failed) {
     cv::Mat rgba(frame.height, frame.width, CV_8UC4, const_cast<uint8_t*>(frame.pixels.data()));
     cv::Mat bgr;

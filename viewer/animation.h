@@ -15,7 +15,7 @@ class AnimationWriter {
   // Frames go to folder/frame_000000.png, ...; the video to folder/animation.avi at `fps`.
   AnimationWriter(std::string folder, double fps);
   ~AnimationWriter();
-  Status AddFrame(const RgbaImage& frame);
+  Status AddFrame(const render::RgbaImage& frame);
   // Finishes the video; returns whether one was written (false: PNG frames only).
   bool Close();
   int frames() const { return frames_; }

@@ -52,7 +52,7 @@ FigureFormat FormatOfPath(const std::string& path) {
 }
 
 std::pair<int, int> VectorLayoutSize(int width_px, int height_px, double width_mm) {
-  const int w = VectorLayoutWidthPx(width_mm);
+  const int w = render::VectorLayoutWidthPx(width_mm);
   const int h = std::max(
       1, static_cast<int>(std::lround(static_cast<double>(w) * height_px / std::max(1, width_px))));
   return {w, h};
@@ -69,19 +69,20 @@ std::vector<FigureTarget> FigureTargets(const std::string& path,
   return targets;
 }
 
-VectorFormat VectorFormatOf(FigureFormat format) {
-  return format == FigureFormat::kPdf ? VectorFormat::kPdf : VectorFormat::kSvg;
+render::VectorFormat VectorFormatOf(FigureFormat format) {
+  return format == FigureFormat::kPdf ? render::VectorFormat::kPdf : render::VectorFormat::kSvg;
 }
 
-StatusOr<std::unique_ptr<SceneRenderer>> RendererFor(const std::vector<FigureTarget>& targets) {
+StatusOr<std::unique_ptr<render::SceneRenderer>> RendererFor(
+    const std::vector<FigureTarget>& targets) {
   for (const FigureTarget& t : targets) {
-    if (t.format == FigureFormat::kPng) return CreateOsMesaRenderer();
+    if (t.format == FigureFormat::kPng) return render::CreateOsMesaRenderer();
   }
-  return std::unique_ptr<SceneRenderer>();
+  return std::unique_ptr<render::SceneRenderer>();
 }
 
-Status WriteFigure(SceneRenderer* renderer, const SceneBuilder& build, int width_px, int height_px,
-                   const std::vector<FigureTarget>& targets, double width_mm) {
+Status WriteFigure(render::SceneRenderer* renderer, const SceneBuilder& build, int width_px,
+                   int height_px, const std::vector<FigureTarget>& targets, double width_mm) {
   return WriteNaturalFigure(
       renderer,
       [&](int layout_width_px) {
@@ -92,17 +93,19 @@ Status WriteFigure(SceneRenderer* renderer, const SceneBuilder& build, int width
       targets, width_mm);
 }
 
-Status WriteNaturalFigure(SceneRenderer* renderer, const std::function<Scene(int width_px)>& build,
+Status WriteNaturalFigure(render::SceneRenderer* renderer,
+                          const std::function<render::Scene(int width_px)>& build,
                           const std::vector<FigureTarget>& targets, double width_mm) {
   for (const FigureTarget& target : targets) {
     if (target.format == FigureFormat::kPng) {
       if (renderer == nullptr) return Status::Error(target.path + ": no PNG renderer");
-      StatusOr<RgbaImage> image = renderer->Render(build(0));
+      StatusOr<render::RgbaImage> image = renderer->Render(build(0));
       if (!image.ok()) return image.status().WithContext(target.path);
-      RATSLAM_RETURN_IF_ERROR(WritePng(image.value(), target.path));
+      RATSLAM_RETURN_IF_ERROR(render::WritePng(image.value(), target.path));
     } else {
-      RATSLAM_RETURN_IF_ERROR(WriteVectorFigure(build(VectorLayoutWidthPx(width_mm)), target.path,
-                                                VectorFormatOf(target.format), width_mm));
+      RATSLAM_RETURN_IF_ERROR(
+          render::WriteVectorFigure(build(render::VectorLayoutWidthPx(width_mm)), target.path,
+                                    VectorFormatOf(target.format), width_mm));
     }
   }
   return Status::Ok();

@@ -33,13 +33,14 @@ struct FigureTarget {
 };
 
 // The Cairo format of a PDF or SVG figure.
-VectorFormat VectorFormatOf(FigureFormat format);
+render::VectorFormat VectorFormatOf(FigureFormat format);
 
 // A PNG renderer (OSMesa) when some target is a PNG, else null: PDF and SVG need none.
-StatusOr<std::unique_ptr<SceneRenderer>> RendererFor(const std::vector<FigureTarget>& targets);
+StatusOr<std::unique_ptr<render::SceneRenderer>> RendererFor(
+    const std::vector<FigureTarget>& targets);
 
 // A figure laid out for a pixel size.
-using SceneBuilder = std::function<Scene(int width_px, int height_px)>;
+using SceneBuilder = std::function<render::Scene(int width_px, int height_px)>;
 
 // The builder of a figure whose options carry width_px and height_px: `draw(options)` at each
 // size asked for.
@@ -61,13 +62,16 @@ std::vector<FigureTarget> FigureTargets(const std::string& path,
 // Writes the figure to each target: PNG built at width_px x height_px and rendered by
 // `renderer`; PDF and SVG built at VectorLayoutSize(...) and set on a page `width_mm` wide.
 // `renderer` may be null when no target is a PNG.
-Status WriteFigure(SceneRenderer* renderer, const SceneBuilder& build, int width_px, int height_px,
-                   const std::vector<FigureTarget>& targets, double width_mm = kOneColumnMm);
+Status WriteFigure(render::SceneRenderer* renderer, const SceneBuilder& build, int width_px,
+                   int height_px, const std::vector<FigureTarget>& targets,
+                   double width_mm = render::kOneColumnMm);
 
 // A figure with a natural size: `build(0)` makes the PNG's scene, `build(w)` a scene laid out
 // w pixels wide for PDF and SVG (w = VectorLayoutWidthPx(width_mm)).
-Status WriteNaturalFigure(SceneRenderer* renderer, const std::function<Scene(int width_px)>& build,
-                          const std::vector<FigureTarget>& targets, double width_mm = kOneColumnMm);
+Status WriteNaturalFigure(render::SceneRenderer* renderer,
+                          const std::function<render::Scene(int width_px)>& build,
+                          const std::vector<FigureTarget>& targets,
+                          double width_mm = render::kOneColumnMm);
 
 // The vector layout's size for a figure whose PNG is width_px x height_px.
 std::pair<int, int> VectorLayoutSize(int width_px, int height_px, double width_mm);

@@ -55,7 +55,7 @@ TEST(FigureOutputTest, VectorFiguresAreBuiltAtTheLayoutWidthWithThePngsAspect) {
   std::vector<std::pair<int, int>> sizes;
   const SceneBuilder build = [&](int w, int h) {
     sizes.push_back({w, h});
-    Scene s(w, h, {255, 255, 255, 255});
+    render::Scene s(w, h, {255, 255, 255, 255});
     s.Text({10, 20}, "x", 13, {0, 0, 0, 255});
     return s;
   };
@@ -109,7 +109,7 @@ TEST(FigureOutputTest, EveryFiguresTextIsAtLeastSevenPointsInPrint) {
     cell_options.height_px = h;
     SimilarityImageOptions similarity_options;
     similarity_options.size_px = w / 2;
-    for (const Scene& scene :
+    for (const render::Scene& scene :
          {ExperienceMapScene(map, map_options), TemplateGraphScene(points, graph_options),
           PoseCellScene(network, cell_options),
           SimilarityMatrixScene(matrix, times, similarity_options),
@@ -117,8 +117,9 @@ TEST(FigureOutputTest, EveryFiguresTextIsAtLeastSevenPointsInPrint) {
           LocalisationCurvesScene({{"a", {1.0, 2.0}}}, "t", 30.0, w),
           PrecisionRecallScene({"within 2 m"}, {{0.1, 0.5}}, {{0.9, 0.8}}, "t", w)}) {
       ASSERT_FALSE(scene.texts().empty());
-      for (const SceneText& t : scene.texts()) {
-        EXPECT_GE(TextPoints(t.height_px, scene.width(), width_mm), kMinTextPt - 1e-9)
+      for (const render::SceneText& t : scene.texts()) {
+        EXPECT_GE(render::TextPoints(t.height_px, scene.width(), width_mm),
+                  render::kMinTextPt - 1e-9)
             << "'" << t.text << "' (" << t.height_px << " px) in a scene " << scene.width()
             << " px wide printed " << width_mm << " mm wide";
       }
@@ -169,7 +170,7 @@ TEST(FigureOutputTest, NoTextRunsOffAFigureLaidOutForAPage) {
   std::vector<int> floors(20, 0);  // the second half of the map on floor 1
   std::fill(floors.begin() + 10, floors.end(), 1);
   for (double width_mm : {88.0, 180.0}) {
-    const int w = VectorLayoutWidthPx(width_mm);
+    const int w = render::VectorLayoutWidthPx(width_mm);
     SimilarityImageOptions similarity;
     similarity.size_px = w - 190;  // as replay --render lays it out
     similarity.title = "Wi-Fi similarity of scans (eqs. 1-4)";
@@ -189,7 +190,7 @@ TEST(FigureOutputTest, NoTextRunsOffAFigureLaidOutForAPage) {
     const auto [cw, ch] = VectorLayoutSize(cell_options.width_px, cell_options.height_px, width_mm);
     cell_options.width_px = cw;
     cell_options.height_px = ch;
-    for (const Scene& scene :
+    for (const render::Scene& scene :
          {PoseCellScene(network, cell_options), SweepParameterScene(sweep, w),
           SweepHeatmapScene(sweep, 0, 1, w), SweepParetoScene(sweep, w),
           SequencePairsScene(pairs, "Wi-Fi sequence pairs", w),
@@ -198,15 +199,16 @@ TEST(FigureOutputTest, NoTextRunsOffAFigureLaidOutForAPage) {
           ExperienceMapFloorsScene(map, floors, {}, map_options)}) {
       ASSERT_FALSE(scene.texts().empty());
       EXPECT_LE(scene.width(), w + 1) << "'" << scene.texts().front().text << "'";
-      for (const SceneText& t : scene.texts()) {
-        const float width = TextWidthPx(t.text, t.height_px);
-        const float left = t.anchor == TextAnchor::kLeft     ? t.position.x
-                           : t.anchor == TextAnchor::kCenter ? t.position.x - width / 2
-                                                             : t.position.x - width;
+      for (const render::SceneText& t : scene.texts()) {
+        const float width = render::TextWidthPx(t.text, t.height_px);
+        const float left = t.anchor == render::TextAnchor::kLeft     ? t.position.x
+                           : t.anchor == render::TextAnchor::kCenter ? t.position.x - width / 2
+                                                                     : t.position.x - width;
         EXPECT_GE(left, 0.0f) << "'" << t.text << "' at " << width_mm << " mm";
         EXPECT_LE(left + width, static_cast<float>(scene.width()))
             << "'" << t.text << "' at " << width_mm << " mm (scene " << scene.width() << " px)";
-        EXPECT_GE(TextPoints(t.height_px, scene.width(), width_mm), kMinTextPt - 1e-9)
+        EXPECT_GE(render::TextPoints(t.height_px, scene.width(), width_mm),
+                  render::kMinTextPt - 1e-9)
             << "'" << t.text << "'";
       }
     }

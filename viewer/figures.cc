@@ -12,11 +12,11 @@
 namespace ratslam::viewer {
 namespace {
 
-constexpr Rgba kWhite{255, 255, 255, 255};
-constexpr Rgba kLoopClosure{220, 50, 32, 255};
-constexpr Rgba kWifiSequence{0, 0, 0,
-                             255};  // links of Wi-Fi sequence loop closure (no category colour)
-constexpr Rgba kGroundTruth{160, 160, 160, 200};
+constexpr render::Rgba kWhite{255, 255, 255, 255};
+constexpr render::Rgba kLoopClosure{220, 50, 32, 255};
+constexpr render::Rgba kWifiSequence{
+    0, 0, 0, 255};  // links of Wi-Fi sequence loop closure (no category colour)
+constexpr render::Rgba kGroundTruth{160, 160, 160, 200};
 
 std::string FormatNumber(double value) {
   char buffer[32];
@@ -28,12 +28,12 @@ std::string FormatNumber(double value) {
   return buffer;
 }
 
-Rgba WithAlpha(Rgba c, uint8_t alpha) {
+render::Rgba WithAlpha(render::Rgba c, uint8_t alpha) {
   c.a = alpha;
   return c;
 }
 
-Rgba Mix(Rgba a, Rgba b, double t) {
+render::Rgba Mix(render::Rgba a, render::Rgba b, double t) {
   auto lerp = [t](uint8_t x, uint8_t y) {
     return static_cast<uint8_t>(std::lround(x + (y - x) * t));
   };
@@ -41,8 +41,8 @@ Rgba Mix(Rgba a, Rgba b, double t) {
 }
 
 // A horizontal gradient strip for colour bars.
-SceneImage ColorBar(float left, float top, float width, float height) {
-  SceneImage bar;
+render::SceneImage ColorBar(float left, float top, float width, float height) {
+  render::SceneImage bar;
   bar.left = left;
   bar.top = top;
   bar.width = width;
@@ -51,7 +51,7 @@ SceneImage ColorBar(float left, float top, float width, float height) {
   bar.pixels_high = 1;
   bar.smooth = true;
   for (int i = 0; i < 256; ++i) {
-    const Rgba c = SequentialColor(i / 255.0);
+    const render::Rgba c = SequentialColor(i / 255.0);
     bar.rgba.insert(bar.rgba.end(), {c.r, c.g, c.b, 255});
   }
   return bar;
@@ -61,13 +61,13 @@ SceneImage ColorBar(float left, float top, float width, float height) {
 struct PlotArea {
   float left, top, width, height;
   double x0, x1, y0, y1;
-  ScenePoint Map(double x, double y) const {
+  render::ScenePoint Map(double x, double y) const {
     return {static_cast<float>(left + (x - x0) / (x1 - x0) * width),
             static_cast<float>(top + height - (y - y0) / (y1 - y0) * height)};
   }
 };
 
-void DrawAxes(Scene& scene, const PlotArea& p, const std::string& x_label,
+void DrawAxes(render::Scene& scene, const PlotArea& p, const std::string& x_label,
               const std::string& y_label, bool grid = true) {
   // At most 8 x and 6 y ticks, fewer on small plots (vector figures are laid out small): a tick
   // label needs about 50 px across and 40 px up.
@@ -75,24 +75,24 @@ void DrawAxes(Scene& scene, const PlotArea& p, const std::string& x_label,
   const int y_ticks = std::clamp(static_cast<int>(p.height / 40), 2, 6);
   const double x_step = NiceStep(p.x1 - p.x0, x_ticks), y_step = NiceStep(p.y1 - p.y0, y_ticks);
   for (double x = std::ceil(p.x0 / x_step) * x_step; x <= p.x1 + 1e-9; x += x_step) {
-    const ScenePoint a = p.Map(x, p.y0);
+    const render::ScenePoint a = p.Map(x, p.y0);
     if (grid) scene.Line({a.x, p.top}, {a.x, p.top + p.height}, 1.0f, kGrid);
     scene.Line(a, {a.x, a.y + 6}, 1.5f, kInk);
-    scene.Text({a.x, a.y + 24}, FormatNumber(x), 15, kInk, TextAnchor::kCenter);
+    scene.Text({a.x, a.y + 24}, FormatNumber(x), 15, kInk, render::TextAnchor::kCenter);
   }
   for (double y = std::ceil(p.y0 / y_step) * y_step; y <= p.y1 + 1e-9; y += y_step) {
-    const ScenePoint a = p.Map(p.x0, y);
+    const render::ScenePoint a = p.Map(p.x0, y);
     if (grid) scene.Line({p.left, a.y}, {p.left + p.width, a.y}, 1.0f, kGrid);
     scene.Line({a.x - 6, a.y}, a, 1.5f, kInk);
-    scene.Text({a.x - 10, a.y + 5}, FormatNumber(y), 15, kInk, TextAnchor::kRight);
+    scene.Text({a.x - 10, a.y + 5}, FormatNumber(y), 15, kInk, render::TextAnchor::kRight);
   }
   scene.Line({p.left, p.top + p.height}, {p.left + p.width, p.top + p.height}, 1.5f, kInk);
   scene.Line({p.left, p.top}, {p.left, p.top + p.height}, 1.5f, kInk);
   if (!x_label.empty()) {
     scene.Text({p.left + p.width / 2, p.top + p.height + 48}, x_label, 16, kInk,
-               TextAnchor::kCenter);
+               render::TextAnchor::kCenter);
   }
-  scene.Text({p.left - 10, p.top - 14}, y_label, 16, kInk, TextAnchor::kLeft);
+  scene.Text({p.left - 10, p.top - 14}, y_label, 16, kInk, render::TextAnchor::kLeft);
 }
 
 constexpr float kLegendGap = 24;
@@ -101,7 +101,7 @@ constexpr float kColorBarWidth = 180;
 // A legend entry: its width and how to draw it with its left end at x, centre line at y.
 struct LegendItem {
   float width;
-  std::function<void(Scene&, float x, float y)> draw;
+  std::function<void(render::Scene&, float x, float y)> draw;
 };
 
 // Greedy rows of legend items no wider than `max_width`.
@@ -127,8 +127,8 @@ float RowLength(const std::vector<LegendItem>& items, const std::vector<size_t>&
 }
 
 // Draws one row right-aligned at `right`.
-void DrawRow(Scene& scene, const std::vector<LegendItem>& items, const std::vector<size_t>& row,
-             float right, float y) {
+void DrawRow(render::Scene& scene, const std::vector<LegendItem>& items,
+             const std::vector<size_t>& row, float right, float y) {
   float x = right - RowLength(items, row);
   for (size_t i : row) {
     items[i].draw(scene, x, y);
@@ -138,21 +138,22 @@ void DrawRow(Scene& scene, const std::vector<LegendItem>& items, const std::vect
 
 }  // namespace
 
-Rgba SequentialColor(double t) {
+render::Rgba SequentialColor(double t) {
   // Anchors of a dark-blue to yellow ramp with monotonically rising lightness.
-  static const Rgba kAnchors[] = {{48, 18, 90, 255},   {40, 70, 140, 255},  {30, 120, 142, 255},
-                                  {40, 165, 120, 255}, {130, 200, 70, 255}, {240, 225, 40, 255}};
+  static const render::Rgba kAnchors[] = {{48, 18, 90, 255},   {40, 70, 140, 255},
+                                          {30, 120, 142, 255}, {40, 165, 120, 255},
+                                          {130, 200, 70, 255}, {240, 225, 40, 255}};
   constexpr int kSegments = static_cast<int>(std::size(kAnchors)) - 1;
   t = std::clamp(std::isfinite(t) ? t : 0.0, 0.0, 1.0) * kSegments;
   const int i = std::min(static_cast<int>(t), kSegments - 1);
   return Mix(kAnchors[i], kAnchors[i + 1], t - i);
 }
 
-Rgba CategoryColor(int index) {
+render::Rgba CategoryColor(int index) {
   // No red: red marks loop closures (a second session in red read as one big loop closure).
-  static const Rgba kColors[] = {{31, 119, 180, 255},  {188, 189, 34, 255}, {44, 160, 44, 255},
-                                 {148, 103, 189, 255}, {255, 127, 14, 255}, {23, 190, 207, 255},
-                                 {140, 86, 75, 255},   {227, 119, 194, 255}};
+  static const render::Rgba kColors[] = {
+      {31, 119, 180, 255}, {188, 189, 34, 255}, {44, 160, 44, 255}, {148, 103, 189, 255},
+      {255, 127, 14, 255}, {23, 190, 207, 255}, {140, 86, 75, 255}, {227, 119, 194, 255}};
   const int n = static_cast<int>(std::size(kColors));
   return kColors[((index % n) + n) % n];
 }
@@ -185,8 +186,8 @@ namespace {
 std::string ElideMiddle(const std::string& text, float height_px, float max_width_px) {
   std::string fitted = text;
   // A character at a time from the centre outwards.
-  for (size_t cut = 1; TextWidthPx(fitted, height_px) > max_width_px && cut + 2 < text.size();
-       ++cut) {
+  for (size_t cut = 1;
+       render::TextWidthPx(fitted, height_px) > max_width_px && cut + 2 < text.size(); ++cut) {
     const size_t keep = text.size() - cut;
     fitted = text.substr(0, (keep + 1) / 2) + "..." + text.substr(text.size() - keep / 2);
   }
@@ -205,8 +206,8 @@ FittedText FitTitle(const std::string& text, float height_px, float max_width_px
   // Two lines are tried before the type gets small: 15 px is the last size on one line.
   const float one_line_floor = max_lines > 1 ? std::min(height_px, 15.0f) : kSmallest;
   float h = height_px;
-  while (h > one_line_floor && TextWidthPx(text, h) > max_width_px) h -= 1.0f;
-  if (TextWidthPx(text, h) <= max_width_px || max_lines < 2) {
+  while (h > one_line_floor && render::TextWidthPx(text, h) > max_width_px) h -= 1.0f;
+  if (render::TextWidthPx(text, h) <= max_width_px || max_lines < 2) {
     out.height_px = h;
     out.lines = {ElideMiddle(text, h, max_width_px)};
     return out;
@@ -215,8 +216,8 @@ FittedText FitTitle(const std::string& text, float height_px, float max_width_px
   size_t best = std::string::npos;
   float best_width = std::numeric_limits<float>::infinity();
   for (size_t i = text.find(' '); i != std::string::npos; i = text.find(' ', i + 1)) {
-    const float wider = std::max(TextWidthPx(text.substr(0, i), height_px),
-                                 TextWidthPx(text.substr(i + 1), height_px));
+    const float wider = std::max(render::TextWidthPx(text.substr(0, i), height_px),
+                                 render::TextWidthPx(text.substr(i + 1), height_px));
     if (wider < best_width) best_width = wider, best = i;
   }
   if (best == std::string::npos) {
@@ -226,7 +227,8 @@ FittedText FitTitle(const std::string& text, float height_px, float max_width_px
   }
   const std::string first = text.substr(0, best), second = text.substr(best + 1);
   h = height_px;
-  while (h > kSmallest && std::max(TextWidthPx(first, h), TextWidthPx(second, h)) > max_width_px) {
+  while (h > kSmallest &&
+         std::max(render::TextWidthPx(first, h), render::TextWidthPx(second, h)) > max_width_px) {
     h -= 1.0f;
   }
   out.height_px = h;
@@ -234,21 +236,23 @@ FittedText FitTitle(const std::string& text, float height_px, float max_width_px
   return out;
 }
 
-void DrawTitle(Scene& scene, ScenePoint position, const FittedText& title, Rgba color) {
+void DrawTitle(render::Scene& scene, render::ScenePoint position, const FittedText& title,
+               render::Rgba color) {
   for (size_t i = 0; i < title.lines.size(); ++i) {
     scene.Text({position.x, position.y + 1.25f * title.height_px * static_cast<float>(i)},
                title.lines[i], title.height_px, color);
   }
 }
 
-void FittedTitle(Scene& scene, ScenePoint position, const std::string& text, float height_px,
-                 float max_width_px, Rgba color) {
+void FittedTitle(render::Scene& scene, render::ScenePoint position, const std::string& text,
+                 float height_px, float max_width_px, render::Rgba color) {
   DrawTitle(scene, position, FitTitle(text, height_px, max_width_px), color);
 }
 
-Scene ExperienceMapScene(const ExperienceMapImageData& data,
-                         const ExperienceMapImageOptions& options, WorldToImage* transform) {
-  Scene scene(options.width_px, options.height_px, kWhite);
+render::Scene ExperienceMapScene(const ExperienceMapImageData& data,
+                                 const ExperienceMapImageOptions& options,
+                                 WorldToImage* transform) {
+  render::Scene scene(options.width_px, options.height_px, kWhite);
   const float w = static_cast<float>(options.width_px), h = static_cast<float>(options.height_px);
   const float margin = 30;
   const FittedText title = FitTitle(options.title.empty() ? "experience map" : options.title, 18,
@@ -286,18 +290,21 @@ Scene ExperienceMapScene(const ExperienceMapImageData& data,
   if (legend_data.ground_truth.size() > 1) {
     // The truth is drawn in the map's frame after a rigid fit (AlignGroundTruthToMap): say so.
     static const char* const kTruthLabel = "ground truth (rigidly aligned)";
-    items.push_back({38 + TextWidthPx(kTruthLabel, 14), [](Scene& s, float x, float y) {
-                       s.Line({x, y}, {x + 30, y}, 2.0f, kGroundTruth);
-                       s.Text({x + 38, y + 5}, kTruthLabel, 14, kInk);
-                     }});
+    items.push_back(
+        {38 + render::TextWidthPx(kTruthLabel, 14), [](render::Scene& s, float x, float y) {
+           s.Line({x, y}, {x + 30, y}, 2.0f, kGroundTruth);
+           s.Text({x + 38, y + 5}, kTruthLabel, 14, kInk);
+         }});
   }
-  items.push_back({38 + TextWidthPx("loop closure", 14), [](Scene& s, float x, float y) {
-                     s.Line({x, y}, {x + 30, y}, 3.0f, kLoopClosure);
-                     s.Text({x + 38, y + 5}, "loop closure", 14, kInk);
-                   }});
+  items.push_back(
+      {38 + render::TextWidthPx("loop closure", 14), [](render::Scene& s, float x, float y) {
+         s.Line({x, y}, {x + 30, y}, 3.0f, kLoopClosure);
+         s.Text({x + 38, y + 5}, "loop closure", 14, kInk);
+       }});
   if (std::any_of(legend_data.links.begin(), legend_data.links.end(),
                   [](const Link& l) { return l.wifi_sequence; })) {
-    items.push_back({38 + TextWidthPx("Wi-Fi sequence link", 14), [](Scene& s, float x, float y) {
+    items.push_back({38 + render::TextWidthPx("Wi-Fi sequence link", 14),
+                     [](render::Scene& s, float x, float y) {
                        s.Line({x, y}, {x + 30, y}, 3.0f, kWifiSequence);
                        s.Text({x + 38, y + 5}, "Wi-Fi sequence link", 14, kInk);
                      }});
@@ -314,16 +321,16 @@ Scene ExperienceMapScene(const ExperienceMapImageData& data,
   }
   if (options.coloring == MapColoring::kTime && std::isfinite(t_first)) {
     // The end labels are centred on the bar's ends: room for half the last one.
-    const float half_label = 0.5f * TextWidthPx(FormatNumber(t_last) + " s", 13);
+    const float half_label = 0.5f * render::TextWidthPx(FormatNumber(t_last) + " s", 13);
     items.push_back(
         {kColorBarWidth + std::max(20.0f, half_label + 6),
-         [t_first, t_last](Scene& s, float x, float y) {
+         [t_first, t_last](render::Scene& s, float x, float y) {
            s.Image(ColorBar(x, y - 7, kColorBarWidth, 14));
-           s.Text({x, y + 24}, FormatNumber(t_first) + " s", 13, kInk, TextAnchor::kCenter);
+           s.Text({x, y + 24}, FormatNumber(t_first) + " s", 13, kInk, render::TextAnchor::kCenter);
            s.Text({x + kColorBarWidth, y + 24}, FormatNumber(t_last) + " s", 13, kInk,
-                  TextAnchor::kCenter);
+                  render::TextAnchor::kCenter);
            s.Text({x + kColorBarWidth / 2, y - 12}, "experience created at", 13, kInk,
-                  TextAnchor::kCenter);
+                  render::TextAnchor::kCenter);
          }});
   } else if (options.coloring == MapColoring::kSession) {
     for (size_t i = 0; i < options.session_start_times_s.size(); ++i) {
@@ -331,10 +338,11 @@ Scene ExperienceMapScene(const ExperienceMapImageData& data,
           i < options.session_names.size() && !options.session_names[i].empty()
               ? options.session_names[i]
               : "session " + std::to_string(i + 1);
-      items.push_back({20 + TextWidthPx(label, 14), [i, label](Scene& s, float x, float y) {
-                         s.Rect(x, y - 7, 14, 14, CategoryColor(static_cast<int>(i)));
-                         s.Text({x + 20, y + 5}, label, 14, kInk);
-                       }});
+      items.push_back(
+          {20 + render::TextWidthPx(label, 14), [i, label](render::Scene& s, float x, float y) {
+             s.Rect(x, y - 7, 14, 14, CategoryColor(static_cast<int>(i)));
+             s.Text({x + 20, y + 5}, label, 14, kInk);
+           }});
     }
   }
   const float row_width = w - 2 * margin;
@@ -376,7 +384,7 @@ Scene ExperienceMapScene(const ExperienceMapImageData& data,
                                                              : 3.0f;
 
   if (data.ground_truth.size() > 1) {
-    std::vector<ScenePoint> path;
+    std::vector<render::ScenePoint> path;
     for (const Point2& p : data.ground_truth) path.push_back(to_image(p.x, p.y));
     scene.Polyline(path, 1.5f, kGroundTruth);
   }
@@ -407,7 +415,7 @@ Scene ExperienceMapScene(const ExperienceMapImageData& data,
   if (data.current && *data.current < data.experiences.size()) {
     // The current pose: an arrow head pointing along the experience's facing.
     const Experience& e = data.experiences[*data.current];
-    const ScenePoint c = to_image(e.x_m, e.y_m);
+    const render::ScenePoint c = to_image(e.x_m, e.y_m);
     const float size = 16, dx = std::cos(e.theta_rad), dy = -std::sin(e.theta_rad);
     scene.Triangle(
         {c.x + dx * size, c.y + dy * size},
@@ -435,7 +443,7 @@ Scene ExperienceMapScene(const ExperienceMapImageData& data,
   scene.Line({margin, bar_y - 7}, {margin, bar_y + 7}, 2.0f, kInk);
   scene.Line({margin + bar_px, bar_y - 7}, {margin + bar_px, bar_y + 7}, 2.0f, kInk);
   scene.Text({margin + bar_px / 2, bar_y - 12}, FormatNumber(bar_m) + " m", 16, kInk,
-             TextAnchor::kCenter);
+             render::TextAnchor::kCenter);
 
   // Legend rows, right-aligned, the last row lowest.
   for (size_t r = 0; r < rows.size(); ++r) {
@@ -446,9 +454,9 @@ Scene ExperienceMapScene(const ExperienceMapImageData& data,
   return scene;
 }
 
-Scene TemplateGraphScene(const std::vector<TemplateGraphPoint>& points,
-                         const TemplateGraphImageOptions& options) {
-  Scene scene(options.width_px, options.height_px, kWhite);
+render::Scene TemplateGraphScene(const std::vector<TemplateGraphPoint>& points,
+                                 const TemplateGraphImageOptions& options) {
+  render::Scene scene(options.width_px, options.height_px, kWhite);
   double t0 = std::numeric_limits<double>::infinity(), t1 = -t0;
   for (const TemplateGraphPoint& p : points) {
     t0 = std::min(t0, p.time_s);
@@ -456,8 +464,9 @@ Scene TemplateGraphScene(const std::vector<TemplateGraphPoint>& points,
   }
   if (!std::isfinite(t0)) t0 = 0, t1 = 1;
   if (t1 <= t0) t1 = t0 + 1;
-  const Rgba source_colors[] = {{31, 119, 180, 255}, {44, 160, 44, 255}, {150, 150, 150, 255}};
-  static constexpr Rgba kExperienceColor{230, 110, 0, 255};
+  const render::Rgba source_colors[] = {
+      {31, 119, 180, 255}, {44, 160, 44, 255}, {150, 150, 150, 255}};
+  static constexpr render::Rgba kExperienceColor{230, 110, 0, 255};
   // Legend, only for what the graph contains, in rows under the title.
   bool present[3] = {false, false, false};
   for (const TemplateGraphPoint& p : points) present[static_cast<int>(p.source)] = true;
@@ -466,9 +475,9 @@ Scene TemplateGraphScene(const std::vector<TemplateGraphPoint>& points,
   for (int s = 0; s < 3; ++s) {
     if (!present[s]) continue;
     const std::string name = names[s];
-    const Rgba color = source_colors[s];
+    const render::Rgba color = source_colors[s];
     items.push_back(
-        {12 + TextWidthPx(name, 14), [s, name, color](Scene& sc, float x, float y) {
+        {12 + render::TextWidthPx(name, 14), [s, name, color](render::Scene& sc, float x, float y) {
            if (s == 2) {
              sc.Disc({x + 3, y}, 2.5f, color, 8);
            } else {
@@ -477,10 +486,11 @@ Scene TemplateGraphScene(const std::vector<TemplateGraphPoint>& points,
            sc.Text({x + 12, y + 5}, name, 14, kInk);
          }});
   }
-  items.push_back({12 + TextWidthPx("experience", 14), [](Scene& sc, float x, float y) {
-                     sc.Disc({x + 3, y}, 2.5f, kExperienceColor, 8);
-                     sc.Text({x + 12, y + 5}, "experience", 14, kInk);
-                   }});
+  items.push_back(
+      {12 + render::TextWidthPx("experience", 14), [](render::Scene& sc, float x, float y) {
+         sc.Disc({x + 3, y}, 2.5f, kExperienceColor, 8);
+         sc.Text({x + 12, y + 5}, "experience", 14, kInk);
+       }});
   // A long title (a data set's name at a column's width) takes a second line, not an ellipsis.
   const FittedText title = FitTitle(options.title.empty() ? "template graph" : options.title, 18,
                                     options.width_px - 40.0f, /*max_lines=*/2);
@@ -506,25 +516,25 @@ Scene TemplateGraphScene(const std::vector<TemplateGraphPoint>& points,
   const PlotArea lower{80, plot_top + panel_h + gap, plot_w, panel_h, t0, t1,
                        0,  experience_max * 1.02};
   // Spans alternate two shades, so adjacent spans stay apart.
-  const Rgba span_shades[2] = {{200, 210, 235, 110}, {235, 215, 185, 110}};
+  const render::Rgba span_shades[2] = {{200, 210, 235, 110}, {235, 215, 185, 110}};
   for (size_t k = 0; k < options.shaded_spans.size(); ++k) {
     const TimeSpan& span = options.shaded_spans[k];
-    const ScenePoint a = upper.Map(std::max(span.start_s, t0), 0);
-    const ScenePoint b = upper.Map(std::min(span.end_s, t1), 0);
+    const render::ScenePoint a = upper.Map(std::max(span.start_s, t0), 0);
+    const render::ScenePoint b = upper.Map(std::min(span.end_s, t1), 0);
     if (b.x <= a.x) continue;
     for (const PlotArea* plot : {&upper, &lower}) {
       scene.Rect(a.x, plot->top, b.x - a.x, plot->height, span_shades[k % 2]);
     }
     // A label wider than its span (long session names side by side) loses its middle.
     scene.Text({0.5f * (a.x + b.x), upper.top + 20}, ElideMiddle(span.label, 14, b.x - a.x - 8), 14,
-               kInk, TextAnchor::kCenter);
+               kInk, render::TextAnchor::kCenter);
   }
   DrawAxes(scene, upper, "", "template id");
   DrawAxes(scene, lower, "time (s)", "experience id");
   const bool many = points.size() > 20000;
   for (const TemplateGraphPoint& p : points) {
-    const Rgba c = source_colors[static_cast<int>(p.source)];
-    const ScenePoint at = upper.Map(p.time_s, p.template_id);
+    const render::Rgba c = source_colors[static_cast<int>(p.source)];
+    const render::ScenePoint at = upper.Map(p.time_s, p.template_id);
     if (p.source == DecisionSource::kNew) {
       scene.Disc(at, many ? 1.0f : 1.8f, c, 8);
     } else {
@@ -541,8 +551,8 @@ Scene TemplateGraphScene(const std::vector<TemplateGraphPoint>& points,
   return scene;
 }
 
-Scene PoseCellScene(const PoseCellNetwork& network, const PoseCellImageOptions& options) {
-  Scene scene(options.width_px, options.height_px, kWhite);
+render::Scene PoseCellScene(const PoseCellNetwork& network, const PoseCellImageOptions& options) {
+  render::Scene scene(options.width_px, options.height_px, kWhite);
   const int n = network.dim_xy(), nt = network.dim_theta();
   std::vector<double> xy(static_cast<size_t>(n) * n, 0.0), theta(nt, 0.0);
   double xy_max = 0.0, theta_max = 0.0;
@@ -561,7 +571,7 @@ Scene PoseCellScene(const PoseCellNetwork& network, const PoseCellImageOptions& 
   // Left: x-y heat map, y up (image row 0 is the largest y).
   const float side = std::min(options.height_px - 190.0f, options.width_px * 0.5f - 100.0f);
   const float left = 80, top = 90;
-  SceneImage heat;
+  render::SceneImage heat;
   heat.left = left;
   heat.top = top;
   heat.width = heat.height = side;
@@ -569,26 +579,27 @@ Scene PoseCellScene(const PoseCellNetwork& network, const PoseCellImageOptions& 
   for (int row = 0; row < n; ++row) {
     const int y = n - 1 - row;
     for (int x = 0; x < n; ++x) {
-      const Rgba c = SequentialColor(xy_max > 0 ? xy[static_cast<size_t>(y) * n + x] / xy_max : 0);
+      const render::Rgba c =
+          SequentialColor(xy_max > 0 ? xy[static_cast<size_t>(y) * n + x] / xy_max : 0);
       heat.rgba.insert(heat.rgba.end(), {c.r, c.g, c.b, 255});
     }
   }
   scene.Image(std::move(heat));
   const PoseCellPosition best = network.BestPosition();
   const float cell = side / n;
-  const ScenePoint best_px{left + static_cast<float>(best.x + 0.5) * cell,
-                           top + side - static_cast<float>(best.y + 0.5) * cell};
+  const render::ScenePoint best_px{left + static_cast<float>(best.x + 0.5) * cell,
+                                   top + side - static_cast<float>(best.y + 0.5) * cell};
   scene.Line({best_px.x - 10, best_px.y}, {best_px.x + 10, best_px.y}, 2.0f, {255, 255, 255, 255});
   scene.Line({best_px.x, best_px.y - 10}, {best_px.x, best_px.y + 10}, 2.0f, {255, 255, 255, 255});
   PlotArea axes{left, top, side, side, 0, static_cast<double>(n), 0, static_cast<double>(n)};
   DrawAxes(scene, axes, "x (cells)", "y (cells)", /*grid=*/false);
 
   // Right: theta marginal on a ring, 0 to the right, counter-clockwise.
-  const ScenePoint center{options.width_px * 0.75f, top + side / 2};
+  const render::ScenePoint center{options.width_px * 0.75f, top + side / 2};
   const float radius = side * 0.38f;
   const float step = 2 * std::numbers::pi_v<float> / nt;
   for (int t = 0; t < nt; ++t) {
-    const Rgba c = SequentialColor(theta_max > 0 ? theta[t] / theta_max : 0);
+    const render::Rgba c = SequentialColor(theta_max > 0 ? theta[t] / theta_max : 0);
     scene.Ring(center, radius * 0.75f, radius, (t - 0.5f) * step, (t + 0.5f) * step, c, 4);
   }
   const float best_angle = static_cast<float>(best.theta) * step;
@@ -598,9 +609,9 @@ Scene PoseCellScene(const PoseCellNetwork& network, const PoseCellImageOptions& 
              3.0f, kInk);
   for (int deg = 0; deg < 360; deg += 90) {
     const float a = deg * std::numbers::pi_v<float> / 180;
-    const TextAnchor anchor = deg == 0     ? TextAnchor::kLeft
-                              : deg == 180 ? TextAnchor::kRight
-                                           : TextAnchor::kCenter;
+    const render::TextAnchor anchor = deg == 0     ? render::TextAnchor::kLeft
+                                      : deg == 180 ? render::TextAnchor::kRight
+                                                   : render::TextAnchor::kCenter;
     const float offset = deg % 180 == 0 ? 12.0f : 24.0f;
     scene.Text({center.x + (radius + offset) * std::cos(a),
                 center.y - (radius + offset) * std::sin(a) + 5},
@@ -609,7 +620,7 @@ Scene PoseCellScene(const PoseCellNetwork& network, const PoseCellImageOptions& 
   char label[128];
   std::snprintf(label, sizeof label, "best pose: x %.2f, y %.2f, theta %.2f cells (%.0f deg)",
                 best.x, best.y, best.theta, best.theta * 360.0 / nt);
-  if (left + TextWidthPx(label, 15) > options.width_px - 10.0f) {  // a narrow page: shorter
+  if (left + render::TextWidthPx(label, 15) > options.width_px - 10.0f) {  // a narrow page: shorter
     std::snprintf(label, sizeof label, "best: x %.2f, y %.2f cells, heading %.0f deg", best.x,
                   best.y, best.theta * 360.0 / nt);
   }
@@ -622,36 +633,38 @@ Scene PoseCellScene(const PoseCellNetwork& network, const PoseCellImageOptions& 
     const float bar_h = 12;
     const float bar_top = static_cast<float>(options.height_px) - 46;
     scene.Image(ColorBar(bar_left, bar_top, bar_w, bar_h));
-    scene.Text({bar_left - 8, bar_top + 11}, "0", 14, kInk, TextAnchor::kRight);
-    scene.Text({bar_left + bar_w + 8, bar_top + 11}, "max", 14, kInk, TextAnchor::kLeft);
+    scene.Text({bar_left - 8, bar_top + 11}, "0", 14, kInk, render::TextAnchor::kRight);
+    scene.Text({bar_left + bar_w + 8, bar_top + 11}, "max", 14, kInk, render::TextAnchor::kLeft);
     char caption[128];
     std::snprintf(caption, sizeof caption, "max: x-y %.3g, heading %.3g", xy_max, theta_max);
-    scene.Text({center.x, bar_top - 8}, caption, 14, kInk, TextAnchor::kCenter);
+    scene.Text({center.x, bar_top - 8}, caption, 14, kInk, render::TextAnchor::kCenter);
   }
-  scene.Text({center.x, top - 30}, "heading (summed over x, y)", 15, kInk, TextAnchor::kCenter);
+  scene.Text({center.x, top - 30}, "heading (summed over x, y)", 15, kInk,
+             render::TextAnchor::kCenter);
   scene.Text({20, 26},
              options.title.empty() ? "pose-cell activity (summed over theta)" : options.title, 18,
              kInk);
   return scene;
 }
 
-Scene SimilarityMatrixScene(const std::vector<float>& matrix, const std::vector<double>& times_s,
-                            const SimilarityImageOptions& options) {
+render::Scene SimilarityMatrixScene(const std::vector<float>& matrix,
+                                    const std::vector<double>& times_s,
+                                    const SimilarityImageOptions& options) {
   const int n = static_cast<int>(times_s.size());
   const int size = options.size_px;
   const float legend_band = options.legend.empty() ? 0 : 24;
-  Scene scene(size + 190, size + 150 + static_cast<int>(legend_band), kWhite);
+  render::Scene scene(size + 190, size + 150 + static_cast<int>(legend_band), kWhite);
   const float left = 80, top = 80 + legend_band;
   const double range =
       options.value_max > options.value_min ? options.value_max - options.value_min : 1.0;
   if (n > 0 && matrix.size() == static_cast<size_t>(n) * n) {
-    SceneImage heat;
+    render::SceneImage heat;
     heat.left = left;
     heat.top = top;
     heat.width = heat.height = static_cast<float>(size);
     heat.pixels_wide = heat.pixels_high = n;
     for (float v : matrix) {
-      const Rgba c = SequentialColor(std::clamp((v - options.value_min) / range, 0.0, 1.0));
+      const render::Rgba c = SequentialColor(std::clamp((v - options.value_min) / range, 0.0, 1.0));
       heat.rgba.insert(heat.rgba.end(), {c.r, c.g, c.b, 255});
     }
     scene.Image(std::move(heat));
@@ -667,16 +680,18 @@ Scene SimilarityMatrixScene(const std::vector<float>& matrix, const std::vector<
     for (double t = std::ceil(t0 / step) * step; t <= t1 + 1e-9; t += step) {
       const float f = static_cast<float>((t - t0) / (t1 - t0)) * size;
       scene.Line({left + f, top + size}, {left + f, top + size + 6}, 1.5f, kInk);
-      scene.Text({left + f, top + size + 24}, FormatNumber(t), 15, kInk, TextAnchor::kCenter);
+      scene.Text({left + f, top + size + 24}, FormatNumber(t), 15, kInk,
+                 render::TextAnchor::kCenter);
       scene.Line({left - 6, top + f}, {left, top + f}, 1.5f, kInk);
-      scene.Text({left - 10, top + f + 5}, FormatNumber(t), 15, kInk, TextAnchor::kRight);
+      scene.Text({left - 10, top + f + 5}, FormatNumber(t), 15, kInk, render::TextAnchor::kRight);
     }
   }
-  scene.Text({left + size / 2.0f, top + size + 50}, "time (s)", 16, kInk, TextAnchor::kCenter);
+  scene.Text({left + size / 2.0f, top + size + 50}, "time (s)", 16, kInk,
+             render::TextAnchor::kCenter);
   scene.Text({left - 10, top - 12}, "time (s)", 16, kInk);
   // Colour bar on the right, low values at the bottom.
-  SceneImage bar = ColorBar(0, 0, 0, 0);
-  SceneImage vertical;
+  render::SceneImage bar = ColorBar(0, 0, 0, 0);
+  render::SceneImage vertical;
   vertical.left = left + size + 30;
   vertical.top = top;
   vertical.width = 20;
@@ -691,20 +706,22 @@ Scene SimilarityMatrixScene(const std::vector<float>& matrix, const std::vector<
   scene.Image(std::move(vertical));
   scene.Text({left + size + 55, top + 12}, FormatNumber(options.value_max), 14, kInk);
   scene.Text({left + size + 55, top + size}, FormatNumber(options.value_min), 14, kInk);
-  scene.Text({left + size + 40, top - 12}, options.value_label, 14, kInk, TextAnchor::kCenter);
+  scene.Text({left + size + 40, top - 12}, options.value_label, 14, kInk,
+             render::TextAnchor::kCenter);
   scene.Text({20, 26}, options.title.empty() ? "similarity matrix" : options.title, 18, kInk);
   float x = 20;
   for (const auto& [color, label] : options.legend) {
     scene.Disc({x + 5, 49}, 5, color, 10);
     scene.Text({x + 16, 54}, label, 14, kInk);
-    x += 40 + TextWidthPx(label, 14);
+    x += 40 + render::TextWidthPx(label, 14);
   }
   return scene;
 }
 
-Scene SequencePairsScene(const SequencePairsData& data, const std::string& title, int width_px) {
+render::Scene SequencePairsScene(const SequencePairsData& data, const std::string& title,
+                                 int width_px) {
   const int panel = width_px > 0 ? std::max(200, width_px / 2) : 800, top = 80, margin = 30;
-  Scene scene(2 * panel, panel + top, kWhite);
+  render::Scene scene(2 * panel, panel + top, kWhite);
   double min_x = std::numeric_limits<double>::infinity(), max_x = -min_x, min_y = min_x,
          max_y = -min_x;
   for (const Point2& p : data.positions) {
@@ -723,7 +740,7 @@ Scene SequencePairsScene(const SequencePairsData& data, const std::string& title
     to_image.center_y_m = 0.5 * (min_y + max_y);
     to_image.center_x_px = p * panel + panel / 2.0;
     to_image.center_y_px = top + panel / 2.0;
-    std::vector<ScenePoint> track;
+    std::vector<render::ScenePoint> track;
     for (const Point2& q : data.positions) track.push_back(to_image(q.x, q.y));
     scene.Polyline(track, 1.5f, kGroundTruth);
     size_t drawn = 0;
@@ -741,7 +758,7 @@ Scene SequencePairsScene(const SequencePairsData& data, const std::string& title
     std::string caption =
         (p == 0 ? "DP pairs before verification: " : "verified: ") + std::to_string(drawn);
     if (p == 1 && data.links_made) caption += ", links made: " + std::to_string(*data.links_made);
-    if (TextWidthPx(caption, 15) > panel - 30) {
+    if (render::TextWidthPx(caption, 15) > panel - 30) {
       caption = (p == 0 ? "DP pairs: " : "verified: ") + std::to_string(drawn);
       if (p == 1 && data.links_made) caption += ", links: " + std::to_string(*data.links_made);
     }
@@ -752,11 +769,12 @@ Scene SequencePairsScene(const SequencePairsData& data, const std::string& title
   return scene;
 }
 
-Scene GridFieldsScene(const std::vector<GridField>& fields, const std::vector<Point2>& points,
-                      const std::string& title, int panel_px) {
+render::Scene GridFieldsScene(const std::vector<GridField>& fields,
+                              const std::vector<Point2>& points, const std::string& title,
+                              int panel_px) {
   const int panel = panel_px, top = 70, bar = 90, bottom = 50;
   const int n = std::max<int>(1, static_cast<int>(fields.size()));
-  Scene scene(n * (panel + bar), top + panel + bottom, kWhite);
+  render::Scene scene(n * (panel + bar), top + panel + bottom, kWhite);
   scene.Text({20, 26}, title, 18, kInk);
   // One world window for every panel: the union of the grids.
   double x0 = std::numeric_limits<double>::infinity(), y0 = x0, x1 = -x0, y1 = -x0;
@@ -781,7 +799,7 @@ Scene GridFieldsScene(const std::vector<GridField>& fields, const std::vector<Po
     if (!std::isfinite(lo)) lo = 0, hi = 1;
     if (hi <= lo) hi = lo + 1;
     if (g.width > 0 && g.height > 0 && g.values.size() == static_cast<size_t>(g.width) * g.height) {
-      SceneImage heat;
+      render::SceneImage heat;
       heat.left = left + static_cast<float>((g.origin_x_m - x0) * scale);
       heat.top = top + static_cast<float>((y1 - (g.origin_y_m + g.height * g.cell_size_m)) * scale);
       heat.width = static_cast<float>(g.width * g.cell_size_m * scale);
@@ -791,8 +809,8 @@ Scene GridFieldsScene(const std::vector<GridField>& fields, const std::vector<Po
       for (int row = g.height - 1; row >= 0; --row) {  // the image's top row is the north
         for (int col = 0; col < g.width; ++col) {
           const float v = g.values[static_cast<size_t>(row) * g.width + col];
-          const Rgba c =
-              std::isnan(v) ? Rgba{255, 255, 255, 0} : SequentialColor((v - lo) / (hi - lo));
+          const render::Rgba c = std::isnan(v) ? render::Rgba{255, 255, 255, 0}
+                                               : SequentialColor((v - lo) / (hi - lo));
           heat.rgba.insert(heat.rgba.end(), {c.r, c.g, c.b, c.a});
         }
       }
@@ -804,8 +822,8 @@ Scene GridFieldsScene(const std::vector<GridField>& fields, const std::vector<Po
                  1.6f, kInk, 8);
     }
     // Colour bar, low values at the bottom.
-    SceneImage strip = ColorBar(0, 0, 0, 0);
-    SceneImage vertical;
+    render::SceneImage strip = ColorBar(0, 0, 0, 0);
+    render::SceneImage vertical;
     vertical.left = left + panel;
     vertical.top = top;
     vertical.width = 18;
@@ -825,7 +843,8 @@ Scene GridFieldsScene(const std::vector<GridField>& fields, const std::vector<Po
   const double bar_m = NiceStep(0.2 * (panel - 20) / scale, 1);
   const float bar_px = static_cast<float>(bar_m * scale), y = top + panel + 20.0f;
   scene.Line({10, y}, {10 + bar_px, y}, 3.0f, kInk);
-  scene.Text({10 + bar_px / 2, y - 8}, FormatNumber(bar_m) + " m", 14, kInk, TextAnchor::kCenter);
+  scene.Text({10 + bar_px / 2, y - 8}, FormatNumber(bar_m) + " m", 14, kInk,
+             render::TextAnchor::kCenter);
   return scene;
 }
 

@@ -18,13 +18,13 @@
 namespace ratslam::viewer {
 
 // The figures' ink (text, axes) and grid lines, shared so that every figure looks alike.
-inline constexpr Rgba kInk{30, 30, 30, 255};
-inline constexpr Rgba kGrid{225, 225, 225, 255};
+inline constexpr render::Rgba kInk{30, 30, 30, 255};
+inline constexpr render::Rgba kGrid{225, 225, 225, 255};
 
 // A perceptual sequential colour map for t in [0, 1] (dark blue, teal, green, yellow).
-Rgba SequentialColor(double t);
+render::Rgba SequentialColor(double t);
 // Distinct colours for categories (sessions, floors).
-Rgba CategoryColor(int index);
+render::Rgba CategoryColor(int index);
 
 // 1, 2 or 5 times a power of ten, near range / target_count.
 double NiceStep(double range, int target_count);
@@ -34,7 +34,7 @@ struct WorldToImage {
   double scale_px_per_m = 1.0;
   double center_x_m = 0.0, center_y_m = 0.0;
   double center_x_px = 0.0, center_y_px = 0.0;
-  ScenePoint operator()(double x_m, double y_m) const {
+  render::ScenePoint operator()(double x_m, double y_m) const {
     return {static_cast<float>(center_x_px + scale_px_per_m * (x_m - center_x_m)),
             static_cast<float>(center_y_px - scale_px_per_m * (y_m - center_y_m))};
   }
@@ -58,10 +58,11 @@ struct FittedText {
 };
 FittedText FitTitle(const std::string& text, float height_px, float max_width_px,
                     int max_lines = 1);
-void DrawTitle(Scene& scene, ScenePoint position, const FittedText& title, Rgba color = kInk);
+void DrawTitle(render::Scene& scene, render::ScenePoint position, const FittedText& title,
+               render::Rgba color = kInk);
 // FitTitle on one line, drawn.
-void FittedTitle(Scene& scene, ScenePoint position, const std::string& text, float height_px,
-                 float max_width_px, Rgba color = kInk);
+void FittedTitle(render::Scene& scene, render::ScenePoint position, const std::string& text,
+                 float height_px, float max_width_px, render::Rgba color = kInk);
 
 struct ExperienceMapImageOptions {
   int width_px = 1600;
@@ -89,9 +90,9 @@ struct ExperienceMapImageData {
 // The experience map with equal aspect, a scale bar in metres, loop-closure links highlighted,
 // the current pose as an arrow, and a time colour bar or a session legend. `transform` receives
 // the world-to-pixel mapping used.
-Scene ExperienceMapScene(const ExperienceMapImageData& data,
-                         const ExperienceMapImageOptions& options,
-                         WorldToImage* transform = nullptr);
+render::Scene ExperienceMapScene(const ExperienceMapImageData& data,
+                                 const ExperienceMapImageOptions& options,
+                                 WorldToImage* transform = nullptr);
 
 // Moves ground-truth points (paired with map points by index) into the map frame with the
 // best-fit rigid transform; returns all `truth_path` points transformed.
@@ -120,8 +121,8 @@ struct TemplateGraphImageOptions {
 
 // Template id (circles, coloured by the deciding sensor; upper panel) and experience id (dots;
 // lower panel) against one time axis; shaded spans alternate two shades.
-Scene TemplateGraphScene(const std::vector<TemplateGraphPoint>& points,
-                         const TemplateGraphImageOptions& options);
+render::Scene TemplateGraphScene(const std::vector<TemplateGraphPoint>& points,
+                                 const TemplateGraphImageOptions& options);
 
 struct PoseCellImageOptions {
   int width_px = 1200;
@@ -130,21 +131,21 @@ struct PoseCellImageOptions {
 };
 
 // The activity summed over theta as an x-y heat map, and the theta marginal as a ring.
-Scene PoseCellScene(const PoseCellNetwork& network, const PoseCellImageOptions& options);
+render::Scene PoseCellScene(const PoseCellNetwork& network, const PoseCellImageOptions& options);
 
 // A dot on a similarity matrix (row and column in matrix cells), e.g. a loop's correspondences.
 struct SimilarityMark {
   int row = 0, col = 0;
-  Rgba color;
+  render::Rgba color;
 };
 
 struct SimilarityImageOptions {
   int size_px = 1000;
   std::string title;
   std::string value_label = "similarity";
-  double value_min = 0.0, value_max = 1.0;           // the colour scale's ends
-  std::vector<SimilarityMark> marks;                 // drawn over the matrix
-  std::vector<std::pair<Rgba, std::string>> legend;  // what the marks mean, under the title
+  double value_min = 0.0, value_max = 1.0;                   // the colour scale's ends
+  std::vector<SimilarityMark> marks;                         // drawn over the matrix
+  std::vector<std::pair<render::Rgba, std::string>> legend;  // what the marks mean, under the title
 };
 
 // Scans on the map and the pairs a loop closer matched between them (Kudo and Miura, fig. 10).
@@ -161,7 +162,8 @@ struct SequencePairsData {
 };
 // Two panels over the same view: every pair (left) and the verified ones (right); the scans'
 // track in grey. The panels are square and `width_px` wide together (0: 1600).
-Scene SequencePairsScene(const SequencePairsData& data, const std::string& title, int width_px = 0);
+render::Scene SequencePairsScene(const SequencePairsData& data, const std::string& title,
+                                 int width_px = 0);
 
 // A field over the plane on a grid of cells (row-major from the south-west corner; NaN: no
 // value), drawn as a heat map with its own colour scale (e.g. a GP Wi-Fi map's mean or variance).
@@ -175,12 +177,14 @@ struct GridField {
 // The fields side by side at one scale (each with a colour bar from its lowest to its highest
 // value), `points` (e.g. where the data was taken) as dots on every panel, a scale bar.
 // `panel_px` is each panel's side.
-Scene GridFieldsScene(const std::vector<GridField>& fields, const std::vector<Point2>& points,
-                      const std::string& title, int panel_px = 700);
+render::Scene GridFieldsScene(const std::vector<GridField>& fields,
+                              const std::vector<Point2>& points, const std::string& title,
+                              int panel_px = 700);
 
 // An n x n matrix (row-major, values in [0, 1]) sampled at `times_s` as a heat map.
-Scene SimilarityMatrixScene(const std::vector<float>& matrix, const std::vector<double>& times_s,
-                            const SimilarityImageOptions& options);
+render::Scene SimilarityMatrixScene(const std::vector<float>& matrix,
+                                    const std::vector<double>& times_s,
+                                    const SimilarityImageOptions& options);
 
 }  // namespace ratslam::viewer
 

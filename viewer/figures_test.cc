@@ -38,7 +38,7 @@ TEST(ExperienceFloorsTest, ExperiencesWithoutTruthTakeTheNearestPointsFloor) {
 TEST(SequentialColorTest, LightnessRisesMonotonically) {
   double previous = -1;
   for (int i = 0; i <= 100; ++i) {
-    const Rgba c = SequentialColor(i / 100.0);
+    const render::Rgba c = SequentialColor(i / 100.0);
     const double lightness = 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b;
     EXPECT_GE(lightness, previous - 1e-9) << i;
     previous = lightness;
@@ -74,7 +74,7 @@ ExperienceMapImageData LMap() {
 TEST(ExperienceMapSceneTest, EqualAspectAndYUp) {
   WorldToImage t;
   ExperienceMapScene(LMap(), {}, &t);
-  const ScenePoint origin = t(0, 0), east = t(20, 0), north = t(20, 10);
+  const render::ScenePoint origin = t(0, 0), east = t(20, 0), north = t(20, 10);
   // 20 m along x spans twice the pixels of 10 m along y: equal scale on both axes.
   EXPECT_NEAR(east.x - origin.x, 2.0 * (east.y - north.y), 1e-3);
   EXPECT_GT(east.x, origin.x);
@@ -95,17 +95,17 @@ TEST(AlignGroundTruthToMapTest, RotatedTruthLandsOnTheMap) {
 
 // Rendered: nodes appear at the pixels the transform gives, the right way up.
 TEST(ExperienceMapSceneTest, RenderedNodesAreWhereTheWorldSays) {
-  StatusOr<std::unique_ptr<SceneRenderer>> renderer = CreateOsMesaRenderer();
+  StatusOr<std::unique_ptr<render::SceneRenderer>> renderer = render::CreateOsMesaRenderer();
   if (!renderer.ok()) GTEST_SKIP() << "OSMesa unavailable: " << renderer.status().message();
   ExperienceMapImageOptions options;
   options.width_px = 400;
   options.height_px = 300;
   WorldToImage t;
-  const Scene scene = ExperienceMapScene(LMap(), options, &t);
-  StatusOr<RgbaImage> image = renderer.value()->Render(scene);
+  const render::Scene scene = ExperienceMapScene(LMap(), options, &t);
+  StatusOr<render::RgbaImage> image = renderer.value()->Render(scene);
   ASSERT_TRUE(image.ok()) << image.status().message();
-  auto is_ink = [&](ScenePoint p) {
-    const Rgba c =
+  auto is_ink = [&](render::ScenePoint p) {
+    const render::Rgba c =
         image->At(static_cast<int>(std::lround(p.x)), static_cast<int>(std::lround(p.y)));
     return c.r + c.g + c.b < 600;
   };
@@ -120,7 +120,7 @@ TEST(ExperienceMapSceneTest, RenderedNodesAreWhereTheWorldSays) {
 // Two floors: two panels at one scale in the figure's size, under one title, with one legend;
 // each shows only its own floor's experiences.
 TEST(ExperienceMapByFloorTest, OnePanelPerFloorOneLegend) {
-  StatusOr<std::unique_ptr<SceneRenderer>> renderer = CreateOsMesaRenderer();
+  StatusOr<std::unique_ptr<render::SceneRenderer>> renderer = render::CreateOsMesaRenderer();
   if (!renderer.ok()) GTEST_SKIP() << "OSMesa unavailable: " << renderer.status().message();
   ExperienceMapImageData data = LMap();  // (0,0) and (20,0) on floor 0, (20,10) on floor 1
   data.links[0].loop_closure = true;
@@ -129,7 +129,7 @@ TEST(ExperienceMapByFloorTest, OnePanelPerFloorOneLegend) {
   options.height_px = 400;
   options.title = "the run";
   FloorPanels layout;
-  const Scene scene = ExperienceMapFloorsScene(data, {0, 0, 1}, {}, options, 0, &layout);
+  const render::Scene scene = ExperienceMapFloorsScene(data, {0, 0, 1}, {}, options, 0, &layout);
   EXPECT_EQ(scene.width(), 800);
   EXPECT_EQ(scene.height(), 400);
   // A 20 m x 10 m map in 800 x 400: side by side draws it larger than stacked.
@@ -137,7 +137,7 @@ TEST(ExperienceMapByFloorTest, OnePanelPerFloorOneLegend) {
   EXPECT_EQ(layout.floors, (std::vector<int>{0, 1}));
   auto count = [&](const std::string& text) {
     return std::count_if(scene.texts().begin(), scene.texts().end(),
-                         [&](const SceneText& t) { return t.text == text; });
+                         [&](const render::SceneText& t) { return t.text == text; });
   };
   EXPECT_EQ(count("the run"), 1);
   EXPECT_EQ(count("floor 0"), 1);
@@ -151,7 +151,7 @@ TEST(ExperienceMapByFloorTest, OnePanelPerFloorOneLegend) {
   ExperienceMapFloorsScene(data, {0, 0, 1}, {}, narrow, 0, &tall);
   EXPECT_EQ(tall.columns, 1);
 
-  StatusOr<RgbaImage> image = renderer.value()->Render(scene);
+  StatusOr<render::RgbaImage> image = renderer.value()->Render(scene);
   ASSERT_TRUE(image.ok()) << image.status().message();
   // Both panels share the full map's view, so a world point maps to the same offset in each.
   ExperienceMapImageOptions panel;
@@ -160,9 +160,9 @@ TEST(ExperienceMapByFloorTest, OnePanelPerFloorOneLegend) {
   panel.bounds = WorldBounds{0, 0, 20, 10};
   WorldToImage t;
   ExperienceMapScene(data, panel, &t);
-  auto ink = [&](ScenePoint p, int k) {
-    const Rgba c = image->At(static_cast<int>(std::lround(p.x)) + layout.panel_width_px * k,
-                             static_cast<int>(std::lround(p.y)) + layout.top_px);
+  auto ink = [&](render::ScenePoint p, int k) {
+    const render::Rgba c = image->At(static_cast<int>(std::lround(p.x)) + layout.panel_width_px * k,
+                                     static_cast<int>(std::lround(p.y)) + layout.top_px);
     return c.r + c.g + c.b < 600;
   };
   EXPECT_TRUE(ink(t(0, 0), 0));
@@ -173,16 +173,16 @@ TEST(ExperienceMapByFloorTest, OnePanelPerFloorOneLegend) {
 
 // A title too long for its width is set smaller, then elided in the middle; a short one is kept.
 TEST(FittedTitleTest, ShrinksThenElidesTheMiddle) {
-  Scene scene(400, 100, {255, 255, 255, 255});
+  render::Scene scene(400, 100, {255, 255, 255, 255});
   FittedTitle(scene, {10, 20}, "short", 18, 380);
   const std::string name = "experience map (IPIN2023_T3_TrainingTrial51_repetition02, run 7)";
   FittedTitle(scene, {10, 40}, name, 18, 380);
   ASSERT_EQ(scene.texts().size(), 2u);
   EXPECT_EQ(scene.texts()[0].text, "short");
   EXPECT_EQ(scene.texts()[0].height_px, 18);
-  const SceneText& t = scene.texts()[1];
+  const render::SceneText& t = scene.texts()[1];
   EXPECT_EQ(t.height_px, 13);
-  EXPECT_LE(TextWidthPx(t.text, t.height_px), 380);
+  EXPECT_LE(render::TextWidthPx(t.text, t.height_px), 380);
   EXPECT_NE(t.text.find("..."), std::string::npos);
   EXPECT_EQ(t.text.substr(0, 15), "experience map ");  // the start and the end survive
   EXPECT_EQ(t.text.substr(t.text.size() - 6), "run 7)");
@@ -194,14 +194,15 @@ TEST(FittedTitleTest, TwoLinesKeepTheWholeTitle) {
   const std::string name =
       "template graph (IPIN2023_T3_TrainingTrial51_repetition02 +3 sessions, walking)";
   // A column's width (88 mm) as the vector figures lay it out.
-  const float width = VectorLayoutWidthPx(88.0) - 40.0f;
+  const float width = render::VectorLayoutWidthPx(88.0) - 40.0f;
   const FittedText one = FitTitle(name, 18, width);
   ASSERT_EQ(one.lines.size(), 1u);
   EXPECT_NE(one.lines[0].find("..."), std::string::npos);
   const FittedText two = FitTitle(name, 18, width, 2);
   ASSERT_EQ(two.lines.size(), 2u);
   EXPECT_EQ(two.lines[0] + " " + two.lines[1], name);
-  for (const std::string& line : two.lines) EXPECT_LE(TextWidthPx(line, two.height_px), width);
+  for (const std::string& line : two.lines)
+    EXPECT_LE(render::TextWidthPx(line, two.height_px), width);
   EXPECT_GE(two.height_px, one.height_px);
   EXPECT_GT(two.ExtraHeightPx(), 0);
   EXPECT_EQ(FitTitle("short", 18, width, 2).lines.size(), 1u);
@@ -209,12 +210,12 @@ TEST(FittedTitleTest, TwoLinesKeepTheWholeTitle) {
   std::vector<TemplateGraphPoint> points = {{0, 0, 0, DecisionSource::kNew},
                                             {30, 1, 1, DecisionSource::kNew}};
   TemplateGraphImageOptions options;
-  options.width_px = VectorLayoutWidthPx(88.0);
+  options.width_px = render::VectorLayoutWidthPx(88.0);
   options.title = name;
-  const Scene scene = TemplateGraphScene(points, options);
+  const render::Scene scene = TemplateGraphScene(points, options);
   float title_bottom = 0, legend_top = 1e9;
   std::string drawn;
-  for (const SceneText& t : scene.texts()) {
+  for (const render::SceneText& t : scene.texts()) {
     if (name.find(t.text) != std::string::npos && t.text.size() > 10) {
       drawn += (drawn.empty() ? "" : " ") + t.text;
       title_bottom = std::max(title_bottom, t.position.y);
@@ -231,20 +232,20 @@ TEST(ExperienceMapSceneTest, SessionLegendNamesTheSessions) {
   options.coloring = MapColoring::kSession;
   options.session_start_times_s = {0.0, 1.5};
   options.session_names = {"day", "night"};
-  const Scene scene = ExperienceMapScene(LMap(), options);
+  const render::Scene scene = ExperienceMapScene(LMap(), options);
   std::set<std::string> texts;
-  for (const SceneText& t : scene.texts()) texts.insert(t.text);
+  for (const render::SceneText& t : scene.texts()) texts.insert(t.text);
   EXPECT_TRUE(texts.count("day") && texts.count("night"));
   EXPECT_FALSE(texts.count("session 1"));
   options.session_names.clear();
   std::set<std::string> numbered;
-  const Scene unnamed = ExperienceMapScene(LMap(), options);
-  for (const SceneText& t : unnamed.texts()) numbered.insert(t.text);
+  const render::Scene unnamed = ExperienceMapScene(LMap(), options);
+  for (const render::SceneText& t : unnamed.texts()) numbered.insert(t.text);
   EXPECT_TRUE(numbered.count("session 1") && numbered.count("session 2"));
 }
 
 TEST(TemplateGraphSceneTest, EmptyInputStillGivesAFigure) {
-  const Scene scene = TemplateGraphScene({}, {});
+  const render::Scene scene = TemplateGraphScene({}, {});
   EXPECT_EQ(scene.width(), 1600);
   EXPECT_FALSE(scene.texts().empty());
 }
@@ -254,18 +255,19 @@ TEST(TemplateGraphSceneTest, EmptyInputStillGivesAFigure) {
 TEST(TemplateGraphSceneTest, ExperienceIdsDoNotHideUnderTemplateIds) {
   std::vector<TemplateGraphPoint> points;
   for (uint32_t i = 0; i < 40; ++i) points.push_back({double(i), i, i, DecisionSource::kCamera});
-  const Scene scene = TemplateGraphScene(points, {});
-  std::vector<ScenePoint> circles, dots;
-  for (const SceneShape& s : scene.shapes()) {
-    if (s.kind == SceneShape::Kind::kRing && s.radius_px < 10) circles.push_back(s.points[0]);
-    if (s.kind == SceneShape::Kind::kDisc && s.color.r == 230 && s.color.g == 110) {
+  const render::Scene scene = TemplateGraphScene(points, {});
+  std::vector<render::ScenePoint> circles, dots;
+  for (const render::SceneShape& s : scene.shapes()) {
+    if (s.kind == render::SceneShape::Kind::kRing && s.radius_px < 10)
+      circles.push_back(s.points[0]);
+    if (s.kind == render::SceneShape::Kind::kDisc && s.color.r == 230 && s.color.g == 110) {
       dots.push_back(s.points[0]);
     }
   }
   ASSERT_EQ(circles.size(), 40u + 1u);  // and the legend's
   ASSERT_EQ(dots.size(), 40u + 1u);     // and the legend's
-  for (const ScenePoint& c : circles) {
-    for (const ScenePoint& d : dots) {
+  for (const render::ScenePoint& c : circles) {
+    for (const render::ScenePoint& d : dots) {
       EXPECT_GT(std::hypot(c.x - d.x, c.y - d.y), 8.0f) << c.x << "," << c.y;
     }
   }
@@ -277,13 +279,13 @@ TEST(TemplateGraphSceneTest, AdjacentSpansHaveDifferentShades) {
                                             {30, 1, 1, DecisionSource::kNew}};
   TemplateGraphImageOptions options;
   options.shaded_spans = {{0, 10, "a"}, {10, 20, "b"}, {20, 30, "c"}};
-  const Scene scene = TemplateGraphScene(points, options);
-  std::vector<Rgba> shades;  // per panel, in order: a, a, b, b, c, c
-  for (const SceneShape& s : scene.shapes()) {
-    if (s.kind == SceneShape::Kind::kRect && s.color.a == 110) shades.push_back(s.color);
+  const render::Scene scene = TemplateGraphScene(points, options);
+  std::vector<render::Rgba> shades;  // per panel, in order: a, a, b, b, c, c
+  for (const render::SceneShape& s : scene.shapes()) {
+    if (s.kind == render::SceneShape::Kind::kRect && s.color.a == 110) shades.push_back(s.color);
   }
   ASSERT_EQ(shades.size(), 6u);
-  auto same = [](Rgba x, Rgba y) { return x.r == y.r && x.g == y.g && x.b == y.b; };
+  auto same = [](render::Rgba x, render::Rgba y) { return x.r == y.r && x.g == y.g && x.b == y.b; };
   EXPECT_FALSE(same(shades[0], shades[2]));
   EXPECT_FALSE(same(shades[2], shades[4]));
   EXPECT_TRUE(same(shades[0], shades[1]));  // one span, one shade in both panels
@@ -292,16 +294,16 @@ TEST(TemplateGraphSceneTest, AdjacentSpansHaveDifferentShades) {
   options.width_px = 600;
   options.shaded_spans = {{0, 15, "IPIN2023_T3_TrainingTrial01_repetition01"},
                           {15, 30, "IPIN2023_T3_TrainingTrial01_repetition02"}};
-  const Scene narrow = TemplateGraphScene(points, options);
-  std::vector<const SceneText*> labels;
-  for (const SceneText& t : narrow.texts()) {
+  const render::Scene narrow = TemplateGraphScene(points, options);
+  std::vector<const render::SceneText*> labels;
+  for (const render::SceneText& t : narrow.texts()) {
     if (t.text.find("...") != std::string::npos) labels.push_back(&t);
   }
   ASSERT_EQ(labels.size(), 2u);
   EXPECT_EQ(labels[0]->text.substr(labels[0]->text.size() - 2), "01");
   EXPECT_EQ(labels[1]->text.substr(labels[1]->text.size() - 2), "02");
-  const float right_of_first = labels[0]->position.x + TextWidthPx(labels[0]->text, 14) / 2;
-  const float left_of_second = labels[1]->position.x - TextWidthPx(labels[1]->text, 14) / 2;
+  const float right_of_first = labels[0]->position.x + render::TextWidthPx(labels[0]->text, 14) / 2;
+  const float left_of_second = labels[1]->position.x - render::TextWidthPx(labels[1]->text, 14) / 2;
   EXPECT_LT(right_of_first, left_of_second);
 }
 
@@ -309,7 +311,7 @@ TEST(TemplateGraphSceneTest, AdjacentSpansHaveDifferentShades) {
 // maps the second session was drawn in a red two units from it.
 TEST(CategoryColorTest, NoCategoryLooksLikeTheLoopClosureRed) {
   for (int i = 0; i < 16; ++i) {
-    const Rgba c = CategoryColor(i);
+    const render::Rgba c = CategoryColor(i);
     const double distance =
         std::sqrt(std::pow(c.r - 220.0, 2) + std::pow(c.g - 50.0, 2) + std::pow(c.b - 32.0, 2));
     EXPECT_GT(distance, 80.0) << "category " << i;  // the old red was 16 away

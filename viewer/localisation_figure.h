@@ -22,14 +22,14 @@ double LocalisationAxisEndM(const std::vector<LocalisationCurve>& curves, double
 
 // Two panels, 0..max_distance_m: correct within d (left) and misplaced beyond d (right), in %.
 // `width_px` > 0 lays the figure out that wide (for vector output); 0: the natural 1380 px.
-Scene LocalisationCurvesScene(const std::vector<LocalisationCurve>& curves,
-                              const std::string& title, double max_distance_m = 30.0,
-                              int width_px = 0);
+render::Scene LocalisationCurvesScene(const std::vector<LocalisationCurve>& curves,
+                                      const std::string& title, double max_distance_m = 30.0,
+                                      int width_px = 0);
 
 // Precision (y) against recall (x), both 0..100 %, one curve per distance d of `labels`:
 // `recall[k]` and `precision[k]` are the points of curve k, from the highest threshold down.
 // `width_px` as for LocalisationCurvesScene (natural: 710 px).
-Scene PrecisionRecallScene(
+render::Scene PrecisionRecallScene(
     const std::vector<std::string>& labels, const std::vector<std::vector<double>>& recall,
     const std::vector<std::vector<double>>& precision, const std::string& title, int width_px = 0,
     const std::string& subtitle = "accepted: the best place's posterior >= a threshold");
@@ -47,7 +47,7 @@ struct DifferenceMatrixFigure {
   std::string title;
   int max_cells = 600;
 };
-Scene DifferenceMatrixScene(const DifferenceMatrixFigure& figure);
+render::Scene DifferenceMatrixScene(const DifferenceMatrixFigure& figure);
 
 }  // namespace ratslam::viewer
 

@@ -72,11 +72,11 @@ std::vector<int> ExperienceFloors(const std::vector<Experience>& experiences,
   return floors;
 }
 
-Scene ExperienceMapFloorsScene(const ExperienceMapImageData& data,
-                               const std::vector<int>& experience_floors,
-                               const std::vector<int>& ground_truth_floors,
-                               const ExperienceMapImageOptions& figure, int columns,
-                               FloorPanels* layout) {
+render::Scene ExperienceMapFloorsScene(const ExperienceMapImageData& data,
+                                       const std::vector<int>& experience_floors,
+                                       const std::vector<int>& ground_truth_floors,
+                                       const ExperienceMapImageOptions& figure, int columns,
+                                       FloorPanels* layout) {
   std::set<int> distinct(experience_floors.begin(), experience_floors.end());
   if (distinct.size() <= 1 || experience_floors.size() != data.experiences.size()) {
     if (layout) *layout = {};
@@ -118,7 +118,7 @@ Scene ExperienceMapFloorsScene(const ExperienceMapImageData& data,
   const int panel_w = w / columns, panel_h = (h - kHeading) / rows;
   if (layout) *layout = {columns, panel_w, panel_h, kHeading, {distinct.begin(), distinct.end()}};
 
-  Scene scene(w, h, {255, 255, 255, 255});
+  render::Scene scene(w, h, {255, 255, 255, 255});
   FittedTitle(scene, {30, 24}, figure.title.empty() ? "experience map" : figure.title, 18,
               w - 60.0f);
   int k = 0;
@@ -188,7 +188,7 @@ std::vector<TemplateGraphPoint> TemplateGraphOf(const RunView& run) {
   return points;
 }
 
-Status WriteRunImages(SceneRenderer* renderer, const RunView& run, const Dataset& dataset,
+Status WriteRunImages(render::SceneRenderer* renderer, const RunView& run, const Dataset& dataset,
                       const std::string& folder, const std::vector<FigureFormat>& formats,
                       double width_mm) {
   namespace fs = std::filesystem;
@@ -230,10 +230,10 @@ Status WriteRunImages(SceneRenderer* renderer, const RunView& run, const Dataset
     for (const FigureTarget& target : targets("experience_map.png")) {
       if (target.format == FigureFormat::kPng) {
         if (renderer == nullptr) return Status::Error(target.path + ": no PNG renderer");
-        StatusOr<RgbaImage> image =
+        StatusOr<render::RgbaImage> image =
             renderer->Render(ExperienceMapFloorsScene(map_data, floors, truth_floors, map_options));
         if (!image.ok()) return image.status().WithContext("experience_map.png");
-        RATSLAM_RETURN_IF_ERROR(WritePng(image.value(), target.path));
+        RATSLAM_RETURN_IF_ERROR(render::WritePng(image.value(), target.path));
         continue;
       }
       // Vector: one panel per floor, stacked (a column of a paper is narrow), each as large as
@@ -243,7 +243,7 @@ Status WriteRunImages(SceneRenderer* renderer, const RunView& run, const Dataset
       ExperienceMapImageOptions page = map_options;
       page.width_px = w;
       page.height_px = panels > 1 ? 34 + panels * h : h;
-      RATSLAM_RETURN_IF_ERROR(WriteVectorFigure(
+      RATSLAM_RETURN_IF_ERROR(render::WriteVectorFigure(
           ExperienceMapFloorsScene(map_data, floors, truth_floors, page, /*columns=*/1),
           target.path, VectorFormatOf(target.format), width_mm));
     }

@@ -39,11 +39,11 @@ struct FloorPanels {
 // the links between them and that floor's ground truth, in a grid within `figure`'s size under
 // one title, with one legend and scale bar (in the last panel). `columns` 0 picks the grid that
 // draws the map largest. A single floor gives the ordinary map.
-Scene ExperienceMapFloorsScene(const ExperienceMapImageData& data,
-                               const std::vector<int>& experience_floors,
-                               const std::vector<int>& ground_truth_floors,
-                               const ExperienceMapImageOptions& figure, int columns = 0,
-                               FloorPanels* layout = nullptr);
+render::Scene ExperienceMapFloorsScene(const ExperienceMapImageData& data,
+                                       const std::vector<int>& experience_floors,
+                                       const std::vector<int>& ground_truth_floors,
+                                       const ExperienceMapImageOptions& figure, int columns = 0,
+                                       FloorPanels* layout = nullptr);
 
 // The experience-map figure data of a run, with the ground truth (if any) aligned to the map.
 ExperienceMapImageData ExperienceMapDataOf(const RunView& run, const Dataset& dataset);
@@ -64,10 +64,10 @@ std::vector<TemplateGraphPoint> TemplateGraphOf(const RunView& run);
 
 // Writes experience_map, template_graph and pose_cells into `folder` in each of `formats` (PNG
 // through `renderer`, which may be null without PNG; PDF and SVG on pages `width_mm` wide).
-Status WriteRunImages(SceneRenderer* renderer, const RunView& run, const Dataset& dataset,
+Status WriteRunImages(render::SceneRenderer* renderer, const RunView& run, const Dataset& dataset,
                       const std::string& folder,
                       const std::vector<FigureFormat>& formats = {FigureFormat::kPng},
-                      double width_mm = kOneColumnMm);
+                      double width_mm = render::kOneColumnMm);
 
 }  // namespace ratslam::viewer
 

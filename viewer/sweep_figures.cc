@@ -14,8 +14,8 @@
 namespace ratslam::viewer {
 namespace {
 
-constexpr Rgba kDot{70, 110, 170, 200};
-constexpr Rgba kBest{215, 40, 40, 255};
+constexpr render::Rgba kDot{70, 110, 170, 200};
+constexpr render::Rgba kBest{215, 40, 40, 255};
 
 std::optional<double> AsNumber(const std::string& text) {
   double v = 0.0;
@@ -90,14 +90,14 @@ Range ObjectiveRange(const SweepFigureData& data) {
 }
 
 // A left axis with ticks for `range` over a panel.
-void ValueTicks(Scene& scene, const Range& range, float left, float top, float width,
+void ValueTicks(render::Scene& scene, const Range& range, float left, float top, float width,
                 float height) {
   const double step = NiceStep(range.hi - range.lo, 5);
   for (double v = std::ceil(range.lo / step) * step; v <= range.hi; v += step) {
     if (std::abs(v) < 1e-9 * step) v = 0.0;  // a sum of steps near 0 printed as "-0"
     const float y = top + height * static_cast<float>(1.0 - range.Fraction(v));
     scene.Line({left, y}, {left + width, y}, 1.0f, kGrid);
-    scene.Text({left - 8, y + 5}, Short(v), 14, kInk, TextAnchor::kRight);
+    scene.Text({left - 8, y + 5}, Short(v), 14, kInk, render::TextAnchor::kRight);
   }
   scene.Line({left, top + height}, {left + width, top + height}, 1.5f, kInk);
   scene.Line({left, top}, {left, top + height}, 1.5f, kInk);
@@ -130,12 +130,13 @@ std::string Goal(const SweepFigureData& data) {
 // The subtitle in lines that fit `width_px` (split after "; " first, else at a space).
 std::vector<std::string> SubtitleLines(const std::string& text, float width_px) {
   const float room = width_px - 40;
-  if (TextWidthPx(text, 15) <= room) return {text};
+  if (render::TextWidthPx(text, 15) <= room) return {text};
   if (size_t semi = text.find("; "); semi != std::string::npos) {
     return {text.substr(0, semi + 1), text.substr(semi + 2)};
   }
   size_t cut = text.rfind(' ');
-  while (cut != std::string::npos && cut > 0 && TextWidthPx(text.substr(0, cut), 15) > room) {
+  while (cut != std::string::npos && cut > 0 &&
+         render::TextWidthPx(text.substr(0, cut), 15) > room) {
     cut = text.rfind(' ', cut - 1);
   }
   if (cut == std::string::npos || cut == 0) return {text};
@@ -143,7 +144,8 @@ std::vector<std::string> SubtitleLines(const std::string& text, float width_px) 
 }
 
 // The title and subtitle lines; returns how far the subtitle's extra lines push the plot down.
-float Heading(Scene& scene, const std::string& title, const std::vector<std::string>& lines) {
+float Heading(render::Scene& scene, const std::string& title,
+              const std::vector<std::string>& lines) {
   scene.Text({20, 32}, title, 20, kInk);
   for (size_t i = 0; i < lines.size(); ++i) {
     scene.Text({20, 58 + 20.0f * i}, lines[i], 15, kInk);
@@ -153,7 +155,7 @@ float Heading(Scene& scene, const std::string& title, const std::vector<std::str
 
 }  // namespace
 
-Scene SweepParameterScene(const SweepFigureData& data, int width_px) {
+render::Scene SweepParameterScene(const SweepFigureData& data, int width_px) {
   const int panels = std::max<int>(1, static_cast<int>(data.keys.size()));
   const float panel_w = 380, panel_h = 280, left0 = 90, gap_x = 110, gap_y = 110;
   // Up to three panels a row, fewer when a given width holds fewer.
@@ -164,8 +166,8 @@ Scene SweepParameterScene(const SweepFigureData& data, int width_px) {
   const std::vector<std::string> lines =
       SubtitleLines(Goal(data) + " of each point; the best in red", scene_w);
   const float top0 = 90 + 20.0f * (lines.size() - 1);
-  Scene scene(static_cast<int>(scene_w), static_cast<int>(top0 + rows * (panel_h + gap_y)),
-              Rgba{255, 255, 255, 255});
+  render::Scene scene(static_cast<int>(scene_w), static_cast<int>(top0 + rows * (panel_h + gap_y)),
+                      render::Rgba{255, 255, 255, 255});
   Heading(scene, data.title, lines);
   const Range range = ObjectiveRange(data);
   for (int k = 0; k < static_cast<int>(data.keys.size()); ++k) {
@@ -181,13 +183,14 @@ Scene SweepParameterScene(const SweepFigureData& data, int width_px) {
     for (size_t i = 0; i < distinct.size(); i += every) {
       const float x = left + panel_w * static_cast<float>(axis(distinct[i]));
       scene.Line({x, top + panel_h}, {x, top + panel_h + 5}, 1.0f, kInk);
-      scene.Text({x, top + panel_h + 22}, distinct[i], 13, kInk, TextAnchor::kCenter);
+      scene.Text({x, top + panel_h + 22}, distinct[i], 13, kInk, render::TextAnchor::kCenter);
     }
     scene.Text({left + panel_w / 2, top + panel_h + 48}, data.keys[k], 15, kInk,
-               TextAnchor::kCenter);
+               render::TextAnchor::kCenter);
     auto at = [&](const SweepFigurePoint& p) {
-      return ScenePoint{left + panel_w * static_cast<float>(axis(p.values[k])),
-                        top + panel_h * static_cast<float>(1.0 - range.Fraction(*p.objective))};
+      return render::ScenePoint{
+          left + panel_w * static_cast<float>(axis(p.values[k])),
+          top + panel_h * static_cast<float>(1.0 - range.Fraction(*p.objective))};
     };
     for (const SweepFigurePoint& p : data.points) {
       if (p.objective) scene.Disc(at(p), 3.5f, kDot);
@@ -197,7 +200,7 @@ Scene SweepParameterScene(const SweepFigureData& data, int width_px) {
   return scene;
 }
 
-Scene SweepHeatmapScene(const SweepFigureData& data, int a, int b, int width_px) {
+render::Scene SweepHeatmapScene(const SweepFigureData& data, int a, int b, int width_px) {
   std::vector<std::string> xs, ys;
   for (const SweepFigurePoint& p : data.points) {
     xs.push_back(p.values.at(a));
@@ -217,7 +220,8 @@ Scene SweepHeatmapScene(const SweepFigureData& data, int a, int b, int width_px)
   const std::vector<std::string> lines =
       SubtitleLines("best " + Goal(data) + " over the other parameters", scene_w);
   const float top = 120 + 20.0f * (lines.size() - 1);
-  Scene scene(scene_w, static_cast<int>(top + height + 90), Rgba{255, 255, 255, 255});
+  render::Scene scene(scene_w, static_cast<int>(top + height + 90),
+                      render::Rgba{255, 255, 255, 255});
   Heading(scene, data.title, lines);
   const Range range = ObjectiveRange(data);
   for (size_t c = 0; c < columns.size(); ++c) {
@@ -239,30 +243,31 @@ Scene SweepHeatmapScene(const SweepFigureData& data, int a, int b, int width_px)
       if (!data.minimize) t = 1.0 - t;
       scene.Rect(cx + 1, cy + 1, cell_w - 2, cell_h - 2, SequentialColor(1.0 - t));
       scene.Text({cx + cell_w / 2, cy + cell_h / 2 + 5}, Short(*best), 13,
-                 t < 0.5 ? kInk : Rgba{255, 255, 255, 255}, TextAnchor::kCenter);
+                 t < 0.5 ? kInk : render::Rgba{255, 255, 255, 255}, render::TextAnchor::kCenter);
     }
   }
   for (size_t c = 0; c < columns.size(); ++c) {
     scene.Text({left + cell_w * (c + 0.5f), top + height + 22}, columns[c], 13, kInk,
-               TextAnchor::kCenter);
+               render::TextAnchor::kCenter);
   }
   for (size_t r = 0; r < rows.size(); ++r) {
     scene.Text({left - 10, top + height - cell_h * (r + 0.5f) + 5}, rows[r], 13, kInk,
-               TextAnchor::kRight);
+               render::TextAnchor::kRight);
   }
-  scene.Text({left + width / 2, top + height + 50}, data.keys[a], 15, kInk, TextAnchor::kCenter);
+  scene.Text({left + width / 2, top + height + 50}, data.keys[a], 15, kInk,
+             render::TextAnchor::kCenter);
   scene.Text({20, top - 16}, data.keys[b], 15, kInk);
   return scene;
 }
 
-Scene SweepParetoScene(const SweepFigureData& data, int width_px) {
+render::Scene SweepParetoScene(const SweepFigureData& data, int width_px) {
   const float left = 100, height = 420;
   const float width = width_px > 0 ? std::max(300.0f, width_px - left - 60.0f) : 700.0f;
   const std::vector<std::string> lines =
       SubtitleLines(Goal(data) + " against run time; the Pareto front in red", left + width + 60);
   const float top = 90 + 20.0f * (lines.size() - 1);
-  Scene scene(static_cast<int>(left + width + 60), static_cast<int>(top + height + 90),
-              Rgba{255, 255, 255, 255});
+  render::Scene scene(static_cast<int>(left + width + 60), static_cast<int>(top + height + 90),
+                      render::Rgba{255, 255, 255, 255});
   Heading(scene, data.title, lines);
   const Range y = ObjectiveRange(data);
   Range x{std::numeric_limits<double>::infinity(), 0.0};
@@ -280,13 +285,13 @@ Scene SweepParetoScene(const SweepFigureData& data, int width_px) {
   for (double v = std::ceil(x.lo / step) * step; v <= x.hi; v += step) {
     const float px = left + width * static_cast<float>(x.Fraction(v));
     scene.Line({px, top}, {px, top + height}, 1.0f, kGrid);
-    scene.Text({px, top + height + 22}, Short(v), 14, kInk, TextAnchor::kCenter);
+    scene.Text({px, top + height + 22}, Short(v), 14, kInk, render::TextAnchor::kCenter);
   }
   scene.Text({left + width / 2, top + height + 50}, "mean wall time per run (s)", 15, kInk,
-             TextAnchor::kCenter);
+             render::TextAnchor::kCenter);
   auto at = [&](const SweepFigurePoint& p) {
-    return ScenePoint{left + width * static_cast<float>(x.Fraction(p.mean_wall_s)),
-                      top + height * static_cast<float>(1.0 - y.Fraction(*p.objective))};
+    return render::ScenePoint{left + width * static_cast<float>(x.Fraction(p.mean_wall_s)),
+                              top + height * static_cast<float>(1.0 - y.Fraction(*p.objective))};
   };
   std::vector<const SweepFigurePoint*> ranked;
   for (const SweepFigurePoint& p : data.points) {
@@ -300,7 +305,7 @@ Scene SweepParetoScene(const SweepFigureData& data, int width_px) {
               if (a->mean_wall_s != b->mean_wall_s) return a->mean_wall_s < b->mean_wall_s;
               return data.minimize ? *a->objective < *b->objective : *a->objective > *b->objective;
             });
-  std::vector<ScenePoint> front;
+  std::vector<render::ScenePoint> front;
   std::optional<double> best;
   for (const auto* p : ranked) {
     if (best && !(data.minimize ? *p->objective < *best : *p->objective > *best)) continue;

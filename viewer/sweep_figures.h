@@ -31,12 +31,12 @@ struct SweepFigureData {
 
 // One panel per parameter: every ranked point's objective over that parameter's values
 // (numbers on a linear axis, other values in plan order), the best point in red.
-Scene SweepParameterScene(const SweepFigureData& data, int width_px = 0);
+render::Scene SweepParameterScene(const SweepFigureData& data, int width_px = 0);
 // Cells over the values of keys[a] (x) and keys[b] (y), coloured and labelled with the best
 // objective among the points that share them.
-Scene SweepHeatmapScene(const SweepFigureData& data, int a, int b, int width_px = 0);
+render::Scene SweepHeatmapScene(const SweepFigureData& data, int a, int b, int width_px = 0);
 // Objective against mean run time; the points no other point beats in both are the front.
-Scene SweepParetoScene(const SweepFigureData& data, int width_px = 0);
+render::Scene SweepParetoScene(const SweepFigureData& data, int width_px = 0);
 
 }  // namespace ratslam::viewer
 

@@ -7,9 +7,9 @@
 namespace ratslam::viewer {
 namespace {
 
-bool HasText(const Scene& scene, const std::string& text) {
+bool HasText(const render::Scene& scene, const std::string& text) {
   return std::any_of(scene.texts().begin(), scene.texts().end(),
-                     [&](const SceneText& t) { return t.text == text; });
+                     [&](const render::SceneText& t) { return t.text == text; });
 }
 
 // Two parameters of two values each, and a third that the heat map takes the best over.
@@ -28,7 +28,7 @@ SweepFigureData Example() {
 }
 
 TEST(SweepFiguresTest, HeatmapCellsHoldTheBestOverTheOtherParameters) {
-  const Scene scene = SweepHeatmapScene(Example(), 0, 1);
+  const render::Scene scene = SweepHeatmapScene(Example(), 0, 1);
   EXPECT_TRUE(HasText(scene, "3"));    // a=1, b=x: min(4, 3)
   EXPECT_TRUE(HasText(scene, "2.5"));  // a=2, b=x
   EXPECT_TRUE(HasText(scene, "7"));    // a=1, b=y
@@ -39,7 +39,7 @@ TEST(SweepFiguresTest, HeatmapCellsHoldTheBestOverTheOtherParameters) {
 }
 
 TEST(SweepFiguresTest, EveryParameterGetsAPanelWithItsValues) {
-  const Scene scene = SweepParameterScene(Example());
+  const render::Scene scene = SweepParameterScene(Example());
   for (const char* text : {"a", "b", "c", "x", "y"}) EXPECT_TRUE(HasText(scene, text)) << text;
   EXPECT_GT(scene.triangles().size(), 0u);
 }
@@ -65,7 +65,7 @@ TEST(SweepFiguresTest, NoTickReadsMinusZero) {
   for (SweepFigurePoint& p : d.points) {
     if (p.objective) *p.objective -= 2.2;  // -0.2 .. 4.8: ticks step through zero
   }
-  const Scene scene = SweepParameterScene(d);
+  const render::Scene scene = SweepParameterScene(d);
   EXPECT_FALSE(HasText(scene, "-0"));
   EXPECT_TRUE(HasText(scene, "0"));
 }

@@ -9,7 +9,7 @@
 
 namespace ratslam::viewer {
 
-Scene WorldMapScene(const sim::World& world, const Dataset& dataset, int panel_px) {
+render::Scene WorldMapScene(const sim::World& world, const Dataset& dataset, int panel_px) {
   std::set<int> floor_set;
   for (const sim::Wall& w : world.walls) floor_set.insert(w.floor);
   const std::vector<int> floors(floor_set.begin(), floor_set.end());
@@ -36,9 +36,9 @@ Scene WorldMapScene(const sim::World& world, const Dataset& dataset, int panel_p
   const std::string legend =
       "walls (grey: light, black: heavy), access points (red), true path (blue)";
   const int width = std::max(static_cast<int>(floors.size()) * (panel_px + gap) + gap,
-                             static_cast<int>(TextWidthPx(legend, 15)) + 40);
-  Scene scene(width, panel_h + top + 70, Rgba{255, 255, 255, 255});
-  const Rgba ink{30, 30, 30, 255};
+                             static_cast<int>(render::TextWidthPx(legend, 15)) + 40);
+  render::Scene scene(width, panel_h + top + 70, render::Rgba{255, 255, 255, 255});
+  const render::Rgba ink{30, 30, 30, 255};
   scene.Text({20, 28}, "world '" + world.name + "'", 18, ink);
   scene.Text({20, 52}, legend, 15, ink);
   for (size_t f = 0; f < floors.size(); ++f) {
@@ -56,32 +56,34 @@ Scene WorldMapScene(const sim::World& world, const Dataset& dataset, int panel_p
       const double db = world.materials_db.at(w.material);
       const uint8_t g = static_cast<uint8_t>(std::clamp(170.0 - 8.0 * db, 0.0, 200.0));
       scene.Line(to(w.from.x_m, w.from.y_m), to(w.to.x_m, w.to.y_m), db >= 10 ? 3.5f : 2.0f,
-                 Rgba{g, g, g, 255});
+                 render::Rgba{g, g, g, 255});
     }
-    std::vector<ScenePoint> path;
+    std::vector<render::ScenePoint> path;
     for (size_t i = 0; i < dataset.ground_truth.size(); ++i) {
       const GroundTruthRow& g = dataset.ground_truth[i];
       if (g.floor != floors[f]) {
-        if (path.size() > 1) scene.Polyline(path, 1.5f, Rgba{40, 90, 200, 200});
+        if (path.size() > 1) scene.Polyline(path, 1.5f, render::Rgba{40, 90, 200, 200});
         path.clear();
         continue;
       }
       path.push_back(to(g.x_m, g.y_m));
     }
-    if (path.size() > 1) scene.Polyline(path, 1.5f, Rgba{40, 90, 200, 200});
+    if (path.size() > 1) scene.Polyline(path, 1.5f, render::Rgba{40, 90, 200, 200});
     for (const sim::Disturbance& d : world.disturbances) {
       if (d.floor == floors[f]) {
-        scene.Ring(
-            to(d.position.x_m, d.position.y_m), static_cast<float>(d.radius_m * scale) - 1.5f,
-            static_cast<float>(d.radius_m * scale), 0.0f, 6.2832f, Rgba{230, 140, 0, 255}, 32);
+        scene.Ring(to(d.position.x_m, d.position.y_m),
+                   static_cast<float>(d.radius_m * scale) - 1.5f,
+                   static_cast<float>(d.radius_m * scale), 0.0f, 6.2832f,
+                   render::Rgba{230, 140, 0, 255}, 32);
       }
     }
     for (const sim::AccessPoint& a : world.access_points) {
       if (a.floor == floors[f])
-        scene.Disc(to(a.position.x_m, a.position.y_m), 5.0f, Rgba{210, 40, 40, 255});
+        scene.Disc(to(a.position.x_m, a.position.y_m), 5.0f, render::Rgba{210, 40, 40, 255});
     }
     // Scale bar: 5 m.
-    const ScenePoint bar = {static_cast<float>(left + 10), static_cast<float>(top + panel_h + 30)};
+    const render::ScenePoint bar = {static_cast<float>(left + 10),
+                                    static_cast<float>(top + panel_h + 30)};
     scene.Line(bar, {bar.x + static_cast<float>(5.0 * scale), bar.y}, 2.0f, ink);
     scene.Text({bar.x, bar.y + 20}, "5 m", 14, ink);
   }

@@ -9,7 +9,7 @@
 
 namespace ratslam::viewer {
 
-Scene WorldMapScene(const sim::World& world, const Dataset& dataset, int panel_px = 700);
+render::Scene WorldMapScene(const sim::World& world, const Dataset& dataset, int panel_px = 700);
 
 }  // namespace ratslam::viewer
 
