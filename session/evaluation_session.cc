@@ -443,7 +443,11 @@ Status EvaluationSession::WriteOutputs() {
   std::ostringstream csv;
   csv << "query,x_m,y_m,floor,match,match_x_m,match_y_m,match_floor,error_m,status,"
          "match_probability,new_place_probability,best_mapped_place,best_mapped_probability,"
-         "best_mapped_log_odds,nearest_place_m\n";
+         "best_mapped_log_odds,nearest_place_m";
+  // Each baseline's error on the same query, in error_m's form: per-query comparisons.
+  for (const auto& [name, b] : result_.baselines) csv << ',' << name << "_error_m";
+  csv << '\n';
+  auto error_cell = [](double e) { return std::isnan(e) ? std::string() : ShortestNumber(e); };
   for (size_t i = 0; i < result_.queries.size(); ++i) {
     const auto& q = result_.queries[i];
     const int64_t match = result_.matches[i];
@@ -455,7 +459,7 @@ Status EvaluationSession::WriteOutputs() {
       csv << ",,,";
     }
     const double e = m.errors_m[i];
-    csv << ',' << (std::isnan(e) ? "" : ShortestNumber(e)) << ','
+    csv << ',' << error_cell(e) << ','
         << (std::isnan(e)   ? "rejected"
             : std::isinf(e) ? "other_floor"
                             : "located")
@@ -468,7 +472,9 @@ Status EvaluationSession::WriteOutputs() {
     } else {
       csv << ',';
     }
-    csv << ',' << ShortestNumber(nearest[i]) << '\n';
+    csv << ',' << ShortestNumber(nearest[i]);
+    for (const auto& [name, b] : result_.baselines) csv << ',' << error_cell(b.errors_m[i]);
+    csv << '\n';
   }
   // Precision-recall: one row per distinct best-mapped-place posterior, highest first.
   std::ostringstream pr;

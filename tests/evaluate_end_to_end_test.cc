@@ -27,11 +27,14 @@ namespace {
 namespace fs = std::filesystem;
 namespace e2e = ratslam::e2e;
 
-// A CSV line's comma-separated fields (a trailing empty field is dropped, as getline does).
+// A CSV line's comma-separated fields, a trailing empty one included ("a,b," has three).
 std::vector<std::string> Fields(const std::string& line) {
   std::vector<std::string> f;
-  std::stringstream fields(line);
-  for (std::string x; std::getline(fields, x, ',');) f.push_back(x);
+  size_t start = 0;
+  for (size_t comma; (comma = line.find(',', start)) != std::string::npos; start = comma + 1) {
+    f.push_back(line.substr(start, comma - start));
+  }
+  f.push_back(line.substr(start));
   return f;
 }
 
@@ -139,7 +142,7 @@ TEST(EvaluateEndToEndTest, MicrosoftWalksWifiOnly) {
     int near = 0, far = 0;
     while (std::getline(csv, line)) {
       const std::vector<std::string> f = Fields(line);
-      ASSERT_EQ(f.size(), 16u) << line;
+      ASSERT_EQ(f.size(), 18u) << line;  // with knn_error_m and fingerprint_error_m
       const double nearest = std::stod(f[15]);
       near += nearest <= 5.0;
       far += nearest > 10.0;
@@ -402,13 +405,16 @@ TEST(EvaluateEndToEndTest, FingerprintRowsAllLearnTheWifiTree) {
   EXPECT_EQ(line,
             "query,x_m,y_m,floor,match,match_x_m,match_y_m,match_floor,error_m,status,"
             "match_probability,new_place_probability,best_mapped_place,best_mapped_probability,"
-            "best_mapped_log_odds,nearest_place_m");
-  size_t located = 0, rows = 0;
+            "best_mapped_log_odds,nearest_place_m,knn_error_m,fingerprint_error_m");
+  size_t located = 0, rows = 0, knn_within_5 = 0;
   std::vector<double> best_mapped;  // posteriors of the rows that have a best mapped place
   while (std::getline(csv, line)) {
     const std::vector<std::string> f = Fields(line);
-    ASSERT_EQ(f.size(), 16u) << line;
+    ASSERT_EQ(f.size(), 18u) << line;
     ++rows;
+    // The baselines' errors on the same query: k-NN answers every query that has a scan.
+    ASSERT_FALSE(f[16].empty()) << line;
+    knn_within_5 += std::stod(f[16]) <= 5.0;
     // Posteriors: the chosen hypothesis is the match (then also the best mapped place) or the
     // new place; every posterior is a probability.
     // strtod, not stod: a posterior can be subnormal (stod throws on underflow).
@@ -437,6 +443,9 @@ TEST(EvaluateEndToEndTest, FingerprintRowsAllLearnTheWifiTree) {
   }
   EXPECT_EQ(rows, j["queries"].get<size_t>());
   EXPECT_GT(located, rows / 2);
+  // The per-query k-NN column recounts the JSON's k-NN rate.
+  EXPECT_DOUBLE_EQ(static_cast<double>(knn_within_5) / static_cast<double>(rows),
+                   j["baselines"]["knn"]["correct_within_m"]["5"].get<double>());
   // pr_curve.csv: thresholds fall, acceptances and recalls grow; each row accepts exactly the
   // queries whose best mapped posterior (from queries.csv) reaches its threshold.
   std::ifstream pr(out / "pr_curve.csv");
