@@ -58,10 +58,28 @@ SadKernel ChooseSad() {
 // Both kernels sum the same integers, so the choice never changes a result.
 const SadKernel kSad = ChooseSad();
 
-// Up to `count` places, best first, none within `exclusion` references of a better one; places
-// with an infinite score are never taken. A scan per place (count is small): sorting every
-// reference cost more than the whole search.
-std::vector<PlaceCandidate> Candidates(const std::vector<double>& score, int count, int exclusion) {
+// The best place and how far ahead of the best outside its exclusion window it is.
+SequenceMatch MatchOf(const std::vector<double>& score, int candidates, int exclusion) {
+  SequenceMatch m;
+  m.candidates = PlaceCandidates(score, std::max(candidates, 1), exclusion);
+  if (m.candidates.empty()) return m;
+  m.declined = false;
+  m.reference = m.candidates.front().reference;
+  double runner_up = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < score.size(); ++i) {
+    if (std::abs(static_cast<int>(i) - m.reference) > exclusion) {
+      runner_up = std::min(runner_up, score[i]);
+    }
+  }
+  m.confidence = std::isfinite(runner_up) ? runner_up - m.candidates.front().score : 0.0;
+  m.candidates.resize(std::min<size_t>(m.candidates.size(), std::max(candidates, 0)));
+  return m;
+}
+
+}  // namespace
+
+std::vector<PlaceCandidate> PlaceCandidates(const std::vector<double>& score, int count,
+                                            int exclusion) {
   std::vector<PlaceCandidate> out;
   const int n = static_cast<int>(score.size());
   while (static_cast<int>(out.size()) < count) {
@@ -81,26 +99,6 @@ std::vector<PlaceCandidate> Candidates(const std::vector<double>& score, int cou
   }
   return out;
 }
-
-// The best place and how far ahead of the best outside its exclusion window it is.
-SequenceMatch MatchOf(const std::vector<double>& score, int candidates, int exclusion) {
-  SequenceMatch m;
-  m.candidates = Candidates(score, std::max(candidates, 1), exclusion);
-  if (m.candidates.empty()) return m;
-  m.declined = false;
-  m.reference = m.candidates.front().reference;
-  double runner_up = std::numeric_limits<double>::infinity();
-  for (size_t i = 0; i < score.size(); ++i) {
-    if (std::abs(static_cast<int>(i) - m.reference) > exclusion) {
-      runner_up = std::min(runner_up, score[i]);
-    }
-  }
-  m.confidence = std::isfinite(runner_up) ? runner_up - m.candidates.front().score : 0.0;
-  m.candidates.resize(std::min<size_t>(m.candidates.size(), std::max(candidates, 0)));
-  return m;
-}
-
-}  // namespace
 
 bool SequenceMatcherOptions::IsValid(std::string* error) const {
   auto fail = [&](const std::string& message) {

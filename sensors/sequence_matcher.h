@@ -135,6 +135,12 @@ struct PlaceCandidate {
   double score = 0.0;  // lower is better (the sequence's summed enhanced difference)
 };
 
+// Up to `count` places, best first (lowest score; a tie goes to the lower index), none within
+// `exclusion` references of a better one; places with an infinite or NaN score are never taken.
+// A scan per place (count is small): sorting every reference cost more than a whole search.
+std::vector<PlaceCandidate> PlaceCandidates(const std::vector<double>& score, int count,
+                                            int exclusion);
+
 struct SequenceMatch {
   bool declined = true;  // blank query, or no reference to match
   int reference = -1;    // the best reference (the place of the newest query frame)

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -235,21 +236,13 @@ StatusOr<ImageSequenceEvaluation::Fabmap> MatchByFabmap(
     a.truth = e.truth[q];
     if (!query_frames[q].blank) {
       const fabmap::LocalisationResult r = (*built)->Localise({query_words[q], std::nullopt});
-      std::vector<size_t> order;
-      for (size_t i = 0; i < r.place_probability.size(); ++i) {
-        if (!e.reference_blank[i]) order.push_back(i);
+      // Lower is better for PlaceCandidates: the negated posterior; blank references never.
+      std::vector<double> score(r.place_probability.size());
+      for (size_t i = 0; i < score.size(); ++i) {
+        score[i] = e.reference_blank[i] ? std::numeric_limits<double>::infinity()
+                                        : -r.place_probability[i];
       }
-      std::stable_sort(order.begin(), order.end(), [&](size_t x, size_t y) {
-        return r.place_probability[x] > r.place_probability[y];
-      });
-      for (size_t i : order) {
-        if (a.match.candidates.size() == 5) break;
-        const bool apart = std::all_of(
-            a.match.candidates.begin(), a.match.candidates.end(), [&](const PlaceCandidate& c) {
-              return std::abs(c.reference - static_cast<int>(i)) > exclusion;
-            });
-        if (apart) a.match.candidates.push_back({static_cast<int>(i), -r.place_probability[i]});
-      }
+      a.match.candidates = PlaceCandidates(score, 5, exclusion);
       if (!a.match.candidates.empty()) {
         a.match.declined = false;
         a.match.reference = a.match.candidates.front().reference;
