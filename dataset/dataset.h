@@ -10,46 +10,10 @@
 #include <string>
 #include <vector>
 
+#include "common/sensor_samples.h"
 #include "common/status.h"
-#include "sensors/pressure_sample.h"
 
 namespace ratslam {
-
-// Velocities that hold from the previous odometry row's time to this row's time.
-struct OdometryRow {
-  double time_s = 0.0;
-  double forward_speed_m_per_s = 0.0;
-  double turn_rate_rad_per_s = 0.0;
-};
-
-struct ImageRow {
-  double time_s = 0.0;
-  std::string file;  // relative to the image folder
-  int line = 0;      // line in images.csv, for error messages
-};
-
-struct GroundTruthRow {
-  double time_s = 0.0;
-  double x_m = 0.0;
-  double y_m = 0.0;
-  double theta_rad = 0.0;
-  int floor = 0;
-};
-
-struct WifiReading {
-  std::string bssid;
-  double rssi_dbm = 0.0;
-};
-
-struct WifiScan {
-  double time_s = 0.0;
-  std::vector<WifiReading> readings;
-};
-
-struct CompassRow {
-  double time_s = 0.0;
-  double heading_rad = 0.0;
-};
 
 struct Dataset {
   std::string name;

@@ -1,5 +1,5 @@
-// Loads grey images for the camera front ends. Behind an interface so that tests can feed images
-// from memory and replays can read them from disk.
+// Loads grey images from files, ROS bags and videos for the camera front ends (the interface and
+// the image type: common/gray_image.h).
 #ifndef RATSLAM_DATASET_IMAGE_LOADER_H_
 #define RATSLAM_DATASET_IMAGE_LOADER_H_
 
@@ -8,21 +8,10 @@
 #include <string>
 #include <vector>
 
+#include "common/gray_image.h"
 #include "common/status.h"
 
 namespace ratslam {
-
-struct GrayImage {
-  int width = 0;
-  int height = 0;
-  std::vector<uint8_t> pixels;  // rows top to bottom, no padding
-};
-
-class ImageLoader {
- public:
-  virtual ~ImageLoader() = default;
-  virtual StatusOr<GrayImage> Load(const std::string& path) = 0;
-};
 
 class BagImageReader;
 class Ros2ImageReader;

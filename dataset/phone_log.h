@@ -11,10 +11,10 @@
 #include <string>
 #include <vector>
 
+#include "common/sensor_samples.h"
 #include "common/status.h"
 #include "dataset/dataset.h"
 #include "sensors/pedestrian_dead_reckoning.h"
-#include "sensors/pressure_sample.h"
 
 namespace ratslam {
 

@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "common/sensor_samples.h"
 #include "common/status.h"
-#include "dataset/dataset.h"
 #include "ratslam/experience_map.h"
 #include "ratslam/records.h"
 

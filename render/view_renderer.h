@@ -7,8 +7,8 @@
 #include <memory>
 #include <vector>
 
+#include "common/gray_image.h"
 #include "common/status.h"
-#include "dataset/image_loader.h"
 
 namespace ratslam::render {
 

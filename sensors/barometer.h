@@ -27,8 +27,8 @@
 #include <vector>
 
 #include "common/schema.h"
+#include "common/sensor_samples.h"
 #include "common/status.h"
-#include "sensors/pressure_sample.h"
 
 namespace ratslam {
 

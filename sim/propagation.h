@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "common/random.h"
-#include "dataset/dataset.h"
+#include "common/sensor_samples.h"
 #include "sim/world.h"
 
 namespace ratslam::sim {

@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "common/schema.h"
+#include "common/sensor_samples.h"
 #include "common/status.h"
-#include "dataset/dataset.h"
 
 namespace ratslam::fabmap {
 

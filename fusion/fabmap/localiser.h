@@ -26,8 +26,8 @@
 #include <vector>
 
 #include "common/schema.h"
+#include "common/sensor_samples.h"
 #include "common/status.h"
-#include "dataset/dataset.h"
 #include "fusion/fabmap/chow_liu.h"
 #include "fusion/fabmap/fabmap.h"
 #include "fusion/fabmap/wifi_words.h"

@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
+#include "common/gray_image.h"
 #include "common/schema.h"
 #include "common/status.h"
-#include "dataset/image_loader.h"
 #include "fusion/fabmap/localiser.h"
 #include "fusion/fabmap/vocabulary.h"
 

@@ -13,9 +13,9 @@
 #include <string>
 #include <vector>
 
+#include "common/gray_image.h"
 #include "common/schema.h"
 #include "common/status.h"
-#include "dataset/image_loader.h"
 #include "fusion/fabmap/chow_liu.h"
 
 namespace ratslam::fabmap {

@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "common/random.h"
+#include "dataset/image_loader.h"
 
 namespace ratslam::fabmap {
 namespace {

@@ -20,8 +20,8 @@
 #include <vector>
 
 #include "common/schema.h"
+#include "common/sensor_samples.h"
 #include "common/status.h"
-#include "dataset/dataset.h"
 #include "fusion/fabmap/chow_liu.h"
 
 namespace ratslam::fabmap {

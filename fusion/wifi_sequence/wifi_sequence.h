@@ -27,8 +27,8 @@
 
 #include "common/geometry.h"
 #include "common/schema.h"
+#include "common/sensor_samples.h"
 #include "common/status.h"
-#include "dataset/dataset.h"
 
 namespace ratslam {
 
