@@ -215,7 +215,7 @@ namespace sim {
 struct World;
 }
 Status SimulateWorld(const sim::World& world, uint64_t seed, const std::string& out, bool quiet,
-                     Dataset* dataset);
+                     dataset::Dataset* dataset);
 
 }  // namespace ratslam
 

@@ -36,6 +36,6 @@ PipelineOptions SyntheticPipelineOptions() {
   return o;
 }
 
-SyntheticOptions DemoSyntheticOptions() { return SyntheticOptions(); }
+dataset::SyntheticOptions DemoSyntheticOptions() { return dataset::SyntheticOptions(); }
 
 }  // namespace ratslam

@@ -17,7 +17,7 @@ PipelineOptions DemoPipelineOptions();
 std::string DemoWorldName();
 // The classic camera matcher on the synthetic pillar loop.
 PipelineOptions SyntheticPipelineOptions();
-SyntheticOptions DemoSyntheticOptions();
+dataset::SyntheticOptions DemoSyntheticOptions();
 
 }  // namespace ratslam
 

@@ -125,7 +125,7 @@ int ImageSequenceEvaluate(const Arguments& args, const PipelineOptions& pipeline
   if (!out.ok()) return fail(out.status());
   ProgressPrinter progress(stderr, args.quiet);
   StopCooperatively();
-  FileImageLoader loader;
+  dataset::FileImageLoader loader;
   StatusOr<session::ImageSequenceEvaluation> e = session::EvaluateImageSequences(
       options, &loader,
       [&](size_t done, size_t total) {

@@ -115,7 +115,7 @@ int LocateCommand(const Arguments& parsed) {
   if (!setup.ok()) return fail(setup.status());
   const std::string map_path = args->values.at("--wifi-map");
   const phone::LocateOptions* options = &setup->options;
-  const Dataset& d = setup->data;
+  const dataset::Dataset& d = setup->data;
   StatusOr<session::LocateResult> located =
       session::Locate(*setup, args->values.at("--data"), map_path);
   if (!located.ok()) return fail(located.status());

@@ -105,10 +105,11 @@ int RenderExperienceMapCommand(const Arguments& args) {
       if (!loaded.ok()) return Fail(loaded.status().message());
       config = *loaded;
     }
-    PhoneLogOptions phone;
+    dataset::PhoneLogOptions phone;
     phone.lenient = true;  // for ground truth to draw: a line the run skipped is skipped here
     phone.pdr = config.pdr;
-    StatusOr<Dataset> dataset = LoadSessions(inputs, phone, 1.0, config.bag, config.video);
+    StatusOr<dataset::Dataset> dataset =
+        dataset::LoadSessions(inputs, phone, 1.0, config.bag, config.video);
     if (!dataset.ok()) {
       return Fail(dataset.status().message() +
                   " (the data set the run read, for its ground truth; --data names another)");
@@ -217,17 +218,17 @@ int RenderSimilarityCommand(const Arguments& args) {
   auto options = LoadOptions(args);
   if (!options) return kExitError;
   const int frames = args.Has("--frames") ? static_cast<int>(args.Whole("--frames")) : 600;
-  PhoneLogOptions phone;
+  dataset::PhoneLogOptions phone;
   phone.pdr = options->pdr;
-  StatusOr<Dataset> dataset =
-      LoadSessions(args.all.at("--data"), phone, 1.0, options->bag, options->video);
+  StatusOr<dataset::Dataset> dataset =
+      dataset::LoadSessions(args.all.at("--data"), phone, 1.0, options->bag, options->video);
   if (!dataset.ok()) return Fail(dataset.status().message());
   const std::string sensor = args.values.count("--sensor") ? args.values.at("--sensor") : "camera";
   viewer::SimilarityImageOptions image_options;
   StatusOr<viewer::SimilarityMatrix> m =
       Status::Error("--sensor must be camera or wifi, not '" + sensor + "'");
   if (sensor == "camera") {
-    FileImageLoader images;
+    dataset::FileImageLoader images;
     m = viewer::CameraSimilarityMatrix(dataset.value(), &images, options->sensors.classic_camera,
                                        frames);
     image_options.title = "camera template similarity (" + dataset->name + ")";

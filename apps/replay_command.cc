@@ -59,7 +59,7 @@ struct ReplayRequest {
 };
 
 // The first and last time of any stream of the data set: the colour range of animation frames.
-std::pair<double, double> DataTimeSpan(const Dataset& d) {
+std::pair<double, double> DataTimeSpan(const dataset::Dataset& d) {
   double first = std::numeric_limits<double>::infinity();
   double last = -std::numeric_limits<double>::infinity();
   auto include = [&](double t) {
@@ -260,10 +260,10 @@ int ReplayCommand(const Arguments& parsed) {
   return RunReplay(request);
 }
 
-int Synthesize(const SyntheticOptions& options, const std::string& folder,
+int Synthesize(const dataset::SyntheticOptions& options, const std::string& folder,
                const std::string& shown_folder, const std::string& bag_path,
                const std::string& video_path) {
-  StatusOr<Dataset> d = WriteSyntheticDataset(options, folder);
+  StatusOr<dataset::Dataset> d = dataset::WriteSyntheticDataset(options, folder);
   if (!d.ok()) {
     std::cerr << MessagePrefix() << d.status().message() << "\n";
     return kExitError;
@@ -272,11 +272,12 @@ int Synthesize(const SyntheticOptions& options, const std::string& folder,
             << "' to " << shown_folder << "\n";
   if (!bag_path.empty()) {
     // OpenRatSLAM's topic names under the root "synthetic" (what topic_root=synthetic implies).
-    const BagTopics topics{"/synthetic/camera/image/compressed", "/synthetic/odom",
-                           "/synthetic/ground_truth", ""};
-    StatusOr<Dataset> written = ReadDataset(folder);
-    FileImageLoader images;
-    Status s = written.ok() ? WriteRosbag(*written, &images, topics, bag_path) : written.status();
+    const dataset::BagTopics topics{"/synthetic/camera/image/compressed", "/synthetic/odom",
+                                    "/synthetic/ground_truth", ""};
+    StatusOr<dataset::Dataset> written = dataset::ReadDataset(folder);
+    dataset::FileImageLoader images;
+    Status s =
+        written.ok() ? dataset::WriteRosbag(*written, &images, topics, bag_path) : written.status();
     if (!s.ok()) {
       std::cerr << MessagePrefix() << s.message() << "\n";
       return kExitError;
@@ -286,9 +287,9 @@ int Synthesize(const SyntheticOptions& options, const std::string& folder,
               << topics.ground_truth_topic << ")\n";
   }
   if (!video_path.empty()) {
-    StatusOr<Dataset> written = ReadDataset(folder);
-    FileImageLoader images;
-    Status s = written.ok() ? WriteVideo(*written, &images, video_path, options.rate_hz)
+    StatusOr<dataset::Dataset> written = dataset::ReadDataset(folder);
+    dataset::FileImageLoader images;
+    Status s = written.ok() ? dataset::WriteVideo(*written, &images, video_path, options.rate_hz)
                             : written.status();
     if (!s.ok()) {
       std::cerr << MessagePrefix() << s.message() << "\n";
@@ -310,7 +311,7 @@ int DemoCommand(const Arguments& parsed) {
     std::cerr << MessagePrefix() << world.status().message() << "\n";
     return kExitError;
   }
-  Dataset simulated;
+  dataset::Dataset simulated;
   Status s = SimulateWorld(*world, 1, data, args->quiet, &simulated);
   if (!s.ok()) {
     std::cerr << MessagePrefix() << s.message() << "\n";
@@ -372,17 +373,17 @@ int ImportCommand(const Arguments& parsed) {
   std::string config_path;
   auto options = LoadOptions(*args, &config_path);
   if (!options) return kExitError;
-  PhoneLogOptions phone;
+  dataset::PhoneLogOptions phone;
   phone.lenient = args->lenient;
   phone.pdr = options->pdr;
-  StatusOr<Dataset> d =
-      LoadSessions(args->all.at("--data"), phone, 1.0, options->bag, options->video);
+  StatusOr<dataset::Dataset> d =
+      dataset::LoadSessions(args->all.at("--data"), phone, 1.0, options->bag, options->video);
   if (!d.ok()) {
     std::cerr << MessagePrefix() << d.status().message() << "\n";
     return kExitError;
   }
   const std::string out = args->values.at("--out");
-  Status copied = CopyImagesInto(&d.value(), out, [&](size_t done, size_t total) {
+  Status copied = dataset::CopyImagesInto(&d.value(), out, [&](size_t done, size_t total) {
     if (!args->quiet) {
       std::cerr << MessagePrefix() << "images " << done << " / " << total << "\n";
     }
@@ -391,7 +392,7 @@ int ImportCommand(const Arguments& parsed) {
     std::cerr << MessagePrefix() << copied.message() << "\n";
     return kExitError;
   }
-  Status written = WriteDataset(d.value(), out);
+  Status written = dataset::WriteDataset(d.value(), out);
   if (!written.ok()) {
     std::cerr << MessagePrefix() << written.message() << "\n";
     return kExitError;
@@ -405,7 +406,7 @@ int ImportCommand(const Arguments& parsed) {
 
 int SynthesizeCommand(const Arguments& parsed) {
   const Arguments* args = &parsed;
-  SyntheticOptions options = DemoSyntheticOptions();
+  dataset::SyntheticOptions options = DemoSyntheticOptions();
   if (args->Has("--seed")) options.seed = static_cast<uint64_t>(args->Whole("--seed"));
   if (args->Has("--laps")) options.laps = static_cast<int>(args->Whole("--laps"));
   if (args->Has("--noise-seed")) {

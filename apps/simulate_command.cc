@@ -25,7 +25,7 @@ StatusOr<sim::World> LoadWorld(const std::string& name_or_path) {
 }
 
 Status SimulateWorld(const sim::World& world, uint64_t seed, const std::string& out, bool quiet,
-                     Dataset* dataset) {
+                     dataset::Dataset* dataset) {
   const auto started = std::chrono::steady_clock::now();
   auto renderer = render::CreateOsMesaViewRenderer();
   if (!renderer.ok()) return renderer.status();
@@ -41,7 +41,7 @@ Status SimulateWorld(const sim::World& world, uint64_t seed, const std::string& 
         progress.Update(u);
       }));
   progress.Finish();
-  RATSLAM_RETURN_IF_ERROR(WriteDataset(*dataset, out));
+  RATSLAM_RETURN_IF_ERROR(dataset::WriteDataset(*dataset, out));
   RATSLAM_RETURN_IF_ERROR(
       WriteFileAtomically((fs::path(out) / "world.toml").string(),
                           "# The simulated world (ratslam simulate).\n" + sim::PrintWorld(world)));
@@ -70,7 +70,7 @@ int SimulateCommand(const Arguments& parsed) {
     std::cerr << MessagePrefix() << world.status().message() << "\n";
     return kExitError;
   }
-  Dataset dataset;
+  dataset::Dataset dataset;
   Status s = SimulateWorld(*world, seed, args->values.at("--out"), args->quiet, &dataset);
   if (!s.ok()) {
     std::cerr << MessagePrefix() << s.message() << "\n";

@@ -34,7 +34,7 @@ std::vector<float> UnitRows(size_t rows, uint64_t seed) {
 
 struct World {
   std::vector<float> stored;  // unit rows
-  Dataset dataset;            // query images at times 0, 1, ...
+  dataset::Dataset dataset;   // query images at times 0, 1, ...
   std::unique_ptr<FrontEnd> front_end;
 };
 
@@ -46,7 +46,7 @@ std::unique_ptr<World> MakeWorld(size_t stored) {
   w->stored = UnitRows(stored, 1);
   constexpr size_t kQueries = 64;
   const std::vector<float> noise = UnitRows(kQueries, 2);
-  DescriptorMatrix queries{kQueries, kDimensions, {}};
+  dataset::DescriptorMatrix queries{kQueries, kDimensions, {}};
   for (size_t q = 0; q < kQueries; ++q) {
     const size_t target = (q * 7919) % stored;
     for (size_t k = 0; k < kDimensions; ++k) {

@@ -31,7 +31,7 @@ class MemoryImages : public ImageLoader {
 
 struct Workload {
   ScratchDir folder{"replay_benchmark"};
-  Dataset dataset;
+  dataset::Dataset dataset;
   MemoryImages images;
   PipelineOptions options;
   std::string error;
@@ -40,9 +40,10 @@ struct Workload {
 Workload* GetWorkload() {
   static Workload* w = [] {
     auto* w = new Workload;
-    SyntheticOptions synthetic;
+    dataset::SyntheticOptions synthetic;
     synthetic.laps = 10;
-    StatusOr<Dataset> d = WriteSyntheticDataset(synthetic, (w->folder.path() / "d").string());
+    StatusOr<dataset::Dataset> d =
+        dataset::WriteSyntheticDataset(synthetic, (w->folder.path() / "d").string());
     StatusOr<PipelineOptions> o =
         LoadConfigFile(std::string(RATSLAM_SOURCE_DIR) + "/configs/synthetic.toml");
     if (!d.ok() || !o.ok()) {
@@ -51,7 +52,7 @@ Workload* GetWorkload() {
     }
     w->dataset = std::move(*d);
     w->options = *o;
-    FileImageLoader files;
+    dataset::FileImageLoader files;
     for (const ImageRow& row : w->dataset.images) {
       const std::string path = w->dataset.ImagePath(row);
       StatusOr<GrayImage> image = files.Load(path);

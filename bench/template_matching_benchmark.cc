@@ -93,12 +93,13 @@ void BM_SyntheticRouteViews(benchmark::State& state) {
     options.crop_top_px = 8;
     options.crop_bottom_px = 32;
     ScratchDir folder("template_benchmark");
-    SyntheticOptions synthetic;
+    dataset::SyntheticOptions synthetic;
     synthetic.laps = kLaps;
-    StatusOr<Dataset> dataset = WriteSyntheticDataset(synthetic, (folder.path() / "d").string());
+    StatusOr<dataset::Dataset> dataset =
+        dataset::WriteSyntheticDataset(synthetic, (folder.path() / "d").string());
     if (!dataset.ok()) return d;
     ClassicCameraMatcher matcher(options);
-    FileImageLoader loader;
+    dataset::FileImageLoader loader;
     for (const ImageRow& row : dataset->images) {
       StatusOr<GrayImage> image = loader.Load(dataset->ImagePath(row));
       if (!image.ok()) return d;

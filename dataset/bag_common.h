@@ -13,7 +13,7 @@
 #include "dataset/dataset.h"
 #include "dataset/rosbag.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 
 // Picks the topic for one stream from `topic_types` (topic -> message type). `wanted` empty: the
 // only topic of one of `types` (none: empty; several: an error naming them and `key`). Named: that
@@ -65,6 +65,6 @@ class BagDatasetBuilder {
   std::map<std::string, int64_t> last_time_ns_;
 };
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset
 
 #endif  // RATSLAM_DATASET_BAG_COMMON_H_

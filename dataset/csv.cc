@@ -8,7 +8,7 @@
 
 #include "common/text_file.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 namespace {
 
 std::vector<std::string> SplitFields(const std::string& line) {
@@ -110,4 +110,4 @@ StatusOr<std::string> CsvTable::Text(size_t row, const std::string& column) cons
   return text;
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset

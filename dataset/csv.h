@@ -9,7 +9,7 @@
 
 #include "common/status.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 
 // No number in a data set is larger: metres, seconds (epoch times included), dBm and radians all
 // stay far below it, and anything beyond is corruption that would overflow later arithmetic.
@@ -42,6 +42,6 @@ class CsvTable {
   std::vector<int> lines_;
 };
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset
 
 #endif  // RATSLAM_DATASET_CSV_H_

@@ -17,7 +17,7 @@
 #include "common/toml_binder.h"
 #include "dataset/csv.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 namespace fs = std::filesystem;
 namespace {
 
@@ -496,4 +496,4 @@ std::optional<int> KnownFloorAt(const Dataset& dataset, double time_s) {
   return KnownFloor(dataset.ground_truth, time_s, dataset.session_start_times_s);
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset

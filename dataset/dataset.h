@@ -13,7 +13,7 @@
 #include "common/sensor_samples.h"
 #include "common/status.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 
 struct Dataset {
   std::string name;
@@ -89,6 +89,6 @@ std::optional<int> KnownFloor(const std::vector<GroundTruthRow>& rows, double ti
 std::optional<GroundTruthRow> GroundTruthAt(const Dataset& dataset, double time_s);
 std::optional<int> KnownFloorAt(const Dataset& dataset, double time_s);
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset
 
 #endif  // RATSLAM_DATASET_DATASET_H_

@@ -15,7 +15,7 @@
 #include "dataset/rosbag2.h"
 #include "dataset/video.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 namespace fs = std::filesystem;
 
 StatusOr<DatasetFormat> DetectDatasetFormat(const std::string& path) {
@@ -230,4 +230,4 @@ Status CopyImagesInto(Dataset* dataset, const std::string& folder,
   return Status::Ok();
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset

@@ -12,7 +12,7 @@
 #include "dataset/rosbag.h"
 #include "dataset/video.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 
 enum class DatasetFormat { kReplayFolder, kIpinLog, kMicrosoftLog, kRosBag, kRos2Bag, kVideo };
 
@@ -43,6 +43,6 @@ StatusOr<Dataset> LoadSessions(const std::vector<std::string>& paths,
 Status CopyImagesInto(Dataset* dataset, const std::string& folder,
                       const std::function<void(size_t, size_t)>& progress = {});
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset
 
 #endif  // RATSLAM_DATASET_DATASET_LOADER_H_

@@ -12,7 +12,7 @@
 #include "dataset/synthetic_dataset.h"
 #include "dataset/visual_odometry_source.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 namespace {
 namespace fs = std::filesystem;
 
@@ -430,9 +430,9 @@ TEST(ImageLoaderTest, MissingAndCorruptFilesAreErrors) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::dataset
 
-namespace ratslam {
+namespace ratslam::dataset {
 namespace {
 
 // OpenRatSLAM's visual odometry on the synthetic loop, whose camera has a known field of view and
@@ -487,4 +487,4 @@ TEST(OpenRatslamVisualOdometrySource, TurnsAsTheGroundTruthOnTheSyntheticLoop) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::dataset

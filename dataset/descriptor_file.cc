@@ -12,7 +12,7 @@
 #include "common/file_util.h"
 #include "common/text_file.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 namespace {
 
 Status ValueError(const std::string& where, const std::string& message) {
@@ -306,4 +306,4 @@ Status WriteDescriptorNpy(const DescriptorMatrix& m, const std::string& path) {
   return WriteFileAtomically(path, bytes);
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset

@@ -15,7 +15,7 @@
 
 #include "common/status.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 
 struct DescriptorMatrix {
   size_t rows = 0;            // frames
@@ -35,6 +35,6 @@ StatusOr<DescriptorMatrix> ParseDescriptors(const std::string& bytes, const std:
 // Writes `m` as a version 1.0 .npy of '<f4' (what numpy.save writes for a float32 array).
 Status WriteDescriptorNpy(const DescriptorMatrix& m, const std::string& path);
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset
 
 #endif  // RATSLAM_DATASET_DESCRIPTOR_FILE_H_

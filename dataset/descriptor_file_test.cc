@@ -9,7 +9,7 @@
 
 #include "common/scratch_dir.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 namespace {
 
 // A .npy written by hand from NumPy's format description: magic, version, header length, the
@@ -138,4 +138,4 @@ TEST(DescriptorFileTest, MissingFileAndFolderAreErrors) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::dataset

@@ -8,7 +8,7 @@
 #include "dataset/rosbag2.h"
 #include "dataset/video.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 
 FileImageLoader::FileImageLoader()
     : bags_(std::make_unique<BagImageReader>()),
@@ -45,4 +45,4 @@ StatusOr<GrayImage> FileImageLoader::Load(const std::string& path) {
   return image;
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset

@@ -11,7 +11,7 @@
 #include "common/gray_image.h"
 #include "common/status.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 
 class BagImageReader;
 class Ros2ImageReader;
@@ -33,6 +33,6 @@ class FileImageLoader : public ImageLoader {
   std::unique_ptr<VideoFrameReader> videos_;
 };
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset
 
 #endif  // RATSLAM_DATASET_IMAGE_LOADER_H_

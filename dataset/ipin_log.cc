@@ -13,7 +13,7 @@
 #include "common/circular.h"
 #include "common/text_file.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 namespace {
 
 constexpr double kEarthRadiusM = 6371008.8;  // mean Earth radius (IUGG)
@@ -227,4 +227,4 @@ StatusOr<PhoneLog> ParseIpinLog(const std::string& path, const PhoneLogOptions& 
   return PhoneLog{std::filesystem::path(path).stem().string(), first_time, std::move(streams)};
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset

@@ -17,7 +17,7 @@
 #include "dataset/dataset.h"
 #include "dataset/phone_log.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 
 // Local east/north metres of a latitude/longitude about `reference` (equirectangular; exact to
 // millimetres over a building).
@@ -32,6 +32,6 @@ StatusOr<PhoneLog> ParseIpinLog(const std::string& path, const PhoneLogOptions& 
 StatusOr<Dataset> ReadIpinLog(const std::string& path, const PhoneLogOptions& options,
                               PhoneLogReport* report = nullptr);
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset
 
 #endif  // RATSLAM_DATASET_IPIN_LOG_H_

@@ -12,7 +12,7 @@
 #include "common/scratch_dir.h"
 #include "dataset/dataset_loader.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 namespace {
 
 // One fresh folder per test process (two checkouts testing at once never collide).
@@ -252,4 +252,4 @@ TEST(IpinLogTest, BadDeadReckoningOptionsFailBeforeTheFileIsRead) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::dataset

@@ -13,7 +13,7 @@
 
 #include "common/text_file.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 namespace {
 
 constexpr uint8_t kMagic[8] = {0x89, 'M', 'C', 'A', 'P', '0', '\r', '\n'};
@@ -612,4 +612,4 @@ StatusOr<std::vector<uint8_t>> McapReader::Payload(const McapMessage& m) {
                               r.begin() + static_cast<ptrdiff_t>(m.data_offset + m.data_size));
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset

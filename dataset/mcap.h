@@ -19,7 +19,7 @@
 
 #include "common/status.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 
 // Whether the file starts with MCAP's magic (0x89 "MCAP0\r\n").
 bool LooksLikeMcap(const std::string& path);
@@ -86,6 +86,6 @@ class McapReader {
   std::vector<uint8_t> cached_records_;
 };
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset
 
 #endif  // RATSLAM_DATASET_MCAP_H_

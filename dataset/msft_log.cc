@@ -11,7 +11,7 @@
 
 #include "common/circular.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 namespace {
 
 constexpr double kMaxTimeMs = 1e15;    // epoch milliseconds (year 2001 is 1e12)
@@ -164,4 +164,4 @@ StatusOr<PhoneLog> ParseMicrosoftLog(const std::string& path, const PhoneLogOpti
   return PhoneLog{std::filesystem::path(path).stem().string(), 0.0, std::move(streams)};
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset

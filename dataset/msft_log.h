@@ -15,7 +15,7 @@
 #include "dataset/dataset.h"
 #include "dataset/phone_log.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 
 // Floor number of a FloorName such as "B2", "F1", "F3"; nullopt for anything else.
 std::optional<int> FloorFromName(const std::string& name);
@@ -33,6 +33,6 @@ StatusOr<Dataset> ReadMicrosoftLog(const std::string& path, const PhoneLogOption
                                    PhoneLogReport* report = nullptr,
                                    double max_wifi_staleness_s = 10.0);
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset
 
 #endif  // RATSLAM_DATASET_MSFT_LOG_H_

@@ -9,7 +9,7 @@
 #include "common/scratch_dir.h"
 #include "dataset/dataset_loader.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 namespace {
 
 // One fresh folder per test process (two checkouts testing at once never collide).
@@ -109,4 +109,4 @@ TEST(MicrosoftLogTest, RealWalkHasWifiAndWaypoints) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::dataset

@@ -9,7 +9,7 @@
 
 #include "dataset/image_loader.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 
 inline StatusOr<GrayImage> GrayFromMat(const cv::Mat& mat, const std::string& where) {
   if (mat.empty()) return Status::Error(where + ": cannot decode image");
@@ -35,6 +35,6 @@ inline StatusOr<GrayImage> GrayFromMat(const cv::Mat& mat, const std::string& wh
   return image;
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset
 
 #endif  // RATSLAM_DATASET_OPENCV_GRAY_H_

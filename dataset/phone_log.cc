@@ -9,7 +9,7 @@
 #include "dataset/ipin_log.h"
 #include "dataset/msft_log.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 namespace {
 
 Status CheckOptions(const PhoneLogOptions& options) {
@@ -111,4 +111,4 @@ StatusOr<Dataset> ReadMicrosoftLog(const std::string& path, const PhoneLogOption
   return PhoneLogToDataset(std::move(*log), options, report);
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset

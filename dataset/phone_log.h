@@ -16,7 +16,7 @@
 #include "dataset/dataset.h"
 #include "sensors/pedestrian_dead_reckoning.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 
 // The point local metres are measured from (IPIN logs carry latitude and longitude).
 struct GeoReference {
@@ -72,6 +72,6 @@ StatusOr<Dataset> PhoneLogToDataset(PhoneLog log, const PhoneLogOptions& options
 // one row per step carrying its length and heading change over the time since the previous row.
 std::vector<OdometryRow> StepsToOdometry(const std::vector<Step>& steps, double start_time_s);
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset
 
 #endif  // RATSLAM_DATASET_PHONE_LOG_H_

@@ -4,7 +4,7 @@
 
 #include <cstring>
 
-namespace ratslam {
+namespace ratslam::dataset {
 namespace {
 
 class CdrReader {
@@ -189,4 +189,4 @@ StatusOr<Ros2Imu> DecodeRos2Imu(const uint8_t* data, size_t size, const std::str
   return m;
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset

@@ -14,7 +14,7 @@
 
 #include "common/status.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 
 // builtin_interfaces/msg/Time
 struct Ros2Time {
@@ -79,6 +79,6 @@ StatusOr<Ros2PoseStamped> DecodeRos2PoseStamped(const uint8_t* data, size_t size
                                                 const std::string& where);
 StatusOr<Ros2Imu> DecodeRos2Imu(const uint8_t* data, size_t size, const std::string& where);
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset
 
 #endif  // RATSLAM_DATASET_ROS2_MESSAGES_H_

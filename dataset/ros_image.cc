@@ -8,7 +8,7 @@
 
 #include "dataset/opencv_gray.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 namespace {
 
 // The raw image as an OpenCV matrix in BGR(A) or grey, after checking its size fields.
@@ -104,4 +104,4 @@ StatusOr<EncodedImage> PngFromRawImage(const RawImageView& image, const std::str
   return out;
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset

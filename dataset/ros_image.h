@@ -12,7 +12,7 @@
 #include "dataset/image_loader.h"
 #include "dataset/rosbag.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 
 // A sensor_msgs Image's fields (the same in ROS 1 and ROS 2); `data` is not owned.
 struct RawImageView {
@@ -39,6 +39,6 @@ std::string CompressedImageExtension(const uint8_t* data, size_t size, std::stri
 // A raw image as a lossless grey PNG.
 StatusOr<EncodedImage> PngFromRawImage(const RawImageView& image, const std::string& where);
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset
 
 #endif  // RATSLAM_DATASET_ROS_IMAGE_H_

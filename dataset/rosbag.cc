@@ -29,7 +29,7 @@
 #include "dataset/ros_image.h"
 #include "dataset/rosbag_check.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 namespace fs = std::filesystem;
 
 namespace {
@@ -466,4 +466,4 @@ Status WriteRosbag(const Dataset& dataset, ImageLoader* images, const BagTopics&
   return Status::Ok();
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset

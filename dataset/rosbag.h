@@ -22,7 +22,7 @@
 #include "dataset/dataset.h"
 #include "dataset/image_loader.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 
 // Which topics of a bag make the data set ([bag] in the configuration). An empty topic means
 // "the bag's only topic of that type".
@@ -102,6 +102,6 @@ class BagImageReader {
 Status WriteRosbag(const Dataset& dataset, ImageLoader* images, const BagTopics& topics,
                    const std::string& path, uint32_t time_offset_s = 1000000000);
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset
 
 #endif  // RATSLAM_DATASET_ROSBAG_H_

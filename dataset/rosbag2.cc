@@ -20,7 +20,7 @@
 #include "dataset/ros2_messages.h"
 #include "dataset/ros_image.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 namespace fs = std::filesystem;
 
 namespace {
@@ -562,4 +562,4 @@ StatusOr<EncodedImage> Ros2ImageReader::Encoded(const std::string& reference) {
   return out;
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset

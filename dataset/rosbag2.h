@@ -23,7 +23,7 @@
 #include "dataset/image_loader.h"
 #include "dataset/rosbag.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 
 // An MCAP file, an SQLite file, or a folder holding metadata.yaml.
 bool LooksLikeRos2Bag(const std::string& path);
@@ -51,6 +51,6 @@ class Ros2ImageReader {
   std::unique_ptr<Impl> impl_;
 };
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset
 
 #endif  // RATSLAM_DATASET_ROSBAG2_H_

@@ -20,7 +20,7 @@
 #include "dataset/mcap.h"
 #include "dataset/ros2_messages.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 namespace {
 namespace fs = std::filesystem;
 
@@ -324,4 +324,4 @@ TEST_F(Rosbag2Test, NotABagAndBrokenFoldersAreNamed) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::dataset

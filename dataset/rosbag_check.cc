@@ -16,7 +16,7 @@
 #include <tuple>
 #include <vector>
 
-namespace ratslam {
+namespace ratslam::dataset {
 namespace {
 namespace fs = std::filesystem;
 
@@ -356,4 +356,4 @@ Status CheckRosbagStructure(const std::string& path) {
   return Status::Ok();
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset

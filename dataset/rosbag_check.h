@@ -8,7 +8,7 @@
 
 #include "common/status.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 
 // Walks every record: the bag header first, chunks (decompressed: none, bz2, lz4) holding
 // connection and message records, then at index_pos exactly conn_count connection records and
@@ -19,6 +19,6 @@ namespace ratslam {
 // A bag that passed is remembered by path, size and modification time.
 Status CheckRosbagStructure(const std::string& path);
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset
 
 #endif  // RATSLAM_DATASET_ROSBAG_CHECK_H_

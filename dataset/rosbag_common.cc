@@ -10,7 +10,7 @@
 #include "dataset/bag_common.h"
 #include "dataset/rosbag.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 namespace {
 
 std::string Quoted(const std::set<std::string>& names) {
@@ -234,4 +234,4 @@ bool ParseBagImageReference(const std::string& path, std::string* bag, uint64_t*
   return true;
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset

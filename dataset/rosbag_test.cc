@@ -20,7 +20,7 @@
 
 #include "dataset/dataset_loader.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 namespace {
 namespace fs = std::filesystem;
 
@@ -389,4 +389,4 @@ TEST(BagImageReference, SplitsAtTheLastHashAfterDotBag) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::dataset

@@ -1,7 +1,7 @@
 // A build without librosbag-storage-dev: every bag operation says how to get it.
 #include "dataset/rosbag.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 namespace {
 Status Unavailable(const std::string& what) {
   return Status::Error(what +
@@ -31,4 +31,4 @@ Status WriteRosbag(const Dataset&, ImageLoader*, const BagTopics&, const std::st
   return Unavailable(path);
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset

@@ -11,7 +11,7 @@
 #include "common/file_util.h"
 #include "common/random.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
@@ -234,4 +234,4 @@ StatusOr<Dataset> WriteSyntheticDataset(const SyntheticOptions& o, const std::st
   return d;
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset

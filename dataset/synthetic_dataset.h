@@ -13,7 +13,7 @@
 #include "common/status.h"
 #include "dataset/dataset.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 
 struct SyntheticOptions {
   uint64_t seed = 1;                // the world (pillars), and the noise unless noise_seed is set
@@ -45,6 +45,6 @@ struct SyntheticOptions {
 // Generates the data set and writes it, with its PNG images, into `folder`.
 StatusOr<Dataset> WriteSyntheticDataset(const SyntheticOptions& options, const std::string& folder);
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset
 
 #endif  // RATSLAM_DATASET_SYNTHETIC_DATASET_H_

@@ -10,7 +10,7 @@
 
 #include "common/text_file.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 namespace {
 
 namespace fs = std::filesystem;
@@ -334,4 +334,4 @@ StatusOr<std::vector<LabelledScan>> ReadUjiLongTermSet(const std::string& path, 
   return scans;
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset

@@ -28,7 +28,7 @@
 #include "common/status.h"
 #include "dataset/ujiindoorloc.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 
 struct UjiLongTermFiles {
   std::string rss, crd, tms, ids;  // tms and ids empty when absent
@@ -56,6 +56,6 @@ StatusOr<std::vector<LabelledScan>> ReadUjiLongTermSet(const std::string& path,
                                                        bool lenient = false,
                                                        UjiLongTermReport* report = nullptr);
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset
 
 #endif  // RATSLAM_DATASET_UJI_LONG_TERM_H_

@@ -7,7 +7,7 @@
 
 #include "common/scratch_dir.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 namespace {
 
 namespace fs = std::filesystem;
@@ -178,4 +178,4 @@ TEST(UjiLongTermTest, LenientSkipsBadRowsAndKeepsTheOthersAligned) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::dataset

@@ -7,7 +7,7 @@
 
 #include "common/text_file.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 namespace {
 
 constexpr double kNotDetected = 100.0;
@@ -137,4 +137,4 @@ StatusOr<std::vector<LabelledScan>> ReadUjiIndoorLoc(const std::string& path, bo
   return scans;
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset

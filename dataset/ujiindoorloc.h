@@ -11,7 +11,7 @@
 #include "common/status.h"
 #include "dataset/dataset.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 
 struct LabelledScan {
   std::vector<WifiReading> readings;  // detected APs only (bssid = the column name)
@@ -35,6 +35,6 @@ struct UjiReadReport {
 StatusOr<std::vector<LabelledScan>> ReadUjiIndoorLoc(const std::string& path, bool lenient = false,
                                                      UjiReadReport* report = nullptr);
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset
 
 #endif  // RATSLAM_DATASET_UJIINDOORLOC_H_

@@ -7,7 +7,7 @@
 
 #include "common/scratch_dir.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 namespace {
 
 // One fresh folder per test process (two checkouts testing at once never collide).
@@ -93,4 +93,4 @@ TEST(UjiIndoorLocTest, RealTrainingFile) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::dataset

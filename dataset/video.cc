@@ -18,7 +18,7 @@
 #include "dataset/opencv_gray.h"
 #include "dataset/rosbag.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 namespace fs = std::filesystem;
 
 namespace {
@@ -307,4 +307,4 @@ Status WriteVideo(const Dataset& dataset, ImageLoader* images, const std::string
   return Status::Ok();
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset

@@ -17,7 +17,7 @@
 #include "dataset/dataset.h"
 #include "dataset/image_loader.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 
 // [video] in the configuration: how a video's frames get times and odometry.
 struct VideoOptions {
@@ -72,6 +72,6 @@ class VideoFrameReader {
 Status WriteVideo(const Dataset& dataset, ImageLoader* images, const std::string& path,
                   double rate_hz);
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset
 
 #endif  // RATSLAM_DATASET_VIDEO_H_

@@ -11,7 +11,7 @@
 
 #include "dataset/dataset_loader.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 namespace {
 namespace fs = std::filesystem;
 
@@ -130,4 +130,4 @@ TEST_F(VideoTest, BadLogsAndFilesAreErrorsNamingFileLineAndColumn) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::dataset

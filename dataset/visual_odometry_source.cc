@@ -1,6 +1,6 @@
 #include "dataset/visual_odometry_source.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 
 Status ReplaceOdometryWithVisual(Dataset* dataset, ImageLoader* images,
                                  const VisualOdometryOptions& options) {
@@ -45,4 +45,4 @@ Status ReplaceOdometryWithVisual(Dataset* dataset, ImageLoader* images,
   return Status::Ok();
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset

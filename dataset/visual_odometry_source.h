@@ -8,12 +8,12 @@
 #include "dataset/image_loader.h"
 #include "sensors/visual_odometry.h"
 
-namespace ratslam {
+namespace ratslam::dataset {
 
 // One odometry row per image (the first at rest). Errors name images.csv's line.
 Status ReplaceOdometryWithVisual(Dataset* dataset, ImageLoader* images,
                                  const VisualOdometryOptions& options);
 
-}  // namespace ratslam
+}  // namespace ratslam::dataset
 
 #endif  // RATSLAM_DATASET_VISUAL_ODOMETRY_SOURCE_H_

@@ -122,11 +122,11 @@ class CustomFrontEndTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = new ScratchDir("ratslam_custom_front_end");
-    SyntheticOptions o;
+    dataset::SyntheticOptions o;
     o.laps = 2;
-    StatusOr<Dataset> d = WriteSyntheticDataset(o, dir_->path().string());
+    StatusOr<dataset::Dataset> d = dataset::WriteSyntheticDataset(o, dir_->path().string());
     ASSERT_TRUE(d.ok()) << d.status().message();
-    dataset_ = new Dataset(std::move(d).value());
+    dataset_ = new dataset::Dataset(std::move(d).value());
     dataset_->folder = dir_->path().string();
   }
   static void TearDownTestSuite() {
@@ -144,15 +144,15 @@ class CustomFrontEndTest : public ::testing::Test {
     return r;
   }
   static ScratchDir* dir_;
-  static Dataset* dataset_;
+  static dataset::Dataset* dataset_;
 };
 ScratchDir* CustomFrontEndTest::dir_ = nullptr;
-Dataset* CustomFrontEndTest::dataset_ = nullptr;
+dataset::Dataset* CustomFrontEndTest::dataset_ = nullptr;
 
 // The pipeline applies the custom front end's decisions: its re-visits become loop closures at
 // places that truly repeat (ground truth, which the front end never sees).
 TEST_F(CustomFrontEndTest, RevisitsCloseLoopsAtTrulyRepeatedPlaces) {
-  FileImageLoader images;
+  dataset::FileImageLoader images;
   ReplayPipeline pipeline(Options(), *dataset_, &images, Resources());
   ASSERT_TRUE(pipeline.Run({}).ok());
   const auto& frames = pipeline.state().frames;
@@ -167,8 +167,9 @@ TEST_F(CustomFrontEndTest, RevisitsCloseLoopsAtTrulyRepeatedPlaces) {
     }
     if (f.recent) continue;
     ++revisits;
-    const auto now = InterpolateGroundTruth(dataset_->ground_truth, f.time_s);
-    const auto then = InterpolateGroundTruth(dataset_->ground_truth, created_s[f.template_id]);
+    const auto now = dataset::InterpolateGroundTruth(dataset_->ground_truth, f.time_s);
+    const auto then =
+        dataset::InterpolateGroundTruth(dataset_->ground_truth, created_s[f.template_id]);
     ASSERT_TRUE(now && then);
     if (std::hypot(now->x_m - then->x_m, now->y_m - then->y_m) < 3.0) ++near;
   }
@@ -183,7 +184,7 @@ TEST_F(CustomFrontEndTest, RevisitsCloseLoopsAtTrulyRepeatedPlaces) {
 // Snapshot and Restore go through EncodeState, DecodeState and the factory: a run stopped
 // halfway and restored into a new pipeline ends where an uninterrupted run ends.
 TEST_F(CustomFrontEndTest, RestoredRunEndsWhereAnUninterruptedRunEnds) {
-  FileImageLoader images;
+  dataset::FileImageLoader images;
   ReplayPipeline whole(Options(), *dataset_, &images, Resources());
   ASSERT_TRUE(whole.Run({}).ok());
   ReplayPipeline first(Options(), *dataset_, &images, Resources());
@@ -210,7 +211,7 @@ TEST_F(CustomFrontEndTest, RestoredRunEndsWhereAnUninterruptedRunEnds) {
 }
 
 TEST_F(CustomFrontEndTest, CustomKindWithoutAFactoryIsRefused) {
-  FileImageLoader images;
+  dataset::FileImageLoader images;
   EXPECT_THROW(ReplayPipeline(Options(), *dataset_, &images), std::invalid_argument);
 }
 

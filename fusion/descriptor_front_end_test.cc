@@ -12,8 +12,8 @@ namespace {
 
 // Images at times 0, 1, 2, ... with the given descriptors.
 struct Fixture {
-  Dataset dataset;
-  DescriptorMatrix matrix;
+  dataset::Dataset dataset;
+  dataset::DescriptorMatrix matrix;
 };
 Fixture Make(const std::vector<std::vector<float>>& rows) {
   Fixture f;

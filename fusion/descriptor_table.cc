@@ -27,7 +27,8 @@ bool UnitDescriptor(const float* values, size_t n, std::vector<float>* unit) {
 }
 
 StatusOr<std::shared_ptr<const DescriptorTable>> DescriptorTable::Make(
-    const DescriptorMatrix& matrix, const Dataset& dataset, const std::string& name) {
+    const dataset::DescriptorMatrix& matrix, const dataset::Dataset& dataset,
+    const std::string& name) {
   if (matrix.rows != dataset.images.size()) {
     return Status::Error(name + ": " + std::to_string(matrix.rows) +
                          " descriptors, but data set '" + dataset.name + "' has " +

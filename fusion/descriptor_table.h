@@ -54,9 +54,9 @@ class DescriptorTable {
   // Row i of `matrix` belongs to `dataset.images[i]`; `name` (the file) is for messages. Fails
   // when the counts differ, a row is all zeros (no direction, so no cosine), or two images share
   // a time with different descriptors.
-  static StatusOr<std::shared_ptr<const DescriptorTable>> Make(const DescriptorMatrix& matrix,
-                                                               const Dataset& dataset,
-                                                               const std::string& name);
+  static StatusOr<std::shared_ptr<const DescriptorTable>> Make(
+      const dataset::DescriptorMatrix& matrix, const dataset::Dataset& dataset,
+      const std::string& name);
 
   size_t dimensions() const { return dimensions_; }
   size_t size() const { return times_s_.size(); }

@@ -365,7 +365,7 @@ std::unique_ptr<FrontEnd> MakeFabmapFrontEnd(const FabmapSettings& settings,
 }  // namespace front_end_internal
 
 StatusOr<std::shared_ptr<const FabmapResources>> PrepareFabmapResources(
-    const FrontEndSettings& settings, const Dataset& dataset,
+    const FrontEndSettings& settings, const dataset::Dataset& dataset,
     std::optional<fabmap::TrainedVisualModel> visual) {
   const FabmapSettings& f = settings.fabmap;
   std::string error;

@@ -30,7 +30,7 @@ std::string ToString(FrontEndKind kind) {
 namespace {
 
 // A shipped config (configs/) for the streams a data set has.
-std::string ConfigThatFits(const Dataset& d) {
+std::string ConfigThatFits(const dataset::Dataset& d) {
   const bool images = !d.images.empty(), wifi = !d.wifi.empty(), compass = !d.compass.empty();
   if (images && wifi && compass) return "configs/sim-fused.toml (camera, Wi-Fi and compass)";
   if (images) return "configs/synthetic.toml (the classic camera front end)";
@@ -41,7 +41,7 @@ std::string ConfigThatFits(const Dataset& d) {
 
 }  // namespace
 
-Status CheckFrontEndInputs(const FrontEndSettings& settings, const Dataset& dataset) {
+Status CheckFrontEndInputs(const FrontEndSettings& settings, const dataset::Dataset& dataset) {
   const FrontEndKind kind = settings.front_end.kind;
   bool camera = kind == FrontEndKind::kClassicCamera || kind == FrontEndKind::kDescriptors,
        wifi = false, compass = false;

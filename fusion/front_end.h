@@ -165,7 +165,7 @@ struct FrontEndResources {
 // exploration of every scan (with odometry travel) when the mode uses Wi-Fi. Reads no file.
 // Fails on invalid settings, a missing visual model or an unusable mode.
 StatusOr<std::shared_ptr<const FabmapResources>> PrepareFabmapResources(
-    const FrontEndSettings& settings, const Dataset& dataset,
+    const FrontEndSettings& settings, const dataset::Dataset& dataset,
     std::optional<fabmap::TrainedVisualModel> visual);
 
 // Fails, before any work, when `dataset` lacks a stream the front end needs: images for a
@@ -173,7 +173,7 @@ StatusOr<std::shared_ptr<const FabmapResources>> PrepareFabmapResources(
 // scans for Wi-Fi (fused use_wifi, FABMAP modes with Wi-Fi), a heading stream for the compass
 // (fused use_compass). The message names the front end, the missing stream and a shipped config
 // that fits the streams the data set has.
-Status CheckFrontEndInputs(const FrontEndSettings& settings, const Dataset& dataset);
+Status CheckFrontEndInputs(const FrontEndSettings& settings, const dataset::Dataset& dataset);
 
 // kFabmap needs resources.fabmap and kCustom resources.custom
 // (returning a front end); without them it throws std::invalid_argument, like the pipeline does

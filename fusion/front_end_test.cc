@@ -129,7 +129,7 @@ TEST(FrontEndTest, WifiOnlyMakesFramesFromScansAndStateRoundTrips) {
 
 // Each front end names the stream it lacks, and the suggested config fits what the data has.
 TEST(FrontEndTest, MissingInputStreamsAreNamedWithAConfigThatFits) {
-  Dataset phone;  // an IPIN log: scans and headings, no images
+  dataset::Dataset phone;  // an IPIN log: scans and headings, no images
   phone.name = "phone";
   phone.wifi.push_back({1.0, {{"ap", -50.0}}});
   phone.compass.push_back({1.0, 0.0});
@@ -144,14 +144,14 @@ TEST(FrontEndTest, MissingInputStreamsAreNamedWithAConfigThatFits) {
   wifi_compass.front_end.kind = FrontEndKind::kFused;
   wifi_compass.fused.use_compass = true;
   EXPECT_TRUE(CheckFrontEndInputs(wifi_compass, phone).ok());
-  Dataset no_compass = phone;
+  dataset::Dataset no_compass = phone;
   no_compass.compass.clear();
   s = CheckFrontEndInputs(wifi_compass, no_compass);
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.message().find("a compass (heading) stream"), std::string::npos) << s.message();
   EXPECT_NE(s.message().find("configs/ipin2023-wifi.toml"), std::string::npos) << s.message();
 
-  Dataset camera_only;
+  dataset::Dataset camera_only;
   camera_only.name = "loop";
   camera_only.images.push_back({0.0, "0.png"});
   FrontEndSettings fabmap_wifi;
@@ -199,8 +199,8 @@ FrontEndSettings FabmapWifiSettings() {
 }
 
 // The corridor walked twice (scans and odometry every 2 s), the second lap noisier.
-Dataset CorridorTwoLaps() {
-  Dataset data;
+dataset::Dataset CorridorTwoLaps() {
+  dataset::Dataset data;
   for (int lap = 0; lap < 2; ++lap) {
     for (int i = 0; i < 40; ++i) {
       const double t = lap * 100.0 + i * 2.0;
@@ -229,7 +229,7 @@ struct TwoLapRun {
   int cross_lap = 0;
 };
 TwoLapRun RunTwoLaps(const FrontEndSettings& settings) {
-  const Dataset data = CorridorTwoLaps();
+  const dataset::Dataset data = CorridorTwoLaps();
   TwoLapRun run;
   auto resources = PrepareFabmapResources(settings, data, std::nullopt);
   EXPECT_TRUE(resources.ok());
@@ -257,7 +257,7 @@ TwoLapRun RunTwoLaps(const FrontEndSettings& settings) {
 
 TEST(FabmapFrontEndTest, SecondLapRecognisesTheFirstLapsPlaces) {
   FrontEndSettings settings = FabmapWifiSettings();
-  Dataset data;
+  dataset::Dataset data;
   std::vector<double> x_of_scan;
   for (int lap = 0; lap < 2; ++lap) {
     for (int i = 0; i < 40; ++i) {
@@ -342,7 +342,7 @@ TEST(FabmapFrontEndTest, BarometerKeepsPlacesOnTheirFloor) {
     if (!r.front_end) return -1;
     const std::unique_ptr<FrontEnd>& f = r.front_end;
     const int cross_floor = r.cross_lap;
-    const Dataset data = CorridorTwoLaps();
+    const dataset::Dataset data = CorridorTwoLaps();
     auto resources = PrepareFabmapResources(settings, data, std::nullopt);
     if (state) *state = f->EncodeState();
     if (barometer) {
@@ -366,7 +366,7 @@ TEST(FabmapFrontEndTest, VisionWithoutAModelIsAClearError) {
   FrontEndSettings settings;
   settings.front_end.kind = FrontEndKind::kFabmap;
   settings.fabmap.localiser.localiser.mode = fabmap::FabmapMode::kVision;
-  const auto resources = PrepareFabmapResources(settings, Dataset{}, std::nullopt);
+  const auto resources = PrepareFabmapResources(settings, dataset::Dataset{}, std::nullopt);
   ASSERT_FALSE(resources.ok());
   EXPECT_NE(resources.status().message().find("visual_model"), std::string::npos);
 }
@@ -474,7 +474,7 @@ TEST(FusedFrontEndTest, LocalisingPrefersTheMapsTemplates) {
 // first walk's words again and re-visit its places; the estimate is part of the state.
 TEST(FabmapFrontEndTest, OnlineRssiOffsetBridgesTwoPhones) {
   constexpr double kShiftDb = -15.0;
-  Dataset data;
+  dataset::Dataset data;
   std::vector<double> x_of_scan;
   for (int session = 0; session < 2; ++session) {
     for (int i = 0; i < 40; ++i) {

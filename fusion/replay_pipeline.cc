@@ -85,12 +85,12 @@ const PipelineOptions& Validated(const PipelineOptions& options) {
 }
 }  // namespace
 
-ReplayPipeline::ReplayPipeline(const PipelineOptions& options, const Dataset& dataset,
+ReplayPipeline::ReplayPipeline(const PipelineOptions& options, const dataset::Dataset& dataset,
                                ImageLoader* images, FrontEndResources resources)
     : options_(Validated(options)),
       dataset_(dataset),
       images_(images),
-      events_(MergeEvents(dataset)),
+      events_(dataset::MergeEvents(dataset)),
       slam_(std::make_unique<Ratslam>(options.ratslam)),
       resources_(std::move(resources)),
       front_end_(CreateFrontEnd(options.sensors, resources_)),
@@ -103,23 +103,23 @@ Status ReplayPipeline::Run(const ReplayControl& control) {
   progress.events_total = events_.size();
   while (state_.next_event < events_.size()) {
     if (control.stop_requested && control.stop_requested->load()) break;
-    const Event& event = events_[state_.next_event];
+    const dataset::Event& event = events_[state_.next_event];
     if (event.time_s > control.until_time_s) break;
     Status status;
     switch (event.type) {
-      case EventType::kOdometry:
+      case dataset::EventType::kOdometry:
         status = HandleOdometry(event);
         break;
-      case EventType::kImage:
+      case dataset::EventType::kImage:
         status = HandleImage(event);
         break;
-      case EventType::kWifi:
+      case dataset::EventType::kWifi:
         status = HandleWifi(event);
         break;
-      case EventType::kCompass:
+      case dataset::EventType::kCompass:
         FeedCompass(dataset_.compass[event.index]);
         break;
-      case EventType::kPressure:
+      case dataset::EventType::kPressure:
         status = HandlePressure(event);
         break;
     }
@@ -146,7 +146,7 @@ Status ReplayPipeline::Run(const ReplayControl& control) {
   return Status::Ok();
 }
 
-Status ReplayPipeline::HandleOdometry(const Event& event) {
+Status ReplayPipeline::HandleOdometry(const dataset::Event& event) {
   return FeedOdometry(dataset_.odometry[event.index]);
 }
 
@@ -181,7 +181,7 @@ Status ReplayPipeline::FeedOdometry(const OdometryRow& row) {
   return Status::Ok();
 }
 
-Status ReplayPipeline::HandleImage(const Event& event) {
+Status ReplayPipeline::HandleImage(const dataset::Event& event) {
   if (!front_end_->WantsImages()) {
     ++state_.images_skipped;
     return Status::Ok();
@@ -222,13 +222,13 @@ void ReplayPipeline::AnnounceSession(double time_s) {
   }
 }
 
-Status ReplayPipeline::HandleWifi(const Event& event) {
+Status ReplayPipeline::HandleWifi(const dataset::Event& event) {
   const WifiScan& scan = dataset_.wifi[event.index];
   AnnounceSession(scan.time_s);
   return FeedWifi(scan);
 }
 
-Status ReplayPipeline::HandlePressure(const Event& event) {
+Status ReplayPipeline::HandlePressure(const dataset::Event& event) {
   const PressureSample& sample = dataset_.pressure[event.index];
   AnnounceSession(sample.time_s);
   return FeedPressure(sample).WithContext("pressure.csv row " + std::to_string(event.index + 1));

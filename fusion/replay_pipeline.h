@@ -38,8 +38,9 @@ struct PipelineOptions {
   RatslamOptions ratslam;
   WifiSequenceOptions wifi_sequence;     // Wi-Fi sequence loop closure beside the front end
   fabmap::EvaluationOptions evaluation;  // `ratslam evaluate` only: how map and queries split
-  BagTopics bag;       // which topics of a ROS bag make the data set (not part of a map's identity)
-  VideoOptions video;  // how a video's frames get times and odometry (ditto)
+  dataset::BagTopics
+      bag;  // which topics of a ROS bag make the data set (not part of a map's identity)
+  dataset::VideoOptions video;  // how a video's frames get times and odometry (ditto)
 
   bool IsValid(std::string* error) const;
   // [sequence] recognise_views needs a front end that takes camera frames.
@@ -121,8 +122,8 @@ class ReplayPipeline {
   // `options` must be valid; throws std::invalid_argument otherwise. `dataset` and `images`
   // must outlive the pipeline.
   // The FABMAP, descriptor and custom front ends also need their `resources` (CreateFrontEnd).
-  ReplayPipeline(const PipelineOptions& options, const Dataset& dataset, ImageLoader* images,
-                 FrontEndResources resources = {});
+  ReplayPipeline(const PipelineOptions& options, const dataset::Dataset& dataset,
+                 ImageLoader* images, FrontEndResources resources = {});
 
   // Replays events from the current position until the data set ends, `until_time_s` passes, or
   // a stop is requested. On an error the state stays valid up to the last complete event.
@@ -163,7 +164,7 @@ class ReplayPipeline {
   Status AdoptMap(const State& map, double lost_after_m);
   bool localising() const { return slam_->frozen(); }
   const std::vector<LocalisationRecord>& localisation() const { return localisation_; }
-  const std::vector<Event>& events() const { return events_; }
+  const std::vector<dataset::Event>& events() const { return events_; }
   // Wi-Fi sequence loop closure (its poses, loops and similarity), whether enabled or not.
   const WifiSequenceLoopCloser& wifi_sequence() const { return *wifi_sequence_; }
   // The map's current estimate of a loop-closer pose: its anchor experience composed with the
@@ -185,19 +186,19 @@ class ReplayPipeline {
   std::optional<int> template_floor(uint32_t id) const { return front_end_->TemplateFloor(id); }
 
  private:
-  Status HandleOdometry(const Event& event);
-  Status HandleImage(const Event& event);
-  Status HandleWifi(const Event& event);
-  Status HandlePressure(const Event& event);
+  Status HandleOdometry(const dataset::Event& event);
+  Status HandleImage(const dataset::Event& event);
+  Status HandleWifi(const dataset::Event& event);
+  Status HandlePressure(const dataset::Event& event);
   void AnnounceSession(double time_s);
   Status Apply(const FrameDecision& decision);
   Status AddSequencePose(const WifiScan& scan);
   Status LinkLoop(const std::optional<SequenceLoop>& loop, double time_s);
 
   PipelineOptions options_;
-  const Dataset& dataset_;
+  const dataset::Dataset& dataset_;
   ImageLoader* images_;
-  std::vector<Event> events_;
+  std::vector<dataset::Event> events_;
   std::unique_ptr<Ratslam> slam_;
   FrontEndResources resources_;
   std::unique_ptr<FrontEnd> front_end_;

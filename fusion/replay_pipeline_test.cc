@@ -15,8 +15,8 @@ namespace {
 // Two laps of a 20 m square at 1 m/s: odometry at 10 Hz, a Wi-Fi scan every 2 s from four access
 // points whose RSSI falls with distance (so the second lap re-matches the first lap's places),
 // and a camera image every second that the Wi-Fi-only front end must skip.
-Dataset SquareLoop() {
-  Dataset d;
+dataset::Dataset SquareLoop() {
+  dataset::Dataset d;
   d.name = "square";
   const double side_m = 20.0, speed = 1.0, rate_hz = 10.0;
   const double lap_s = 4 * side_m / speed;
@@ -71,7 +71,7 @@ class NoImages : public ImageLoader {
 };
 
 TEST(ReplayPipelineTest, SkipsImagesTheFrontEndDoesNotUseAndReportsProgress) {
-  const Dataset data = SquareLoop();
+  const dataset::Dataset data = SquareLoop();
   NoImages images;
   ReplayPipeline pipeline(WifiOptions(), data, &images);
   std::vector<ReplayProgress> reports;
@@ -98,7 +98,7 @@ TEST(ReplayPipelineTest, SkipsImagesTheFrontEndDoesNotUseAndReportsProgress) {
 }
 
 TEST(ReplayPipelineTest, ImageErrorsNameTheRowAndKeepTheStateSoFar) {
-  const Dataset data = SquareLoop();
+  const dataset::Dataset data = SquareLoop();
   NoImages images;
   PipelineOptions options;  // the classic camera wants every image
   ReplayPipeline pipeline(options, data, &images);
@@ -112,7 +112,7 @@ TEST(ReplayPipelineTest, ImageErrorsNameTheRowAndKeepTheStateSoFar) {
 }
 
 TEST(ReplayPipelineTest, CheckpointsRunAtTheirPeriodAndAnErrorStopsTheReplay) {
-  const Dataset data = SquareLoop();
+  const dataset::Dataset data = SquareLoop();
   NoImages images;
   ReplayPipeline pipeline(WifiOptions(), data, &images);
   std::vector<uint64_t> at;
@@ -130,7 +130,7 @@ TEST(ReplayPipelineTest, CheckpointsRunAtTheirPeriodAndAnErrorStopsTheReplay) {
 }
 
 TEST(ReplayPipelineTest, StopAndResumeEqualsOneRunForTheFusedFrontEnd) {
-  const Dataset data = SquareLoop();
+  const dataset::Dataset data = SquareLoop();
   NoImages images;
   ReplayPipeline whole(WifiOptions(), data, &images);
   ASSERT_TRUE(whole.Run({}).ok());
@@ -156,7 +156,7 @@ TEST(ReplayPipelineTest, StopAndResumeEqualsOneRunForTheFusedFrontEnd) {
 }
 
 TEST(ReplayPipelineTest, RestoreRefusesStatesThatDoNotFit) {
-  const Dataset data = SquareLoop();
+  const dataset::Dataset data = SquareLoop();
   NoImages images;
   ReplayPipeline pipeline(WifiOptions(), data, &images);
   ReplayControl half;
@@ -206,8 +206,8 @@ TEST(ReplayPipelineTest, RestoreRefusesStatesThatDoNotFit) {
 
 // Two laps of the same 20 m square with 20 access points along it, each heard within 7 m: every
 // stretch of the loop has its own set of APs, which FABMAP's presence words can tell apart.
-Dataset ApLoop() {
-  Dataset d = SquareLoop();
+dataset::Dataset ApLoop() {
+  dataset::Dataset d = SquareLoop();
   const double side = 20.0, lap = 80.0;
   auto position = [&](double along, double* x, double* y) {
     along = std::fmod(along, lap);
@@ -244,7 +244,7 @@ PipelineOptions FabmapWifiOptions(WifiLearning learning) {
 }
 
 // Replays `data` with the FABMAP Wi-Fi front end; returns the frames' decisions.
-std::vector<FrameRecord> FabmapFrames(const Dataset& data, WifiLearning learning,
+std::vector<FrameRecord> FabmapFrames(const dataset::Dataset& data, WifiLearning learning,
                                       std::optional<FabmapLearningReport>* report = nullptr) {
   NoImages images;
   const PipelineOptions options = FabmapWifiOptions(learning);
@@ -271,8 +271,8 @@ bool SameDecisions(const std::vector<FrameRecord>& a, const std::vector<FrameRec
 // at T or goes on. Whole-data-set learning sees the future, and its early decisions change when
 // later scans are added (the test checks that too, so that it can fail).
 TEST(ReplayPipelineTest, OnlineFabmapLearningNeverUsesFutureScans) {
-  Dataset whole = ApLoop();
-  Dataset first_lap = whole;
+  dataset::Dataset whole = ApLoop();
+  dataset::Dataset first_lap = whole;
   // In the second lap the building changed: six new access points are heard everywhere and two
   // old ones are gone. A model that saw those scans differs from one that did not.
   for (WifiScan& scan : whole.wifi) {
@@ -309,7 +309,7 @@ TEST(ReplayPipelineTest, OnlineFabmapLearningNeverUsesFutureScans) {
 }
 
 TEST(ReplayPipelineTest, StopAndResumeEqualsOneRunForOnlineFabmapLearning) {
-  const Dataset data = ApLoop();
+  const dataset::Dataset data = ApLoop();
   NoImages images;
   const PipelineOptions options = FabmapWifiOptions(WifiLearning::kOnline);
   auto resources = PrepareFabmapResources(options.sensors, data, std::nullopt);
@@ -343,7 +343,7 @@ PipelineOptions SequenceOptions(FrontEndKind kind) {
 }
 
 TEST(ReplayPipelineWifiSequenceTest, SequenceLoopClosureAloneLinksTheSecondLapToTheFirst) {
-  const Dataset data = SquareLoop();
+  const dataset::Dataset data = SquareLoop();
   NoImages images;
   ReplayPipeline pipeline(SequenceOptions(FrontEndKind::kNone), data, &images);
   ASSERT_TRUE(pipeline.Run({}).ok());
@@ -370,7 +370,7 @@ TEST(ReplayPipelineWifiSequenceTest, SequenceLoopClosureAloneLinksTheSecondLapTo
 }
 
 TEST(ReplayPipelineWifiSequenceTest, StopAndResumeEqualsOneRun) {
-  const Dataset data = SquareLoop();
+  const dataset::Dataset data = SquareLoop();
   NoImages images;
   const PipelineOptions options = SequenceOptions(FrontEndKind::kFused);
   ReplayPipeline whole(options, data, &images);
@@ -399,7 +399,7 @@ TEST(ReplayPipelineWifiSequenceTest, StopAndResumeEqualsOneRun) {
 }
 
 TEST(ReplayPipelineWifiSequenceTest, RestoreRefusesAPoseAnchoredToAMissingExperience) {
-  const Dataset data = SquareLoop();
+  const dataset::Dataset data = SquareLoop();
   NoImages images;
   const PipelineOptions options = SequenceOptions(FrontEndKind::kNone);
   ReplayPipeline pipeline(options, data, &images);
@@ -420,7 +420,7 @@ namespace ratslam {
 namespace {
 
 TEST(ReplayPipelineWifiSequenceTest, RunsBesideTheFabmapFrontEnd) {
-  const Dataset data = SquareLoop();
+  const dataset::Dataset data = SquareLoop();
   NoImages images;
   PipelineOptions options = FabmapWifiOptions(WifiLearning::kOnline);
   options.wifi_sequence.enabled = true;

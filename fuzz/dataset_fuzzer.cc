@@ -36,7 +36,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::vector<std::string> parts = fuzz::SplitParts(data, size, "\n%%\n");
   const fs::path folder = fuzz::WriteScratchFolder(
       "dataset", parts, {std::begin(fuzz::kFiles), std::end(fuzz::kFiles)});
-  StatusOr<Dataset> d = ReadDataset(folder.string());
+  StatusOr<dataset::Dataset> d = dataset::ReadDataset(folder.string());
   if (!d.ok()) {
     if (d.status().message().rfind(folder.string(), 0) != 0) {
       fuzz::InvariantFailed("error does not name a file of the data set: " + d.status().message());

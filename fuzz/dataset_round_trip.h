@@ -13,16 +13,16 @@
 
 namespace ratslam::fuzz {
 
-inline size_t Readings(const Dataset& d) {
+inline size_t Readings(const dataset::Dataset& d) {
   size_t n = 0;
   for (const WifiScan& s : d.wifi) n += s.readings.size();
   return n;
 }
 
-inline void CheckWritesAndReadsBack(const Dataset& d) {
+inline void CheckWritesAndReadsBack(const dataset::Dataset& d) {
   const std::string folder = (Scratch() / "round_trip").string();
   std::filesystem::remove_all(folder);  // nothing left from the previous input
-  const Status written = WriteDataset(d, folder);
+  const Status written = dataset::WriteDataset(d, folder);
   if (!written.ok()) {
     // Refusing to write a value the reader cannot give back is allowed, and must say so.
     if (written.message().find("cannot be stored") == std::string::npos &&
@@ -31,7 +31,7 @@ inline void CheckWritesAndReadsBack(const Dataset& d) {
     }
     return;
   }
-  StatusOr<Dataset> back = ReadDataset(folder);
+  StatusOr<dataset::Dataset> back = dataset::ReadDataset(folder);
   if (!back.ok())
     InvariantFailed("a written data set does not read back: " + back.status().message());
   if (back->odometry.size() != d.odometry.size() || back->images.size() != d.images.size() ||
@@ -48,9 +48,9 @@ template <typename Reader>
 int FuzzPhoneLog(const uint8_t* data, size_t size, Reader read) {
   const std::string path = WriteScratchFile("log.txt", data, size);
   for (bool lenient : {false, true}) {
-    PhoneLogOptions options;
+    dataset::PhoneLogOptions options;
     options.lenient = lenient;
-    StatusOr<Dataset> d = read(path, options);
+    StatusOr<dataset::Dataset> d = read(path, options);
     if (!d.ok()) {
       if (d.status().message().rfind(path, 0) != 0) {
         InvariantFailed("error does not name the file: " + d.status().message());

@@ -13,9 +13,9 @@
 namespace ratslam::fuzz {
 
 std::vector<std::string> FuzzSeeds() {
-  DescriptorMatrix m{3, 4, {1, 2, 3, 4, 0.5f, -1, 2, 0, 1, 2, 3, 4.5f}};
+  dataset::DescriptorMatrix m{3, 4, {1, 2, 3, 4, 0.5f, -1, 2, 0, 1, 2, 3, 4.5f}};
   const std::string path = (Scratch().path() / "seed.npy").string();
-  (void)WriteDescriptorNpy(m, path);
+  (void)dataset::WriteDescriptorNpy(m, path);
   std::string npy = "n";
   {
     std::FILE* f = std::fopen(path.c_str(), "rb");
@@ -34,7 +34,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size == 0) return 0;
   const bool npy = data[0] == 'n';
   const std::string bytes(reinterpret_cast<const char*>(data) + 1, size - 1);
-  StatusOr<DescriptorMatrix> m = ParseDescriptors(bytes, "fuzz.desc", npy);
+  StatusOr<dataset::DescriptorMatrix> m = dataset::ParseDescriptors(bytes, "fuzz.desc", npy);
   if (!m.ok()) {
     if (m.status().message().find("fuzz.desc") == std::string::npos) {
       fuzz::InvariantFailed("an error that does not name the file");
@@ -48,14 +48,14 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (!std::isfinite(v)) fuzz::InvariantFailed("a non-finite value was accepted");
   }
   const std::string path = (fuzz::Scratch().path() / "round.npy").string();
-  if (!WriteDescriptorNpy(*m, path).ok()) fuzz::InvariantFailed("write failed");
-  StatusOr<DescriptorMatrix> back = ReadDescriptorFile(path);
+  if (!dataset::WriteDescriptorNpy(*m, path).ok()) fuzz::InvariantFailed("write failed");
+  StatusOr<dataset::DescriptorMatrix> back = dataset::ReadDescriptorFile(path);
   if (!back.ok() || back->rows != m->rows || back->cols != m->cols ||
       std::memcmp(back->values.data(), m->values.data(), 4 * m->values.size()) != 0) {
     fuzz::InvariantFailed("npy round trip");
   }
   if (m->rows > 200 || m->cols > 64) return 0;  // the front end on small matrices only
-  Dataset dataset;
+  dataset::Dataset dataset;
   dataset.name = "fuzz";
   for (size_t i = 0; i < m->rows; ++i) dataset.images.push_back({static_cast<double>(i), "x", 0});
   auto table = DescriptorTable::Make(*m, dataset, "fuzz.desc");

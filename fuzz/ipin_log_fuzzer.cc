@@ -34,10 +34,11 @@ std::vector<std::string> FuzzSeeds() {
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   return ratslam::fuzz::FuzzPhoneLog(
-      data, size, [](const std::string& path, const ratslam::PhoneLogOptions& options) {
+      data, size, [](const std::string& path, const ratslam::dataset::PhoneLogOptions& options) {
         // The barometer's floors from whatever PRES lines were accepted: never a crash.
-        ratslam::StatusOr<ratslam::PhoneLog> log = ratslam::ParseIpinLog(path, options);
+        ratslam::StatusOr<ratslam::dataset::PhoneLog> log =
+            ratslam::dataset::ParseIpinLog(path, options);
         if (log.ok()) (void)ratslam::EstimateFloors(log->streams.pressure);
-        return ratslam::ReadIpinLog(path, options);
+        return ratslam::dataset::ReadIpinLog(path, options);
       });
 }

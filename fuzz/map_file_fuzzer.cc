@@ -19,8 +19,8 @@ namespace {
 // Two laps of a 16 m square: odometry 10 Hz, scans every 2 s from four APs, compass 2 Hz, a
 // barometer at 10 Hz, one camera image a second whose content depends on the position (so templates
 // re-match).
-Dataset MakeDataset() {
-  Dataset d;
+dataset::Dataset MakeDataset() {
+  dataset::Dataset d;
   d.name = "fuzz-square";
   const double side = 16.0, lap = 4 * side;
   auto where = [&](double t, double* x, double* y, double* heading) {
@@ -86,7 +86,7 @@ class GeneratedImages : public ImageLoader {
 };
 
 struct Setup {
-  Dataset dataset = MakeDataset();
+  dataset::Dataset dataset = MakeDataset();
   GeneratedImages images;
   std::vector<PipelineOptions> options;
   std::vector<FrontEndResources> resources;
@@ -119,7 +119,7 @@ struct Setup {
     descriptors.sensors.front_end.kind = FrontEndKind::kDescriptors;
     descriptors.sensors.descriptors.min_similarity = 0.99;
     options = {classic, fused, fabmap_wifi, sequence, descriptors};
-    DescriptorMatrix places{dataset.images.size(), 8, {}};
+    dataset::DescriptorMatrix places{dataset.images.size(), 8, {}};
     for (const ImageRow& image : dataset.images) {
       const int place = std::atoi(image.file.c_str());
       for (int k = 0; k < 8; ++k) places.values.push_back(std::cos(0.7 * place * (k + 1) + k));

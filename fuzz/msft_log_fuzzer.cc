@@ -30,7 +30,7 @@ std::vector<std::string> FuzzSeeds() {
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   return ratslam::fuzz::FuzzPhoneLog(
-      data, size, [](const std::string& path, const ratslam::PhoneLogOptions& options) {
-        return ratslam::ReadMicrosoftLog(path, options);
+      data, size, [](const std::string& path, const ratslam::dataset::PhoneLogOptions& options) {
+        return ratslam::dataset::ReadMicrosoftLog(path, options);
       });
 }

@@ -14,16 +14,16 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace ratslam;
   const std::string path = fuzz::WriteScratchFile("input.mcap", data, size);
   for (const char* images : {"/camera/image_raw", "/camera/image/compressed"}) {
-    BagTopics topics;
+    dataset::BagTopics topics;
     topics.image_topic = images;
     topics.ground_truth_topic = "/pose";
     topics.imu_topic = "/imu";
-    StatusOr<Dataset> d = ReadRos2Bag(path, topics);
+    StatusOr<dataset::Dataset> d = dataset::ReadRos2Bag(path, topics);
     if (!d.ok()) {
       if (d.status().message().find("input.mcap") == std::string::npos) __builtin_trap();
       continue;
     }
-    FileImageLoader loader;  // a fresh one: the file changes between inputs
+    dataset::FileImageLoader loader;  // a fresh one: the file changes between inputs
     for (size_t i = 0; i < d->images.size() && i < 20; ++i) {
       StatusOr<GrayImage> image = loader.Load(d->ImagePath(d->images[i]));
       if (image.ok() && image->pixels.size() != static_cast<size_t>(image->width) *

@@ -20,19 +20,19 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   auto named = [&](const Status& s) {
     if (s.message().rfind(where + ": ", 0) != 0) __builtin_trap();
   };
-  if (auto m = DecodeRos2Stamp(data, size, where); !m.ok()) named(m.status());
-  if (auto m = DecodeRos2Image(data, size, where); !m.ok()) {
+  if (auto m = dataset::DecodeRos2Stamp(data, size, where); !m.ok()) named(m.status());
+  if (auto m = dataset::DecodeRos2Image(data, size, where); !m.ok()) {
     named(m.status());
   } else if (m->data.size() > size) {
     __builtin_trap();
   }
-  if (auto m = DecodeRos2CompressedImage(data, size, where); !m.ok()) {
+  if (auto m = dataset::DecodeRos2CompressedImage(data, size, where); !m.ok()) {
     named(m.status());
   } else if (m->data.size() > size) {
     __builtin_trap();
   }
-  if (auto m = DecodeRos2Odometry(data, size, where); !m.ok()) named(m.status());
-  if (auto m = DecodeRos2PoseStamped(data, size, where); !m.ok()) named(m.status());
-  if (auto m = DecodeRos2Imu(data, size, where); !m.ok()) named(m.status());
+  if (auto m = dataset::DecodeRos2Odometry(data, size, where); !m.ok()) named(m.status());
+  if (auto m = dataset::DecodeRos2PoseStamped(data, size, where); !m.ok()) named(m.status());
+  if (auto m = dataset::DecodeRos2Imu(data, size, where); !m.ok()) named(m.status());
   return 0;
 }

@@ -25,8 +25,8 @@ class Pattern : public ImageLoader {
 }  // namespace
 
 std::vector<std::string> FuzzSeeds() {
-  if (!RosbagSupported()) return {"#ROSBAG V2.0\n"};
-  Dataset d;
+  if (!dataset::RosbagSupported()) return {"#ROSBAG V2.0\n"};
+  dataset::Dataset d;
   for (int i = 0; i < 3; ++i) {
     d.images.push_back({0.5 * i, std::string(static_cast<size_t>(i + 1), 'x'), i});
     d.odometry.push_back({0.5 * i + 0.1, 0.4, 0.1});
@@ -34,7 +34,8 @@ std::vector<std::string> FuzzSeeds() {
   }
   Pattern images;
   const std::string path = (Scratch().path() / "seed.bag").string();
-  if (!WriteRosbag(d, &images, {"/r/camera/image/compressed", "/r/odom", "/r/pose", ""}, path)
+  if (!dataset::WriteRosbag(d, &images, {"/r/camera/image/compressed", "/r/odom", "/r/pose", ""},
+                            path)
            .ok()) {
     return {"#ROSBAG V2.0\n"};
   }
@@ -47,12 +48,12 @@ std::vector<std::string> FuzzSeeds() {
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace ratslam;
   const std::string path = fuzz::WriteScratchFile("input.bag", data, size);
-  StatusOr<Dataset> d = ReadRosbag(path, {"", "", "/r/pose", ""});
+  StatusOr<dataset::Dataset> d = dataset::ReadRosbag(path, {"", "", "/r/pose", ""});
   if (!d.ok()) {
     if (d.status().message().find("input.bag") == std::string::npos) __builtin_trap();
     return 0;
   }
-  FileImageLoader loader;  // a fresh one: the file changes between inputs
+  dataset::FileImageLoader loader;  // a fresh one: the file changes between inputs
   for (size_t i = 0; i < d->images.size() && i < 20; ++i) {
     StatusOr<GrayImage> image = loader.Load(d->ImagePath(d->images[i]));
     if (image.ok() && image->pixels.size() !=

@@ -28,8 +28,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       "uji_long_term", parts, {"trn01rss.csv", "trn01crd.csv", "trn01tms.csv", "trn01ids.csv"});
   const std::string path = folder + "/trn01rss.csv";
   for (bool lenient : {false, true}) {
-    UjiLongTermReport report;
-    StatusOr<std::vector<LabelledScan>> scans = ReadUjiLongTermSet(path, lenient, &report);
+    dataset::UjiLongTermReport report;
+    StatusOr<std::vector<dataset::LabelledScan>> scans =
+        dataset::ReadUjiLongTermSet(path, lenient, &report);
     if (!scans.ok()) {
       if (scans.status().message().rfind(folder + "/trn01", 0) != 0) {
         fuzz::InvariantFailed("error does not name a file of the set: " + scans.status().message());
@@ -39,7 +40,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (scans->size() + report.skipped_malformed != report.rows) {
       fuzz::InvariantFailed("rows read, kept and skipped do not add up");
     }
-    for (const LabelledScan& s : *scans) {
+    for (const dataset::LabelledScan& s : *scans) {
       if (!std::isfinite(s.x_m) || !std::isfinite(s.y_m) || !std::isfinite(s.time_s) ||
           s.time_s < 0) {
         fuzz::InvariantFailed("accepted a row with a non-finite or negative value");

@@ -21,14 +21,14 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace ratslam;
   const std::string path = fuzz::WriteScratchFile("uji.csv", data, size);
   for (bool lenient : {false, true}) {
-    StatusOr<std::vector<LabelledScan>> scans = ReadUjiIndoorLoc(path, lenient);
+    StatusOr<std::vector<dataset::LabelledScan>> scans = dataset::ReadUjiIndoorLoc(path, lenient);
     if (!scans.ok()) {
       if (scans.status().message().rfind(path, 0) != 0) {
         fuzz::InvariantFailed("error does not name the file: " + scans.status().message());
       }
       continue;
     }
-    for (const LabelledScan& s : *scans) {
+    for (const dataset::LabelledScan& s : *scans) {
       if (!std::isfinite(s.x_m) || !std::isfinite(s.y_m) || !std::isfinite(s.time_s) ||
           s.time_s < 0) {
         fuzz::InvariantFailed("accepted a row with a non-finite or negative value");

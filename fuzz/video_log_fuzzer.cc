@@ -24,10 +24,10 @@ class Flat : public ImageLoader {
 const std::string& Video() {
   static const std::string path = [] {
     const std::string p = (Scratch().path() / "log_fuzz.avi").string();
-    Dataset d;
+    dataset::Dataset d;
     for (int i = 0; i < 4; ++i) d.images.push_back({0.1 * i, "x", i});
     Flat images;
-    (void)WriteVideo(d, &images, p, 10.0);
+    (void)dataset::WriteVideo(d, &images, p, 10.0);
     return p;
   }();
   return path;
@@ -47,9 +47,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace ratslam;
   const std::string& video = fuzz::Video();
   const std::string log = fuzz::WriteScratchFile("log.txt", data, size);
-  VideoOptions options;
+  dataset::VideoOptions options;
   options.odometry_log = log;
-  StatusOr<Dataset> d = ReadVideo(video, options);
+  StatusOr<dataset::Dataset> d = dataset::ReadVideo(video, options);
   if (!d.ok()) {
     const std::string& m = d.status().message();
     if (m.find("log.txt") == std::string::npos && m.find("log_fuzz.avi") == std::string::npos) {

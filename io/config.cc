@@ -183,7 +183,7 @@ StatusOr<PipelineOptions> LoadConfigFile(const std::string& path) {
   // A data set given where the configuration belongs (`--config LOG.txt --data x.toml`) is
   // named as such, instead of "larger than 1048576 bytes" or a TOML syntax error.
   // Asked only once reading or parsing failed: a good configuration is never sniffed.
-  auto is_data_set = [&] { return IsRegularFile(path) && DetectDatasetFormat(path).ok(); };
+  auto is_data_set = [&] { return IsRegularFile(path) && dataset::DetectDatasetFormat(path).ok(); };
   const auto data_set = [&] {
     return Status::Error(path +
                          " is a data set, not a configuration: give it as --data, and the "
@@ -686,8 +686,9 @@ StatusOr<ImportedConfig> ImportOpenRatslamIni(const std::string& path) {
     // Topics are topic_root plus fixed suffixes; odometry comes from the bag unless the file
     // configures OpenRatSLAM's visual odometry node (facts file, section 5). ROS resolves a
     // relative name under "/" and collapses "//".
-    o.bag.image_topic = NormaliseRosTopic(*topic_root + "/camera/image");
-    o.bag.odometry_topic = visual_odometry_section ? "" : NormaliseRosTopic(*topic_root + "/odom");
+    o.bag.image_topic = dataset::NormaliseRosTopic(*topic_root + "/camera/image");
+    o.bag.odometry_topic =
+        visual_odometry_section ? "" : dataset::NormaliseRosTopic(*topic_root + "/odom");
     imported.notes.insert(
         imported.notes.begin() + static_cast<std::ptrdiff_t>(topic_root_note),
         topic_root_at + " (-> [bag] image_topic = \"" + o.bag.image_topic + "\"" +

@@ -11,7 +11,7 @@ namespace fs = std::filesystem;
 
 StatusOr<std::shared_ptr<const DescriptorTable>> LoadDescriptorTable(
     const DescriptorOptions& options, const std::vector<std::string>& data_paths,
-    const Dataset& dataset) {
+    const dataset::Dataset& dataset) {
   if (data_paths.empty()) return Status::Error("descriptors: no data set given");
   const fs::path file(options.file);
   if (file.is_absolute() && data_paths.size() > 1) {
@@ -20,7 +20,7 @@ StatusOr<std::shared_ptr<const DescriptorTable>> LoadDescriptorTable(
                          " sessions: give a name each session's folder holds");
   }
   const std::vector<double>& starts = dataset.session_start_times_s;
-  DescriptorMatrix joined;
+  dataset::DescriptorMatrix joined;
   std::string names;
   size_t image = 0;
   for (size_t s = 0; s < data_paths.size(); ++s) {
@@ -28,7 +28,7 @@ StatusOr<std::shared_ptr<const DescriptorTable>> LoadDescriptorTable(
     const fs::path data(data_paths[s]);
     const fs::path folder = fs::is_directory(data, ec) ? data : data.parent_path();
     const std::string path = file.is_absolute() ? file.string() : (folder / file).string();
-    StatusOr<DescriptorMatrix> m = ReadDescriptorFile(path);
+    StatusOr<dataset::DescriptorMatrix> m = dataset::ReadDescriptorFile(path);
     if (!m.ok()) return m.status();
     // This session's images: those before the next session's start.
     size_t end = dataset.images.size();
@@ -58,7 +58,8 @@ StatusOr<std::shared_ptr<const DescriptorTable>> LoadDescriptorTable(
 
 StatusOr<FrontEndResources> LoadFrontEndResources(const FrontEndSettings& settings,
                                                   const std::vector<std::string>& data_paths,
-                                                  const Dataset& dataset, ImageLoader& images) {
+                                                  const dataset::Dataset& dataset,
+                                                  ImageLoader& images) {
   FrontEndResources resources;
   if (settings.front_end.kind == FrontEndKind::kFabmap) {
     auto prepared = LoadFabmapResources(settings, dataset, images);

@@ -19,13 +19,14 @@ namespace ratslam {
 // row per image of its session; an absolute path for a single session.
 StatusOr<std::shared_ptr<const DescriptorTable>> LoadDescriptorTable(
     const DescriptorOptions& options, const std::vector<std::string>& data_paths,
-    const Dataset& dataset);
+    const dataset::Dataset& dataset);
 
 // Every resource the configured front end needs (none for most kinds; the custom factory is
 // the caller's to add).
 StatusOr<FrontEndResources> LoadFrontEndResources(const FrontEndSettings& settings,
                                                   const std::vector<std::string>& data_paths,
-                                                  const Dataset& dataset, ImageLoader& images);
+                                                  const dataset::Dataset& dataset,
+                                                  ImageLoader& images);
 
 }  // namespace ratslam
 

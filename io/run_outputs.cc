@@ -82,7 +82,7 @@ nlohmann::ordered_json ErrorStatistics(const std::vector<double>& v) {
 // pose is from the past pose truly nearest the current one, among the poses the past sequence
 // spans). Verified: inliers of accepted loops; unverified: every DP pair of every loop matched.
 nlohmann::ordered_json SequenceSummary(const WifiSequenceLoopCloser& closer,
-                                       const ExperienceMap& map, const Dataset& dataset) {
+                                       const ExperienceMap& map, const dataset::Dataset& dataset) {
   nlohmann::ordered_json j;
   size_t accepted = 0, links = 0, verified = 0;
   for (const SequenceLoop& l : closer.loops()) {
@@ -110,7 +110,7 @@ nlohmann::ordered_json SequenceSummary(const WifiSequenceLoopCloser& closer,
   if (dataset.ground_truth.empty()) return j;
   std::vector<std::optional<GroundTruthRow>> truth(closer.size());
   for (size_t i = 0; i < closer.size(); ++i) {
-    truth[i] = GroundTruthAt(dataset, closer.pose(i).time_s);
+    truth[i] = dataset::GroundTruthAt(dataset, closer.pose(i).time_s);
   }
   auto metres = [&](uint32_t a, uint32_t b) {
     if (!truth[a] || !truth[b]) return std::numeric_limits<double>::quiet_NaN();
@@ -162,7 +162,7 @@ nlohmann::ordered_json SequenceSummary(const WifiSequenceLoopCloser& closer,
 }  // namespace
 
 CrossSessionPlaces ScoreCrossSessionPlaces(const std::vector<FrameRecord>& frames,
-                                           const Dataset& dataset) {
+                                           const dataset::Dataset& dataset) {
   CrossSessionPlaces out;
   out.correct.assign(std::size(kPlaceTolerancesFrames), 0);
   const std::vector<double>& starts = dataset.session_start_times_s;
@@ -232,7 +232,8 @@ std::vector<double> LocalisationErrors(const std::vector<LocalisationRecord>& re
   std::vector<Point2> true_at(records.size(), {nan, nan});
   std::vector<Point2> estimate, paired_truth;
   for (size_t i = 0; i < records.size(); ++i) {
-    const auto gt = InterpolateGroundTruth(ground_truth, records[i].time_s, session_starts);
+    const auto gt =
+        dataset::InterpolateGroundTruth(ground_truth, records[i].time_s, session_starts);
     if (!gt) continue;
     true_at[i] = {gt->x_m, gt->y_m};
     if (records[i].lost) continue;
@@ -254,7 +255,8 @@ std::vector<double> LocalisationErrors(const std::vector<LocalisationRecord>& re
   return errors;
 }
 
-RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, const RunInfo& info) {
+RunSummary Summarise(const ReplayPipeline& pipeline, const dataset::Dataset& dataset,
+                     const RunInfo& info) {
   const ReplayPipeline::State& state = pipeline.state();
   const Ratslam& slam = pipeline.slam();
   const ExperienceMap& map = slam.experience_map();
@@ -271,7 +273,7 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
     // (A localisation run's experiences were made on another data set's clock.)
     for (const Experience& e : map.experiences()) {
       if (pipeline.localising()) break;
-      if (auto gt = GroundTruthAt(dataset, e.time_s)) {
+      if (auto gt = dataset::GroundTruthAt(dataset, e.time_s)) {
         estimate.push_back({e.x_m, e.y_m});
         truth.push_back({gt->x_m, gt->y_m});
       }
@@ -284,7 +286,7 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
     for (size_t i = 0; i < state.trajectory.size(); ++i) {
       const TrajectoryRecord& r = state.trajectory[i];
       if (!InTumFiles(state.trajectory, i)) continue;
-      if (auto gt = GroundTruthAt(dataset, r.time_s)) {
+      if (auto gt = dataset::GroundTruthAt(dataset, r.time_s)) {
         double x, y, theta;
         RecordPose(map, r, &x, &y, &theta);
         corrected.push_back({x, y});
@@ -311,15 +313,15 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
       if (pipeline.localising()) break;    // templates stored on another data set's clock
       if (f.is_new || f.recent) continue;  // only matches that can close a loop
       const double created_s = slam.local_view().at(f.template_id).created_time_s;
-      const auto now = GroundTruthAt(dataset, f.time_s);
-      const auto then = GroundTruthAt(dataset, created_s);
+      const auto now = dataset::GroundTruthAt(dataset, f.time_s);
+      const auto then = dataset::GroundTruthAt(dataset, created_s);
       if (!now || !then) continue;
       ++s.evaluated_matches;
       // Floors are known only where the ground-truth points around a time agree. A match with
       // either end between points on different floors (on the stairs) cannot be judged: it is
       // counted as unverified and left out of the rates.
-      const std::optional<int> floor_now = KnownFloorAt(dataset, f.time_s);
-      const std::optional<int> floor_then = KnownFloorAt(dataset, created_s);
+      const std::optional<int> floor_now = dataset::KnownFloorAt(dataset, f.time_s);
+      const std::optional<int> floor_then = dataset::KnownFloorAt(dataset, created_s);
       if (!floor_now || !floor_then) {
         ++s.floor_unverified_matches;
         continue;
@@ -552,7 +554,7 @@ const std::vector<std::string>& SummaryKeys() {
 }
 
 StatusOr<RunSummary> WriteRunOutputs(OutputFolder& folder, const ReplayPipeline& pipeline,
-                                     const Dataset& dataset, const RunInfo& info) {
+                                     const dataset::Dataset& dataset, const RunInfo& info) {
   const ExperienceMap& map = pipeline.slam().experience_map();
   const ReplayPipeline::State& state = pipeline.state();
   std::vector<std::pair<std::string, std::string>> files;
@@ -592,7 +594,7 @@ StatusOr<RunSummary> WriteRunOutputs(OutputFolder& folder, const ReplayPipeline&
     RecordPose(map, r, &x, &y, &theta);
     trajectory << TumLine(r.time_s, x, y, theta);
     odometry << TumLine(r.time_s, r.odometry_x_m, r.odometry_y_m, r.odometry_theta_rad);
-    if (auto gt = GroundTruthAt(dataset, r.time_s)) {
+    if (auto gt = dataset::GroundTruthAt(dataset, r.time_s)) {
       ground_truth << TumLine(r.time_s, gt->x_m, gt->y_m, gt->theta_rad);
     }
   }

@@ -75,14 +75,15 @@ inline constexpr int kPlaceTolerancesFrames[] = {0, 1, 2, 5};
 // Frames pair with images by time. Nothing (frames == 0) when the data set has one session or
 // no name recurs.
 CrossSessionPlaces ScoreCrossSessionPlaces(const std::vector<FrameRecord>& frames,
-                                           const Dataset& dataset);
+                                           const dataset::Dataset& dataset);
 
 std::vector<double> LocalisationErrors(const std::vector<LocalisationRecord>& records,
                                        const std::vector<GroundTruthRow>& ground_truth,
                                        std::vector<Point2>* truth = nullptr,
                                        const std::vector<double>& session_starts = {});
 
-RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, const RunInfo& info);
+RunSummary Summarise(const ReplayPipeline& pipeline, const dataset::Dataset& dataset,
+                     const RunInfo& info);
 
 // Writes experiences.csv, links.csv, trajectory_tum.txt, odometry_tum.txt (and with ground truth
 // ground_truth_tum.txt), experience_map.g2o,
@@ -93,7 +94,7 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const Dataset& dataset, con
 const std::vector<std::string>& SummaryKeys();
 
 StatusOr<RunSummary> WriteRunOutputs(OutputFolder& folder, const ReplayPipeline& pipeline,
-                                     const Dataset& dataset, const RunInfo& info);
+                                     const dataset::Dataset& dataset, const RunInfo& info);
 
 }  // namespace ratslam
 

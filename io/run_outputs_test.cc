@@ -59,7 +59,7 @@ namespace {
 // new template, d on d's (0 apart), z on b's (not scored: no namesake before). Four frames
 // scored, three matched, correct within 0 and 1: two; within 2 and 5: three.
 TEST(CrossSessionPlacesTest, ScoresByTheNamesakeInTheTemplatesSession) {
-  Dataset d;
+  dataset::Dataset d;
   d.session_start_times_s = {0.0, 100.0};
   const std::vector<std::string> names = {"a.png", "b.png", "c.png", "d.png", "e.png"};
   std::vector<FrameRecord> frames;

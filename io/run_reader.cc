@@ -22,7 +22,8 @@ namespace fs = std::filesystem;
     lhs = value_.value();                                  \
   } while (false)
 
-Status ReadId(const CsvTable& t, size_t row, const std::string& column, int64_t min, int64_t* out) {
+Status ReadId(const dataset::CsvTable& t, size_t row, const std::string& column, int64_t min,
+              int64_t* out) {
   double v = 0;
   READ_NUMBER(v, t, row, column);
   if (v != std::floor(v) || v < static_cast<double>(min) || v > 4e9) {
@@ -39,8 +40,9 @@ StatusOr<RunFolder> ReadRunFolder(const std::string& folder) {
   // that what is read is one run's outputs.
   RATSLAM_RETURN_IF_ERROR(RecoverOutputFolder(folder));
   RunFolder run;
-  StatusOr<CsvTable> ex = CsvTable::Read((fs::path(folder) / "experiences.csv").string(),
-                                         kExperienceColumns.required, kExperienceColumns.optional);
+  StatusOr<dataset::CsvTable> ex =
+      dataset::CsvTable::Read((fs::path(folder) / "experiences.csv").string(),
+                              kExperienceColumns.required, kExperienceColumns.optional);
   if (!ex.ok()) return ex.status();
   for (size_t r = 0; r < ex->rows(); ++r) {
     Experience e;
@@ -56,8 +58,8 @@ StatusOr<RunFolder> ReadRunFolder(const std::string& folder) {
     READ_NUMBER(e.time_s, *ex, r, "time_s");
     run.experiences.push_back(e);
   }
-  StatusOr<CsvTable> li = CsvTable::Read((fs::path(folder) / "links.csv").string(),
-                                         kLinkColumns.required, kLinkColumns.optional);
+  StatusOr<dataset::CsvTable> li = dataset::CsvTable::Read(
+      (fs::path(folder) / "links.csv").string(), kLinkColumns.required, kLinkColumns.optional);
   if (!li.ok()) return li.status();
   const int64_t n = static_cast<int64_t>(run.experiences.size());
   for (size_t r = 0; r < li->rows(); ++r) {
@@ -90,8 +92,8 @@ StatusOr<RunFolder> ReadRunFolder(const std::string& folder) {
     }
     run.links.push_back(l);
   }
-  StatusOr<CsvTable> fr = CsvTable::Read((fs::path(folder) / "frames.csv").string(),
-                                         kFrameColumns.required, kFrameColumns.optional);
+  StatusOr<dataset::CsvTable> fr = dataset::CsvTable::Read(
+      (fs::path(folder) / "frames.csv").string(), kFrameColumns.required, kFrameColumns.optional);
   if (!fr.ok()) return fr.status();
   for (size_t r = 0; r < fr->rows(); ++r) {
     FrameRecord f;

@@ -49,7 +49,7 @@ StatusOr<fabmap::TrainedVisualModel> LoadOrTrainVisualModel(
 }
 
 StatusOr<std::shared_ptr<const FabmapResources>> LoadFabmapResources(
-    const FrontEndSettings& settings, const Dataset& dataset, ImageLoader& images) {
+    const FrontEndSettings& settings, const dataset::Dataset& dataset, ImageLoader& images) {
   const FabmapSettings& f = settings.fabmap;
   std::optional<fabmap::TrainedVisualModel> visual;
   if (fabmap::UsesVision(f.localiser.localiser.mode)) {

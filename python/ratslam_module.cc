@@ -432,7 +432,7 @@ class Session {
   // The bound every number of a data-set file meets (kMaxCsvMagnitude): what a file could not
   // hold, a caller cannot feed either.
   static void Within(double value, const std::string& what) {
-    if (!std::isfinite(value) || std::abs(value) > kMaxCsvMagnitude) {
+    if (!std::isfinite(value) || std::abs(value) > dataset::kMaxCsvMagnitude) {
       throw Error(what + " must be a finite number of magnitude at most 1e12, got " +
                   std::to_string(value));
     }
@@ -447,8 +447,8 @@ class Session {
   }
 
   PipelineOptions options_;
-  Dataset dataset_;
-  FileImageLoader images_;
+  dataset::Dataset dataset_;
+  dataset::FileImageLoader images_;
   std::unique_ptr<ReplayPipeline> pipeline_;
   std::optional<double> last_time_s_;
 };

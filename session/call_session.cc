@@ -61,7 +61,7 @@ std::string CallResult::RouteCsv() const {
 StatusOr<CallResult> CallRobot(const PhoneSetup& setup, const RobotMap& robot, double at_s,
                                const CallLabels& labels) {
   const phone::WifiGpMap& map = setup.map;
-  const Dataset& d = setup.data;
+  const dataset::Dataset& d = setup.data;
   if (d.wifi.empty() || d.wifi.front().time_s > at_s) {
     return Status::Error(
         labels.data + ": no Wi-Fi scan at or before --at " + ShortestNumber(at_s) +
@@ -99,7 +99,7 @@ StatusOr<CallResult> CallRobot(const PhoneSetup& setup, const RobotMap& robot, d
   j["last_scan_s"] = r.last_scan_s;
   j["robot_experience"] = *robot.current;
   j["estimate"] = {{"x_m", r.estimate.x_m}, {"y_m", r.estimate.y_m}, {"floor", r.estimate.floor}};
-  if (const auto truth = GroundTruthAt(d, r.last_scan_s)) {
+  if (const auto truth = dataset::GroundTruthAt(d, r.last_scan_s)) {
     r.truth_on_map = TruthToMap(map, {truth->x_m, truth->y_m});
     const Point2& t = *r.truth_on_map;
     j["truth_on_map"] = {{"x_m", t.x}, {"y_m", t.y}};

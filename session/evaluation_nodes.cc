@@ -72,10 +72,10 @@ StatusOr<std::vector<EvaluationNode>> ImageFolderNodes(const std::string& path,
 // No travel between rows: the Wi-Fi tree spaces them by time only (every map row learns it by
 // default).
 template <typename FloorAndSession>
-std::vector<EvaluationNode> CaptureNodes(const std::vector<LabelledScan>& rows,
+std::vector<EvaluationNode> CaptureNodes(const std::vector<dataset::LabelledScan>& rows,
                                          FloorAndSession floor_and_session) {
   std::vector<EvaluationNode> nodes;
-  for (const LabelledScan& s : rows) {
+  for (const dataset::LabelledScan& s : rows) {
     EvaluationNode n;
     n.x_m = s.x_m;
     n.y_m = s.y_m;
@@ -93,9 +93,9 @@ std::vector<EvaluationNode> CaptureNodes(const std::vector<LabelledScan>& rows,
 
 // UJIIndoorLoc: another building counts as another floor; a session is a user and phone.
 StatusOr<std::vector<EvaluationNode>> UjiNodes(const std::string& path, bool lenient) {
-  auto rows = ReadUjiIndoorLoc(path, lenient);
+  auto rows = dataset::ReadUjiIndoorLoc(path, lenient);
   if (!rows.ok()) return rows.status();
-  auto nodes = CaptureNodes(*rows, [](const LabelledScan& s) {
+  auto nodes = CaptureNodes(*rows, [](const dataset::LabelledScan& s) {
     return std::pair(s.building * 100 + s.floor, s.user * 100 + s.phone);
   });
   for (EvaluationNode& n : nodes) n.building = n.floor / 100;
@@ -106,16 +106,16 @@ StatusOr<std::vector<EvaluationNode>> UjiNodes(const std::string& path, bool len
 // the month (the folder's number) + the set's number (tst03 -> 3; 0 to 99), so that sets of
 // different months never share one.
 StatusOr<std::vector<EvaluationNode>> LongTermNodes(const std::string& path, bool lenient) {
-  auto rows = ReadUjiLongTermSet(path, lenient);
+  auto rows = dataset::ReadUjiLongTermSet(path, lenient);
   if (!rows.ok()) return rows.status();
   const fs::path p(path);
   const int month = std::clamp(FloorOfFolder(p.parent_path().filename().string(), 0), 0, 1000000);
   const int set = std::clamp(FloorOfFolder(p.filename().string(), 0), 0, 99);
-  return CaptureNodes(*rows,
-                      [&](const LabelledScan& s) { return std::pair(s.floor, month * 100 + set); });
+  return CaptureNodes(
+      *rows, [&](const dataset::LabelledScan& s) { return std::pair(s.floor, month * 100 + set); });
 }
 
-std::vector<EvaluationNode> DatasetNodes(const Dataset& d, bool as_map, bool want_images,
+std::vector<EvaluationNode> DatasetNodes(const dataset::Dataset& d, bool as_map, bool want_images,
                                          const EvaluationOptions& options) {
   std::vector<EvaluationNode> nodes;
   auto session_of = [&](double t) {
@@ -126,7 +126,7 @@ std::vector<EvaluationNode> DatasetNodes(const Dataset& d, bool as_map, bool wan
     return s;
   };
   auto add = [&](double t, std::string image, std::optional<std::vector<WifiReading>> wifi) {
-    const auto truth = GroundTruthAt(d, t);
+    const auto truth = dataset::GroundTruthAt(d, t);
     if (!truth) return;
     EvaluationNode n;
     n.x_m = truth->x_m;
@@ -179,15 +179,18 @@ bool HasManifest(const std::string& path) {
 
 }  // namespace
 
-StatusOr<std::vector<EvaluationNode>> LoadEvaluationNodes(
-    const std::string& path, bool as_map, bool want_images, const EvaluationOptions& options,
-    const PhoneLogOptions& phone, const BagTopics& bag, const VideoOptions& video) {
+StatusOr<std::vector<EvaluationNode>> LoadEvaluationNodes(const std::string& path, bool as_map,
+                                                          bool want_images,
+                                                          const EvaluationOptions& options,
+                                                          const dataset::PhoneLogOptions& phone,
+                                                          const dataset::BagTopics& bag,
+                                                          const dataset::VideoOptions& video) {
   std::string error;
   if (!options.IsValid(&error)) return Status::Error("[evaluation] " + error);
   std::error_code ec;
   if (!fs::exists(path, ec)) return Status::Error(path + ": no such file or folder");
   if (fs::is_regular_file(path, ec) && fs::path(path).extension() == ".csv") {
-    if (IsUjiLongTermSet(path)) return LongTermNodes(path, phone.lenient);
+    if (dataset::IsUjiLongTermSet(path)) return LongTermNodes(path, phone.lenient);
     return UjiNodes(path, phone.lenient);
   }
   if (fs::is_directory(path, ec) && !HasManifest(path)) {
@@ -196,17 +199,17 @@ StatusOr<std::vector<EvaluationNode>> LoadEvaluationNodes(
     for (auto it = fs::recursive_directory_iterator(path, ec);
          !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
       if (it->is_regular_file(ec) && it->path().extension() == ".txt" &&
-          DetectDatasetFormat(it->path().string()).ok()) {
+          dataset::DetectDatasetFormat(it->path().string()).ok()) {
         logs.push_back(it->path().string());
       }
     }
     std::sort(logs.begin(), logs.end());
     if (logs.empty()) return ImageFolderNodes(path, options);
-    auto d = LoadSessions(logs, phone);
+    auto d = dataset::LoadSessions(logs, phone);
     if (!d.ok()) return d.status();
     return DatasetNodes(*d, as_map, want_images, options);
   }
-  auto d = LoadDataset(path, phone, bag, video);
+  auto d = dataset::LoadDataset(path, phone, bag, video);
   if (!d.ok()) return d.status();
   return DatasetNodes(*d, as_map, want_images, options);
 }

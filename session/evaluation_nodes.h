@@ -21,8 +21,8 @@ namespace ratslam::session {
 // are read with `phone` (dead reckoning, leniency); UJIIndoorLoc with its leniency.
 StatusOr<std::vector<fabmap::EvaluationNode>> LoadEvaluationNodes(
     const std::string& path, bool as_map, bool want_images,
-    const fabmap::EvaluationOptions& options, const PhoneLogOptions& phone,
-    const BagTopics& bag = {}, const VideoOptions& video = {});
+    const fabmap::EvaluationOptions& options, const dataset::PhoneLogOptions& phone,
+    const dataset::BagTopics& bag = {}, const dataset::VideoOptions& video = {});
 
 // A query session's RSSI offset to the map (the phone's reading minus the map's, dB).
 struct SessionRssiOffset {

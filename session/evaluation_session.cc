@@ -100,7 +100,7 @@ EvaluationSession::EvaluationSession(EvaluationSessionOptions options, OutputFol
       images_(images) {
   if (out_ == nullptr) throw std::invalid_argument("EvaluationSession needs an output folder");
   if (images_ == nullptr) {
-    own_images_ = std::make_unique<FileImageLoader>();
+    own_images_ = std::make_unique<dataset::FileImageLoader>();
     images_ = own_images_.get();
   }
   started_s_ = clock_->Seconds();
@@ -117,7 +117,7 @@ Status EvaluationSession::Load() {
   if (!options_.pipeline.IsValid(&error)) return Status::Error("configuration: " + error);
   RATSLAM_RETURN_IF_ERROR(out_->Write("config.toml", PrintConfig(options_.pipeline)));
   const bool vision = fabmap::UsesVision(mode());
-  PhoneLogOptions phone;
+  dataset::PhoneLogOptions phone;
   phone.lenient = options_.lenient;
   phone.pdr = options_.pipeline.pdr;
   const fabmap::EvaluationOptions& evaluation = options_.pipeline.evaluation;

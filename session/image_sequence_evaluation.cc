@@ -90,7 +90,7 @@ struct DescriptorRows {
 // The descriptors of `path`, one row per image of `folder`, each scaled to unit length.
 StatusOr<DescriptorRows> LoadDescriptorRows(const std::string& path, const std::string& folder,
                                             size_t images) {
-  StatusOr<DescriptorMatrix> m = ReadDescriptorFile(path);
+  StatusOr<dataset::DescriptorMatrix> m = dataset::ReadDescriptorFile(path);
   if (!m.ok()) return m.status();
   if (m->rows != images) {
     return Status::Error(path + ": " + std::to_string(m->rows) + " rows for the " +
@@ -298,7 +298,8 @@ StatusOr<std::vector<int>> PairQueriesWithReferences(const std::vector<std::stri
   for (size_t i = 0; i < queries.size(); ++i) query_index[queries[i]] = int(i);
   std::vector<int> truth(queries.size(), -1);
   if (!ground_truth_csv.empty()) {
-    StatusOr<CsvTable> t = CsvTable::Read(ground_truth_csv, {"query", "reference"});
+    StatusOr<dataset::CsvTable> t =
+        dataset::CsvTable::Read(ground_truth_csv, {"query", "reference"});
     if (!t.ok()) return t.status();
     for (size_t r = 0; r < t->rows(); ++r) {
       StatusOr<std::string> q = t->Text(r, "query"), ref = t->Text(r, "reference");

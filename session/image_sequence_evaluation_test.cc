@@ -112,7 +112,7 @@ TEST_F(ImageFoldersTest, PlacesEveryQueryByNameAndNamesABadFile) {
   options.reference_folder = (root_ / "ref").string();
   options.query_folder = (root_ / "query").string();
   options.frame_tolerance = 0;
-  FileImageLoader loader;
+  dataset::FileImageLoader loader;
   StatusOr<ImageSequenceEvaluation> e = EvaluateImageSequences(options, &loader, {}, nullptr);
   ASSERT_TRUE(e.ok()) << e.status().message();
   EXPECT_TRUE(IsImageSequenceFolder(options.query_folder));
@@ -144,7 +144,7 @@ TEST_F(ImageFoldersTest, PlacesEveryQueryByNameAndNamesABadFile) {
 TEST_F(ImageFoldersTest, DescriptorFilesAreMatchedBesideTheImages) {
   Random noise(4);
   const int n = 40, shift = 7, dims = 16;
-  DescriptorMatrix refs{size_t(n), size_t(dims), {}}, queries{size_t(n), size_t(dims), {}};
+  dataset::DescriptorMatrix refs{size_t(n), size_t(dims), {}}, queries{size_t(n), size_t(dims), {}};
   Random draw(5);
   for (int i = 0; i < n; ++i) {
     char name[32];
@@ -160,15 +160,15 @@ TEST_F(ImageFoldersTest, DescriptorFilesAreMatchedBesideTheImages) {
       queries.values.push_back(3.0f * row[k] + static_cast<float>(draw.Gaussian(0, 0.05)));
     }
   }
-  ASSERT_TRUE(WriteDescriptorNpy(refs, (root_ / "ref" / "d.npy").string()).ok());
-  ASSERT_TRUE(WriteDescriptorNpy(queries, (root_ / "query" / "d.npy").string()).ok());
+  ASSERT_TRUE(dataset::WriteDescriptorNpy(refs, (root_ / "ref" / "d.npy").string()).ok());
+  ASSERT_TRUE(dataset::WriteDescriptorNpy(queries, (root_ / "query" / "d.npy").string()).ok());
   ImageSequenceEvaluationOptions options;
   options.reference_folder = (root_ / "ref").string();
   options.query_folder = (root_ / "query").string();
   options.frame_tolerance = 0;
   options.reference_descriptors = (root_ / "ref" / "d.npy").string();
   options.query_descriptors = (root_ / "query" / "d.npy").string();
-  FileImageLoader loader;
+  dataset::FileImageLoader loader;
   StatusOr<ImageSequenceEvaluation> e = EvaluateImageSequences(options, &loader, {}, nullptr);
   ASSERT_TRUE(e.ok()) << e.status().message();
   ASSERT_TRUE(e->descriptors.has_value());
@@ -192,19 +192,19 @@ TEST_F(ImageFoldersTest, DescriptorFilesAreMatchedBesideTheImages) {
       << error_of(missing);
   missing.query_descriptors.clear();
   EXPECT_NE(error_of(missing).find("one for the queries"), std::string::npos) << error_of(missing);
-  DescriptorMatrix short_rows = queries;
+  dataset::DescriptorMatrix short_rows = queries;
   short_rows.rows = n - 1;
   short_rows.values.resize(size_t(n - 1) * dims);
-  ASSERT_TRUE(WriteDescriptorNpy(short_rows, (root_ / "query" / "d.npy").string()).ok());
+  ASSERT_TRUE(dataset::WriteDescriptorNpy(short_rows, (root_ / "query" / "d.npy").string()).ok());
   EXPECT_NE(error_of(options).find("d.npy: 39 rows for the 40 images"), std::string::npos)
       << error_of(options);
-  DescriptorMatrix zero = queries;
+  dataset::DescriptorMatrix zero = queries;
   std::fill(zero.values.begin() + 2 * dims, zero.values.begin() + 3 * dims, 0.0f);
-  ASSERT_TRUE(WriteDescriptorNpy(zero, (root_ / "query" / "d.npy").string()).ok());
+  ASSERT_TRUE(dataset::WriteDescriptorNpy(zero, (root_ / "query" / "d.npy").string()).ok());
   EXPECT_NE(error_of(options).find("d.npy: row 3 has no direction"), std::string::npos)
       << error_of(options);
-  DescriptorMatrix narrow{size_t(n), 4, std::vector<float>(size_t(n) * 4, 1.0f)};
-  ASSERT_TRUE(WriteDescriptorNpy(narrow, (root_ / "query" / "d.npy").string()).ok());
+  dataset::DescriptorMatrix narrow{size_t(n), 4, std::vector<float>(size_t(n) * 4, 1.0f)};
+  ASSERT_TRUE(dataset::WriteDescriptorNpy(narrow, (root_ / "query" / "d.npy").string()).ok());
   EXPECT_NE(error_of(options).find("4 values per row"), std::string::npos) << error_of(options);
 }
 
@@ -247,7 +247,7 @@ TEST_F(ImageFoldersTest, FabmapPlacesSingleFramesFromVisualWords) {
   options.fabmap = true;
   options.fabmap_settings.vocabulary.words = 200;
   options.fabmap_settings.visual_model.training_image_step = 1;
-  FileImageLoader loader;
+  dataset::FileImageLoader loader;
   StatusOr<ImageSequenceEvaluation> e = EvaluateImageSequences(options, &loader, {}, nullptr);
   ASSERT_TRUE(e.ok()) << e.status().message();
   ASSERT_TRUE(e->fabmap.has_value());

@@ -12,17 +12,17 @@
 
 namespace ratslam::session {
 
-StatusOr<std::vector<Dataset>> LoadInOneFrame(const std::vector<std::string>& paths,
-                                              PhoneLogOptions phone,
-                                              std::optional<std::pair<double, double>>* origin) {
-  if (*origin) phone.reference = GeoReference{(*origin)->first, (*origin)->second};
-  std::vector<Dataset> out;
+StatusOr<std::vector<dataset::Dataset>> LoadInOneFrame(
+    const std::vector<std::string>& paths, dataset::PhoneLogOptions phone,
+    std::optional<std::pair<double, double>>* origin) {
+  if (*origin) phone.reference = dataset::GeoReference{(*origin)->first, (*origin)->second};
+  std::vector<dataset::Dataset> out;
   for (const std::string& path : paths) {
-    StatusOr<DatasetFormat> format = DetectDatasetFormat(path);
+    StatusOr<dataset::DatasetFormat> format = dataset::DetectDatasetFormat(path);
     if (!format.ok()) return format.status();
-    if (format.value() == DatasetFormat::kIpinLog) {
-      PhoneLogReport report;
-      StatusOr<Dataset> d = ReadIpinLog(path, phone, &report);
+    if (format.value() == dataset::DatasetFormat::kIpinLog) {
+      dataset::PhoneLogReport report;
+      StatusOr<dataset::Dataset> d = dataset::ReadIpinLog(path, phone, &report);
       if (!d.ok()) return d.status();
       if (!phone.reference) {
         phone.reference = report.reference;
@@ -30,7 +30,7 @@ StatusOr<std::vector<Dataset>> LoadInOneFrame(const std::vector<std::string>& pa
       }
       out.push_back(std::move(d.value()));
     } else {
-      StatusOr<Dataset> d = LoadDataset(path, phone);
+      StatusOr<dataset::Dataset> d = dataset::LoadDataset(path, phone);
       if (!d.ok()) return d.status();
       out.push_back(std::move(d.value()));
     }
@@ -81,11 +81,11 @@ StatusOr<PhoneSetup> SetUpPhone(const phone::LocateOptions& options,
   StatusOr<phone::WifiGpMap> map = phone::WifiGpMap::Load(wifi_map_path);
   if (!map.ok()) return map.status();
   setup.map = std::move(map).value();
-  PhoneLogOptions phone;
+  dataset::PhoneLogOptions phone;
   phone.lenient = lenient;
   phone.pdr = options.pdr;
   std::optional<std::pair<double, double>> origin = setup.map.geo_reference_deg();
-  StatusOr<std::vector<Dataset>> data = LoadInOneFrame({data_path}, phone, &origin);
+  StatusOr<std::vector<dataset::Dataset>> data = LoadInOneFrame({data_path}, phone, &origin);
   if (!data.ok()) return data.status();
   setup.data = std::move(data.value().front());
   if (setup.data.wifi.empty()) {
@@ -109,16 +109,17 @@ StatusOr<PhoneSetup> SetUpPhone(const phone::LocateOptions& options,
   return setup;
 }
 
-void FilterPhoneLog(const Dataset& d, const phone::WifiGpMap& map, phone::ParticleFilter* filter,
-                    double until_s, const std::function<void(const WifiScan&, size_t)>& on_scan) {
+void FilterPhoneLog(const dataset::Dataset& d, const phone::WifiGpMap& map,
+                    phone::ParticleFilter* filter, double until_s,
+                    const std::function<void(const WifiScan&, size_t)>& on_scan) {
   const bool compass = !d.compass.empty();
   std::optional<double> heading, last_time, last_odometry;
   double integrated_heading = 0.0;
-  for (const Event& e : MergeEvents(d)) {
+  for (const dataset::Event& e : dataset::MergeEvents(d)) {
     if (e.time_s > until_s) break;
-    if (e.type == EventType::kCompass) {
+    if (e.type == dataset::EventType::kCompass) {
       heading = d.compass[e.index].heading_rad;
-    } else if (e.type == EventType::kOdometry) {
+    } else if (e.type == dataset::EventType::kOdometry) {
       const OdometryRow& row = d.odometry[e.index];
       const double dt = last_odometry ? row.time_s - *last_odometry : 0.0;
       last_odometry = row.time_s;
@@ -128,7 +129,7 @@ void FilterPhoneLog(const Dataset& d, const phone::WifiGpMap& map, phone::Partic
         filter->Step(forward,
                      compass && heading ? *heading + map.compass_to_map_rad() : integrated_heading);
       }
-    } else if (e.type == EventType::kWifi) {
+    } else if (e.type == dataset::EventType::kWifi) {
       const WifiScan& scan = d.wifi[e.index];
       if (d.odometry.empty() && last_time) filter->Diffuse(scan.time_s - *last_time);
       last_time = scan.time_s;
@@ -140,7 +141,8 @@ void FilterPhoneLog(const Dataset& d, const phone::WifiGpMap& map, phone::Partic
 namespace {
 
 // The weighted 3-NN fingerprint answer per scan of `d` on the map's own training scans.
-std::vector<fabmap::Estimate> KnnOnTrainingScans(const phone::WifiGpMap& map, const Dataset& d) {
+std::vector<fabmap::Estimate> KnnOnTrainingScans(const phone::WifiGpMap& map,
+                                                 const dataset::Dataset& d) {
   std::vector<fabmap::EvaluationNode> map_nodes;
   for (const phone::WifiMapSample& s : map.training_samples()) {
     fabmap::EvaluationNode n;
@@ -167,7 +169,7 @@ StatusOr<LocateResult> Locate(const PhoneSetup& setup, const std::string& data_l
                               const std::string& map_label) {
   const phone::WifiGpMap& map = setup.map;
   const phone::LocateOptions& options = setup.options;
-  const Dataset& d = setup.data;
+  const dataset::Dataset& d = setup.data;
   phone::ParticleFilter filter(map, options.particle_filter);
   const bool compass = !d.compass.empty();
   Status initialised = filter.Initialise(compass);
@@ -185,7 +187,7 @@ StatusOr<LocateResult> Locate(const PhoneSetup& setup, const std::string& data_l
                    s.estimate = filter.Estimate();
                    s.known_aps = known;
                    s.candidates = filter.Candidates();
-                   s.truth = GroundTruthAt(d, scan.time_s);
+                   s.truth = dataset::GroundTruthAt(d, scan.time_s);
                    if (s.truth) {
                      // A map made from a run is in the run's frame and has one floor: its
                      // estimates are scored after its alignment onto the truth, on position alone.

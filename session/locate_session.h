@@ -26,9 +26,9 @@ namespace ratslam::session {
 
 // Loads data sets in one frame: IPIN logs share the first one's geographic origin (or the given
 // one, `*origin`). Sets `*origin` to the origin used, if any log had one.
-StatusOr<std::vector<Dataset>> LoadInOneFrame(const std::vector<std::string>& paths,
-                                              PhoneLogOptions phone,
-                                              std::optional<std::pair<double, double>>* origin);
+StatusOr<std::vector<dataset::Dataset>> LoadInOneFrame(
+    const std::vector<std::string>& paths, dataset::PhoneLogOptions phone,
+    std::optional<std::pair<double, double>>* origin);
 
 // A scan's readings as the Wi-Fi map takes them.
 std::vector<std::pair<std::string, double>> ScanReadings(const WifiScan& scan);
@@ -46,7 +46,7 @@ Point2 TruthToMap(const phone::WifiGpMap& map, const Point2& p);
 struct PhoneSetup {
   phone::LocateOptions options;
   phone::WifiGpMap map;
-  Dataset data;
+  dataset::Dataset data;
 };
 // Loads the map and the log (which must hold a Wi-Fi scan), and refuses a particle count that
 // would take over half an hour on it.
@@ -58,8 +58,9 @@ StatusOr<PhoneSetup> SetUpPhone(const phone::LocateOptions& options,
 // the compass, turned into the map's frame, or integrated turn rate), a random walk between
 // scans without odometry, and a weight update per scan, after which `on_scan` runs with the
 // number of readings the map knew.
-void FilterPhoneLog(const Dataset& d, const phone::WifiGpMap& map, phone::ParticleFilter* filter,
-                    double until_s, const std::function<void(const WifiScan&, size_t)>& on_scan);
+void FilterPhoneLog(const dataset::Dataset& d, const phone::WifiGpMap& map,
+                    phone::ParticleFilter* filter, double until_s,
+                    const std::function<void(const WifiScan&, size_t)>& on_scan);
 
 // One scan of the located log.
 struct LocatedScan {

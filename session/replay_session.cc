@@ -45,7 +45,7 @@ ReplaySession::ReplaySession(ReplaySessionOptions options, SessionEnvironment en
   if (env_.clock == nullptr) env_.clock = &system_clock_;
   if (env_.progress == nullptr) env_.progress = &no_progress_;
   if (env_.images == nullptr) {
-    own_images_ = std::make_unique<FileImageLoader>();
+    own_images_ = std::make_unique<dataset::FileImageLoader>();
     env_.images = own_images_.get();
   }
   fingerprint_ = ConfigFingerprint(options_.pipeline);
@@ -65,16 +65,16 @@ Status ReplaySession::Load() {
       return Status::Error("localisation: the lost distance must be positive and finite");
     }
   }
-  PhoneLogOptions phone;
+  dataset::PhoneLogOptions phone;
   phone.lenient = options_.lenient;
   phone.pdr = options_.pipeline.pdr;
-  StatusOr<Dataset> dataset =
-      LoadSessions(options_.data, phone, 1.0, options_.pipeline.bag, options_.pipeline.video);
+  StatusOr<dataset::Dataset> dataset = dataset::LoadSessions(
+      options_.data, phone, 1.0, options_.pipeline.bag, options_.pipeline.video);
   if (!dataset.ok()) return dataset.status();
   if (options_.pipeline.visual_odometry.enabled) {
-    RATSLAM_RETURN_IF_ERROR(
-        ReplaceOdometryWithVisual(&dataset.value(), env_.images, options_.pipeline.visual_odometry)
-            .WithContext("visual odometry"));
+    RATSLAM_RETURN_IF_ERROR(dataset::ReplaceOdometryWithVisual(&dataset.value(), env_.images,
+                                                               options_.pipeline.visual_odometry)
+                                .WithContext("visual odometry"));
   }
   if (dataset->odometry.empty()) {
     return Status::Error("data set '" + dataset->name +

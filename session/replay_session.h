@@ -102,7 +102,7 @@ class ReplaySession {
   StatusOr<ReplayResult> Run(const ReplayCheckpoint& checkpoint = {});
 
   const ReplaySessionOptions& options() const { return options_; }
-  const Dataset& dataset() const { return *dataset_; }           // after Load
+  const dataset::Dataset& dataset() const { return *dataset_; }  // after Load
   const ReplayPipeline& pipeline() const { return *pipeline_; }  // after Prepare
   const ReplayResult& result() const { return result_; }
 
@@ -112,7 +112,7 @@ class ReplaySession {
   SteadyClock system_clock_;
   SilentProgress no_progress_;
   std::unique_ptr<ImageLoader> own_images_;
-  std::optional<Dataset> dataset_;
+  std::optional<dataset::Dataset> dataset_;
   std::unique_ptr<ReplayPipeline> pipeline_;
   uint64_t fingerprint_ = 0;
   ReplayResult result_;

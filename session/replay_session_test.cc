@@ -58,9 +58,9 @@ class ReplaySessionTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = new ScratchDir("ratslam_session");
-    SyntheticOptions small;
+    dataset::SyntheticOptions small;
     small.laps = 1;
-    ASSERT_TRUE(WriteSyntheticDataset(small, (dir_->path() / "data").string()).ok());
+    ASSERT_TRUE(dataset::WriteSyntheticDataset(small, (dir_->path() / "data").string()).ok());
   }
   static void TearDownTestSuite() { delete dir_; }
   static ReplaySessionOptions Options() {

@@ -49,10 +49,10 @@ Status SamplesFromRun(const std::string& run_folder, const std::vector<std::stri
   StatusOr<std::vector<GroundTruthRow>> trajectory =
       ReadTumTrajectory((run / "trajectory_tum.txt").string());
   if (!trajectory.ok()) return trajectory.status();
-  PhoneLogOptions phone;
+  dataset::PhoneLogOptions phone;
   phone.lenient = lenient;
   phone.pdr = config->pdr;
-  StatusOr<Dataset> data = LoadSessions(paths, phone);
+  StatusOr<dataset::Dataset> data = dataset::LoadSessions(paths, phone);
   if (!data.ok()) return data.status();
   if (!folder->dataset_name.empty() && folder->dataset_name != data->name) {
     return Status::Error(run.string() + ": the run replayed data set '" + folder->dataset_name +
@@ -60,14 +60,14 @@ Status SamplesFromRun(const std::string& run_folder, const std::vector<std::stri
   }
   for (const WifiScan& scan : data->wifi) {
     ++*scans;
-    const auto pose = InterpolateGroundTruth(*trajectory, scan.time_s);
+    const auto pose = dataset::InterpolateGroundTruth(*trajectory, scan.time_s);
     if (!pose || scan.readings.empty()) continue;
     samples->push_back({{pose->x_m, pose->y_m}, 0, ScanReadings(scan)});
   }
   // The compass's offset: circular mean of map heading minus compass heading.
   double sum_sin = 0.0, sum_cos = 0.0;
   for (const CompassRow& c : data->compass) {
-    const auto pose = InterpolateGroundTruth(*trajectory, c.time_s);
+    const auto pose = dataset::InterpolateGroundTruth(*trajectory, c.time_s);
     if (!pose) continue;
     sum_sin += std::sin(pose->theta_rad - c.heading_rad);
     sum_cos += std::cos(pose->theta_rad - c.heading_rad);
@@ -76,7 +76,7 @@ Status SamplesFromRun(const std::string& run_folder, const std::vector<std::stri
     frame_of->set_compass_to_map_rad(std::atan2(sum_sin, sum_cos));
   std::vector<Point2> on_map, on_truth;
   for (const GroundTruthRow& p : *trajectory) {
-    const auto truth = GroundTruthAt(*data, p.time_s);
+    const auto truth = dataset::GroundTruthAt(*data, p.time_s);
     if (!truth) continue;
     on_map.push_back({p.x_m, p.y_m});
     on_truth.push_back({truth->x_m, truth->y_m});
@@ -89,7 +89,7 @@ Status SamplesFromRun(const std::string& run_folder, const std::vector<std::stri
 
 StatusOr<BuiltWifiMap> BuildWifiMap(const phone::LocateOptions& options, const WifiMapInput& input,
                                     const std::string& map_label) {
-  PhoneLogOptions phone;
+  dataset::PhoneLogOptions phone;
   phone.lenient = input.lenient;
   phone.pdr = options.pdr;
   std::optional<std::pair<double, double>> origin;
@@ -102,15 +102,16 @@ StatusOr<BuiltWifiMap> BuildWifiMap(const phone::LocateOptions& options, const W
     Status got = SamplesFromRun(*input.run, input.data, input.lenient, &samples, &scans, &frame);
     if (!got.ok()) return got;
     // The geographic origin the replay's phone logs were read in (the first log's).
-    StatusOr<std::vector<Dataset>> first = LoadInOneFrame({input.data.front()}, phone, &origin);
+    StatusOr<std::vector<dataset::Dataset>> first =
+        LoadInOneFrame({input.data.front()}, phone, &origin);
     if (!first.ok()) return first.status();
   } else {
-    StatusOr<std::vector<Dataset>> data = LoadInOneFrame(input.data, phone, &origin);
+    StatusOr<std::vector<dataset::Dataset>> data = LoadInOneFrame(input.data, phone, &origin);
     if (!data.ok()) return data.status();
-    for (const Dataset& d : data.value()) {
+    for (const dataset::Dataset& d : data.value()) {
       for (const WifiScan& scan : d.wifi) {
         ++scans;
-        const auto truth = GroundTruthAt(d, scan.time_s);
+        const auto truth = dataset::GroundTruthAt(d, scan.time_s);
         if (!truth || scan.readings.empty()) continue;
         samples.push_back({{truth->x_m, truth->y_m}, truth->floor, ScanReadings(scan)});
       }

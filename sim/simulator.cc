@@ -317,13 +317,13 @@ render::ViewLighting LightingOf(const World& world, int session) {
 }
 
 Status Simulate(const World& world, uint64_t seed, render::ViewRenderer* renderer,
-                const std::string& image_folder, Dataset* dataset, SimulationReport* report,
-                const std::function<void(double)>& progress) {
+                const std::string& image_folder, dataset::Dataset* dataset,
+                SimulationReport* report, const std::function<void(double)>& progress) {
   RATSLAM_RETURN_IF_ERROR(world.Validate());
   const double step_s = 1.0 / world.odometry.rate_hz;
   const std::vector<TruePose> poses = TrueTrajectory(world, step_s);
   if (poses.size() < 2) return Status::Error("world: the routes give no motion");
-  *dataset = Dataset();
+  *dataset = dataset::Dataset();
   *report = SimulationReport();
   dataset->name = world.name.empty() ? "simulated" : world.name;
   if (renderer) {

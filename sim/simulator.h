@@ -52,8 +52,8 @@ struct SimulationReport {
 // Simulates `world` into `dataset`; images go to `image_folder` (PNG, created) when `renderer`
 // is given, else the data set has no images. `progress` (optional) gets the fraction done.
 Status Simulate(const World& world, uint64_t seed, render::ViewRenderer* renderer,
-                const std::string& image_folder, Dataset* dataset, SimulationReport* report,
-                const std::function<void(double)>& progress = nullptr);
+                const std::string& image_folder, dataset::Dataset* dataset,
+                SimulationReport* report, const std::function<void(double)>& progress = nullptr);
 
 }  // namespace ratslam::sim
 

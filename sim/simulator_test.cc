@@ -138,12 +138,12 @@ TEST(SimulatorTest, SameSeedSameBytes) {
   std::string first_csvs;
   for (int run = 0; run < 3; ++run) {
     const fs::path folder = base / std::to_string(run);
-    Dataset d;
+    dataset::Dataset d;
     SimulationReport report;
     ASSERT_TRUE(
         Simulate(w, run < 2 ? 7 : 8, renderer->get(), (folder / "images").string(), &d, &report)
             .ok());
-    ASSERT_TRUE(WriteDataset(d, folder.string()).ok());
+    ASSERT_TRUE(dataset::WriteDataset(d, folder.string()).ok());
     EXPECT_GT(report.images, 10u);
     EXPECT_GT(report.scans, 10u);
     std::string all;
@@ -217,14 +217,14 @@ TEST(SimulatorTest, TrajectoryFollowsTheRouteAndCompassFeelsDisturbances) {
     EXPECT_GE(p.x_m, 1.0 - 1e-6);
     EXPECT_LE(p.x_m, 9.0 + 1e-6);
   }
-  Dataset d;
+  dataset::Dataset d;
   SimulationReport report;
   ASSERT_TRUE(Simulate(w, 3, nullptr, "", &d, &report).ok());
   EXPECT_TRUE(d.images.empty());
   // Near the disturbance (8, 2) the compass is off by up to 40 degrees; far away by noise only.
   double worst_near = 0, worst_far = 0;
   for (const CompassRow& c : d.compass) {
-    const auto truth = InterpolateGroundTruth(d.ground_truth, c.time_s);
+    const auto truth = dataset::InterpolateGroundTruth(d.ground_truth, c.time_s);
     ASSERT_TRUE(truth.has_value());
     const double error =
         std::abs(std::remainder(c.heading_rad - truth->theta_rad, 2 * M_PI)) * 180 / M_PI;
@@ -245,7 +245,7 @@ TEST(SimulatorTest, SessionsAreNamedByWhatSetsThemApart) {
   Session back = w.sessions.front();
   back.reverse = true;
   w.sessions = {w.sessions.front(), night, w.sessions.front(), back};
-  Dataset d;
+  dataset::Dataset d;
   SimulationReport report;
   ASSERT_TRUE(Simulate(w, 3, nullptr, "", &d, &report).ok());
   ASSERT_EQ(d.session_start_times_s.size(), 4u);

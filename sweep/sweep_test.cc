@@ -42,7 +42,7 @@ std::string Write(const std::string& name, const std::string& text) {
 // A 40 m square walked twice at 1 m/s, with four access points heard by distance and ground
 // truth: a Wi-Fi-only replay of it takes milliseconds.
 std::string SquareWalk(const std::string& name, double noise_dbm) {
-  Dataset d;
+  dataset::Dataset d;
   d.name = name;
   const double side = 10.0;
   double x = 0.0, y = 0.0, heading = 0.0;
@@ -68,7 +68,7 @@ std::string SquareWalk(const std::string& name, double noise_dbm) {
     (void)side;
   }
   const std::string folder = (Scratch().path() / "data" / name).string();
-  EXPECT_TRUE(WriteDataset(d, folder).ok());
+  EXPECT_TRUE(dataset::WriteDataset(d, folder).ok());
   return folder;
 }
 

@@ -27,7 +27,7 @@ constexpr int kDimensions = 256;
 constexpr double kLengthScaleM = 1.0;
 
 // One descriptor per image from the true position at its time, plus noise.
-DescriptorMatrix OracleDescriptors(const Dataset& d, uint64_t noise_seed) {
+dataset::DescriptorMatrix OracleDescriptors(const dataset::Dataset& d, uint64_t noise_seed) {
   Random features(7);  // the same features for every session: one descriptor "network"
   std::vector<double> wx(kDimensions), wy(kDimensions), phase(kDimensions);
   for (int k = 0; k < kDimensions; ++k) {
@@ -36,11 +36,12 @@ DescriptorMatrix OracleDescriptors(const Dataset& d, uint64_t noise_seed) {
     phase[k] = features.Uniform(0.0, 2.0 * M_PI);
   }
   Random noise(noise_seed);
-  DescriptorMatrix m;
+  dataset::DescriptorMatrix m;
   m.rows = d.images.size();
   m.cols = kDimensions;
   for (const ImageRow& image : d.images) {
-    const std::optional<GroundTruthRow> p = InterpolateGroundTruth(d.ground_truth, image.time_s);
+    const std::optional<GroundTruthRow> p =
+        dataset::InterpolateGroundTruth(d.ground_truth, image.time_s);
     const double x = p ? p->x_m : 0.0, y = p ? p->y_m : 0.0;
     for (int k = 0; k < kDimensions; ++k) {
       m.values.push_back(
@@ -57,17 +58,17 @@ class DescriptorEndToEndTest : public ::testing::Test {
     fs::remove_all(root_);
     fs::create_directories(root_);
     for (int session = 0; session < 2; ++session) {
-      SyntheticOptions o;
+      dataset::SyntheticOptions o;
       o.laps = session == 0 ? 2 : 1;
       o.noise_seed = 11 + session;
       o.start_m = session == 0 ? 0.0 : 30.0;
       const fs::path folder = root_ / ("session" + std::to_string(session));
-      StatusOr<Dataset> d = WriteSyntheticDataset(o, folder.string());
+      StatusOr<dataset::Dataset> d = dataset::WriteSyntheticDataset(o, folder.string());
       ASSERT_TRUE(d.ok()) << d.status().message();
       // The descriptors were computed elsewhere; the images are not needed any more.
       fs::remove_all(folder / "images");
-      ASSERT_TRUE(WriteDescriptorNpy(OracleDescriptors(*d, 100 + session),
-                                     (folder / "descriptors.npy").string())
+      ASSERT_TRUE(dataset::WriteDescriptorNpy(OracleDescriptors(*d, 100 + session),
+                                              (folder / "descriptors.npy").string())
                       .ok());
     }
     std::string toml = Slurp(fs::path(RATSLAM_SOURCE_DIR) / "configs" / "synthetic.toml");
@@ -131,8 +132,8 @@ TEST_F(DescriptorEndToEndTest, MissingOrMiscountedDescriptorsNameTheFile) {
   const fs::path folder = root_ / "session1";
   fs::copy_file(folder / "descriptors.npy", root_ / "saved.npy",
                 fs::copy_options::overwrite_existing);
-  DescriptorMatrix three{3, kDimensions, std::vector<float>(3 * kDimensions, 1.0f)};
-  ASSERT_TRUE(WriteDescriptorNpy(three, (folder / "descriptors.npy").string()).ok());
+  dataset::DescriptorMatrix three{3, kDimensions, std::vector<float>(3 * kDimensions, 1.0f)};
+  ASSERT_TRUE(dataset::WriteDescriptorNpy(three, (folder / "descriptors.npy").string()).ok());
   const e2e::Result miscounted = RunRatslam(Replay("session1", "bad1"), root_);
   fs::copy_file(root_ / "saved.npy", folder / "descriptors.npy",
                 fs::copy_options::overwrite_existing);

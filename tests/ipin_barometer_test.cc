@@ -27,7 +27,8 @@ struct FloorScore {
 
 FloorScore ScoreLog(const fs::path& path) {
   FloorScore score;
-  StatusOr<PhoneLog> log = ParseIpinLog(path.string(), PhoneLogOptions());
+  StatusOr<dataset::PhoneLog> log =
+      dataset::ParseIpinLog(path.string(), dataset::PhoneLogOptions());
   EXPECT_TRUE(log.ok()) << log.status().message();
   if (!log.ok() || log->streams.ground_truth.empty()) return score;
   BarometricFloorTracker tracker;

@@ -50,11 +50,11 @@ TEST(IpinEndToEndTest, WifiRatslamClosesOutAndBackLoops) {
   const int matches = s["matches"];
 
   // Chance: frames paired at random (at least 40 s apart) within 10 m of each other.
-  StatusOr<Dataset> d = LoadSessions({a.string(), b.string()}, {});
+  StatusOr<dataset::Dataset> d = dataset::LoadSessions({a.string(), b.string()}, {});
   ASSERT_TRUE(d.ok());
   std::vector<GroundTruthRow> at_scans;
   for (const WifiScan& scan : d->wifi) {
-    if (auto gt = GroundTruthAt(*d, scan.time_s)) at_scans.push_back(*gt);
+    if (auto gt = dataset::GroundTruthAt(*d, scan.time_s)) at_scans.push_back(*gt);
   }
   size_t pairs = 0, near = 0;
   for (size_t i = 0; i < at_scans.size(); ++i) {
@@ -230,7 +230,7 @@ TEST(IpinEndToEndTest, BarometerKeepsMatchesOnTheirFloors) {
   // experiences.csv's floor (relative to the walk's start) against the ground truth's, where
   // both are known (measured: 5 of 5; the others were made on the stairs or before the first
   // ground-truth point).
-  StatusOr<Dataset> walk = LoadSessions({logs[0].string()}, {});
+  StatusOr<dataset::Dataset> walk = dataset::LoadSessions({logs[0].string()}, {});
   ASSERT_TRUE(walk.ok());
   std::ifstream experiences(root / "51" / "experiences.csv");
   std::string line;
@@ -243,7 +243,7 @@ TEST(IpinEndToEndTest, BarometerKeepsMatchesOnTheirFloors) {
     std::stringstream row(line);
     for (std::string cell; std::getline(row, cell, ',');) cells.push_back(cell);
     if (cells.size() < 10 || cells[9].empty()) continue;
-    const std::optional<int> truth = KnownFloor(walk->ground_truth, std::stod(cells[5]));
+    const std::optional<int> truth = dataset::KnownFloor(walk->ground_truth, std::stod(cells[5]));
     if (!truth) continue;
     ++judged;
     agree += std::stoi(cells[9]) + start_floor == *truth;
@@ -331,7 +331,7 @@ TEST(IpinEndToEndTest, OnlineRssiOffsetFindsTheSecondPhonesOffset) {
       if (!fs::exists(p)) GTEST_SKIP() << "missing " << p;
       paths.push_back(p.string());
     }
-    StatusOr<Dataset> d = LoadSessions(paths, {});
+    StatusOr<dataset::Dataset> d = dataset::LoadSessions(paths, {});
     ASSERT_TRUE(d.ok()) << d.status().message();
     const std::vector<double>& starts = d->session_start_times_s;
     ASSERT_EQ(starts.size(), 4u);
@@ -347,7 +347,7 @@ TEST(IpinEndToEndTest, OnlineRssiOffsetFindsTheSecondPhonesOffset) {
     };
     std::vector<Located> scans;
     for (const WifiScan& scan : d->wifi) {
-      if (auto gt = GroundTruthAt(*d, scan.time_s)) {
+      if (auto gt = dataset::GroundTruthAt(*d, scan.time_s)) {
         scans.push_back({session_of(scan.time_s), *gt, &scan});
       }
     }
@@ -455,11 +455,11 @@ TEST(IpinEndToEndTest, PhoneLogsLocaliseOnASavedMap) {
                         map.string() + " > /dev/null";
   ASSERT_EQ(std::system(command.c_str()), 0) << command;
 
-  StatusOr<Dataset> d = LoadSessions({logs[0].string()}, {});
+  StatusOr<dataset::Dataset> d = dataset::LoadSessions({logs[0].string()}, {});
   ASSERT_TRUE(d.ok()) << d.status().message();
   std::vector<GroundTruthRow> at_scans;
   for (const WifiScan& scan : d->wifi) {
-    if (auto gt = GroundTruthAt(*d, scan.time_s)) at_scans.push_back(*gt);
+    if (auto gt = dataset::GroundTruthAt(*d, scan.time_s)) at_scans.push_back(*gt);
   }
   ASSERT_GT(at_scans.size(), 20u);
   double cx = 0, cy = 0;

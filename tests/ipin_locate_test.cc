@@ -67,10 +67,10 @@ TEST(IpinLocateTest, AParticleFilterLocatesAnotherPhoneInTheWifiMap) {
   ASSERT_EQ(wifi->floors().size(), 1u);
   const std::vector<Point2> cells = wifi->KnownCells(wifi->floors().front());
   ASSERT_FALSE(cells.empty());
-  StatusOr<CsvTable> errors =
-      CsvTable::Read((root / "o" / "errors.csv").string(),
-                     {"time_s", "x_m", "y_m", "floor", "known_aps", "true_x_m", "true_y_m",
-                      "true_floor", "error_m", "knn_error_m"});
+  StatusOr<dataset::CsvTable> errors =
+      dataset::CsvTable::Read((root / "o" / "errors.csv").string(),
+                              {"time_s", "x_m", "y_m", "floor", "known_aps", "true_x_m", "true_y_m",
+                               "true_floor", "error_m", "knn_error_m"});
   ASSERT_TRUE(errors.ok()) << errors.status().message();
   double chance = 0.0;
   size_t n = 0;
@@ -197,7 +197,7 @@ TEST(IpinLocateTest, ARunsMapLocatesThePhoneAndTheRobotIsCalled) {
         {std::cos(a.rotation_rad) * c.x - std::sin(a.rotation_rad) * c.y + a.translation_x_m,
          std::sin(a.rotation_rad) * c.x + std::cos(a.rotation_rad) * c.y + a.translation_y_m});
   }
-  StatusOr<CsvTable> errors = CsvTable::Read(
+  StatusOr<dataset::CsvTable> errors = dataset::CsvTable::Read(
       (root / "o" / "errors.csv").string(), {"time_s", "true_x_m", "true_y_m", "error_m"},
       {"x_m", "y_m", "floor", "known_aps", "true_floor", "knn_error_m"});
   ASSERT_TRUE(errors.ok()) << errors.status().message();
@@ -255,14 +255,16 @@ TEST(IpinLocateTest, ARunsMapLocatesThePhoneAndTheRobotIsCalled) {
     EXPECT_EQ(magic, "%PDF-");
   }
   EXPECT_LT(c["nearest_candidate_error_m"].get<double>(), 0.3 * chance);
-  StatusOr<CsvTable> ex = CsvTable::Read(run + "/experiences.csv", {"id", "x_m", "y_m"},
-                                         {"theta_rad", "template_id", "time_s", "pose_cell_x",
-                                          "pose_cell_y", "pose_cell_theta", "floor"});
-  StatusOr<CsvTable> links = CsvTable::Read(
+  StatusOr<dataset::CsvTable> ex =
+      dataset::CsvTable::Read(run + "/experiences.csv", {"id", "x_m", "y_m"},
+                              {"theta_rad", "template_id", "time_s", "pose_cell_x", "pose_cell_y",
+                               "pose_cell_theta", "floor"});
+  StatusOr<dataset::CsvTable> links = dataset::CsvTable::Read(
       run + "/links.csv", {"from_id", "to_id"},
       {"id", "distance_m", "heading_rad", "facing_rad", "duration_s", "loop_closure", "kind"});
-  StatusOr<CsvTable> route = CsvTable::Read((root / "c" / "route.csv").string(), {"experience_id"},
-                                            {"step", "x_m", "y_m", "stop_of_candidates"});
+  StatusOr<dataset::CsvTable> route =
+      dataset::CsvTable::Read((root / "c" / "route.csv").string(), {"experience_id"},
+                              {"step", "x_m", "y_m", "stop_of_candidates"});
   ASSERT_TRUE(ex.ok() && links.ok() && route.ok());
   std::set<std::pair<int, int>> linked;
   for (size_t r = 0; r < links->rows(); ++r) {

@@ -96,10 +96,10 @@ TEST_P(IpinWifiSequenceTest, VerifiedSequencesCloseLoopsOnRealWalks) {
 
   // Chance from the ground truth: for each verified correspondence, the mean true distance from
   // its current scan to every scan of the earlier sessions.
-  StatusOr<Dataset> d =
-      LoadSessions({logs[0].string(), logs[1].string(), logs[2].string(), logs[3].string()}, {});
+  StatusOr<dataset::Dataset> d = dataset::LoadSessions(
+      {logs[0].string(), logs[1].string(), logs[2].string(), logs[3].string()}, {});
   ASSERT_TRUE(d.ok());
-  StatusOr<CsvTable> loops = CsvTable::Read(
+  StatusOr<dataset::CsvTable> loops = dataset::CsvTable::Read(
       (out / "with" / "wifi_sequence_loops.csv").string(), {"accepted", "inlier", "current_time_s"},
       {"loop_id", "matched_time_s", "current_pose", "past_pose", "past_time_s", "similarity",
        "residual_m", "current_x_m", "current_y_m", "past_x_m", "past_y_m"});
@@ -111,7 +111,7 @@ TEST_P(IpinWifiSequenceTest, VerifiedSequencesCloseLoopsOnRealWalks) {
       continue;
     }
     const double t = loops->Number(r, "current_time_s").value();
-    const auto now = GroundTruthAt(*d, t);
+    const auto now = dataset::GroundTruthAt(*d, t);
     if (!now) continue;
     size_t session = 0;
     while (session + 1 < d->session_start_times_s.size() &&
@@ -122,7 +122,7 @@ TEST_P(IpinWifiSequenceTest, VerifiedSequencesCloseLoopsOnRealWalks) {
     size_t n = 0;
     for (const WifiScan& scan : d->wifi) {
       if (scan.time_s >= d->session_start_times_s[session]) break;
-      if (auto then = GroundTruthAt(*d, scan.time_s)) {
+      if (auto then = dataset::GroundTruthAt(*d, scan.time_s)) {
         sum += std::hypot(now->x_m - then->x_m, now->y_m - then->y_m);
         ++n;
       }
@@ -142,9 +142,10 @@ TEST_P(IpinWifiSequenceTest, VerifiedSequencesCloseLoopsOnRealWalks) {
   EXPECT_LT(with["map_ate_m"].get<double>(), 0.8 * without["map_ate_m"].get<double>());
 
   // Every link the summary counts is marked in links.csv.
-  StatusOr<CsvTable> links = CsvTable::Read((out / "with" / "links.csv").string(), {"kind"},
-                                            {"id", "from_id", "to_id", "distance_m", "heading_rad",
-                                             "facing_rad", "duration_s", "loop_closure"});
+  StatusOr<dataset::CsvTable> links =
+      dataset::CsvTable::Read((out / "with" / "links.csv").string(), {"kind"},
+                              {"id", "from_id", "to_id", "distance_m", "heading_rad", "facing_rad",
+                               "duration_s", "loop_closure"});
   ASSERT_TRUE(links.ok()) << links.status().message();
   int marked = 0;
   for (size_t r = 0; r < links->rows(); ++r)

@@ -191,12 +191,12 @@ TEST(MalformedInputTest, DataSetsAndLogsNeverCrash) {
   for (int k = 0; k < 300; ++k) {
     std::ofstream(folder / "manifest.toml") << Mutate(manifest, rng);
     std::ofstream(folder / "odometry.csv") << Mutate(odometry, rng);
-    (void)ReadDataset(folder.string());
+    (void)dataset::ReadDataset(folder.string());
     const fs::path log = Scratch("_log.txt");
     std::ofstream(log) << Mutate(ipin, rng);
-    (void)ReadIpinLog(log.string(), {});
+    (void)dataset::ReadIpinLog(log.string(), {});
     std::ofstream(log) << Mutate(msft, rng);
-    (void)ReadMicrosoftLog(log.string(), {});
+    (void)dataset::ReadMicrosoftLog(log.string(), {});
     fs::remove(log);
   }
   fs::remove_all(folder);

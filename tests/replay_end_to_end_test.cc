@@ -84,7 +84,8 @@ class ReplayEndToEndTest : public ::testing::Test {
     root_ = fs::temp_directory_path() / ("ratslam_e2e_" + std::to_string(::getpid()));
     fs::remove_all(root_);
     fs::create_directories(root_);
-    StatusOr<Dataset> d = WriteSyntheticDataset(DemoSyntheticOptions(), (root_ / "data").string());
+    StatusOr<dataset::Dataset> d =
+        dataset::WriteSyntheticDataset(DemoSyntheticOptions(), (root_ / "data").string());
     ASSERT_TRUE(d.ok()) << d.status().message();
     config_ = (fs::path(RATSLAM_SOURCE_DIR) / "configs" / "synthetic.toml").string();
   }
@@ -487,7 +488,7 @@ TEST_F(ReplayEndToEndTest, DataWithoutOdometryReplaysOnVisualOdometry) {
 // folder it was written from, with ground truth from the bag; `import` turns the bag back into a
 // folder that replays to the same map again.
 TEST_F(ReplayEndToEndTest, BagReplayGivesTheFolderReplaysMap) {
-  if (!RosbagSupported()) GTEST_SKIP() << "built without librosbag-storage-dev";
+  if (!dataset::RosbagSupported()) GTEST_SKIP() << "built without librosbag-storage-dev";
   const fs::path dir = root_ / "bag";
   const Result made = RunRatslam(
       "synthesize --out " + (dir / "data").string() + " --bag " + (dir / "loop.bag").string(),
@@ -1074,10 +1075,11 @@ TEST_F(ReplayEndToEndTest, PrintConfigFailsWithLineNumber) {
 TEST_F(ReplayEndToEndTest, RouteIsTheShortestPathOverTheExperienceGraph) {
   const fs::path run = root_ / "route_run";
   ASSERT_EQ(RunRatslam(ReplayArgs(run), root_).exit_code, 0);
-  StatusOr<CsvTable> ex = CsvTable::Read((run / "experiences.csv").string(), {"id", "x_m", "y_m"},
-                                         {"theta_rad", "template_id", "time_s", "pose_cell_x",
-                                          "pose_cell_y", "pose_cell_theta", "floor"});
-  StatusOr<CsvTable> li = CsvTable::Read(
+  StatusOr<dataset::CsvTable> ex =
+      dataset::CsvTable::Read((run / "experiences.csv").string(), {"id", "x_m", "y_m"},
+                              {"theta_rad", "template_id", "time_s", "pose_cell_x", "pose_cell_y",
+                               "pose_cell_theta", "floor"});
+  StatusOr<dataset::CsvTable> li = dataset::CsvTable::Read(
       (run / "links.csv").string(), {"from_id", "to_id"},
       {"id", "distance_m", "heading_rad", "facing_rad", "duration_s", "loop_closure", "kind"});
   ASSERT_TRUE(ex.ok() && li.ok());
@@ -1127,9 +1129,9 @@ TEST_F(ReplayEndToEndTest, RouteIsTheShortestPathOverTheExperienceGraph) {
     along += std::hypot(x[path[k]] - x[path[k - 1]], y[path[k]] - y[path[k - 1]]);
   }
   EXPECT_NEAR(along, d[far], 1e-9 * (1 + d[far]));
-  StatusOr<CsvTable> csv =
-      CsvTable::Read((root_ / "route" / "route.csv").string(),
-                     {"step", "experience_id", "x_m", "y_m", "distance_m"}, {});
+  StatusOr<dataset::CsvTable> csv =
+      dataset::CsvTable::Read((root_ / "route" / "route.csv").string(),
+                              {"step", "experience_id", "x_m", "y_m", "distance_m"}, {});
   ASSERT_TRUE(csv.ok()) << csv.status().message();
   EXPECT_EQ(csv->rows(), path.size());
   EXPECT_TRUE(fs::exists(root_ / "route" / "route.png"));
@@ -1158,17 +1160,20 @@ TEST_F(ReplayEndToEndTest, RouteIsTheShortestPathOverTheExperienceGraph) {
 // with ground truth through the map run's own alignment (an oracle independent of the
 // localisation run) far better than chance. A session in another world recognises nothing.
 TEST_F(ReplayEndToEndTest, LocalisationOnASavedMapFollowsTheNextSession) {
-  SyntheticOptions map_options = DemoSyntheticOptions();
+  dataset::SyntheticOptions map_options = DemoSyntheticOptions();
   map_options.laps = 2;
-  SyntheticOptions next = DemoSyntheticOptions();
+  dataset::SyntheticOptions next = DemoSyntheticOptions();
   next.laps = 1;
   next.noise_seed = 7;
   next.start_m = 60.0;
-  SyntheticOptions elsewhere = next;
+  dataset::SyntheticOptions elsewhere = next;
   elsewhere.seed = map_options.seed + 1;
-  StatusOr<Dataset> map_data = WriteSyntheticDataset(map_options, (root_ / "loc_map").string());
-  StatusOr<Dataset> next_data = WriteSyntheticDataset(next, (root_ / "loc_next").string());
-  StatusOr<Dataset> other_data = WriteSyntheticDataset(elsewhere, (root_ / "loc_other").string());
+  StatusOr<dataset::Dataset> map_data =
+      dataset::WriteSyntheticDataset(map_options, (root_ / "loc_map").string());
+  StatusOr<dataset::Dataset> next_data =
+      dataset::WriteSyntheticDataset(next, (root_ / "loc_next").string());
+  StatusOr<dataset::Dataset> other_data =
+      dataset::WriteSyntheticDataset(elsewhere, (root_ / "loc_other").string());
   ASSERT_TRUE(map_data.ok() && next_data.ok() && other_data.ok());
   const fs::path map_run = root_ / "loc_map_run", map_file = root_ / "loc.map";
   const std::string base = "replay --quiet --config " + config_ + " --data ";
@@ -1193,13 +1198,14 @@ TEST_F(ReplayEndToEndTest, LocalisationOnASavedMapFollowsTheNextSession) {
   EXPECT_EQ(l["frames"].get<size_t>(), next_data->images.size());
 
   // The map run's frame against the world's, from its experiences and its ground truth.
-  StatusOr<CsvTable> ex = CsvTable::Read(
+  StatusOr<dataset::CsvTable> ex = dataset::CsvTable::Read(
       (map_run / "experiences.csv").string(), {"id", "x_m", "y_m", "time_s"},
       {"theta_rad", "template_id", "pose_cell_x", "pose_cell_y", "pose_cell_theta", "floor"});
   ASSERT_TRUE(ex.ok()) << ex.status().message();
   std::vector<Point2> map_xy, world_xy;
   for (size_t i = 0; i < ex->rows(); ++i) {
-    const auto gt = InterpolateGroundTruth(map_data->ground_truth, *ex->Number(i, "time_s"));
+    const auto gt =
+        dataset::InterpolateGroundTruth(map_data->ground_truth, *ex->Number(i, "time_s"));
     ASSERT_TRUE(gt.has_value());
     map_xy.push_back({*ex->Number(i, "x_m"), *ex->Number(i, "y_m")});
     world_xy.push_back({gt->x_m, gt->y_m});
@@ -1207,16 +1213,17 @@ TEST_F(ReplayEndToEndTest, LocalisationOnASavedMapFollowsTheNextSession) {
   const std::optional<RigidAlignment2D> to_world = AlignRigid2D(map_xy, world_xy);
   ASSERT_TRUE(to_world.has_value());
 
-  StatusOr<CsvTable> rows =
-      CsvTable::Read((run / "localisation.csv").string(),
-                     {"time_s", "experience_id", "lost", "x_m", "y_m", "theta_rad"},
-                     {"true_x_m", "true_y_m", "error_m"});
+  StatusOr<dataset::CsvTable> rows =
+      dataset::CsvTable::Read((run / "localisation.csv").string(),
+                              {"time_s", "experience_id", "lost", "x_m", "y_m", "theta_rad"},
+                              {"true_x_m", "true_y_m", "error_m"});
   ASSERT_TRUE(rows.ok()) << rows.status().message();
   ASSERT_EQ(rows->rows(), next_data->images.size());
   std::vector<double> errors, chance;
   size_t lost = 0;
   for (size_t i = 0; i < rows->rows(); ++i) {
-    const auto truth = InterpolateGroundTruth(next_data->ground_truth, *rows->Number(i, "time_s"));
+    const auto truth =
+        dataset::InterpolateGroundTruth(next_data->ground_truth, *rows->Number(i, "time_s"));
     ASSERT_TRUE(truth.has_value());
     if (*rows->Number(i, "lost") != 0) {
       ++lost;

@@ -23,7 +23,7 @@ TEST(NiceStepTest, PicksOneTwoFive) {
 // calibration): experiences made in those minutes have no measured position but belong to the
 // walk's floor, not to a floor 0 the building may not have.
 TEST(ExperienceFloorsTest, ExperiencesWithoutTruthTakeTheNearestPointsFloor) {
-  Dataset d;
+  dataset::Dataset d;
   d.session_start_times_s = {0.0, 100.0};
   d.ground_truth = {
       {60.0, 0, 0, 0, -2}, {90.0, 5, 0, 0, -2}, {160.0, 0, 0, 0, -1}, {190.0, 5, 0, 0, -1}};
@@ -32,7 +32,7 @@ TEST(ExperienceFloorsTest, ExperiencesWithoutTruthTakeTheNearestPointsFloor) {
   for (size_t i = 0; i < ex.size(); ++i) ex[i].time_s = times[i];
   const std::vector<int> floors = ExperienceFloors(ex, d);
   EXPECT_EQ(floors, (std::vector<int>{-2, -2, -2, -1, -1, -1}));
-  EXPECT_EQ(ExperienceFloors(ex, Dataset{}), std::vector<int>(6, 0));
+  EXPECT_EQ(ExperienceFloors(ex, dataset::Dataset{}), std::vector<int>(6, 0));
 }
 
 TEST(SequentialColorTest, LightnessRisesMonotonically) {

@@ -11,11 +11,11 @@
 namespace ratslam::viewer {
 
 std::vector<Point2> GroundTruthInMapFrame(const std::vector<Experience>& experiences,
-                                          const Dataset& dataset, double until_time_s,
+                                          const dataset::Dataset& dataset, double until_time_s,
                                           std::vector<int>* floors) {
   std::vector<Point2> map_points, truth_points, truth_path;
   for (const Experience& e : experiences) {
-    if (auto gt = GroundTruthAt(dataset, e.time_s)) {
+    if (auto gt = dataset::GroundTruthAt(dataset, e.time_s)) {
       map_points.push_back({e.x_m, e.y_m});
       truth_points.push_back({gt->x_m, gt->y_m});
     }
@@ -31,7 +31,7 @@ std::vector<Point2> GroundTruthInMapFrame(const std::vector<Experience>& experie
   return aligned;
 }
 
-ExperienceMapImageData ExperienceMapDataOf(const RunView& run, const Dataset& dataset) {
+ExperienceMapImageData ExperienceMapDataOf(const RunView& run, const dataset::Dataset& dataset) {
   const ExperienceMap& map = run.map;
   ExperienceMapImageData data;
   data.experiences = map.experiences();
@@ -45,12 +45,12 @@ ExperienceMapImageData ExperienceMapDataOf(const RunView& run, const Dataset& da
 }
 
 std::vector<int> ExperienceFloors(const std::vector<Experience>& experiences,
-                                  const Dataset& dataset) {
+                                  const dataset::Dataset& dataset) {
   std::vector<int> floors;
   floors.reserve(experiences.size());
   const std::vector<GroundTruthRow>& rows = dataset.ground_truth;
   for (const Experience& e : experiences) {
-    if (const auto gt = GroundTruthAt(dataset, e.time_s)) {
+    if (const auto gt = dataset::GroundTruthAt(dataset, e.time_s)) {
       floors.push_back(gt->floor);
       continue;
     }
@@ -161,8 +161,8 @@ render::Scene ExperienceMapFloorsScene(const ExperienceMapImageData& data,
   return scene;
 }
 
-ExperienceMapFigure ExperienceMapFigureOf(ExperienceMapImageData data, const Dataset& dataset,
-                                          double until_time_s) {
+ExperienceMapFigure ExperienceMapFigureOf(ExperienceMapImageData data,
+                                          const dataset::Dataset& dataset, double until_time_s) {
   ExperienceMapFigure figure;
   figure.options.title = "experience map (" + dataset.name + ")";
   if (dataset.session_start_times_s.size() > 1) {
@@ -188,9 +188,9 @@ std::vector<TemplateGraphPoint> TemplateGraphOf(const RunView& run) {
   return points;
 }
 
-Status WriteRunImages(render::SceneRenderer* renderer, const RunView& run, const Dataset& dataset,
-                      const std::string& folder, const std::vector<FigureFormat>& formats,
-                      double width_mm) {
+Status WriteRunImages(render::SceneRenderer* renderer, const RunView& run,
+                      const dataset::Dataset& dataset, const std::string& folder,
+                      const std::vector<FigureFormat>& formats, double width_mm) {
   namespace fs = std::filesystem;
   auto targets = [&](const char* name) {
     return FigureTargets((fs::path(folder) / name).string(), &formats);
@@ -216,7 +216,7 @@ Status WriteRunImages(render::SceneRenderer* renderer, const RunView& run, const
       map_options.title = "localisation on a saved map (" + dataset.name + ")";
       std::vector<Point2> localised, truth, path;
       for (const LocalisationRecord& r : *run.localisation) {
-        const auto gt = GroundTruthAt(dataset, r.time_s);
+        const auto gt = dataset::GroundTruthAt(dataset, r.time_s);
         if (!gt) continue;
         path.push_back({gt->x_m, gt->y_m});
         if (r.lost) continue;

@@ -18,14 +18,14 @@ namespace ratslam::viewer {
 // experiences to the ground truth at their creation times; empty without ground truth.
 // `floors`, if given, receives the floor of each returned point.
 std::vector<Point2> GroundTruthInMapFrame(const std::vector<Experience>& experiences,
-                                          const Dataset& dataset, double until_time_s,
+                                          const dataset::Dataset& dataset, double until_time_s,
                                           std::vector<int>* floors = nullptr);
 
 // The floor of each experience: the ground truth's floor at its creation; where there is none
 // (before a walk's first point, between two walks), the floor of the point nearest in time; 0
 // without ground truth.
 std::vector<int> ExperienceFloors(const std::vector<Experience>& experiences,
-                                  const Dataset& dataset);
+                                  const dataset::Dataset& dataset);
 
 // How ExperienceMapFloorsScene laid out its panels (columns 0: a single map, no panels).
 struct FloorPanels {
@@ -46,7 +46,7 @@ render::Scene ExperienceMapFloorsScene(const ExperienceMapImageData& data,
                                        FloorPanels* layout = nullptr);
 
 // The experience-map figure data of a run, with the ground truth (if any) aligned to the map.
-ExperienceMapImageData ExperienceMapDataOf(const RunView& run, const Dataset& dataset);
+ExperienceMapImageData ExperienceMapDataOf(const RunView& run, const dataset::Dataset& dataset);
 // What `replay --render` draws as experience_map: coloured by session for a multi-session data
 // set, the ground truth the run reached by `until_time_s` aligned to the map, one panel per floor
 // (ExperienceMapFloorsScene); `render experience-map` draws the same from a run folder.
@@ -56,16 +56,16 @@ struct ExperienceMapFigure {
   std::vector<int> truth_floors;  // per ground-truth point of data.ground_truth
   ExperienceMapImageOptions options;
 };
-ExperienceMapFigure ExperienceMapFigureOf(ExperienceMapImageData data, const Dataset& dataset,
-                                          double until_time_s);
+ExperienceMapFigure ExperienceMapFigureOf(ExperienceMapImageData data,
+                                          const dataset::Dataset& dataset, double until_time_s);
 
 // One template-graph point per view frame.
 std::vector<TemplateGraphPoint> TemplateGraphOf(const RunView& run);
 
 // Writes experience_map, template_graph and pose_cells into `folder` in each of `formats` (PNG
 // through `renderer`, which may be null without PNG; PDF and SVG on pages `width_mm` wide).
-Status WriteRunImages(render::SceneRenderer* renderer, const RunView& run, const Dataset& dataset,
-                      const std::string& folder,
+Status WriteRunImages(render::SceneRenderer* renderer, const RunView& run,
+                      const dataset::Dataset& dataset, const std::string& folder,
                       const std::vector<FigureFormat>& formats = {FigureFormat::kPng},
                       double width_mm = render::kOneColumnMm);
 

@@ -4,7 +4,8 @@
 
 namespace ratslam::viewer {
 
-StatusOr<SimilarityMatrix> CameraSimilarityMatrix(const Dataset& dataset, ImageLoader* images,
+StatusOr<SimilarityMatrix> CameraSimilarityMatrix(const dataset::Dataset& dataset,
+                                                  ImageLoader* images,
                                                   const ClassicCameraOptions& options,
                                                   int max_frames) {
   if (dataset.images.empty()) return Status::Error(dataset.name + ": the data set has no images");
@@ -42,7 +43,7 @@ StatusOr<SimilarityMatrix> CameraSimilarityMatrix(const Dataset& dataset, ImageL
   return m;
 }
 
-StatusOr<SimilarityMatrix> WifiSimilarityMatrix(const Dataset& dataset,
+StatusOr<SimilarityMatrix> WifiSimilarityMatrix(const dataset::Dataset& dataset,
                                                 const WifiMatcherOptions& options, int max_scans) {
   if (dataset.wifi.empty())
     return Status::Error(dataset.name + ": the data set has no Wi-Fi scans");

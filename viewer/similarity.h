@@ -21,13 +21,14 @@ struct SimilarityMatrix {
 // Samples at most `max_frames` evenly spaced frames, makes their templates with `options`, and
 // compares every pair (best shift). Similarity = clamp(1 - d / d95, 0, 1), d95 the 95th
 // percentile of all pairwise differences.
-StatusOr<SimilarityMatrix> CameraSimilarityMatrix(const Dataset& dataset, ImageLoader* images,
+StatusOr<SimilarityMatrix> CameraSimilarityMatrix(const dataset::Dataset& dataset,
+                                                  ImageLoader* images,
                                                   const ClassicCameraOptions& options,
                                                   int max_frames);
 
 // Pairwise Wi-Fi similarity between at most `max_scans` evenly spaced scans: the weight of eq. 6
 // (already in [0, 1]; 1 for identical scans).
-StatusOr<SimilarityMatrix> WifiSimilarityMatrix(const Dataset& dataset,
+StatusOr<SimilarityMatrix> WifiSimilarityMatrix(const dataset::Dataset& dataset,
                                                 const WifiMatcherOptions& options, int max_scans);
 
 }  // namespace ratslam::viewer

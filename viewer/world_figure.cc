@@ -9,7 +9,8 @@
 
 namespace ratslam::viewer {
 
-render::Scene WorldMapScene(const sim::World& world, const Dataset& dataset, int panel_px) {
+render::Scene WorldMapScene(const sim::World& world, const dataset::Dataset& dataset,
+                            int panel_px) {
   std::set<int> floor_set;
   for (const sim::Wall& w : world.walls) floor_set.insert(w.floor);
   const std::vector<int> floors(floor_set.begin(), floor_set.end());

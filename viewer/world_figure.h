@@ -9,7 +9,8 @@
 
 namespace ratslam::viewer {
 
-render::Scene WorldMapScene(const sim::World& world, const Dataset& dataset, int panel_px = 700);
+render::Scene WorldMapScene(const sim::World& world, const dataset::Dataset& dataset,
+                            int panel_px = 700);
 
 }  // namespace ratslam::viewer
 

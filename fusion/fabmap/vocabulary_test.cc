@@ -113,7 +113,7 @@ TEST(VocabularyTest, FeaturesFromARealCorridorImage) {
   const std::string path =
       std::string(RATSLAM_SHARED_DATA_DIR) + "/multifloor-corridors/floor1/frame00001.jpg";
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "missing " << path;
-  FileImageLoader loader;
+  dataset::FileImageLoader loader;
   const auto image = loader.Load(path);
   ASSERT_TRUE(image.ok());
   for (DescriptorKind kind : {DescriptorKind::kOrb, DescriptorKind::kSift}) {
