@@ -16,9 +16,9 @@ namespace {
 
 constexpr int kW = 64, kH = 32;
 
-std::vector<PreparedFrame> Route(int n, uint64_t seed, double noise) {
+std::vector<sensors::PreparedFrame> Route(int n, uint64_t seed, double noise) {
   Random random(seed);
-  std::vector<PreparedFrame> frames;
+  std::vector<sensors::PreparedFrame> frames;
   for (int i = 0; i < n; ++i) {
     Random place(1000 + i);
     std::vector<uint8_t> p(kW * kH);
@@ -26,16 +26,16 @@ std::vector<PreparedFrame> Route(int n, uint64_t seed, double noise) {
       v = static_cast<uint8_t>(
           std::clamp(place.Uniform(20, 230) + random.Gaussian(0, noise), 0.0, 255.0));
     }
-    frames.push_back(PrepareFrame(p.data(), kW, kH, 8, 8.0));
+    frames.push_back(sensors::PrepareFrame(p.data(), kW, kH, 8, 8.0));
   }
   return frames;
 }
 
 void BM_MatchRoute(benchmark::State& state) {
   const int n = static_cast<int>(state.range(0));
-  const std::vector<PreparedFrame> references = Route(n, 1, 0), queries = Route(n, 2, 30);
-  SequenceMatcher matcher{SequenceMatcherOptions{}};
-  for (const PreparedFrame& f : references) (void)matcher.AddReference(f);
+  const std::vector<sensors::PreparedFrame> references = Route(n, 1, 0), queries = Route(n, 2, 30);
+  sensors::SequenceMatcher matcher{sensors::SequenceMatcherOptions{}};
+  for (const sensors::PreparedFrame& f : references) (void)matcher.AddReference(f);
   for (auto _ : state) {
     matcher.ResetQueries();
     int right = 0;
@@ -50,7 +50,7 @@ BENCHMARK(BM_MatchRoute)->Arg(500)->Arg(1788)->Unit(benchmark::kMillisecond);
 
 void BM_ScalarDifferenceMatrix(benchmark::State& state) {
   const int n = static_cast<int>(state.range(0));
-  const std::vector<PreparedFrame> references = Route(n, 1, 0), queries = Route(n, 2, 30);
+  const std::vector<sensors::PreparedFrame> references = Route(n, 1, 0), queries = Route(n, 2, 30);
   std::vector<float> matrix(static_cast<size_t>(n) * n);
   for (auto _ : state) {
     for (int q = 0; q < n; ++q) {

@@ -27,11 +27,11 @@ std::vector<uint8_t> RandomImage(Random& rng) {
 }
 
 void BM_ClassicTemplateMatching(benchmark::State& state) {
-  ClassicCameraOptions options;
+  sensors::ClassicCameraOptions options;
   options.template_width_px = kWidth;
   options.template_height_px = kHeight;
   options.shift_px = kShift;
-  ClassicCameraMatcher matcher(options);
+  sensors::ClassicCameraMatcher matcher(options);
   Random rng(1);
   const int templates = static_cast<int>(state.range(0));
   for (int i = 0; i < templates; ++i) {
@@ -88,8 +88,8 @@ BENCHMARK(BM_ClassicTemplateMatchingFloatBaseline)
 void BM_SyntheticRouteViews(benchmark::State& state) {
   constexpr int kLaps = 10;
   static const auto* data = [] {
-    auto* d = new std::pair<std::vector<std::vector<uint8_t>>, ClassicCameraOptions>();
-    ClassicCameraOptions& options = d->second;
+    auto* d = new std::pair<std::vector<std::vector<uint8_t>>, sensors::ClassicCameraOptions>();
+    sensors::ClassicCameraOptions& options = d->second;
     options.crop_top_px = 8;
     options.crop_bottom_px = 32;
     ScratchDir folder("template_benchmark");
@@ -98,7 +98,7 @@ void BM_SyntheticRouteViews(benchmark::State& state) {
     StatusOr<dataset::Dataset> dataset =
         dataset::WriteSyntheticDataset(synthetic, (folder.path() / "d").string());
     if (!dataset.ok()) return d;
-    ClassicCameraMatcher matcher(options);
+    sensors::ClassicCameraMatcher matcher(options);
     dataset::FileImageLoader loader;
     for (const ImageRow& row : dataset->images) {
       StatusOr<GrayImage> image = loader.Load(dataset->ImagePath(row));
@@ -117,7 +117,7 @@ void BM_SyntheticRouteViews(benchmark::State& state) {
   const int scan = static_cast<int>(state.range(0));
   const size_t per_lap = views.size() / kLaps;
   const size_t stored = per_lap * static_cast<size_t>(state.range(1));
-  ClassicCameraMatcher matcher(data->second);
+  sensors::ClassicCameraMatcher matcher(data->second);
   for (size_t i = 0; i < stored; ++i) matcher.Add(views[i]);
   size_t next = stored;
   for (auto _ : state) {

@@ -14,9 +14,9 @@ namespace ratslam {
 namespace {
 
 struct Setup {
-  WifiFingerprintMatcher matcher{WifiMatcherOptions()};
-  std::vector<Fingerprint> stored;
-  Fingerprint query;
+  sensors::WifiFingerprintMatcher matcher{sensors::WifiMatcherOptions()};
+  std::vector<sensors::Fingerprint> stored;
+  sensors::Fingerprint query;
 };
 
 Setup Make(int fingerprints, int universe) {
@@ -54,9 +54,9 @@ BENCHMARK(BM_WifiBestIndexed)
 // that lack the query's strongest APs once it has met a good match: from the block of ids
 // holding k on (these synthetic places have random RSSI, so other places never score well).
 // A revisit of stored fingerprint `id`: its readings with 3 dB noise, one AP missed.
-Fingerprint Revisit(const Setup& s, size_t id) {
+sensors::Fingerprint Revisit(const Setup& s, size_t id) {
   Random rng(11);
-  Fingerprint q = s.stored[id];
+  sensors::Fingerprint q = s.stored[id];
   for (float& rssi : q.rssi_dbm) rssi += static_cast<float>(rng.Gaussian(0, 3));
   q.ap_ids.pop_back();
   q.rssi_dbm.pop_back();
@@ -65,7 +65,7 @@ Fingerprint Revisit(const Setup& s, size_t id) {
 
 void BM_WifiBestRevisit(benchmark::State& state) {
   Setup s = Make(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
-  const Fingerprint q = Revisit(s, static_cast<size_t>(state.range(2)));
+  const sensors::Fingerprint q = Revisit(s, static_cast<size_t>(state.range(2)));
   for (auto _ : state) benchmark::DoNotOptimize(s.matcher.Best(q));
 }
 BENCHMARK(BM_WifiBestRevisit)
@@ -78,7 +78,7 @@ BENCHMARK(BM_WifiBestRevisit)
 // the pruning has its budget from the start. A new place (above) and the revisit of id 7000.
 void BM_WifiBestAtThreshold(benchmark::State& state) {
   Setup s = Make(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
-  const Fingerprint q =
+  const sensors::Fingerprint q =
       state.range(2) >= 0 ? Revisit(s, static_cast<size_t>(state.range(2))) : s.query;
   const double t = s.matcher.options().match_threshold;
   for (auto _ : state) benchmark::DoNotOptimize(s.matcher.Best(q, nullptr, t));
@@ -93,7 +93,8 @@ void BM_WifiBestPairwiseBaseline(benchmark::State& state) {
   Setup s = Make(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
   for (auto _ : state) {
     double best = 0.0;
-    for (const Fingerprint& f : s.stored) best = std::max(best, s.matcher.Weight(s.query, f));
+    for (const sensors::Fingerprint& f : s.stored)
+      best = std::max(best, s.matcher.Weight(s.query, f));
     benchmark::DoNotOptimize(best);
   }
 }

@@ -447,7 +447,7 @@ TEST(OpenRatslamVisualOdometrySource, TurnsAsTheGroundTruthOnTheSyntheticLoop) {
       fs::temp_directory_path() / ("ratslam_vo_loop_" + std::to_string(::getpid()));
   StatusOr<Dataset> d = WriteSyntheticDataset(synthetic, folder.string());
   ASSERT_TRUE(d.ok()) << d.status().message();
-  VisualOdometryOptions vo;
+  sensors::VisualOdometryOptions vo;
   vo.enabled = true;
   vo.model = "openratslam";
   vo.max_shift_px = 39;
@@ -456,7 +456,7 @@ TEST(OpenRatslamVisualOdometrySource, TurnsAsTheGroundTruthOnTheSyntheticLoop) {
   vo.rotation_top_px = 8;
   vo.rotation_bottom_px = 32;
   FileImageLoader images;
-  auto turn = [&](const VisualOdometryOptions& options) {
+  auto turn = [&](const sensors::VisualOdometryOptions& options) {
     Dataset data = d.value();
     EXPECT_TRUE(ReplaceOdometryWithVisual(&data, &images, options).ok());
     EXPECT_EQ(data.odometry.size(), data.images.size());
@@ -470,7 +470,7 @@ TEST(OpenRatslamVisualOdometrySource, TurnsAsTheGroundTruthOnTheSyntheticLoop) {
     return turned;
   };
   const double turned = turn(vo);
-  VisualOdometryOptions constant = vo;
+  sensors::VisualOdometryOptions constant = vo;
   constant.model = "constant_speed";
   constant.crop_top_px = 8;
   constant.crop_bottom_px = 32;

@@ -105,8 +105,8 @@ StatusOr<PhoneLog> ParseIpinLog(const std::string& path, const PhoneLogOptions& 
   r = PhoneLogReport();
 
   PhoneLogStreams streams;
-  std::vector<AccelerometerSample>& accelerometer = streams.accelerometer;
-  std::vector<HeadingSample>& headings = streams.headings;
+  std::vector<sensors::AccelerometerSample>& accelerometer = streams.accelerometer;
+  std::vector<sensors::HeadingSample>& headings = streams.headings;
   std::map<double, std::vector<WifiReading>>& scans = streams.scans;  // by app timestamp
   struct Posi {
     double time_s, latitude, longitude;

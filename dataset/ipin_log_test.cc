@@ -174,7 +174,7 @@ TEST(IpinLogTest, BarometerReadingsAreKeptInTimeOrder) {
 }
 
 TEST(IpinLogTest, StepsBecomeOdometryRows) {
-  const std::vector<Step> steps = {{1.0, 0.7, 0.0}, {1.5, 0.8, 0.5}};
+  const std::vector<sensors::Step> steps = {{1.0, 0.7, 0.0}, {1.5, 0.8, 0.5}};
   const std::vector<OdometryRow> rows = StepsToOdometry(steps, 0.0);
   ASSERT_EQ(rows.size(), 3u);
   EXPECT_DOUBLE_EQ(rows[1].forward_speed_m_per_s * 1.0, 0.7);

@@ -67,8 +67,8 @@ StatusOr<PhoneLog> ParseMicrosoftLog(const std::string& path, const PhoneLogOpti
   r = PhoneLogReport();
 
   PhoneLogStreams streams;
-  std::vector<AccelerometerSample>& accelerometer = streams.accelerometer;
-  std::vector<HeadingSample>& headings = streams.headings;
+  std::vector<sensors::AccelerometerSample>& accelerometer = streams.accelerometer;
+  std::vector<sensors::HeadingSample>& headings = streams.headings;
   std::map<double, std::vector<WifiReading>>& scans = streams.scans;
   std::vector<GroundTruthRow>& waypoints = streams.ground_truth;
   int floor = 0;

@@ -49,9 +49,9 @@ StatusOr<Dataset> PhoneLogToDataset(PhoneLog log, const PhoneLogOptions& options
   std::stable_sort(streams.pressure.begin(), streams.pressure.end(), by_time);
   Dataset d;
   d.name = log.name;
-  PdrReport pdr;
-  const std::vector<Step> steps =
-      PedestrianDeadReckoning(streams.accelerometer, streams.headings, options.pdr, &pdr);
+  sensors::PdrReport pdr;
+  const std::vector<sensors::Step> steps =
+      sensors::PedestrianDeadReckoning(streams.accelerometer, streams.headings, options.pdr, &pdr);
   if (report) {
     report->steps = steps.size();
     report->steps_not_walking = pdr.steps_not_walking;
@@ -59,7 +59,7 @@ StatusOr<Dataset> PhoneLogToDataset(PhoneLog log, const PhoneLogOptions& options
   d.odometry = StepsToOdometry(steps, log.start_time_s);
   for (auto& [time, readings] : streams.scans) d.wifi.push_back({time, std::move(readings)});
   double last_compass = -std::numeric_limits<double>::infinity();
-  for (const HeadingSample& h : streams.headings) {
+  for (const sensors::HeadingSample& h : streams.headings) {
     if (h.time_s - last_compass >= 1.0 / options.compass_rate_hz) {
       d.compass.push_back({h.time_s, h.heading_rad});
       last_compass = h.time_s;
@@ -78,12 +78,13 @@ StatusOr<Dataset> PhoneLogToDataset(PhoneLog log, const PhoneLogOptions& options
   return d;
 }
 
-std::vector<OdometryRow> StepsToOdometry(const std::vector<Step>& steps, double start_time_s) {
+std::vector<OdometryRow> StepsToOdometry(const std::vector<sensors::Step>& steps,
+                                         double start_time_s) {
   std::vector<OdometryRow> rows;
   rows.push_back({start_time_s, 0.0, 0.0});
   double previous_time = start_time_s;
   double previous_heading = steps.empty() ? 0.0 : steps.front().heading_rad;
-  for (const Step& s : steps) {
+  for (const sensors::Step& s : steps) {
     const double dt = s.time_s - previous_time;
     if (dt <= 0.0) continue;  // a step at the start time carries no usable interval
     rows.push_back({s.time_s, s.length_m / dt, WrapAngle(s.heading_rad - previous_heading) / dt});

@@ -26,7 +26,7 @@ struct GeoReference {
 
 struct PhoneLogOptions {
   bool lenient = false;           // parsing: skip (and count) malformed lines instead of failing
-  PdrOptions pdr;                 // dead reckoning: step detection and length
+  sensors::PdrOptions pdr;        // dead reckoning: step detection and length
   double compass_rate_hz = 10.0;  // compass events kept per second (AHRS arrives at ~100 Hz)
   std::optional<GeoReference> reference;  // parsing: default is the log's first POSI point
 };
@@ -42,8 +42,8 @@ struct PhoneLogReport {
 
 // What a phone log reader collects, in file order.
 struct PhoneLogStreams {
-  std::vector<AccelerometerSample> accelerometer;
-  std::vector<HeadingSample> headings;
+  std::vector<sensors::AccelerometerSample> accelerometer;
+  std::vector<sensors::HeadingSample> headings;
   std::map<double, std::vector<WifiReading>> scans;  // readings by scan time
   std::vector<GroundTruthRow> ground_truth;          // headings not yet set
   std::vector<PressureSample> pressure;              // barometer (IPIN's PRES), hPa
@@ -70,7 +70,8 @@ StatusOr<Dataset> PhoneLogToDataset(PhoneLog log, const PhoneLogOptions& options
 
 // Builds odometry rows from pedestrian dead-reckoning steps: a zero row at `start_time_s`, then
 // one row per step carrying its length and heading change over the time since the previous row.
-std::vector<OdometryRow> StepsToOdometry(const std::vector<Step>& steps, double start_time_s);
+std::vector<OdometryRow> StepsToOdometry(const std::vector<sensors::Step>& steps,
+                                         double start_time_s);
 
 }  // namespace ratslam::dataset
 

@@ -3,7 +3,7 @@
 namespace ratslam::dataset {
 
 Status ReplaceOdometryWithVisual(Dataset* dataset, ImageLoader* images,
-                                 const VisualOdometryOptions& options) {
+                                 const sensors::VisualOdometryOptions& options) {
   if (dataset->images.empty()) {
     return Status::Error(dataset->name + ": visual odometry needs images; the data set has none");
   }
@@ -11,11 +11,11 @@ Status ReplaceOdometryWithVisual(Dataset* dataset, ImageLoader* images,
   if (options.model == "openratslam") {
     // OpenRatSLAM publishes velocities per frame, stamped with the frame; they hold from the
     // previous frame, as an odometry row's do.
-    OpenRatslamVisualOdometry vo(options);
+    sensors::OpenRatslamVisualOdometry vo(options);
     for (const ImageRow& row : dataset->images) {
       StatusOr<GrayImage> image = images->Load(dataset->ImagePath(row));
       if (!image.ok()) return image.status().WithContext("image " + std::to_string(row.line));
-      StatusOr<std::optional<VisualVelocities>> v =
+      StatusOr<std::optional<sensors::VisualVelocities>> v =
           vo.Step({image->width, image->height, image->width, image->pixels.data()});
       if (!v.ok()) return v.status().WithContext(dataset->ImagePath(row));
       if (rows.empty()) {
@@ -27,7 +27,7 @@ Status ReplaceOdometryWithVisual(Dataset* dataset, ImageLoader* images,
     dataset->odometry = std::move(rows);
     return Status::Ok();
   }
-  VisualOdometry vo(options);
+  sensors::VisualOdometry vo(options);
   for (const ImageRow& row : dataset->images) {
     StatusOr<GrayImage> image = images->Load(dataset->ImagePath(row));
     if (!image.ok()) return image.status().WithContext("images.csv:" + std::to_string(row.line));

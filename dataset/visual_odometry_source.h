@@ -12,7 +12,7 @@ namespace ratslam::dataset {
 
 // One odometry row per image (the first at rest). Errors name images.csv's line.
 Status ReplaceOdometryWithVisual(Dataset* dataset, ImageLoader* images,
-                                 const VisualOdometryOptions& options);
+                                 const sensors::VisualOdometryOptions& options);
 
 }  // namespace ratslam::dataset
 

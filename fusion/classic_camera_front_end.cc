@@ -13,7 +13,8 @@ namespace {
 
 class ClassicCameraFrontEnd : public FrontEnd {
  public:
-  explicit ClassicCameraFrontEnd(const ClassicCameraOptions& options) : matcher_(options) {}
+  explicit ClassicCameraFrontEnd(const sensors::ClassicCameraOptions& options)
+      : matcher_(options) {}
 
   StatusOr<std::optional<FrameDecision>> OnImage(double time_s, const GrayImage& image) override {
     StatusOr<ViewDecision> view = matcher_.Observe(ViewOf(image), time_s);
@@ -34,7 +35,7 @@ class ClassicCameraFrontEnd : public FrontEnd {
   }
   Status DecodeState(const std::string& bytes) override {
     ByteReader r(bytes, "classic camera state");
-    ClassicCameraMatcher::State state;
+    sensors::ClassicCameraMatcher::State state;
     if (!(r.Pod(&state.template_count) && r.PodVector(&state.templates) && r.AtEnd())) {
       return Status::Error(r.error().empty() ? "classic camera state: trailing bytes" : r.error());
     }
@@ -42,12 +43,12 @@ class ClassicCameraFrontEnd : public FrontEnd {
   }
 
  private:
-  ClassicCameraMatcher matcher_;
+  sensors::ClassicCameraMatcher matcher_;
 };
 
 }  // namespace
 
-std::unique_ptr<FrontEnd> MakeClassicCameraFrontEnd(const ClassicCameraOptions& options) {
+std::unique_ptr<FrontEnd> MakeClassicCameraFrontEnd(const sensors::ClassicCameraOptions& options) {
   return std::make_unique<ClassicCameraFrontEnd>(options);
 }
 

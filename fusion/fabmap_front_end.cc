@@ -48,7 +48,7 @@ class FabmapFrontEnd : public FrontEnd {
     if (!fabmap::UsesWifi(mode())) return std::optional<FrameDecision>();
     newest_scan_ = scan.readings;
     if (settings_.front_end.online_rssi_offset) {
-      Fingerprint f = Intern(newest_scan_);
+      sensors::Fingerprint f = Intern(newest_scan_);
       offset_.Calibrate(reference_, &f);
       const double offset = offset_.CurrentOffset();
       for (WifiReading& r : newest_scan_) r.rssi_dbm -= offset;
@@ -148,7 +148,7 @@ class FabmapFrontEnd : public FrontEnd {
     std::vector<WifiReading> newest;
     uint64_t scans_seen = 0, learned_from = 0, relearnt = 0;
     FloorRule floors = floors_;
-    RssiOffsetTracker offset = offset_;
+    sensors::RssiOffsetTracker offset = offset_;
     ok = ok && r.Optional(&newest_time) && readings(&newest) &&
          (!online() || (r.Pod(&scans_seen) && r.Pod(&learned_from) && r.Pod(&relearnt))) &&
          (!settings_.front_end.online_rssi_offset || offset.Decode(&r, count)) &&
@@ -236,12 +236,12 @@ class FabmapFrontEnd : public FrontEnd {
 
   // A scan as a fingerprint over this front end's own AP ids (for the RSSI offset estimate):
   // sorted by id, a repeated AP's readings averaged.
-  Fingerprint Intern(const std::vector<WifiReading>& readings) {
-    return InternedFingerprint(readings, &ap_ids_);
+  sensors::Fingerprint Intern(const std::vector<WifiReading>& readings) {
+    return sensors::InternedFingerprint(readings, &ap_ids_);
   }
-  Fingerprint Reference(const fabmap::Query& place) {
+  sensors::Fingerprint Reference(const fabmap::Query& place) {
     return settings_.front_end.online_rssi_offset && place.wifi ? Intern(*place.wifi)
-                                                                : Fingerprint();
+                                                                : sensors::Fingerprint();
   }
   void AddPlace(fabmap::Query q, double time_s) {
     floors_.AddTemplate();
@@ -348,8 +348,8 @@ class FabmapFrontEnd : public FrontEnd {
   uint64_t relearnt_ = 0;      // online: models built so far
   // [fabmap_front_end] online_rssi_offset (sensors/rssi_offset.h): the estimator, and per place
   // its scan over ap_ids_ (empty without the option or without Wi-Fi).
-  RssiOffsetTracker offset_;
-  std::vector<Fingerprint> reference_;
+  sensors::RssiOffsetTracker offset_;
+  std::vector<sensors::Fingerprint> reference_;
   std::unordered_map<std::string, uint32_t> ap_ids_;
   FloorRule floors_;  // [barometer] use_barometer: see fusion/floor_rule.h
 };

@@ -14,7 +14,7 @@ FloorRule::FloorRule(const FloorOptions& options) : options_(options), tracker_(
 
 Status FloorRule::OnPressure(double time_s, double pressure_hpa) {
   if (!enabled()) return Status::Ok();
-  StatusOr<FloorEstimate> e = tracker_.Add({time_s, pressure_hpa});
+  StatusOr<sensors::FloorEstimate> e = tracker_.Add({time_s, pressure_hpa});
   if (!e.ok()) return e.status();
   ++pressure_readings_;
   // Before the first dwell a session is on its first level (level 0): walks start standing.
@@ -43,7 +43,7 @@ void FloorRule::SettleForLocalisation() {
 
 void FloorRule::NewSession() {
   floor_changes_before_ += tracker_.floor_changes();
-  tracker_ = BarometricFloorTracker(options_.tracker);
+  tracker_ = sensors::BarometricFloorTracker(options_.tracker);
   ++session_;
   level_floors_.emplace_back();
   offsets_.push_back(0);

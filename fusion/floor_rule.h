@@ -74,7 +74,7 @@ class FloorRule {
   void CountVote(uint32_t template_id);
 
   FloorOptions options_;
-  BarometricFloorTracker tracker_;
+  sensors::BarometricFloorTracker tracker_;
   uint64_t pressure_readings_ = 0;
   uint64_t floor_changes_before_ = 0;  // of the sessions before the current one
   int32_t level_ = kNoBarometer;

@@ -135,16 +135,16 @@ class FrontEnd {
 
 struct FrontEndSettings {
   FrontEndOptions front_end;
-  ClassicCameraOptions classic_camera;
+  sensors::ClassicCameraOptions classic_camera;
   FusedOptions fused;
-  KernelCameraOptions camera_12x9;
-  WifiMatcherOptions wifi;
+  sensors::KernelCameraOptions camera_12x9;
+  sensors::WifiMatcherOptions wifi;
   FloorOptions barometer;
   FabmapSettings fabmap;
   DescriptorOptions descriptors;
   // Image sequences (SeqSLAM): `ratslam evaluate --frame-tolerance`, and with recognise_views a
   // sequence recogniser in front of the classic camera and fused front ends.
-  SequenceMatcherOptions sequence;
+  sensors::SequenceMatcherOptions sequence;
 };
 
 // Makes a fresh front end (for kCustom); called again for every restore.

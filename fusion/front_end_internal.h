@@ -19,7 +19,7 @@ bool AllFinite(const std::vector<T>& values) {
 }
 inline bool FiniteOrAbsent(const std::optional<double>& v) { return !v || std::isfinite(*v); }
 
-inline GrayImageView ViewOf(const GrayImage& image) {
+inline sensors::GrayImageView ViewOf(const GrayImage& image) {
   return {image.width, image.height, image.width, image.pixels.data()};
 }
 
@@ -32,10 +32,10 @@ inline bool OldEnough(int64_t count, int64_t best, double now_s, double created_
   return best < settled || (count - best >= recency_templates && now_s - created_s >= recency_s);
 }
 
-std::unique_ptr<FrontEnd> MakeClassicCameraFrontEnd(const ClassicCameraOptions& options);
+std::unique_ptr<FrontEnd> MakeClassicCameraFrontEnd(const sensors::ClassicCameraOptions& options);
 std::unique_ptr<FrontEnd> MakeFusedFrontEnd(const FusedOptions& options,
-                                            const KernelCameraOptions& camera,
-                                            const WifiMatcherOptions& wifi,
+                                            const sensors::KernelCameraOptions& camera,
+                                            const sensors::WifiMatcherOptions& wifi,
                                             const FloorOptions& floors);
 std::unique_ptr<FrontEnd> MakeNoViewFrontEnd();
 std::unique_ptr<FrontEnd> MakeDescriptorFrontEnd(const DescriptorOptions& options,
@@ -49,7 +49,7 @@ std::unique_ptr<FrontEnd> MakeFabmapFrontEnd(const FabmapSettings& settings,
 // the frame it matched, a blank frame (no contrast) gives no view, and `inner` decides every
 // other frame.
 std::unique_ptr<FrontEnd> MakeSequenceRecognition(std::unique_ptr<FrontEnd> inner,
-                                                  const SequenceMatcherOptions& options);
+                                                  const sensors::SequenceMatcherOptions& options);
 
 }  // namespace ratslam::front_end_internal
 

@@ -16,8 +16,8 @@ namespace {
 
 class FusedFrontEnd : public FrontEnd {
  public:
-  FusedFrontEnd(const FusedOptions& options, const KernelCameraOptions& camera,
-                const WifiMatcherOptions& wifi, const FloorOptions& floors)
+  FusedFrontEnd(const FusedOptions& options, const sensors::KernelCameraOptions& camera,
+                const sensors::WifiMatcherOptions& wifi, const FloorOptions& floors)
       : options_(options),
         camera_(camera),
         wifi_(wifi),
@@ -48,7 +48,7 @@ class FusedFrontEnd : public FrontEnd {
     if (!newest_scan_.empty()) {
       floors_.Vote(
           [&](const std::vector<uint8_t>& mask) {
-            const WifiMatch m = wifi_.Best(newest_scan_, &mask);
+            const sensors::WifiMatch m = wifi_.Best(newest_scan_, &mask);
             return std::pair<int64_t, double>(m.id, m.weight);
           },
           wifi_.options().match_threshold);
@@ -91,11 +91,11 @@ class FusedFrontEnd : public FrontEnd {
     ByteWriter w;
     w.Count(camera_.templates().size());
     for (const auto& t : camera_.templates()) w.PodVector(t);
-    const WifiFingerprintMatcher::State& ws = wifi_.state();
+    const sensors::WifiFingerprintMatcher::State& ws = wifi_.state();
     w.Count(ws.bssids.size());
     for (const std::string& b : ws.bssids) w.String(b);
     w.Count(ws.fingerprints.size());
-    for (const Fingerprint& f : ws.fingerprints) {
+    for (const sensors::Fingerprint& f : ws.fingerprints) {
       w.PodVector(f.ap_ids);
       w.PodVector(f.rssi_dbm);
     }
@@ -126,7 +126,7 @@ class FusedFrontEnd : public FrontEnd {
     for (auto& t : camera) {
       if (!r.PodVector(&t)) return Status::Error(r.error());
     }
-    WifiFingerprintMatcher::State ws;
+    sensors::WifiFingerprintMatcher::State ws;
     if (!r.Count(8, &n)) return Status::Error(r.error());
     ws.bssids.resize(n);
     for (std::string& b : ws.bssids) {
@@ -134,12 +134,12 @@ class FusedFrontEnd : public FrontEnd {
     }
     if (!r.Count(16, &n)) return Status::Error(r.error());
     ws.fingerprints.resize(n);
-    for (Fingerprint& f : ws.fingerprints) {
+    for (sensors::Fingerprint& f : ws.fingerprints) {
       if (!(r.PodVector(&f.ap_ids) && r.PodVector(&f.rssi_dbm))) return Status::Error(r.error());
     }
     std::vector<double> created;
     std::vector<std::optional<double>> headings;
-    Fingerprint newest;
+    sensors::Fingerprint newest;
     std::optional<double> newest_time, heading;
     if (!(r.PodVector(&created) && r.Count(9, &n))) return Status::Error(r.error());
     headings.resize(n);
@@ -150,7 +150,7 @@ class FusedFrontEnd : public FrontEnd {
           r.Optional(&newest_time) && r.Optional(&heading))) {
       return Status::Error(r.error());
     }
-    RssiOffsetTracker offset = offset_;
+    sensors::RssiOffsetTracker offset = offset_;
     if (options_.online_rssi_offset && !offset.Decode(&r, created.size())) {
       return Status::Error(r.error());
     }
@@ -177,7 +177,7 @@ class FusedFrontEnd : public FrontEnd {
           "fused front-end state: a time, heading or RSSI is not finite, or the newest scan "
           "names an unknown access point");
     }
-    for (const Fingerprint& f : ws.fingerprints) {
+    for (const sensors::Fingerprint& f : ws.fingerprints) {
       if (!AllFinite(f.rssi_dbm)) {
         return Status::Error("fused front-end state: a fingerprint RSSI is not finite");
       }
@@ -209,7 +209,8 @@ class FusedFrontEnd : public FrontEnd {
     return old_enough ? Verdict::kMatch : Verdict::kFamiliarRecent;
   }
 
-  FrameDecision Decide(double time_s, const std::vector<float>* view, const Fingerprint* scan) {
+  FrameDecision Decide(double time_s, const std::vector<float>* view,
+                       const sensors::Fingerprint* scan) {
     const uint32_t n = size();
     Verdict camera_verdict = Verdict::kNovel, wifi_verdict = Verdict::kNovel;
     int32_t camera_best = -1, wifi_best = -1;
@@ -230,7 +231,7 @@ class FusedFrontEnd : public FrontEnd {
     }
     if (view) {
       const double threshold = camera_.options().match_threshold;
-      KernelCameraMatch best;
+      sensors::KernelCameraMatch best;
       if (!mapped.empty()) {
         best = camera_.Best(*view, &mapped);
         camera_verdict = Judge(best.id, best.similarity, threshold, time_s);
@@ -244,7 +245,7 @@ class FusedFrontEnd : public FrontEnd {
     if (scan && !scan->empty()) {
       // Eq. 9; a best below t_wifi would be novel anyway, so the matcher may prune by it.
       const double threshold = wifi_.options().match_threshold;
-      WifiMatch best;
+      sensors::WifiMatch best;
       if (!mapped.empty()) {
         best = wifi_.Best(*scan, &mapped, threshold);
         wifi_verdict = Judge(best.id, best.weight, threshold, time_s);
@@ -289,7 +290,7 @@ class FusedFrontEnd : public FrontEnd {
         static_cast<int32_t>(*chosen) == wifi_best &&
         wifi_best_weight >= options_.revisit_update_weight) {
       // A revisit the scan is sure of: the template follows the APs changed since.
-      const WifiFingerprintMatcher::Update u = wifi_.FollowRevisit(*chosen, *scan);
+      const sensors::WifiFingerprintMatcher::Update u = wifi_.FollowRevisit(*chosen, *scan);
       aps_added_ += u.added;
       aps_dropped_ += u.dropped;
       newest_scan_followed_ = true;
@@ -307,7 +308,7 @@ class FusedFrontEnd : public FrontEnd {
     }
     // Both sensors say novel: a new joint template.
     camera_.Add(view ? *view : std::vector<float>());
-    wifi_.Add(scan ? *scan : Fingerprint());
+    wifi_.Add(scan ? *scan : sensors::Fingerprint());
     created_time_s_.push_back(time_s);
     headings_.push_back(options_.use_compass ? heading_rad_ : std::nullopt);
     if (options_.online_rssi_offset) offset_.AddTemplate();
@@ -319,25 +320,25 @@ class FusedFrontEnd : public FrontEnd {
   }
 
   FusedOptions options_;
-  KernelCameraMatcher camera_;
-  WifiFingerprintMatcher wifi_;
+  sensors::KernelCameraMatcher camera_;
+  sensors::WifiFingerprintMatcher wifi_;
   std::vector<double> created_time_s_;  // by template
   int64_t settled_ = 0;                 // templates from a saved map (SettleForLocalisation)
   std::vector<std::optional<double>> headings_;  // by template
-  Fingerprint newest_scan_;
+  sensors::Fingerprint newest_scan_;
   std::optional<double> newest_scan_time_s_;
   bool newest_scan_followed_ = false;  // the newest scan updated a template (revisit_update_weight)
   uint64_t aps_added_ = 0, aps_dropped_ = 0;  // by revisit_update_weight, so far
   std::optional<double> heading_rad_;
-  RssiOffsetTracker offset_;  // [fused] online_rssi_offset: see sensors/rssi_offset.h
-  FloorRule floors_;          // [barometer] use_barometer: see fusion/floor_rule.h
+  sensors::RssiOffsetTracker offset_;  // [fused] online_rssi_offset: see sensors/rssi_offset.h
+  FloorRule floors_;                   // [barometer] use_barometer: see fusion/floor_rule.h
 };
 
 }  // namespace
 
 std::unique_ptr<FrontEnd> MakeFusedFrontEnd(const FusedOptions& options,
-                                            const KernelCameraOptions& camera,
-                                            const WifiMatcherOptions& wifi,
+                                            const sensors::KernelCameraOptions& camera,
+                                            const sensors::WifiMatcherOptions& wifi,
                                             const FloorOptions& floors) {
   return std::make_unique<FusedFrontEnd>(options, camera, wifi, floors);
 }

@@ -105,7 +105,7 @@ struct FusedOptions {
 struct FloorOptions {
   bool use_barometer = false;      // floors from a pressure stream, when there is one
   int floor_offset_min_votes = 3;  // lead of a floor offset over any other value
-  BarometerOptions tracker;
+  sensors::BarometerOptions tracker;
 
   bool IsValid(std::string* error) const;
   template <typename Visitor>

@@ -32,9 +32,9 @@ namespace ratslam {
 
 // Everything a replay or an evaluation is configured by; one TOML section per member.
 struct PipelineOptions {
-  FrontEndSettings sensors;               // front end choice and every sensor's options
-  PdrOptions pdr;                         // odometry from phone logs
-  VisualOdometryOptions visual_odometry;  // odometry from a camera alone
+  FrontEndSettings sensors;                        // front end choice and every sensor's options
+  sensors::PdrOptions pdr;                         // odometry from phone logs
+  sensors::VisualOdometryOptions visual_odometry;  // odometry from a camera alone
   RatslamOptions ratslam;
   WifiSequenceOptions wifi_sequence;     // Wi-Fi sequence loop closure beside the front end
   fabmap::EvaluationOptions evaluation;  // `ratslam evaluate` only: how map and queries split

@@ -26,18 +26,20 @@ constexpr uint32_t kNoTemplate = std::numeric_limits<uint32_t>::max();
 
 class SequenceRecognition : public FrontEnd {
  public:
-  SequenceRecognition(std::unique_ptr<FrontEnd> inner, const SequenceMatcherOptions& options)
+  SequenceRecognition(std::unique_ptr<FrontEnd> inner,
+                      const sensors::SequenceMatcherOptions& options)
       : inner_(std::move(inner)), options_(options), matcher_(options) {}
 
   StatusOr<std::optional<FrameDecision>> OnImage(double time_s, const GrayImage& image) override {
-    PreparedFrame frame = PrepareFrame(image.pixels.data(), image.width, image.height, options_);
+    sensors::PreparedFrame frame =
+        sensors::PrepareFrame(image.pixels.data(), image.width, image.height, options_);
     const int64_t frames = static_cast<int64_t>(matcher_.references());
     const int64_t searchable =
         std::max<int64_t>(settled_, frames - static_cast<int64_t>(options_.recency_frames));
-    StatusOr<SequenceMatcher::Result> r =
+    StatusOr<sensors::SequenceMatcher::Result> r =
         matcher_.AddQuery(frame, 1, static_cast<int>(std::max<int64_t>(searchable, 0)));
     if (!r.ok()) return r.status();
-    const SequenceMatch& m = r->sequence;
+    const sensors::SequenceMatch& m = r->sequence;
     const bool confident =
         !m.declined && searchable >= options_.min_references &&
         matcher_.queries_in_sequence() >= static_cast<size_t>(options_.sequence_length) &&
@@ -98,16 +100,16 @@ class SequenceRecognition : public FrontEnd {
     w.PodVector(template_of_);
     w.Pod<int64_t>(settled_);
     w.Pod<int64_t>(previous_);
-    const SequenceMatcher::State state = matcher_.state();
+    const sensors::SequenceMatcher::State state = matcher_.state();
     w.Count(state.references.size());
-    for (const PreparedFrame& f : state.references) {
+    for (const sensors::PreparedFrame& f : state.references) {
       w.Pod<int32_t>(f.width);
       w.Pod<int32_t>(f.height);
       w.Bool(f.blank);
       w.PodVector(f.bytes);
     }
     w.Count(state.rows.size());
-    for (const SequenceMatcher::Row& row : state.rows) {
+    for (const sensors::SequenceMatcher::Row& row : state.rows) {
       w.PodVector(row.enhanced);
       w.Pod(row.neutral);
       w.Bool(row.blank);
@@ -120,14 +122,14 @@ class SequenceRecognition : public FrontEnd {
     std::string inner;
     std::vector<uint32_t> template_of;
     int64_t settled = 0, previous = -1;
-    SequenceMatcher::State state;
+    sensors::SequenceMatcher::State state;
     size_t references = 0, rows = 0;
     // A frame takes at least its two sizes, a flag and a byte count; a row a count, a float and a
     // flag: the counts cannot claim more than the bytes hold.
     bool ok = r.String(&inner) && r.PodVector(&template_of) && r.Pod(&settled) &&
               r.Pod(&previous) && r.Count(4 + 4 + 1 + 8, &references);
     for (size_t i = 0; ok && i < references; ++i) {
-      PreparedFrame f;
+      sensors::PreparedFrame f;
       int32_t width = 0, height = 0;
       ok = r.Pod(&width) && r.Pod(&height) && r.Bool(&f.blank) && r.PodVector(&f.bytes);
       f.width = width;
@@ -136,7 +138,7 @@ class SequenceRecognition : public FrontEnd {
     }
     ok = ok && r.Count(8 + 4 + 1, &rows);
     for (size_t i = 0; ok && i < rows; ++i) {
-      SequenceMatcher::Row row;
+      sensors::SequenceMatcher::Row row;
       ok = r.PodVector(&row.enhanced) && r.Pod(&row.neutral) && r.Bool(&row.blank);
       state.rows.push_back(std::move(row));
     }
@@ -176,8 +178,8 @@ class SequenceRecognition : public FrontEnd {
 
  private:
   std::unique_ptr<FrontEnd> inner_;
-  SequenceMatcherOptions options_;
-  SequenceMatcher matcher_;
+  sensors::SequenceMatcherOptions options_;
+  sensors::SequenceMatcher matcher_;
   std::vector<uint32_t> template_of_;  // by frame: the template it ended on
   int64_t settled_ = 0;                // frames from a saved map: never too recent
   int64_t previous_ = -1;              // the previous frame's confident match, -1 if none
@@ -186,7 +188,7 @@ class SequenceRecognition : public FrontEnd {
 }  // namespace
 
 std::unique_ptr<FrontEnd> MakeSequenceRecognition(std::unique_ptr<FrontEnd> inner,
-                                                  const SequenceMatcherOptions& options) {
+                                                  const sensors::SequenceMatcherOptions& options) {
   return std::make_unique<SequenceRecognition>(std::move(inner), options);
 }
 

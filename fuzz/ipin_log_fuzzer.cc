@@ -38,7 +38,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         // The barometer's floors from whatever PRES lines were accepted: never a crash.
         ratslam::StatusOr<ratslam::dataset::PhoneLog> log =
             ratslam::dataset::ParseIpinLog(path, options);
-        if (log.ok()) (void)ratslam::EstimateFloors(log->streams.pressure);
+        if (log.ok()) (void)ratslam::sensors::EstimateFloors(log->streams.pressure);
         return ratslam::dataset::ReadIpinLog(path, options);
       });
 }

@@ -351,7 +351,7 @@ TEST(ConfigTest, ShippedOpenRatslamConfigsImportWithOpenRatslamsDefaults) {
                             "vtrans_scaling=1000\nvtrans_max=20\n";
   StatusOr<ImportedConfig> slvo = ImportOpenRatslamIni(stlucia.string());
   ASSERT_TRUE(slvo.ok()) << slvo.status().message();
-  const VisualOdometryOptions& vo = slvo->options.visual_odometry;
+  const sensors::VisualOdometryOptions& vo = slvo->options.visual_odometry;
   EXPECT_TRUE(vo.enabled);
   EXPECT_EQ(vo.model, "openratslam");
   EXPECT_EQ(vo.max_shift_px, 39);

@@ -14,7 +14,7 @@ namespace ratslam::phone {
 struct LocateOptions {
   WifiGpOptions wifi_map;                 // the GP maps (wifi-map)
   ParticleFilterOptions particle_filter;  // the filter (locate)
-  PdrOptions pdr;                         // steps from the phone's IMU (IPIN logs)
+  sensors::PdrOptions pdr;                // steps from the phone's IMU (IPIN logs)
 
   bool IsValid(std::string* error) const {
     std::string inner;

@@ -141,11 +141,11 @@ bool OnSegment(const Point2& p, const Point2& q, const Point2& r) {  // q on p-r
 int Sign(double v) { return (v > 0) - (v < 0); }
 
 // (AP index, RSSI) readings as a Fingerprint.
-Fingerprint ToFingerprint(const std::vector<std::pair<int64_t, double>>& readings) {
+sensors::Fingerprint ToFingerprint(const std::vector<std::pair<int64_t, double>>& readings) {
   std::vector<std::pair<uint32_t, double>> by_id;
   by_id.reserve(readings.size());
   for (const auto& [ap, rssi] : readings) by_id.emplace_back(static_cast<uint32_t>(ap), rssi);
-  return FingerprintOf(std::move(by_id));
+  return sensors::FingerprintOf(std::move(by_id));
 }
 }  // namespace
 
@@ -366,7 +366,7 @@ size_t ParticleFilter::Update(const std::vector<std::pair<std::string, double>>&
   }
   if (known.empty() || particles_.empty()) return known.size();
   if (options_.online_rssi_offset) {
-    Fingerprint scan = ToFingerprint(known);
+    sensors::Fingerprint scan = ToFingerprint(known);
     offset_.Calibrate(offset_references_, &scan);
     const double offset = offset_.CurrentOffset();
     for (auto& reading : known) reading.second -= offset;

@@ -219,8 +219,8 @@ class ParticleFilter {
   std::vector<std::vector<std::pair<int64_t, double>>> fingerprints_;
   // online_rssi_offset: the estimator (the map is its first session, the phone its second) and
   // the training scans in its terms.
-  RssiOffsetTracker offset_;
-  std::vector<Fingerprint> offset_references_;
+  sensors::RssiOffsetTracker offset_;
+  std::vector<sensors::Fingerprint> offset_references_;
 };
 
 // Whether segments p1-p2 and q1-q2 intersect (touching counts).

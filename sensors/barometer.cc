@@ -6,7 +6,7 @@
 
 #include "common/byte_buffer.h"
 
-namespace ratslam {
+namespace ratslam::sensors {
 namespace {
 // R T / (g M) for dry air at 15 C: 287.05 J/(kg K) x 288.15 K / 9.80665 m/s^2 (metres).
 constexpr double kScaleHeightM = 8434.5;
@@ -245,4 +245,4 @@ StatusOr<std::vector<FloorEstimate>> EstimateFloors(const std::vector<PressureSa
   return out;
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::sensors

@@ -26,14 +26,12 @@
 #include <string>
 #include <vector>
 
+#include "common/byte_buffer.h"
 #include "common/schema.h"
 #include "common/sensor_samples.h"
 #include "common/status.h"
 
-namespace ratslam {
-
-class ByteWriter;
-class ByteReader;
+namespace ratslam::sensors {
 
 struct BarometerOptions {
   double smoothing_s = 2.0;         // moving mean of pressure over this window
@@ -117,6 +115,6 @@ class BarometricFloorTracker {
 StatusOr<std::vector<FloorEstimate>> EstimateFloors(const std::vector<PressureSample>& samples,
                                                     const BarometerOptions& options = {});
 
-}  // namespace ratslam
+}  // namespace ratslam::sensors
 
 #endif  // RATSLAM_SENSORS_BAROMETER_H_

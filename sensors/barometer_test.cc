@@ -10,7 +10,7 @@
 
 #include "common/byte_buffer.h"
 
-namespace ratslam {
+namespace ratslam::sensors {
 namespace {
 
 // A 10 Hz pressure trace through heights given as (duration s, height m at its end) legs,
@@ -183,4 +183,4 @@ TEST(BarometerTest, StateRoundTripsAndCorruptStatesAreRefused) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::sensors

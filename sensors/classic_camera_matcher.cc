@@ -15,7 +15,7 @@
 
 #include "common/circular.h"
 
-namespace ratslam {
+namespace ratslam::sensors {
 
 // Shifted, masked copies of the query, one per compared offset, in the stored-template layout.
 struct ClassicCameraMatcher::PreparedQuery {
@@ -760,4 +760,4 @@ Status ClassicCameraMatcher::SetState(State state) {
   return Status::Ok();
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::sensors

@@ -20,7 +20,7 @@
 #include "common/status.h"
 #include "ratslam/local_view_cells.h"
 
-namespace ratslam {
+namespace ratslam::sensors {
 
 // A borrowed 8-bit grey image, rows top to bottom.
 struct GrayImageView {
@@ -169,6 +169,6 @@ class ClassicCameraMatcher {
   bool force_portable_ = false;
 };
 
-}  // namespace ratslam
+}  // namespace ratslam::sensors
 
 #endif  // RATSLAM_SENSORS_CLASSIC_CAMERA_MATCHER_H_

@@ -7,7 +7,7 @@
 #include <numbers>
 #include <random>
 
-namespace ratslam {
+namespace ratslam::sensors {
 namespace {
 
 struct Image {
@@ -194,9 +194,9 @@ TEST(ClassicCameraMatcherTest, PatchNormalisationRemovesBrightnessChange) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::sensors
 
-namespace ratslam {
+namespace ratslam::sensors {
 namespace {
 
 // Views along a route: a smooth panorama seen from nearby positions (shifted, brightened,
@@ -388,4 +388,4 @@ TEST(ClassicCameraBoundTest, BoundSkipsMostTemplatesOnRouteViews) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::sensors

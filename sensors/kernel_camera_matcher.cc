@@ -3,7 +3,7 @@
 #include <cmath>
 #include <stdexcept>
 
-namespace ratslam {
+namespace ratslam::sensors {
 
 bool KernelCameraOptions::IsValid(std::string* error) const {
   return schema::CheckFields(*this, error);
@@ -85,4 +85,4 @@ Status KernelCameraMatcher::SetTemplates(std::vector<std::vector<float>> templat
   return Status::Ok();
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::sensors

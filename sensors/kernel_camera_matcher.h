@@ -16,7 +16,7 @@
 #include "common/status.h"
 #include "sensors/classic_camera_matcher.h"
 
-namespace ratslam {
+namespace ratslam::sensors {
 
 struct KernelCameraOptions {
   int template_width_px = 12;     // template columns
@@ -72,6 +72,6 @@ class KernelCameraMatcher {
   std::vector<std::vector<float>> templates_;
 };
 
-}  // namespace ratslam
+}  // namespace ratslam::sensors
 
 #endif  // RATSLAM_SENSORS_KERNEL_CAMERA_MATCHER_H_

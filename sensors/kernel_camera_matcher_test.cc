@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-namespace ratslam {
+namespace ratslam::sensors {
 namespace {
 
 TEST(KernelCameraOptionsTest, DefaultsAreValid) {
@@ -61,4 +61,4 @@ TEST(KernelCameraMatcherTest, BestPicksTheNearestTemplate) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::sensors

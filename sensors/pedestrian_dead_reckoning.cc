@@ -5,7 +5,7 @@
 
 #include "common/circular.h"
 
-namespace ratslam {
+namespace ratslam::sensors {
 bool PdrOptions::IsValid(std::string* error) const {
   auto fail = [error](const std::string& message) {
     if (error) *error = message;
@@ -122,4 +122,4 @@ std::vector<Step> PedestrianDeadReckoning(const std::vector<AccelerometerSample>
   return steps;
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::sensors

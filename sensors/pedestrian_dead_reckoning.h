@@ -25,7 +25,7 @@
 
 #include "common/schema.h"
 
-namespace ratslam {
+namespace ratslam::sensors {
 
 struct PdrOptions {
   double smoothing_s = 0.1;           // time constant of the magnitude low-pass filter
@@ -106,6 +106,6 @@ std::vector<Step> PedestrianDeadReckoning(const std::vector<AccelerometerSample>
                                           const std::vector<HeadingSample>& headings,
                                           const PdrOptions& options, PdrReport* report = nullptr);
 
-}  // namespace ratslam
+}  // namespace ratslam::sensors
 
 #endif  // RATSLAM_SENSORS_PEDESTRIAN_DEAD_RECKONING_H_

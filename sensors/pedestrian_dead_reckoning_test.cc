@@ -7,7 +7,7 @@
 
 #include "common/random.h"
 
-namespace ratslam {
+namespace ratslam::sensors {
 namespace {
 
 // A walk: vertical acceleration g + 2.5 sin(2 pi f t) at f = 1.8 steps/s, sampled at 50 Hz, with
@@ -109,4 +109,4 @@ TEST(PedestrianDeadReckoningTest, CalibrationGestureIsNotCountedAsSteps) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::sensors

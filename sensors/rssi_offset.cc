@@ -7,7 +7,7 @@
 
 #include "common/median.h"
 
-namespace ratslam {
+namespace ratslam::sensors {
 
 Fingerprint FingerprintOf(std::vector<std::pair<uint32_t, double>> readings) {
   std::sort(readings.begin(), readings.end());
@@ -122,4 +122,4 @@ bool RssiOffsetTracker::Decode(ByteReader* r, size_t templates) {
   return true;
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::sensors

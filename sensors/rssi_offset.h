@@ -23,7 +23,7 @@
 #include "common/byte_buffer.h"
 #include "sensors/wifi_fingerprint_matcher.h"
 
-namespace ratslam {
+namespace ratslam::sensors {
 
 // Readings (AP id, RSSI) as a Fingerprint: sorted by AP, a repeated AP's readings averaged.
 Fingerprint FingerprintOf(std::vector<std::pair<uint32_t, double>> readings);
@@ -78,6 +78,6 @@ class RssiOffsetTracker {
   std::vector<uint8_t> calibrated_;   // by template: stored in the reference units
 };
 
-}  // namespace ratslam
+}  // namespace ratslam::sensors
 
 #endif  // RATSLAM_SENSORS_RSSI_OFFSET_H_

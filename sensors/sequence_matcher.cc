@@ -10,7 +10,7 @@
 #define RATSLAM_HAVE_X86_SIMD 1
 #endif
 
-namespace ratslam {
+namespace ratslam::sensors {
 namespace {
 
 constexpr int kRowAlignment = 32;  // bytes: one AVX2 register
@@ -432,4 +432,4 @@ SequenceMatch SequenceMatcher::Search(int back, int answers, int candidates) con
   return MatchOf(score, candidates, options_.exclusion_window);
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::sensors

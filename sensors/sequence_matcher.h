@@ -22,7 +22,7 @@
 #include "common/schema.h"
 #include "common/status.h"
 
-namespace ratslam {
+namespace ratslam::sensors {
 
 struct SequenceMatcherOptions {
   int patch_px = 8;             // side of the patches normalised to zero mean, unit spread
@@ -217,6 +217,6 @@ class SequenceMatcher {
   std::deque<Row> rows_;                   // the newest sequence_length query rows, newest last
 };
 
-}  // namespace ratslam
+}  // namespace ratslam::sensors
 
 #endif  // RATSLAM_SENSORS_SEQUENCE_MATCHER_H_

@@ -9,7 +9,7 @@
 
 #include "common/random.h"
 
-namespace ratslam {
+namespace ratslam::sensors {
 namespace {
 
 constexpr int kW = 64, kH = 32;
@@ -303,4 +303,4 @@ TEST(SequenceMatcherTest, RowsOfDifferencesFromElsewhere) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::sensors

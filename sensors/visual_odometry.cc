@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <utility>
 
-namespace ratslam {
+namespace ratslam::sensors {
 
 bool VisualOdometryOptions::IsValid(std::string* error) const {
   if (!schema::CheckFields(*this, error)) return false;
@@ -180,4 +180,4 @@ StatusOr<std::optional<double>> VisualOdometry::Rotation(const GrayImageView& im
   return rotation;
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::sensors

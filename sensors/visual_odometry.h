@@ -18,7 +18,7 @@
 #include "common/status.h"
 #include "sensors/classic_camera_matcher.h"
 
-namespace ratslam {
+namespace ratslam::sensors {
 
 struct VisualOdometryOptions {
   bool enabled = false;                  // replace the data set's odometry with visual odometry
@@ -127,6 +127,6 @@ class VisualOdometry {
   std::vector<double> previous_;
 };
 
-}  // namespace ratslam
+}  // namespace ratslam::sensors
 
 #endif  // RATSLAM_SENSORS_VISUAL_ODOMETRY_H_

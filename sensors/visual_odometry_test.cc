@@ -6,7 +6,7 @@
 
 #include "common/random.h"
 
-namespace ratslam {
+namespace ratslam::sensors {
 namespace {
 
 // A panorama strip; the camera sees `width` columns starting at `offset` (larger offset: the
@@ -134,4 +134,4 @@ TEST_F(OpenRatslamVisualOdometryTest, RegionsThatDoNotFitAreErrors) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::sensors

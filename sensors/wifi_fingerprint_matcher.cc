@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <utility>
 
-namespace ratslam {
+namespace ratslam::sensors {
 
 bool WifiMatcherOptions::IsValid(std::string* error) const {
   return schema::CheckFields(*this, error);
@@ -374,4 +374,4 @@ Status WifiFingerprintMatcher::SetState(State state) {
   return Status::Ok();
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::sensors

@@ -38,7 +38,7 @@
 #include "common/schema.h"
 #include "common/status.h"
 
-namespace ratslam {
+namespace ratslam::sensors {
 
 struct WifiMatcherOptions {
   double kernel_variance_dbm2 = 20.0;  // sigma^2 of eqs. 3-5 (Chiou et al., the paper's value)
@@ -194,6 +194,6 @@ class WifiFingerprintMatcher {
   mutable std::vector<ListCursor> lists_;
 };
 
-}  // namespace ratslam
+}  // namespace ratslam::sensors
 
 #endif  // RATSLAM_SENSORS_WIFI_FINGERPRINT_MATCHER_H_

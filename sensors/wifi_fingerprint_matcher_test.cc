@@ -6,7 +6,7 @@
 
 #include "common/random.h"
 
-namespace ratslam {
+namespace ratslam::sensors {
 namespace {
 
 using Readings = std::vector<std::pair<std::string, double>>;
@@ -305,4 +305,4 @@ TEST(WifiFingerprintMatcherTest, PruningKeepsAWinnerThatLacksTheStrongestAp) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::sensors

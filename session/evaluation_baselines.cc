@@ -145,9 +145,9 @@ std::vector<Estimate> KnnEstimates(const std::vector<EvaluationNode>& map,
 
 std::vector<Estimate> FingerprintEstimates(const std::vector<EvaluationNode>& map,
                                            const std::vector<EvaluationNode>& queries,
-                                           const WifiMatcherOptions& options) {
+                                           const sensors::WifiMatcherOptions& options) {
   std::vector<Estimate> out(queries.size());
-  WifiFingerprintMatcher matcher(options);
+  sensors::WifiFingerprintMatcher matcher(options);
   std::vector<uint32_t> nodes;
   const auto pairs = [](const std::vector<WifiReading>& scan) {
     std::vector<std::pair<std::string, double>> readings;
@@ -161,8 +161,8 @@ std::vector<Estimate> FingerprintEstimates(const std::vector<EvaluationNode>& ma
   }
   for (size_t q = 0; q < queries.size(); ++q) {
     if (!queries[q].wifi || nodes.empty()) continue;
-    const WifiMatch best = matcher.Best(matcher.MakeFingerprint(pairs(*queries[q].wifi)), nullptr,
-                                        options.match_threshold);
+    const sensors::WifiMatch best = matcher.Best(matcher.MakeFingerprint(pairs(*queries[q].wifi)),
+                                                 nullptr, options.match_threshold);
     if (best.id < 0) continue;
     const EvaluationNode& n = map[nodes[best.id]];
     out[q] = {true, n.x_m, n.y_m, n.floor};

@@ -33,7 +33,7 @@ std::vector<fabmap::Estimate> KnnEstimates(const std::vector<fabmap::EvaluationN
 // `options` must be valid (throws std::invalid_argument otherwise, as the matcher does).
 std::vector<fabmap::Estimate> FingerprintEstimates(
     const std::vector<fabmap::EvaluationNode>& map,
-    const std::vector<fabmap::EvaluationNode>& queries, const WifiMatcherOptions& options);
+    const std::vector<fabmap::EvaluationNode>& queries, const sensors::WifiMatcherOptions& options);
 
 }  // namespace ratslam::session
 

@@ -128,12 +128,13 @@ TEST(EvaluationBaselinesTest, QueriesWithoutScansAreRejectedAndFingerprintHonour
   EXPECT_LT(knn[0].x_m, 1.0);    // weights ~1/1.4 against ~1/135 for the scan at 30 m
   EXPECT_TRUE(knn[1].located);   // k-NN never rejects a query that has a scan
   EXPECT_FALSE(knn[2].located);  // no scan: rejected
-  const std::vector<Estimate> fp = FingerprintEstimates(map, queries, WifiMatcherOptions{});
+  const std::vector<Estimate> fp =
+      FingerprintEstimates(map, queries, sensors::WifiMatcherOptions{});
   ASSERT_TRUE(fp[0].located);
   EXPECT_EQ(fp[0].x_m, 0.0);
   EXPECT_FALSE(fp[1].located);
   EXPECT_FALSE(fp[2].located);
-  WifiMatcherOptions strict;
+  sensors::WifiMatcherOptions strict;
   strict.match_threshold = 1.0;  // only an identical scan could reach it
   EXPECT_FALSE(FingerprintEstimates(map, queries, strict)[0].located);
 }

@@ -219,12 +219,12 @@ std::vector<SessionRssiOffset> RemoveQueryRssiOffsets(
     int min_common_aps, int min_estimates) {
   std::unordered_map<std::string, uint32_t> ap_ids;
   auto fingerprint = [&](const std::vector<WifiReading>& readings) {
-    return InternedFingerprint(readings, &ap_ids);
+    return sensors::InternedFingerprint(readings, &ap_ids);
   };
-  std::vector<Fingerprint> references;
+  std::vector<sensors::Fingerprint> references;
   references.reserve(map.size());
   for (const fabmap::EvaluationNode& n : map) {
-    references.push_back(n.wifi ? fingerprint(*n.wifi) : Fingerprint());
+    references.push_back(n.wifi ? fingerprint(*n.wifi) : sensors::Fingerprint());
   }
   std::vector<int> order;  // sessions by first appearance
   std::unordered_map<int, std::vector<size_t>> members;
@@ -239,14 +239,14 @@ std::vector<SessionRssiOffset> RemoveQueryRssiOffsets(
     std::stable_sort(nodes.begin(), nodes.end(), [&](size_t a, size_t b) {
       return (*queries)[a].time_s < (*queries)[b].time_s;
     });
-    RssiOffsetTracker tracker(min_common_aps, min_estimates);
+    sensors::RssiOffsetTracker tracker(min_common_aps, min_estimates);
     tracker.OnSessionStart(0.0, 0);  // the map: the reference units
     for (size_t k = 0; k < references.size(); ++k) tracker.AddTemplate();
     tracker.OnSessionStart(1.0, static_cast<uint32_t>(references.size()));
     for (size_t i : nodes) {
       std::optional<std::vector<WifiReading>>& wifi = (*queries)[i].wifi;
       if (!wifi || wifi->empty()) continue;
-      Fingerprint scan = fingerprint(*wifi);
+      sensors::Fingerprint scan = fingerprint(*wifi);
       tracker.Calibrate(references, &scan);
       const double offset = tracker.CurrentOffset();
       for (WifiReading& r : *wifi) r.rssi_dbm -= offset;

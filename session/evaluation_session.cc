@@ -357,7 +357,7 @@ Status EvaluationSession::Localise() {
     result_.floor_accuracy.emplace_back("knn", fabmap::FloorAccuracy(result_.queries, floors));
     result_.baselines.emplace_back("knn",
                                    fabmap::ComputeMetrics(result_.queries, knn, kDistancesM));
-    const WifiMatcherOptions& wifi = options_.pipeline.sensors.wifi;
+    const sensors::WifiMatcherOptions& wifi = options_.pipeline.sensors.wifi;
     result_.baselines.emplace_back(
         "fingerprint", fabmap::ComputeMetrics(
                            result_.queries,

@@ -57,18 +57,18 @@ nlohmann::ordered_json MetricsJson(const PlaceRecognitionMetrics& m) {
 // Places every query in turn (`add(q)` adds query q to the matcher and returns its result):
 // sequence answers (centred when the options say so) and single-frame answers, and each
 // query's raw differences when `differences` is not null.
-Status MatchQueries(const SequenceMatcherOptions& o, size_t queries,
-                    const std::function<StatusOr<SequenceMatcher::Result>(size_t)>& add,
+Status MatchQueries(const sensors::SequenceMatcherOptions& o, size_t queries,
+                    const std::function<StatusOr<sensors::SequenceMatcher::Result>(size_t)>& add,
                     const std::vector<int>& truth, std::vector<QueryAnswer>* sequence,
                     std::vector<QueryAnswer>* single, std::vector<std::vector<float>>* differences,
                     const std::function<void(size_t, size_t)>& progress,
-                    const std::atomic<bool>* stop, SequenceMatcher* matcher) {
+                    const std::atomic<bool>* stop, sensors::SequenceMatcher* matcher) {
   // Centred: query q is placed once the (sequence_length - 1) / 2 frames after it are in, the
   // route's last ones by its last sequence.
   const size_t lag = o.centred ? static_cast<size_t>(o.sequence_length - 1) / 2 : 0;
   for (size_t q = 0; q < queries; ++q) {
     if (stop && stop->load()) return Status::Error("stopped");
-    StatusOr<SequenceMatcher::Result> r = add(q);
+    StatusOr<sensors::SequenceMatcher::Result> r = add(q);
     if (!r.ok()) return r.status();
     sequence->push_back({truth[q], std::move(r->sequence)});
     if (lag > 0 && q >= lag) (*sequence)[q - lag].match = matcher->MatchAt(static_cast<int>(lag));
@@ -143,11 +143,11 @@ StatusOr<std::optional<DescriptorPair>> LoadDescriptorPair(
 StatusOr<MatcherAnswers> MatchByDescriptors(const ImageSequenceEvaluationOptions& options,
                                             const DescriptorPair& d,
                                             const ImageSequenceEvaluation& e,
-                                            const std::vector<PreparedFrame>& query_frames,
+                                            const std::vector<sensors::PreparedFrame>& query_frames,
                                             const std::atomic<bool>* stop) {
-  SequenceMatcher matcher(options.matcher);
+  sensors::SequenceMatcher matcher(options.matcher);
   for (bool blank : e.reference_blank) {
-    PreparedFrame place;
+    sensors::PreparedFrame place;
     place.blank = blank;
     RATSLAM_RETURN_IF_ERROR(matcher.AddReference(std::move(place)));
   }
@@ -198,7 +198,7 @@ Status WordsOf(const fabmap::TrainedVisualModel& model, const std::string& folde
 // up to five candidates, best first, each outside the others' `exclusion` windows.
 StatusOr<ImageSequenceEvaluation::Fabmap> MatchByFabmap(
     const ImageSequenceEvaluationOptions& options, const ImageSequenceEvaluation& e,
-    const std::vector<PreparedFrame>& query_frames, ImageLoader* loader,
+    const std::vector<sensors::PreparedFrame>& query_frames, ImageLoader* loader,
     const std::atomic<bool>* stop) {
   const auto start = std::chrono::steady_clock::now();
   ImageSequenceEvaluation::Fabmap f;
@@ -242,7 +242,7 @@ StatusOr<ImageSequenceEvaluation::Fabmap> MatchByFabmap(
         score[i] = e.reference_blank[i] ? std::numeric_limits<double>::infinity()
                                         : -r.place_probability[i];
       }
-      a.match.candidates = PlaceCandidates(score, 5, exclusion);
+      a.match.candidates = sensors::PlaceCandidates(score, 5, exclusion);
       if (!a.match.candidates.empty()) {
         a.match.declined = false;
         a.match.reference = a.match.candidates.front().reference;
@@ -352,7 +352,7 @@ PlaceRecognitionMetrics MetricsOf(const std::vector<QueryAnswer>& answers, int f
     const size_t top = std::min<size_t>(5, a.match.candidates.size());
     right_at_5 += std::any_of(
         a.match.candidates.begin(), a.match.candidates.begin() + top,
-        [&](const PlaceCandidate& c) { return Within(a, c.reference, frame_tolerance); });
+        [&](const sensors::PlaceCandidate& c) { return Within(a, c.reference, frame_tolerance); });
     accepted.push_back(&a);
   }
   if (m.queries == 0) return m;
@@ -408,18 +408,18 @@ StatusOr<ImageSequenceEvaluation> EvaluateImageSequences(
   StatusOr<std::optional<DescriptorPair>> descriptors = LoadDescriptorPair(options, e);
   if (!descriptors.ok()) return descriptors.status();
 
-  const SequenceMatcherOptions& o = options.matcher;
+  const sensors::SequenceMatcherOptions& o = options.matcher;
   auto prepare = [&](const std::string& folder,
-                     const std::string& name) -> StatusOr<PreparedFrame> {
+                     const std::string& name) -> StatusOr<sensors::PreparedFrame> {
     const std::string path = (fs::path(folder) / name).string();
     StatusOr<GrayImage> image = loader->Load(path);
     if (!image.ok()) return image.status();
-    return PrepareFrame(image->pixels.data(), image->width, image->height, o);
+    return sensors::PrepareFrame(image->pixels.data(), image->width, image->height, o);
   };
-  SequenceMatcher matcher(o);
+  sensors::SequenceMatcher matcher(o);
   for (const std::string& name : e.reference_files) {
     if (stop && stop->load()) return Status::Error("stopped");
-    StatusOr<PreparedFrame> f = prepare(options.reference_folder, name);
+    StatusOr<sensors::PreparedFrame> f = prepare(options.reference_folder, name);
     if (!f.ok()) return f.status();
     e.blank_references += f->blank;
     e.reference_blank.push_back(f->blank);
@@ -428,11 +428,11 @@ StatusOr<ImageSequenceEvaluation> EvaluateImageSequences(
                            s.message());
     }
   }
-  std::vector<PreparedFrame> query_frames;
+  std::vector<sensors::PreparedFrame> query_frames;
   query_frames.reserve(e.query_files.size());
   for (const std::string& name : e.query_files) {
     if (stop && stop->load()) return Status::Error("stopped");
-    StatusOr<PreparedFrame> f = prepare(options.query_folder, name);
+    StatusOr<sensors::PreparedFrame> f = prepare(options.query_folder, name);
     if (!f.ok()) return f.status();
     e.blank_queries += f->blank;
     query_frames.push_back(std::move(*f));
@@ -442,8 +442,8 @@ StatusOr<ImageSequenceEvaluation> EvaluateImageSequences(
   const auto matching = std::chrono::steady_clock::now();
   RATSLAM_RETURN_IF_ERROR(MatchQueries(
       o, query_frames.size(),
-      [&](size_t q) -> StatusOr<SequenceMatcher::Result> {
-        StatusOr<SequenceMatcher::Result> r = matcher.AddQuery(query_frames[q]);
+      [&](size_t q) -> StatusOr<sensors::SequenceMatcher::Result> {
+        StatusOr<sensors::SequenceMatcher::Result> r = matcher.AddQuery(query_frames[q]);
         if (!r.ok()) {
           return Status::Error((fs::path(options.query_folder) / e.query_files[q]).string() + ": " +
                                r.status().message());

@@ -38,7 +38,7 @@ StatusOr<std::vector<int>> PairQueriesWithReferences(const std::vector<std::stri
 
 struct QueryAnswer {
   int truth = -1;  // true reference, -1 when not known
-  SequenceMatch match;
+  sensors::SequenceMatch match;
 };
 
 struct PrecisionRecall {
@@ -64,7 +64,7 @@ struct ImageSequenceEvaluationOptions {
   std::string query_folder;
   std::string ground_truth_csv;  // optional
   int frame_tolerance = 1;
-  SequenceMatcherOptions matcher;
+  sensors::SequenceMatcherOptions matcher;
   // Place descriptors computed elsewhere (NetVLAD, a ViT, ...; formats in
   // dataset/descriptor_file.h), one row per image of its folder in file-name order. Both or
   // neither: given, they are matched too, by single frames and by sequences over 1 - cosine

@@ -31,12 +31,12 @@ FloorScore ScoreLog(const fs::path& path) {
       dataset::ParseIpinLog(path.string(), dataset::PhoneLogOptions());
   EXPECT_TRUE(log.ok()) << log.status().message();
   if (!log.ok() || log->streams.ground_truth.empty()) return score;
-  BarometricFloorTracker tracker;
+  sensors::BarometricFloorTracker tracker;
   const auto& truth = log->streams.ground_truth;
   const int start = truth.front().floor;
   size_t next = 0;
   for (const PressureSample& p : log->streams.pressure) {
-    StatusOr<FloorEstimate> e = tracker.Add(p);
+    StatusOr<sensors::FloorEstimate> e = tracker.Add(p);
     EXPECT_TRUE(e.ok()) << e.status().message();
     if (!e.ok()) return score;
     ++score.readings;

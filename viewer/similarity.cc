@@ -6,13 +6,13 @@ namespace ratslam::viewer {
 
 StatusOr<SimilarityMatrix> CameraSimilarityMatrix(const dataset::Dataset& dataset,
                                                   ImageLoader* images,
-                                                  const ClassicCameraOptions& options,
+                                                  const sensors::ClassicCameraOptions& options,
                                                   int max_frames) {
   if (dataset.images.empty()) return Status::Error(dataset.name + ": the data set has no images");
   if (max_frames < 2) return Status::Error("max_frames must be at least 2");
   const size_t total = dataset.images.size();
   const size_t n = std::min(total, static_cast<size_t>(max_frames));
-  ClassicCameraMatcher matcher(options);
+  sensors::ClassicCameraMatcher matcher(options);
   std::vector<std::vector<uint8_t>> templates;
   SimilarityMatrix m;
   for (size_t i = 0; i < n; ++i) {
@@ -44,14 +44,15 @@ StatusOr<SimilarityMatrix> CameraSimilarityMatrix(const dataset::Dataset& datase
 }
 
 StatusOr<SimilarityMatrix> WifiSimilarityMatrix(const dataset::Dataset& dataset,
-                                                const WifiMatcherOptions& options, int max_scans) {
+                                                const sensors::WifiMatcherOptions& options,
+                                                int max_scans) {
   if (dataset.wifi.empty())
     return Status::Error(dataset.name + ": the data set has no Wi-Fi scans");
   if (max_scans < 2) return Status::Error("max_scans must be at least 2");
   const size_t total = dataset.wifi.size();
   const size_t n = std::min(total, static_cast<size_t>(max_scans));
-  WifiFingerprintMatcher matcher(options);
-  std::vector<Fingerprint> fingerprints;
+  sensors::WifiFingerprintMatcher matcher(options);
+  std::vector<sensors::Fingerprint> fingerprints;
   SimilarityMatrix m;
   for (size_t i = 0; i < n; ++i) {
     const WifiScan& scan = dataset.wifi[i * (total - 1) / std::max<size_t>(n - 1, 1)];
@@ -61,7 +62,7 @@ StatusOr<SimilarityMatrix> WifiSimilarityMatrix(const dataset::Dataset& dataset,
     matcher.Add(fingerprints.back());
     m.times_s.push_back(scan.time_s);
   }
-  for (const Fingerprint& f : fingerprints) {
+  for (const sensors::Fingerprint& f : fingerprints) {
     for (double w : matcher.Weights(f)) m.values.push_back(static_cast<float>(w));
   }
   m.reference_difference = 0.0;

@@ -23,13 +23,14 @@ struct SimilarityMatrix {
 // percentile of all pairwise differences.
 StatusOr<SimilarityMatrix> CameraSimilarityMatrix(const dataset::Dataset& dataset,
                                                   ImageLoader* images,
-                                                  const ClassicCameraOptions& options,
+                                                  const sensors::ClassicCameraOptions& options,
                                                   int max_frames);
 
 // Pairwise Wi-Fi similarity between at most `max_scans` evenly spaced scans: the weight of eq. 6
 // (already in [0, 1]; 1 for identical scans).
 StatusOr<SimilarityMatrix> WifiSimilarityMatrix(const dataset::Dataset& dataset,
-                                                const WifiMatcherOptions& options, int max_scans);
+                                                const sensors::WifiMatcherOptions& options,
+                                                int max_scans);
 
 }  // namespace ratslam::viewer
 
