@@ -117,12 +117,12 @@ inline std::optional<int64_t> ParseInteger(const std::string& flag, const std::s
 
 // The options of --config, or the defaults; prints the error and returns nullopt on a bad file.
 // `path` (optional) receives the file name.
-inline std::optional<PipelineOptions> LoadOptions(const Arguments& args,
-                                                  std::string* path = nullptr) {
+inline std::optional<fusion::PipelineOptions> LoadOptions(const Arguments& args,
+                                                          std::string* path = nullptr) {
   auto it = args.values.find("--config");
-  if (it == args.values.end()) return PipelineOptions();
+  if (it == args.values.end()) return fusion::PipelineOptions();
   if (path) *path = it->second;
-  StatusOr<PipelineOptions> options = LoadConfigFile(it->second);
+  StatusOr<fusion::PipelineOptions> options = LoadConfigFile(it->second);
   if (!options.ok()) {
     std::cerr << MessagePrefix() << options.status().message() << "\n";
     return std::nullopt;

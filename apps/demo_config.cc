@@ -2,10 +2,10 @@
 
 namespace ratslam {
 
-PipelineOptions DemoPipelineOptions() {
+fusion::PipelineOptions DemoPipelineOptions() {
   // As configs/sim-fused.toml (see the comments there).
-  PipelineOptions o;
-  o.sensors.front_end.kind = FrontEndKind::kFused;
+  fusion::PipelineOptions o;
+  o.sensors.front_end.kind = fusion::FrontEndKind::kFused;
   o.sensors.fused.use_camera = true;
   o.sensors.fused.use_wifi = true;
   o.sensors.fused.use_compass = true;
@@ -20,8 +20,8 @@ PipelineOptions DemoPipelineOptions() {
 
 std::string DemoWorldName() { return "day_night"; }
 
-PipelineOptions SyntheticPipelineOptions() {
-  PipelineOptions o;
+fusion::PipelineOptions SyntheticPipelineOptions() {
+  fusion::PipelineOptions o;
   // The synthetic camera is 120x40 px with the horizon at row 20: keep the band where the
   // pillars are, drop most of the featureless sky and ground.
   o.sensors.classic_camera.crop_top_px = 8;

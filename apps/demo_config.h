@@ -12,11 +12,11 @@
 namespace ratslam {
 
 // Camera (12x9) + Wi-Fi + compass with the b_out rule, for the simulated worlds.
-PipelineOptions DemoPipelineOptions();
+fusion::PipelineOptions DemoPipelineOptions();
 // The built-in world the demo simulates.
 std::string DemoWorldName();
 // The classic camera matcher on the synthetic pillar loop.
-PipelineOptions SyntheticPipelineOptions();
+fusion::PipelineOptions SyntheticPipelineOptions();
 dataset::SyntheticOptions DemoSyntheticOptions();
 
 }  // namespace ratslam

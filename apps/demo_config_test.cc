@@ -11,14 +11,14 @@ namespace ratslam {
 namespace {
 
 TEST(DemoConfigTest, CommittedDemoTomlEqualsBuiltInDemoConfig) {
-  StatusOr<PipelineOptions> committed =
+  StatusOr<fusion::PipelineOptions> committed =
       LoadConfigFile(std::string(RATSLAM_SOURCE_DIR) + "/configs/demo.toml");
   ASSERT_TRUE(committed.ok()) << committed.status().message();
   EXPECT_EQ(PrintConfig(committed.value()), PrintConfig(DemoPipelineOptions()));
 }
 
 TEST(DemoConfigTest, CommittedSyntheticTomlEqualsBuiltInSyntheticConfig) {
-  StatusOr<PipelineOptions> committed =
+  StatusOr<fusion::PipelineOptions> committed =
       LoadConfigFile(std::string(RATSLAM_SOURCE_DIR) + "/configs/synthetic.toml");
   ASSERT_TRUE(committed.ok()) << committed.status().message();
   EXPECT_EQ(PrintConfig(committed.value()), PrintConfig(SyntheticPipelineOptions()));
@@ -31,7 +31,7 @@ TEST(DemoConfigTest, CommittedDefaultTomlIsThePrintedDefaults) {
   std::ifstream in(path);
   ASSERT_TRUE(in) << path;
   const std::string committed((std::istreambuf_iterator<char>(in)), {});
-  EXPECT_EQ(committed, PrintConfig(PipelineOptions()))
+  EXPECT_EQ(committed, PrintConfig(fusion::PipelineOptions()))
       << "regenerate with: ratslam print-config > configs/default.toml";
 }
 

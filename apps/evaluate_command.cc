@@ -99,7 +99,7 @@ std::string MatcherTable(const std::vector<ImageSequenceMatcherRow>& rows) {
 }
 
 // Place recognition along a route: two image folders, right within N frames.
-int ImageSequenceEvaluate(const Arguments& args, const PipelineOptions& pipeline) {
+int ImageSequenceEvaluate(const Arguments& args, const fusion::PipelineOptions& pipeline) {
   auto fail = [](const Status& s) {
     std::cerr << MessagePrefix() << s.message() << "\n";
     return kExitError;

@@ -98,10 +98,10 @@ int RenderExperienceMapCommand(const Arguments& args) {
     figure.data = std::move(data);
     figure.floors.assign(figure.data.experiences.size(), 0);
   } else {
-    PipelineOptions config;
+    fusion::PipelineOptions config;
     const fs::path config_path = fs::path(run_folder) / "config.toml";
     if (IsRegularFile(config_path)) {
-      StatusOr<PipelineOptions> loaded = LoadConfigFile(config_path.string());
+      StatusOr<fusion::PipelineOptions> loaded = LoadConfigFile(config_path.string());
       if (!loaded.ok()) return Fail(loaded.status().message());
       config = *loaded;
     }
@@ -184,7 +184,7 @@ int RenderPoseCellsCommand(const Arguments& args) {
   StatusOr<MapFile> map = LoadMapFile(map_path);
   if (!map.ok()) return Fail(map.status().message());
   // The map carries the configuration that made it (format 3 on); --config overrides it.
-  std::optional<PipelineOptions> options;
+  std::optional<fusion::PipelineOptions> options;
   if (args.values.count("--config") || map->config.empty()) {
     if (!args.values.count("--config")) {
       return Fail(map_path + ": a map of format " + std::to_string(map->format_version) +
@@ -193,7 +193,7 @@ int RenderPoseCellsCommand(const Arguments& args) {
     options = LoadOptions(args);
     if (!options) return kExitError;
   } else {
-    StatusOr<PipelineOptions> from_map = ParseMapConfig(map->config, map->format_version);
+    StatusOr<fusion::PipelineOptions> from_map = ParseMapConfig(map->config, map->format_version);
     if (!from_map.ok()) return Fail(map_path + ": " + from_map.status().message());
     options = *from_map;
   }

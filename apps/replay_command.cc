@@ -143,7 +143,7 @@ int RunReplay(const ReplayRequest& request) {
     animation = std::make_unique<viewer::AnimationWriter>(
         (fs::path(request.out) / "animation").string(), 10.0);
     checkpoint.every = request.animate_every;
-    checkpoint.callback = [&](const ReplayPipeline& p) -> Status {
+    checkpoint.callback = [&](const fusion::ReplayPipeline& p) -> Status {
       viewer::ExperienceMapImageOptions options;
       options.width_px = 960;
       options.height_px = 720;

@@ -10,11 +10,11 @@
 
 namespace ratslam {
 
-Status WriteWifiSequenceImages(render::SceneRenderer* renderer, const ReplayPipeline& pipeline,
-                               const std::string& folder,
+Status WriteWifiSequenceImages(render::SceneRenderer* renderer,
+                               const fusion::ReplayPipeline& pipeline, const std::string& folder,
                                const std::vector<viewer::FigureFormat>& formats, double width_mm) {
   namespace fs = std::filesystem;
-  const WifiSequenceLoopCloser& closer = pipeline.wifi_sequence();
+  const wifi_sequence::WifiSequenceLoopCloser& closer = pipeline.wifi_sequence();
   auto write = [&](const std::function<render::Scene(int)>& build, const char* name) -> Status {
     return viewer::WriteNaturalFigure(
                renderer, build, viewer::FigureTargets((fs::path(folder) / name).string(), &formats),
@@ -44,8 +44,8 @@ Status WriteWifiSequenceImages(render::SceneRenderer* renderer, const ReplayPipe
   const render::Rgba verified{220, 50, 32, 255}, rejected{235, 235, 235, 255};
   options.legend = {{verified, "verified correspondence"},
                     {{170, 170, 170, 255}, "DP pair not verified (light)"}};
-  for (const SequenceLoop& loop : closer.loops()) {
-    for (const SequenceCorrespondence& c : loop.correspondences) {
+  for (const wifi_sequence::SequenceLoop& loop : closer.loops()) {
+    for (const wifi_sequence::SequenceCorrespondence& c : loop.correspondences) {
       const bool good = loop.accepted && c.inlier;
       options.marks.push_back({static_cast<int>(c.current_pose / stride),
                                static_cast<int>(c.past_pose / stride), good ? verified : rejected});
@@ -67,8 +67,8 @@ Status WriteWifiSequenceImages(render::SceneRenderer* renderer, const ReplayPipe
     const Pose2 p = pipeline.MapPose(closer.pose(i));
     pairs.positions.push_back({p.x_m, p.y_m});
   }
-  for (const SequenceLoop& loop : closer.loops()) {
-    for (const SequenceCorrespondence& c : loop.correspondences) {
+  for (const wifi_sequence::SequenceLoop& loop : closer.loops()) {
+    for (const wifi_sequence::SequenceCorrespondence& c : loop.correspondences) {
       pairs.pairs.push_back({c.current_pose, c.past_pose, loop.accepted && c.inlier});
     }
   }

@@ -17,8 +17,8 @@ namespace ratslam {
 // wifi_sequence_pairs.png (the correspondences on the final map before and after verification)
 // into `folder`, in each of `formats` (PDF and SVG on a page `width_mm` wide). `renderer` may be
 // null when PNG is not among them.
-Status WriteWifiSequenceImages(render::SceneRenderer* renderer, const ReplayPipeline& pipeline,
-                               const std::string& folder,
+Status WriteWifiSequenceImages(render::SceneRenderer* renderer,
+                               const fusion::ReplayPipeline& pipeline, const std::string& folder,
                                const std::vector<viewer::FigureFormat>& formats, double width_mm);
 
 }  // namespace ratslam

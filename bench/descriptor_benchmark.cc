@@ -35,7 +35,7 @@ std::vector<float> UnitRows(size_t rows, uint64_t seed) {
 struct World {
   std::vector<float> stored;  // unit rows
   dataset::Dataset dataset;   // query images at times 0, 1, ...
-  std::unique_ptr<FrontEnd> front_end;
+  std::unique_ptr<fusion::FrontEnd> front_end;
 };
 
 // `stored` templates already in the front end (through its state, as a loaded map would have
@@ -57,11 +57,11 @@ std::unique_ptr<World> MakeWorld(size_t stored) {
     image.time_s = 1000.0 + static_cast<double>(q);
     w->dataset.images.push_back(image);
   }
-  FrontEndSettings settings;
-  settings.front_end.kind = FrontEndKind::kDescriptors;
-  FrontEndResources resources;
-  resources.descriptors = DescriptorTable::Make(queries, w->dataset, "queries").value();
-  w->front_end = CreateFrontEnd(settings, resources);
+  fusion::FrontEndSettings settings;
+  settings.front_end.kind = fusion::FrontEndKind::kDescriptors;
+  fusion::FrontEndResources resources;
+  resources.descriptors = fusion::DescriptorTable::Make(queries, w->dataset, "queries").value();
+  w->front_end = fusion::CreateFrontEnd(settings, resources);
   ByteWriter state;
   state.Pod(static_cast<uint64_t>(kDimensions));
   state.PodVector(w->stored);

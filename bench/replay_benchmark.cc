@@ -33,7 +33,7 @@ struct Workload {
   ScratchDir folder{"replay_benchmark"};
   dataset::Dataset dataset;
   MemoryImages images;
-  PipelineOptions options;
+  fusion::PipelineOptions options;
   std::string error;
 };
 
@@ -44,7 +44,7 @@ Workload* GetWorkload() {
     synthetic.laps = 10;
     StatusOr<dataset::Dataset> d =
         dataset::WriteSyntheticDataset(synthetic, (w->folder.path() / "d").string());
-    StatusOr<PipelineOptions> o =
+    StatusOr<fusion::PipelineOptions> o =
         LoadConfigFile(std::string(RATSLAM_SOURCE_DIR) + "/configs/synthetic.toml");
     if (!d.ok() || !o.ok()) {
       w->error = !d.ok() ? d.status().message() : o.status().message();
@@ -75,7 +75,7 @@ void BM_SyntheticReplay(benchmark::State& state) {
     state.SkipWithError(w->error.c_str());
     return;
   }
-  PipelineOptions options = w->options;
+  fusion::PipelineOptions options = w->options;
   if (state.range(0) == 1) options.sensors.classic_camera.match_threshold = 0.015;
   ExperienceMapOptions& map = options.ratslam.experience_map;
   map.relaxation_scheme = state.range(1) == 0   ? RelaxationScheme::kFull
@@ -85,7 +85,7 @@ void BM_SyntheticReplay(benchmark::State& state) {
   uint64_t frames = 0, link_updates = 0;
   size_t templates = 0, experiences = 0, links = 0;
   for (auto _ : state) {
-    ReplayPipeline pipeline(options, w->dataset, &w->images);
+    fusion::ReplayPipeline pipeline(options, w->dataset, &w->images);
     const Status s = pipeline.Run({});
     if (!s.ok()) {
       state.SkipWithError(s.message().c_str());

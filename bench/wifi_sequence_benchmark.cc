@@ -22,7 +22,7 @@ namespace {
 
 constexpr int kAps = 300;
 
-SparseSignal Scan(int pose, Random* rng) {
+wifi_sequence::SparseSignal Scan(int pose, Random* rng) {
   // 30 APs around a point that moves along the AP universe with the walk.
   std::vector<std::pair<uint32_t, double>> s;
   const int center = (pose / 20) % kAps;
@@ -31,7 +31,7 @@ SparseSignal Scan(int pose, Random* rng) {
     s.emplace_back(static_cast<uint32_t>(ap), rng->Uniform(5, 90));
   }
   std::sort(s.begin(), s.end());
-  SparseSignal unique;
+  wifi_sequence::SparseSignal unique;
   for (const auto& e : s) {
     if (unique.empty() || unique.back().first != e.first) unique.push_back(e);
   }
@@ -40,7 +40,7 @@ SparseSignal Scan(int pose, Random* rng) {
 
 void BM_SmoothedMatrixAdd(benchmark::State& state) {
   Random rng(1);
-  SmoothedSignalMatrix m(1.5, 4.0);
+  wifi_sequence::SmoothedSignalMatrix m(1.5, 4.0);
   int pose = 0;
   for (; pose < 5000; ++pose) m.Add(pose * 1.0, Scan(pose, &rng));
   for (auto _ : state) {
@@ -54,7 +54,7 @@ BENCHMARK(BM_SmoothedMatrixAdd);
 // its neighbours, as a full recomputation restricted to the changed rows would.
 void BM_SmoothedRowsRecomputed(benchmark::State& state) {
   Random rng(1);
-  std::vector<SparseSignal> raw;
+  std::vector<wifi_sequence::SparseSignal> raw;
   for (int pose = 0; pose < 5000; ++pose) raw.push_back(Scan(pose, &rng));
   const int last = 4999;
   std::vector<double> dense(kAps);
@@ -76,10 +76,10 @@ BENCHMARK(BM_SmoothedRowsRecomputed);
 
 void BM_LoopCloserAddPose(benchmark::State& state) {
   Random rng(2);
-  WifiSequenceLoopCloser closer{WifiSequenceOptions()};
+  wifi_sequence::WifiSequenceLoopCloser closer{wifi_sequence::WifiSequenceOptions()};
   std::vector<Point2> map;
   auto add = [&](int i) {
-    SequencePose pose;
+    wifi_sequence::SequencePose pose;
     pose.time_s = i;
     pose.travel_m = i;
     pose.odometry = {1.0 * i, 0.0, 0.0};  // straight on: no revisit
@@ -103,7 +103,7 @@ void BM_ContinuousDp(benchmark::State& state) {
   std::vector<double> cost(rows * cols);
   for (double& c : cost) c = 1.0 / rng.Uniform(0.05, 1.0);
   for (auto _ : state) {
-    auto match = ContinuousDpMatch(cost, rows, cols, 1.1);
+    auto match = wifi_sequence::ContinuousDpMatch(cost, rows, cols, 1.1);
     benchmark::DoNotOptimize(match);
   }
 }
@@ -117,9 +117,9 @@ void BM_Verify(benchmark::State& state) {
     current.push_back({2.4 * i, 0.3 * std::sin(i * 0.1)});
     past.push_back({2.4 * i + rng.Gaussian(0, 1), 5 + rng.Gaussian(0, 1)});
   }
-  const WifiSequenceOptions options;
+  const wifi_sequence::WifiSequenceOptions options;
   for (auto _ : state) {
-    Verification v = VerifyCorrespondences(current, past, options);
+    wifi_sequence::Verification v = wifi_sequence::VerifyCorrespondences(current, past, options);
     benchmark::DoNotOptimize(v);
   }
 }

@@ -7,7 +7,7 @@
 #include "common/byte_buffer.h"
 #include "fusion/front_end_internal.h"
 
-namespace ratslam {
+namespace ratslam::fusion {
 namespace front_end_internal {
 namespace {
 
@@ -53,4 +53,4 @@ std::unique_ptr<FrontEnd> MakeClassicCameraFrontEnd(const sensors::ClassicCamera
 }
 
 }  // namespace front_end_internal
-}  // namespace ratslam
+}  // namespace ratslam::fusion

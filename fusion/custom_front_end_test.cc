@@ -15,7 +15,7 @@
 #include "fusion/front_end.h"
 #include "fusion/replay_pipeline.h"
 
-namespace ratslam {
+namespace ratslam::fusion {
 namespace {
 
 class ThumbnailFrontEnd : public FrontEnd {
@@ -216,4 +216,4 @@ TEST_F(CustomFrontEndTest, CustomKindWithoutAFactoryIsRefused) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::fusion

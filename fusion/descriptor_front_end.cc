@@ -11,7 +11,7 @@
 #include "common/number_text.h"
 #include "fusion/front_end_internal.h"
 
-namespace ratslam {
+namespace ratslam::fusion {
 namespace front_end_internal {
 namespace {
 
@@ -158,4 +158,4 @@ std::unique_ptr<FrontEnd> MakeDescriptorFrontEnd(const DescriptorOptions& option
 }
 
 }  // namespace front_end_internal
-}  // namespace ratslam
+}  // namespace ratslam::fusion

@@ -7,7 +7,7 @@
 
 #include "fusion/front_end.h"
 
-namespace ratslam {
+namespace ratslam::fusion {
 namespace {
 
 // Images at times 0, 1, 2, ... with the given descriptors.
@@ -227,4 +227,4 @@ TEST(DescriptorFrontEndTest, FedDescriptorsDecideAsTheFileDoes) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::fusion

@@ -5,7 +5,7 @@
 
 #include "common/number_text.h"
 
-namespace ratslam {
+namespace ratslam::fusion {
 
 bool DescriptorOptions::IsValid(std::string* error) const {
   if (!schema::CheckFields(*this, error)) return false;
@@ -75,4 +75,4 @@ const float* DescriptorTable::At(double time_s) const {
   return unit_.data() + static_cast<size_t>(it - times_s_.begin()) * dimensions_;
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::fusion

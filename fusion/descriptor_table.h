@@ -15,7 +15,7 @@
 #include "dataset/dataset.h"
 #include "dataset/descriptor_file.h"
 
-namespace ratslam {
+namespace ratslam::fusion {
 
 struct DescriptorOptions {
   // The data set's descriptor file (.npy or .csv, dataset/descriptor_file.h): a relative
@@ -70,6 +70,6 @@ class DescriptorTable {
   std::vector<float> unit_;      // row-major, in times_s_ order
 };
 
-}  // namespace ratslam
+}  // namespace ratslam::fusion
 
 #endif  // RATSLAM_FUSION_DESCRIPTOR_TABLE_H_

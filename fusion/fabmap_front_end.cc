@@ -12,7 +12,7 @@
 #include "fusion/front_end_internal.h"
 #include "sensors/rssi_offset.h"
 
-namespace ratslam {
+namespace ratslam::fusion {
 namespace front_end_internal {
 namespace {
 
@@ -408,4 +408,4 @@ StatusOr<std::shared_ptr<const FabmapResources>> PrepareFabmapResources(
   return std::shared_ptr<const FabmapResources>(std::move(resources));
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::fusion

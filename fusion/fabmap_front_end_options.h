@@ -24,7 +24,7 @@
 #include "fusion/fabmap/visual_model.h"
 #include "fusion/fabmap/vocabulary.h"
 
-namespace ratslam {
+namespace ratslam::fusion {
 
 // Where the FABMAP front end's Wi-Fi words, tree and unknown world come from.
 //   kWholeDataSet: every scan of the data set, future sessions included (an exploration done
@@ -124,6 +124,6 @@ struct FabmapLearningReport {
   uint64_t wifi_tree_scans = 0;          // of the scans, those that learnt the Wi-Fi tree
 };
 
-}  // namespace ratslam
+}  // namespace ratslam::fusion
 
 #endif  // RATSLAM_FUSION_FABMAP_FRONT_END_OPTIONS_H_

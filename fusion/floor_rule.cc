@@ -5,7 +5,7 @@
 #include <stdexcept>
 #include <string>
 
-namespace ratslam::front_end_internal {
+namespace ratslam::fusion::front_end_internal {
 
 FloorRule::FloorRule(const FloorOptions& options) : options_(options), tracker_(options.tracker) {
   std::string error;
@@ -205,4 +205,4 @@ bool FloorRule::Decode(ByteReader* r, size_t templates) {
   return true;
 }
 
-}  // namespace ratslam::front_end_internal
+}  // namespace ratslam::fusion::front_end_internal

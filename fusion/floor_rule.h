@@ -17,7 +17,7 @@
 #include "fusion/front_end.h"
 #include "sensors/barometer.h"
 
-namespace ratslam::front_end_internal {
+namespace ratslam::fusion::front_end_internal {
 
 class FloorRule {
  public:
@@ -108,6 +108,6 @@ void FloorRule::Vote(Best&& best, double threshold) {
   CountVote(static_cast<uint32_t>(top.first));
 }
 
-}  // namespace ratslam::front_end_internal
+}  // namespace ratslam::fusion::front_end_internal
 
 #endif  // RATSLAM_FUSION_FLOOR_RULE_H_

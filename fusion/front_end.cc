@@ -7,7 +7,7 @@
 
 #include "fusion/front_end_internal.h"
 
-namespace ratslam {
+namespace ratslam::fusion {
 
 std::string ToString(FrontEndKind kind) {
   switch (kind) {
@@ -165,4 +165,4 @@ std::unique_ptr<FrontEnd> CreateFrontEnd(const FrontEndSettings& s,
   return front_end;
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::fusion

@@ -31,7 +31,7 @@
 #include "sensors/sequence_matcher.h"
 #include "sensors/wifi_fingerprint_matcher.h"
 
-namespace ratslam {
+namespace ratslam::fusion {
 
 // kDescriptors without a table takes its descriptors from FrontEnd::OnDescriptor only.
 // kNone matches nothing: every Wi-Fi scan is a new template (Wi-Fi sequence loop closure alone).
@@ -181,6 +181,6 @@ Status CheckFrontEndInputs(const FrontEndSettings& settings, const dataset::Data
 std::unique_ptr<FrontEnd> CreateFrontEnd(const FrontEndSettings& settings,
                                          const FrontEndResources& resources = {});
 
-}  // namespace ratslam
+}  // namespace ratslam::fusion
 
 #endif  // RATSLAM_FUSION_FRONT_END_H_

@@ -11,7 +11,7 @@
 
 #include "fusion/front_end.h"
 
-namespace ratslam::front_end_internal {
+namespace ratslam::fusion::front_end_internal {
 
 template <typename T>
 bool AllFinite(const std::vector<T>& values) {
@@ -51,6 +51,6 @@ std::unique_ptr<FrontEnd> MakeFabmapFrontEnd(const FabmapSettings& settings,
 std::unique_ptr<FrontEnd> MakeSequenceRecognition(std::unique_ptr<FrontEnd> inner,
                                                   const sensors::SequenceMatcherOptions& options);
 
-}  // namespace ratslam::front_end_internal
+}  // namespace ratslam::fusion::front_end_internal
 
 #endif  // RATSLAM_FUSION_FRONT_END_INTERNAL_H_

@@ -9,7 +9,7 @@
 
 #include "common/random.h"
 
-namespace ratslam {
+namespace ratslam::fusion {
 namespace {
 
 // A 24x18 grey image with a distinct pattern per seed.
@@ -785,9 +785,9 @@ TEST(FusedFrontEndTest, SecondSessionsFloorOffsetComesFromWifiVotes) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::fusion
 
-namespace ratslam {
+namespace ratslam::fusion {
 namespace {
 
 // A 64x32 image per place (blocks of 4x4 pixels, so that block means differ between places); on
@@ -928,4 +928,4 @@ TEST(SequenceRecognitionTest, StateRoundTripsAndTheOptionNeedsACamera) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::fusion

@@ -10,7 +10,7 @@
 #include "fusion/front_end_internal.h"
 #include "sensors/rssi_offset.h"
 
-namespace ratslam {
+namespace ratslam::fusion {
 namespace front_end_internal {
 namespace {
 
@@ -344,4 +344,4 @@ std::unique_ptr<FrontEnd> MakeFusedFrontEnd(const FusedOptions& options,
 }
 
 }  // namespace front_end_internal
-}  // namespace ratslam
+}  // namespace ratslam::fusion

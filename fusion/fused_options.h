@@ -39,7 +39,7 @@
 #include "common/schema.h"
 #include "sensors/barometer.h"
 
-namespace ratslam {
+namespace ratslam::fusion {
 
 struct FusedOptions {
   bool use_camera = false;      // 12x9 camera templates (eq. 7)
@@ -135,6 +135,6 @@ struct FloorReport {
   std::vector<int> session_floor_offsets;
 };
 
-}  // namespace ratslam
+}  // namespace ratslam::fusion
 
 #endif  // RATSLAM_FUSION_FUSED_OPTIONS_H_

@@ -7,7 +7,7 @@
 #include "common/byte_buffer.h"
 #include "fusion/front_end_internal.h"
 
-namespace ratslam {
+namespace ratslam::fusion {
 namespace front_end_internal {
 namespace {
 
@@ -61,4 +61,4 @@ class NoViewFrontEnd : public FrontEnd {
 std::unique_ptr<FrontEnd> MakeNoViewFrontEnd() { return std::make_unique<NoViewFrontEnd>(); }
 
 }  // namespace front_end_internal
-}  // namespace ratslam
+}  // namespace ratslam::fusion

@@ -6,7 +6,7 @@
 #include "common/circular.h"
 #include "common/geometry.h"
 
-namespace ratslam {
+namespace ratslam::fusion {
 
 bool PipelineOptions::IsValid(std::string* error) const {
   std::string inner;
@@ -94,7 +94,8 @@ ReplayPipeline::ReplayPipeline(const PipelineOptions& options, const dataset::Da
       slam_(std::make_unique<Ratslam>(options.ratslam)),
       resources_(std::move(resources)),
       front_end_(CreateFrontEnd(options.sensors, resources_)),
-      wifi_sequence_(std::make_unique<WifiSequenceLoopCloser>(options.wifi_sequence)) {
+      wifi_sequence_(
+          std::make_unique<wifi_sequence::WifiSequenceLoopCloser>(options.wifi_sequence)) {
   state_.events_total = events_.size();
 }
 
@@ -246,7 +247,7 @@ Status ReplayPipeline::FeedWifi(const WifiScan& scan) {
   return options_.wifi_sequence.enabled && !localising() ? AddSequencePose(scan) : Status::Ok();
 }
 
-Pose2 ReplayPipeline::MapPose(const SequencePose& pose) const {
+Pose2 ReplayPipeline::MapPose(const wifi_sequence::SequencePose& pose) const {
   const ExperienceMap& map = slam_->experience_map();
   if (pose.anchor < 0 || static_cast<size_t>(pose.anchor) >= map.num_experiences()) {
     return pose.odometry;
@@ -273,7 +274,7 @@ Pose2 Then(const Pose2& a, const Pose2& b) { return Compose(a, b.x_m, b.y_m, b.t
 
 Status ReplayPipeline::AddSequencePose(const WifiScan& scan) {
   const ExperienceMap& map = slam_->experience_map();
-  SequencePose pose;
+  wifi_sequence::SequencePose pose;
   pose.time_s = scan.time_s;
   pose.travel_m =
       state_.travel_m + kSessionGapM * static_cast<double>(dataset_.SessionAt(scan.time_s));
@@ -291,19 +292,21 @@ Status ReplayPipeline::AddSequencePose(const WifiScan& scan) {
   }
   const Pose2 here = MapPose(pose);
   positions.push_back({here.x_m, here.y_m});
-  StatusOr<std::optional<SequenceLoop>> loop = wifi_sequence_->AddPose(pose, scan, positions);
+  StatusOr<std::optional<wifi_sequence::SequenceLoop>> loop =
+      wifi_sequence_->AddPose(pose, scan, positions);
   if (!loop.ok()) return loop.status();
   return LinkLoop(loop.value(), scan.time_s);
 }
 
-Status ReplayPipeline::LinkLoop(const std::optional<SequenceLoop>& loop, double time_s) {
+Status ReplayPipeline::LinkLoop(const std::optional<wifi_sequence::SequenceLoop>& loop,
+                                double time_s) {
   if (!loop || !loop->accepted) return Status::Ok();
   bool added = false;
   size_t joined = 0, inliers = 0;
-  for (const SequenceCorrespondence& c : loop->correspondences) {
+  for (const wifi_sequence::SequenceCorrespondence& c : loop->correspondences) {
     if (!c.inlier) continue;
-    const SequencePose& now = wifi_sequence_->pose(c.current_pose);
-    const SequencePose& then = wifi_sequence_->pose(c.past_pose);
+    const wifi_sequence::SequencePose& now = wifi_sequence_->pose(c.current_pose);
+    const wifi_sequence::SequencePose& then = wifi_sequence_->pose(c.past_pose);
     if (now.anchor < 0 || then.anchor < 0) continue;
     // Where the front end has already joined the two places, a second, differently measured
     // link only pulls against its own (on the IPIN routes such links made b_out's maps worse).
@@ -379,9 +382,10 @@ Status ReplayPipeline::Restore(const State& state) {
   RATSLAM_RETURN_IF_ERROR(slam->SetState(state.ratslam));
   std::unique_ptr<FrontEnd> front_end = CreateFrontEnd(options_.sensors, resources_);
   RATSLAM_RETURN_IF_ERROR(front_end->DecodeState(state.front_end));
-  auto wifi_sequence = std::make_unique<WifiSequenceLoopCloser>(options_.wifi_sequence);
+  auto wifi_sequence =
+      std::make_unique<wifi_sequence::WifiSequenceLoopCloser>(options_.wifi_sequence);
   RATSLAM_RETURN_IF_ERROR(wifi_sequence->SetState(state.wifi_sequence));
-  for (const SequencePose& p : state.wifi_sequence.poses) {
+  for (const wifi_sequence::SequencePose& p : state.wifi_sequence.poses) {
     if (p.anchor >= static_cast<int64_t>(state.ratslam.experience_map.experiences.size())) {
       return Status::Error(
           "saved map: a Wi-Fi sequence pose refers to an experience that does "
@@ -419,4 +423,4 @@ Status ReplayPipeline::AdoptMap(const State& map, double lost_after_m) {
   return Status::Ok();
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::fusion

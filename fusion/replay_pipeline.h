@@ -28,7 +28,7 @@
 #include "sensors/sequence_matcher.h"
 #include "sensors/visual_odometry.h"
 
-namespace ratslam {
+namespace ratslam::fusion {
 
 // Everything a replay or an evaluation is configured by; one TOML section per member.
 struct PipelineOptions {
@@ -36,7 +36,8 @@ struct PipelineOptions {
   sensors::PdrOptions pdr;                         // odometry from phone logs
   sensors::VisualOdometryOptions visual_odometry;  // odometry from a camera alone
   RatslamOptions ratslam;
-  WifiSequenceOptions wifi_sequence;     // Wi-Fi sequence loop closure beside the front end
+  wifi_sequence::WifiSequenceOptions
+      wifi_sequence;                     // Wi-Fi sequence loop closure beside the front end
   fabmap::EvaluationOptions evaluation;  // `ratslam evaluate` only: how map and queries split
   dataset::BagTopics
       bag;  // which topics of a ROS bag make the data set (not part of a map's identity)
@@ -114,7 +115,7 @@ class ReplayPipeline {
     uint64_t images_skipped = 0;  // images the front end does not use
     // Wi-Fi sequence loop closure: its poses and loops, the odometric travel so far, and
     // whether the sequence open at the end of the data was matched.
-    WifiSequenceLoopCloser::State wifi_sequence;
+    wifi_sequence::WifiSequenceLoopCloser::State wifi_sequence;
     double travel_m = 0.0;
     bool wifi_sequence_flushed = false;
   };
@@ -166,10 +167,10 @@ class ReplayPipeline {
   const std::vector<LocalisationRecord>& localisation() const { return localisation_; }
   const std::vector<dataset::Event>& events() const { return events_; }
   // Wi-Fi sequence loop closure (its poses, loops and similarity), whether enabled or not.
-  const WifiSequenceLoopCloser& wifi_sequence() const { return *wifi_sequence_; }
+  const wifi_sequence::WifiSequenceLoopCloser& wifi_sequence() const { return *wifi_sequence_; }
   // The map's current estimate of a loop-closer pose: its anchor experience composed with the
   // pose's offset (the dead-reckoned position before the first experience).
-  Pose2 MapPose(const SequencePose& pose) const;
+  Pose2 MapPose(const wifi_sequence::SequencePose& pose) const;
   // How a FABMAP front end learnt its Wi-Fi model; nothing for the other front ends.
   std::optional<FabmapLearningReport> fabmap_learning() const {
     return front_end_->Report().fabmap_learning;
@@ -193,7 +194,7 @@ class ReplayPipeline {
   void AnnounceSession(double time_s);
   Status Apply(const FrameDecision& decision);
   Status AddSequencePose(const WifiScan& scan);
-  Status LinkLoop(const std::optional<SequenceLoop>& loop, double time_s);
+  Status LinkLoop(const std::optional<wifi_sequence::SequenceLoop>& loop, double time_s);
 
   PipelineOptions options_;
   const dataset::Dataset& dataset_;
@@ -202,12 +203,12 @@ class ReplayPipeline {
   std::unique_ptr<Ratslam> slam_;
   FrontEndResources resources_;
   std::unique_ptr<FrontEnd> front_end_;
-  std::unique_ptr<WifiSequenceLoopCloser> wifi_sequence_;
+  std::unique_ptr<wifi_sequence::WifiSequenceLoopCloser> wifi_sequence_;
   State state_;                                   // the parts not held by slam_ and camera_
   std::vector<LocalisationRecord> localisation_;  // localisation runs only (not saved)
   double lost_after_m_ = 0.0;
 };
 
-}  // namespace ratslam
+}  // namespace ratslam::fusion
 
 #endif  // RATSLAM_FUSION_REPLAY_PIPELINE_H_

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-namespace ratslam {
+namespace ratslam::fusion {
 namespace {
 
 // Two laps of a 20 m square at 1 m/s: odometry at 10 Hz, a Wi-Fi scan every 2 s from four access
@@ -330,9 +330,9 @@ TEST(ReplayPipelineTest, StopAndResumeEqualsOneRunForOnlineFabmapLearning) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::fusion
 
-namespace ratslam {
+namespace ratslam::fusion {
 namespace {
 
 PipelineOptions SequenceOptions(FrontEndKind kind) {
@@ -414,9 +414,9 @@ TEST(ReplayPipelineWifiSequenceTest, RestoreRefusesAPoseAnchoredToAMissingExperi
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::fusion
 
-namespace ratslam {
+namespace ratslam::fusion {
 namespace {
 
 TEST(ReplayPipelineWifiSequenceTest, RunsBesideTheFabmapFrontEnd) {
@@ -432,15 +432,15 @@ TEST(ReplayPipelineWifiSequenceTest, RunsBesideTheFabmapFrontEnd) {
   // is matched against the first.
   EXPECT_EQ(pipeline.wifi_sequence().size(), data.wifi.size());
   EXPECT_GE(pipeline.wifi_sequence().loops().size(), 1u);
-  for (const SequencePose& p : pipeline.wifi_sequence().state().poses) {
+  for (const wifi_sequence::SequencePose& p : pipeline.wifi_sequence().state().poses) {
     EXPECT_LT(p.anchor, static_cast<int64_t>(pipeline.slam().experience_map().num_experiences()));
   }
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::fusion
 
-namespace ratslam {
+namespace ratslam::fusion {
 namespace {
 
 // Sequence recognition needs a front end that takes camera frames.
@@ -459,4 +459,4 @@ TEST(PipelineOptionsTest, SequenceRecognitionNeedsACameraFrontEnd) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::fusion

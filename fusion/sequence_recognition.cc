@@ -18,7 +18,7 @@
 #include "common/byte_buffer.h"
 #include "fusion/front_end_internal.h"
 
-namespace ratslam {
+namespace ratslam::fusion {
 namespace front_end_internal {
 namespace {
 
@@ -193,4 +193,4 @@ std::unique_ptr<FrontEnd> MakeSequenceRecognition(std::unique_ptr<FrontEnd> inne
 }
 
 }  // namespace front_end_internal
-}  // namespace ratslam
+}  // namespace ratslam::fusion

@@ -8,11 +8,11 @@
 namespace ratslam::fuzz {
 
 std::vector<std::string> FuzzSeeds() {
-  PipelineOptions fused;
-  fused.sensors.front_end.kind = FrontEndKind::kFused;
+  fusion::PipelineOptions fused;
+  fused.sensors.front_end.kind = fusion::FrontEndKind::kFused;
   fused.sensors.fused.use_camera = true;
   fused.sensors.fused.use_compass = true;
-  return {PrintConfig(PipelineOptions()), PrintConfig(fused, false),
+  return {PrintConfig(fusion::PipelineOptions()), PrintConfig(fused, false),
           "[front_end]\nkind = \"fabmap\"\n[fabmap]\nmode = \"early\"\n[wifi_words]\nbins = 8\n",
           PrintLocateConfig(phone::LocateOptions())};
 }
@@ -36,7 +36,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       fuzz::InvariantFailed("locate config print/parse round trip differs");
     }
   }
-  StatusOr<PipelineOptions> options = ParseConfig(text, "fuzz.toml");
+  StatusOr<fusion::PipelineOptions> options = ParseConfig(text, "fuzz.toml");
   if (!options.ok()) {
     if (options.status().message().rfind("fuzz.toml", 0) != 0) {
       fuzz::InvariantFailed("error does not name the file: " + options.status().message());
@@ -44,7 +44,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     // From a file, a text that fails may be recognised as an OpenRatSLAM INI: still an error
     // naming the file.
     const std::string path = fuzz::WriteScratchFile("config.toml", data, size);
-    StatusOr<PipelineOptions> loaded = LoadConfigFile(path);
+    StatusOr<fusion::PipelineOptions> loaded = LoadConfigFile(path);
     if (loaded.ok() || loaded.status().message().rfind(path, 0) != 0) {
       fuzz::InvariantFailed("a file that does not parse loaded, or its error lacks the path");
     }
@@ -53,7 +53,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   std::string error;
   if (!options->IsValid(&error)) fuzz::InvariantFailed("accepted an invalid config: " + error);
   const std::string printed = PrintConfig(*options);
-  StatusOr<PipelineOptions> back = ParseConfig(printed, "printed.toml");
+  StatusOr<fusion::PipelineOptions> back = ParseConfig(printed, "printed.toml");
   if (!back.ok()) fuzz::InvariantFailed("printed config does not read: " + back.status().message());
   if (PrintConfig(*back) != printed) fuzz::InvariantFailed("print/parse round trip differs");
   return 0;

@@ -58,21 +58,21 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   dataset::Dataset dataset;
   dataset.name = "fuzz";
   for (size_t i = 0; i < m->rows; ++i) dataset.images.push_back({static_cast<double>(i), "x", 0});
-  auto table = DescriptorTable::Make(*m, dataset, "fuzz.desc");
+  auto table = fusion::DescriptorTable::Make(*m, dataset, "fuzz.desc");
   if (!table.ok()) return 0;  // a zero row
-  FrontEndSettings settings;
-  settings.front_end.kind = FrontEndKind::kDescriptors;
+  fusion::FrontEndSettings settings;
+  settings.front_end.kind = fusion::FrontEndKind::kDescriptors;
   settings.descriptors.recency_s = 1.5;
-  FrontEndResources resources;
+  fusion::FrontEndResources resources;
   resources.descriptors = *table;
-  auto front_end = CreateFrontEnd(settings, resources);
+  auto front_end = fusion::CreateFrontEnd(settings, resources);
   for (const ImageRow& image : dataset.images) {
     auto d = front_end->OnImage(image.time_s, GrayImage());
     if (!d.ok() || !d.value()) fuzz::InvariantFailed("a known image was refused");
     if (d.value()->view.template_id > front_end->size()) fuzz::InvariantFailed("template id");
   }
   // Fed one by one without the table, the same rows make the same state.
-  auto fed = CreateFrontEnd(settings);
+  auto fed = fusion::CreateFrontEnd(settings);
   for (size_t i = 0; i < m->rows; ++i) {
     const std::vector<float> row(m->values.begin() + static_cast<ptrdiff_t>(i * m->cols),
                                  m->values.begin() + static_cast<ptrdiff_t>((i + 1) * m->cols));
@@ -81,7 +81,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     }
   }
   if (fed->EncodeState() != front_end->EncodeState()) fuzz::InvariantFailed("fed state differs");
-  auto copy = CreateFrontEnd(settings, resources);
+  auto copy = fusion::CreateFrontEnd(settings, resources);
   if (!copy->DecodeState(front_end->EncodeState()).ok() ||
       copy->EncodeState() != front_end->EncodeState()) {
     fuzz::InvariantFailed("state round trip");

@@ -33,7 +33,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (!imported->options.IsValid(&error))
     fuzz::InvariantFailed("imported invalid options: " + error);
   const std::string printed = PrintConfig(imported->options);
-  StatusOr<PipelineOptions> back = ParseConfig(printed, "printed.toml");
+  StatusOr<fusion::PipelineOptions> back = ParseConfig(printed, "printed.toml");
   if (!back.ok() || PrintConfig(*back) != printed) fuzz::InvariantFailed("TOML round trip failed");
   return 0;
 }

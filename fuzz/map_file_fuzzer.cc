@@ -88,35 +88,35 @@ class GeneratedImages : public ImageLoader {
 struct Setup {
   dataset::Dataset dataset = MakeDataset();
   GeneratedImages images;
-  std::vector<PipelineOptions> options;
-  std::vector<FrontEndResources> resources;
+  std::vector<fusion::PipelineOptions> options;
+  std::vector<fusion::FrontEndResources> resources;
 
   Setup() {
-    PipelineOptions classic;
+    fusion::PipelineOptions classic;
     classic.sensors.classic_camera.template_width_px = 32;
     classic.sensors.classic_camera.template_height_px = 8;
-    PipelineOptions fused;
-    fused.sensors.front_end.kind = FrontEndKind::kFused;
+    fusion::PipelineOptions fused;
+    fused.sensors.front_end.kind = fusion::FrontEndKind::kFused;
     fused.sensors.fused.use_camera = true;
     fused.sensors.fused.use_compass = true;
     fused.sensors.fused.recency_s = 20.0;
     fused.sensors.fused.online_rssi_offset = true;     // its estimates are part of the state
     fused.sensors.barometer.use_barometer = true;      // and so are its floors
     fused.sensors.fused.revisit_update_weight = 0.25;  // and the revisit counts
-    PipelineOptions fabmap_wifi;
-    fabmap_wifi.sensors.front_end.kind = FrontEndKind::kFabmap;
+    fusion::PipelineOptions fabmap_wifi;
+    fabmap_wifi.sensors.front_end.kind = fusion::FrontEndKind::kFabmap;
     fabmap_wifi.sensors.fabmap.localiser.localiser.mode = fabmap::FabmapMode::kWifi;
     fabmap_wifi.sensors.fabmap.localiser.virtual_wifi.use_exploration_scans = true;
     fabmap_wifi.sensors.barometer.use_barometer = true;
     fabmap_wifi.sensors.fabmap.front_end.online_rssi_offset = true;  // its estimates: state
     // Wi-Fi sequence loop closure alone (its poses, loops and links in the saved state).
-    PipelineOptions sequence;
-    sequence.sensors.front_end.kind = FrontEndKind::kNone;
+    fusion::PipelineOptions sequence;
+    sequence.sensors.front_end.kind = fusion::FrontEndKind::kNone;
     sequence.wifi_sequence.enabled = true;
     sequence.wifi_sequence.min_loop_travel_m = 20.0;
     // Descriptors of the place each image shows (8 dimensions), re-matching on the second lap.
-    PipelineOptions descriptors;
-    descriptors.sensors.front_end.kind = FrontEndKind::kDescriptors;
+    fusion::PipelineOptions descriptors;
+    descriptors.sensors.front_end.kind = fusion::FrontEndKind::kDescriptors;
     descriptors.sensors.descriptors.min_similarity = 0.99;
     options = {classic, fused, fabmap_wifi, sequence, descriptors};
     dataset::DescriptorMatrix places{dataset.images.size(), 8, {}};
@@ -124,18 +124,18 @@ struct Setup {
       const int place = std::atoi(image.file.c_str());
       for (int k = 0; k < 8; ++k) places.values.push_back(std::cos(0.7 * place * (k + 1) + k));
     }
-    for (const PipelineOptions& o : options) {
-      FrontEndResources r;
-      if (o.sensors.front_end.kind == FrontEndKind::kFabmap) {
-        r.fabmap = PrepareFabmapResources(o.sensors, dataset, std::nullopt).value();
-      } else if (o.sensors.front_end.kind == FrontEndKind::kDescriptors) {
-        r.descriptors = DescriptorTable::Make(places, dataset, "places").value();
+    for (const fusion::PipelineOptions& o : options) {
+      fusion::FrontEndResources r;
+      if (o.sensors.front_end.kind == fusion::FrontEndKind::kFabmap) {
+        r.fabmap = fusion::PrepareFabmapResources(o.sensors, dataset, std::nullopt).value();
+      } else if (o.sensors.front_end.kind == fusion::FrontEndKind::kDescriptors) {
+        r.descriptors = fusion::DescriptorTable::Make(places, dataset, "places").value();
       }
       resources.push_back(r);
     }
   }
-  std::unique_ptr<ReplayPipeline> Pipeline(size_t i) {
-    return std::make_unique<ReplayPipeline>(options[i], dataset, &images, resources[i]);
+  std::unique_ptr<fusion::ReplayPipeline> Pipeline(size_t i) {
+    return std::make_unique<fusion::ReplayPipeline>(options[i], dataset, &images, resources[i]);
   }
 };
 
@@ -151,7 +151,7 @@ std::vector<std::string> FuzzSeeds() {
   for (size_t i = 0; i < Shared().options.size(); ++i) {
     for (double until : {30.0, 100.0, 127.0}) {
       auto pipeline = Shared().Pipeline(i);
-      ReplayControl control;
+      fusion::ReplayControl control;
       control.until_time_s = until;
       if (!pipeline->Run(control).ok()) InvariantFailed("the seed replay failed");
       MapFile map;
@@ -178,7 +178,7 @@ int DecodeAndRun(const std::string& bytes) {
     // A few hundred events on from where the map stopped, then everything the outputs read.
     const auto& events = pipeline->events();
     const uint64_t stop = std::min<uint64_t>(events.size(), map->state.next_event + 300);
-    ReplayControl control;
+    fusion::ReplayControl control;
     control.until_time_s = stop < events.size() ? events[stop].time_s : events.back().time_s;
     (void)pipeline->Run(control);
     const RunSummary summary = Summarise(*pipeline, setup.dataset, RunInfo{});

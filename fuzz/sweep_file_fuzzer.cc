@@ -55,7 +55,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   }
   if (plan->tasks.size() > 2000) return 0;  // large plans are valid; checking each is slow
   for (const sweep::Task& task : plan->tasks) {
-    StatusOr<PipelineOptions> config = sweep::TaskConfig(*plan, task);
+    StatusOr<fusion::PipelineOptions> config = sweep::TaskConfig(*plan, task);
     std::string error;
     if (!config.ok() || !config->IsValid(&error)) {
       fuzz::InvariantFailed("a planned task has no valid configuration");

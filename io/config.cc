@@ -50,13 +50,15 @@ template <>
 struct TomlCodec<fabmap::NewPlaceRule>
     : EnumCodec<fabmap::NewPlaceRule, fabmap::NewPlaceRuleFromString> {};
 template <>
-struct TomlCodec<WifiLearning> : EnumCodec<WifiLearning, WifiLearningFromString> {};
+struct TomlCodec<fusion::WifiLearning>
+    : EnumCodec<fusion::WifiLearning, fusion::WifiLearningFromString> {};
 template <>
 struct TomlCodec<RelaxationScheme> : EnumCodec<RelaxationScheme, RelaxationSchemeFromString> {};
 template <>
 struct TomlCodec<ViewMemory> : EnumCodec<ViewMemory, ViewMemoryFromString> {};
 template <>
-struct TomlCodec<FrontEndKind> : EnumCodec<FrontEndKind, FrontEndKindFromString> {};
+struct TomlCodec<fusion::FrontEndKind>
+    : EnumCodec<fusion::FrontEndKind, fusion::FrontEndKindFromString> {};
 template <>
 struct TomlCodec<phone::ScanLikelihood>
     : EnumCodec<phone::ScanLikelihood, phone::ScanLikelihoodFromString> {};
@@ -81,8 +83,9 @@ std::string LocateField(const toml::table& root, const std::string& source,
 
 }  // namespace
 
-StatusOr<PipelineOptions> ParseConfig(const std::string& text, const std::string& source_name) {
-  return ParseConfigOnto(text, source_name, PipelineOptions());
+StatusOr<fusion::PipelineOptions> ParseConfig(const std::string& text,
+                                              const std::string& source_name) {
+  return ParseConfigOnto(text, source_name, fusion::PipelineOptions());
 }
 
 namespace {
@@ -130,8 +133,9 @@ StatusOr<Options> ParseSectionsOnto(const std::string& text, const std::string& 
 
 }  // namespace
 
-StatusOr<PipelineOptions> ParseConfigOnto(const std::string& text, const std::string& source_name,
-                                          const PipelineOptions& base) {
+StatusOr<fusion::PipelineOptions> ParseConfigOnto(const std::string& text,
+                                                  const std::string& source_name,
+                                                  const fusion::PipelineOptions& base) {
   return ParseSectionsOnto(text, source_name, base);
 }
 
@@ -179,7 +183,7 @@ std::optional<std::string> OpenRatslamEvidence(const std::string& text) {
 }
 }  // namespace
 
-StatusOr<PipelineOptions> LoadConfigFile(const std::string& path) {
+StatusOr<fusion::PipelineOptions> LoadConfigFile(const std::string& path) {
   // A data set given where the configuration belongs (`--config LOG.txt --data x.toml`) is
   // named as such, instead of "larger than 1048576 bytes" or a TOML syntax error.
   // Asked only once reading or parsing failed: a good configuration is never sniffed.
@@ -191,7 +195,7 @@ StatusOr<PipelineOptions> LoadConfigFile(const std::string& path) {
   };
   StatusOr<std::string> text = ReadRegularFile(path, "config file", kMaxConfigBytes);
   if (!text.ok()) return is_data_set() ? data_set() : text.status();
-  StatusOr<PipelineOptions> parsed = ParseConfig(*text, path);
+  StatusOr<fusion::PipelineOptions> parsed = ParseConfig(*text, path);
   if (parsed.ok()) {
     // Paths inside a configuration are relative to its file (as a sweep file's are), not to the
     // folder the program runs in: the resolved configuration holds them absolute.
@@ -232,7 +236,7 @@ std::string PrintSections(const Options& options, bool comments) {
 }
 }  // namespace
 
-std::string PrintConfig(const PipelineOptions& options, bool comments) {
+std::string PrintConfig(const fusion::PipelineOptions& options, bool comments) {
   return PrintSections(options, comments);
 }
 
@@ -276,7 +280,7 @@ std::string MarkdownTables(const std::string& printed) {
 
 std::string ConfigReferenceMarkdown() {
   return "\n## Replay, evaluation and sweeps (`--config`)\n" +
-         MarkdownTables(PrintConfig(PipelineOptions(), true)) +
+         MarkdownTables(PrintConfig(fusion::PipelineOptions(), true)) +
          "\n## `ratslam locate` (`--config`)\n" +
          MarkdownTables(PrintLocateConfig(phone::LocateOptions(), true));
 }
@@ -385,12 +389,12 @@ constexpr AddedSection kSectionsAddedAfter[] = {
 
 }  // namespace
 
-uint64_t ConfigFingerprint(const PipelineOptions& options) {
+uint64_t ConfigFingerprint(const fusion::PipelineOptions& options) {
   return Fnv1a(PrintConfig(options, false));
 }
 
-std::vector<std::string> ConfigDifferences(const PipelineOptions& before,
-                                           const PipelineOptions& now) {
+std::vector<std::string> ConfigDifferences(const fusion::PipelineOptions& before,
+                                           const fusion::PipelineOptions& now) {
   const auto a = KeyedLines(PrintConfig(before, false));
   const auto b = KeyedLines(PrintConfig(now, false));
   std::vector<std::string> out;
@@ -402,9 +406,10 @@ std::vector<std::string> ConfigDifferences(const PipelineOptions& before,
   return out;
 }
 
-StatusOr<uint64_t> FingerprintAsOfMapVersion(const PipelineOptions& options, uint32_t map_version) {
+StatusOr<uint64_t> FingerprintAsOfMapVersion(const fusion::PipelineOptions& options,
+                                             uint32_t map_version) {
   const std::string printed = PrintConfig(options, false);
-  const auto defaults = KeyedLines(PrintConfig(PipelineOptions(), false));
+  const auto defaults = KeyedLines(PrintConfig(fusion::PipelineOptions(), false));
   const auto lines = KeyedLines(printed);
   std::set<std::string> dropped;
   for (const AddedKey& added : kKeysAddedAfter) {
@@ -450,7 +455,7 @@ StatusOr<uint64_t> FingerprintAsOfMapVersion(const PipelineOptions& options, uin
   return Fnv1a(kept);
 }
 
-StatusOr<PipelineOptions> ParseMapConfig(const std::string& text, uint32_t map_version) {
+StatusOr<fusion::PipelineOptions> ParseMapConfig(const std::string& text, uint32_t map_version) {
   std::string then;
   for (const AddedKey& added : kKeysAddedAfter) {
     if (map_version > added.after_version || !added.value_then) continue;
@@ -459,8 +464,8 @@ StatusOr<PipelineOptions> ParseMapConfig(const std::string& text, uint32_t map_v
     then.append("[").append(key.substr(0, dot)).append("]\n");
     then.append(key.substr(dot + 1)).append(" = ").append(added.value_then).append("\n");
   }
-  StatusOr<PipelineOptions> base = ParseConfigOnto(
-      then, "format " + std::to_string(map_version) + " defaults", PipelineOptions());
+  StatusOr<fusion::PipelineOptions> base = ParseConfigOnto(
+      then, "format " + std::to_string(map_version) + " defaults", fusion::PipelineOptions());
   if (!base.ok()) return base.status();
   return ParseConfigOnto(text, "the map's configuration", *base);
 }
@@ -478,7 +483,7 @@ StatusOr<ImportedConfig> ImportOpenRatslamIni(const std::string& path) {
   if (!text.ok()) return text.status();
   std::istringstream in(*text);
   ImportedConfig imported;
-  PipelineOptions& o = imported.options;
+  fusion::PipelineOptions& o = imported.options;
   // OpenRatSLAM relaxes every link exp_loops times after each action.
   o.ratslam.experience_map.relaxation_scheme = RelaxationScheme::kFull;
   using Setter = std::function<Status(double)>;

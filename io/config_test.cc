@@ -22,21 +22,21 @@ const ScratchDir& TestScratch() {
 }
 
 std::string ErrorOf(const std::string& text) {
-  StatusOr<PipelineOptions> o = ParseConfig(text, "c.toml");
+  StatusOr<fusion::PipelineOptions> o = ParseConfig(text, "c.toml");
   EXPECT_FALSE(o.ok());
   return o.status().message();
 }
 
 TEST(ConfigTest, DefaultsAreValidAndEmptyFileGivesDefaults) {
   std::string error;
-  EXPECT_TRUE(PipelineOptions().IsValid(&error)) << error;
-  StatusOr<PipelineOptions> o = ParseConfig("", "empty.toml");
+  EXPECT_TRUE(fusion::PipelineOptions().IsValid(&error)) << error;
+  StatusOr<fusion::PipelineOptions> o = ParseConfig("", "empty.toml");
   ASSERT_TRUE(o.ok());
-  EXPECT_EQ(PrintConfig(o.value()), PrintConfig(PipelineOptions()));
+  EXPECT_EQ(PrintConfig(o.value()), PrintConfig(fusion::PipelineOptions()));
 }
 
 TEST(ConfigTest, ReadsValuesAndAcceptsIntegersForReals) {
-  StatusOr<PipelineOptions> o = ParseConfig(
+  StatusOr<fusion::PipelineOptions> o = ParseConfig(
       "[pose_cells]\ndim_xy_cells = 30\ncell_size_m = 2\n[camera]\npanoramic = true\n"
       "[front_end]\nkind = \"classic_camera\"\n",
       "c.toml");
@@ -57,7 +57,7 @@ TEST(ConfigTest, ADataSetGivenAsTheConfigurationIsNamedAsOne) {
       out << "% IPIN log\n";
       for (size_t i = 0; i < lines; ++i) out << "ACCE;" << i * 0.02 << ";1;0.1;0.2;9.8;3\n";
     }
-    StatusOr<PipelineOptions> options = LoadConfigFile(log.string());
+    StatusOr<fusion::PipelineOptions> options = LoadConfigFile(log.string());
     ASSERT_FALSE(options.ok());
     EXPECT_NE(options.status().message().find(log.string() +
                                               " is a data set, not a configuration: give it as "
@@ -75,7 +75,7 @@ TEST(ConfigTest, PathsInAConfigurationAreRelativeToItsFile) {
   const std::filesystem::path config = folder / "paths.toml";
   std::ofstream(config) << "[visual_model]\ntraining_images = \"../images\"\n"
                            "file = \"/abs/model.bin\"\n[video]\nodometry_log = \"odo.txt\"\n";
-  StatusOr<PipelineOptions> o = LoadConfigFile(config.string());
+  StatusOr<fusion::PipelineOptions> o = LoadConfigFile(config.string());
   ASSERT_TRUE(o.ok()) << o.status().message();
   EXPECT_EQ(
       o->sensors.fabmap.visual_model.training_images,
@@ -181,17 +181,17 @@ TEST(ConfigTest, SyntaxErrorNamesLine) {
 }
 
 TEST(ConfigTest, PrintThenParseRoundTrips) {
-  PipelineOptions options;
+  fusion::PipelineOptions options;
   options.ratslam.pose_cells.cell_size_m = 0.1 + 0.2;
   options.sensors.classic_camera.match_threshold = 1e-7;
   options.ratslam.action.refuse_ambiguous_links = true;
-  StatusOr<PipelineOptions> back = ParseConfig(PrintConfig(options), "printed");
+  StatusOr<fusion::PipelineOptions> back = ParseConfig(PrintConfig(options), "printed");
   ASSERT_TRUE(back.ok()) << back.status().message();
   EXPECT_EQ(back->ratslam.pose_cells.cell_size_m, 0.1 + 0.2);
   EXPECT_EQ(back->sensors.classic_camera.match_threshold, 1e-7);
   EXPECT_EQ(PrintConfig(back.value()), PrintConfig(options));
   EXPECT_EQ(ConfigFingerprint(back.value()), ConfigFingerprint(options));
-  EXPECT_NE(ConfigFingerprint(PipelineOptions()), ConfigFingerprint(options));
+  EXPECT_NE(ConfigFingerprint(fusion::PipelineOptions()), ConfigFingerprint(options));
 }
 
 TEST(ConfigTest, ImportsOpenRatslamIniAndReportsUnusedKeys) {
@@ -202,7 +202,7 @@ TEST(ConfigTest, ImportsOpenRatslamIniAndReportsUnusedKeys) {
                          "template_x_size=60\n[draw]\nenable=1\n";
   StatusOr<ImportedConfig> imported = ImportOpenRatslamIni(path.string());
   ASSERT_TRUE(imported.ok()) << imported.status().message();
-  const PipelineOptions& o = imported->options;
+  const fusion::PipelineOptions& o = imported->options;
   EXPECT_EQ(o.sensors.classic_camera.match_threshold, 0.085);
   EXPECT_EQ(o.ratslam.pose_cells.dim_xy_cells, 30);
   EXPECT_EQ(o.ratslam.pose_cells.cell_size_m, 0.015);
@@ -286,7 +286,7 @@ TEST(ConfigTest, ShippedOpenRatslamConfigsImportWithOpenRatslamsDefaults) {
        "pc_vt_inject_energy=0.2\nvt_active_decay=1.0\nexp_delta_pc_threshold=2.0\n"
        "exp_loops=100\n"},
   };
-  std::map<std::string, PipelineOptions> got;
+  std::map<std::string, fusion::PipelineOptions> got;
   for (const Shipped& c : shipped) {
     const auto path = dir / (std::string("config_") + c.name + ".txt");
     std::ofstream(path) << "[general]\ntopic_root=" << c.name << "\n[ratslam]\n"
@@ -294,12 +294,12 @@ TEST(ConfigTest, ShippedOpenRatslamConfigsImportWithOpenRatslamsDefaults) {
     StatusOr<ImportedConfig> imported = ImportOpenRatslamIni(path.string());
     ASSERT_TRUE(imported.ok()) << c.name << ": " << imported.status().message();
     // Reloads: the converted file parses back to the same options.
-    StatusOr<PipelineOptions> back = ParseConfig(PrintConfig(imported->options), c.name);
+    StatusOr<fusion::PipelineOptions> back = ParseConfig(PrintConfig(imported->options), c.name);
     ASSERT_TRUE(back.ok()) << back.status().message();
     EXPECT_EQ(PrintConfig(*back), PrintConfig(imported->options));
     got[c.name] = imported->options;
   }
-  const PipelineOptions& nc = got["newcollege"];
+  const fusion::PipelineOptions& nc = got["newcollege"];
   EXPECT_EQ(nc.sensors.classic_camera.shift_step_px, 5);  // left out: 12 rotations, 30 deg apart
   EXPECT_EQ(nc.sensors.classic_camera.shift_px, 25);
   EXPECT_EQ(nc.ratslam.local_view.decay_restore_per_frame, 0.05);
@@ -318,7 +318,7 @@ TEST(ConfigTest, ShippedOpenRatslamConfigsImportWithOpenRatslamsDefaults) {
     EXPECT_EQ(o.ratslam.experience_map.relaxation_correction, 0.5);
     EXPECT_EQ(o.ratslam.experience_map.relaxation_scheme, RelaxationScheme::kFull);
   }
-  const PipelineOptions& sl = got["stlucia"];
+  const fusion::PipelineOptions& sl = got["stlucia"];
   EXPECT_EQ(sl.sensors.classic_camera.shift_px, 5);
   EXPECT_EQ(sl.sensors.classic_camera.shift_step_px, 1);
   EXPECT_EQ(sl.sensors.classic_camera.crop_left_px, 40);
@@ -328,7 +328,7 @@ TEST(ConfigTest, ShippedOpenRatslamConfigsImportWithOpenRatslamsDefaults) {
   EXPECT_EQ(sl.ratslam.pose_cells.cell_size_m, 2.0);
   EXPECT_EQ(sl.ratslam.action.match_distance_cells, 1.0);
   EXPECT_EQ(sl.ratslam.experience_map.relaxation_sweeps, 20);
-  const PipelineOptions& ir = got["irataus"];
+  const fusion::PipelineOptions& ir = got["irataus"];
   EXPECT_EQ(ir.sensors.classic_camera.template_height_px, 20);
   EXPECT_EQ(ir.sensors.classic_camera.shift_px, 4);
   EXPECT_EQ(ir.ratslam.local_view.injection_gain, 0.1);
@@ -387,7 +387,7 @@ TEST(ConfigTest, AnOpenRatslamIniPassedAsConfigSaysHowToConvertIt) {
   // Keys OpenRatSLAM uses, in a section of ours: the INI's [ratslam] section is found first.
   std::ofstream(path) << "# from an OpenRatSLAM data set\n[ratslam]\nvt_match_threshold=0.085\n"
                          "pc_dim_xy=30\n";
-  StatusOr<PipelineOptions> loaded = LoadConfigFile(path.string());
+  StatusOr<fusion::PipelineOptions> loaded = LoadConfigFile(path.string());
   ASSERT_FALSE(loaded.ok());
   const std::string& m = loaded.status().message();
   EXPECT_NE(m.find("is an OpenRatSLAM configuration (line 2: section [ratslam])"),

@@ -9,8 +9,8 @@ namespace ratslam {
 
 namespace fs = std::filesystem;
 
-StatusOr<std::shared_ptr<const DescriptorTable>> LoadDescriptorTable(
-    const DescriptorOptions& options, const std::vector<std::string>& data_paths,
+StatusOr<std::shared_ptr<const fusion::DescriptorTable>> LoadDescriptorTable(
+    const fusion::DescriptorOptions& options, const std::vector<std::string>& data_paths,
     const dataset::Dataset& dataset) {
   if (data_paths.empty()) return Status::Error("descriptors: no data set given");
   const fs::path file(options.file);
@@ -53,19 +53,18 @@ StatusOr<std::shared_ptr<const DescriptorTable>> LoadDescriptorTable(
     names += (s ? ", " : "") + path;
     image = end;
   }
-  return DescriptorTable::Make(joined, dataset, names);
+  return fusion::DescriptorTable::Make(joined, dataset, names);
 }
 
-StatusOr<FrontEndResources> LoadFrontEndResources(const FrontEndSettings& settings,
-                                                  const std::vector<std::string>& data_paths,
-                                                  const dataset::Dataset& dataset,
-                                                  ImageLoader& images) {
-  FrontEndResources resources;
-  if (settings.front_end.kind == FrontEndKind::kFabmap) {
+StatusOr<fusion::FrontEndResources> LoadFrontEndResources(
+    const fusion::FrontEndSettings& settings, const std::vector<std::string>& data_paths,
+    const dataset::Dataset& dataset, ImageLoader& images) {
+  fusion::FrontEndResources resources;
+  if (settings.front_end.kind == fusion::FrontEndKind::kFabmap) {
     auto prepared = LoadFabmapResources(settings, dataset, images);
     if (!prepared.ok()) return prepared.status().WithContext("FABMAP front end");
     resources.fabmap = *prepared;
-  } else if (settings.front_end.kind == FrontEndKind::kDescriptors) {
+  } else if (settings.front_end.kind == fusion::FrontEndKind::kDescriptors) {
     auto table = LoadDescriptorTable(settings.descriptors, data_paths, dataset);
     if (!table.ok()) return table.status().WithContext("descriptor front end");
     resources.descriptors = *table;

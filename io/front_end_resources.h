@@ -17,16 +17,15 @@ namespace ratslam {
 // LoadSessions) by DescriptorOptions::file: a relative name inside each session's folder (a
 // folder data set) or beside its file (bag, video, log), one file per session, each with one
 // row per image of its session; an absolute path for a single session.
-StatusOr<std::shared_ptr<const DescriptorTable>> LoadDescriptorTable(
-    const DescriptorOptions& options, const std::vector<std::string>& data_paths,
+StatusOr<std::shared_ptr<const fusion::DescriptorTable>> LoadDescriptorTable(
+    const fusion::DescriptorOptions& options, const std::vector<std::string>& data_paths,
     const dataset::Dataset& dataset);
 
 // Every resource the configured front end needs (none for most kinds; the custom factory is
 // the caller's to add).
-StatusOr<FrontEndResources> LoadFrontEndResources(const FrontEndSettings& settings,
-                                                  const std::vector<std::string>& data_paths,
-                                                  const dataset::Dataset& dataset,
-                                                  ImageLoader& images);
+StatusOr<fusion::FrontEndResources> LoadFrontEndResources(
+    const fusion::FrontEndSettings& settings, const std::vector<std::string>& data_paths,
+    const dataset::Dataset& dataset, ImageLoader& images);
 
 }  // namespace ratslam
 

@@ -42,7 +42,7 @@ struct MapFile {
   // The resolved configuration that made the map (PrintConfig without comments); empty in maps
   // of format 2, which hold only the fingerprint.
   std::string config;
-  ReplayPipeline::State state;
+  fusion::ReplayPipeline::State state;
 };
 
 // Serialises to bytes / parses bytes (`source` names the file in errors).

@@ -190,12 +190,13 @@ TEST(MapFileTest, SchemaListsEveryMemberOfEverySavedStruct) {
   ExpectSchemaComplete<TrajectoryRecord>("TrajectoryRecord", 6);
   ExpectSchemaComplete<FrameRecord>("FrameRecord", 6);
   ExpectSchemaComplete<Pose2>("Pose2", 3);
-  ExpectSchemaComplete<PoseSignal>("PoseSignal", 2);
-  ExpectSchemaComplete<SequencePose>("SequencePose", 6);
-  ExpectSchemaComplete<SequenceCorrespondence>("SequenceCorrespondence", 5);
-  ExpectSchemaComplete<SequenceLoop>("SequenceLoop", 11);
-  ExpectSchemaComplete<WifiSequenceLoopCloser::State>("WifiSequenceLoopCloser::State", 8);
-  ExpectSchemaComplete<ReplayPipeline::State>("ReplayPipeline::State", 17);
+  ExpectSchemaComplete<wifi_sequence::PoseSignal>("PoseSignal", 2);
+  ExpectSchemaComplete<wifi_sequence::SequencePose>("SequencePose", 6);
+  ExpectSchemaComplete<wifi_sequence::SequenceCorrespondence>("SequenceCorrespondence", 5);
+  ExpectSchemaComplete<wifi_sequence::SequenceLoop>("SequenceLoop", 11);
+  ExpectSchemaComplete<wifi_sequence::WifiSequenceLoopCloser::State>(
+      "WifiSequenceLoopCloser::State", 8);
+  ExpectSchemaComplete<fusion::ReplayPipeline::State>("ReplayPipeline::State", 17);
   ExpectSchemaComplete<MapFile>("MapFile", 5, /*header_members=*/1);  // format_version
 }
 

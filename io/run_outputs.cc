@@ -81,11 +81,11 @@ nlohmann::ordered_json ErrorStatistics(const std::vector<double>& v) {
 // table I: in metres (true positions of the two scans) and in poses (how many poses the past
 // pose is from the past pose truly nearest the current one, among the poses the past sequence
 // spans). Verified: inliers of accepted loops; unverified: every DP pair of every loop matched.
-nlohmann::ordered_json SequenceSummary(const WifiSequenceLoopCloser& closer,
+nlohmann::ordered_json SequenceSummary(const wifi_sequence::WifiSequenceLoopCloser& closer,
                                        const ExperienceMap& map, const dataset::Dataset& dataset) {
   nlohmann::ordered_json j;
   size_t accepted = 0, links = 0, verified = 0;
-  for (const SequenceLoop& l : closer.loops()) {
+  for (const wifi_sequence::SequenceLoop& l : closer.loops()) {
     accepted += l.accepted;
     if (l.accepted) verified += l.inliers;
   }
@@ -96,7 +96,7 @@ nlohmann::ordered_json SequenceSummary(const WifiSequenceLoopCloser& closer,
   j["verified_correspondences"] = verified;
   j["links"] = links;
   nlohmann::ordered_json loops = nlohmann::ordered_json::array();
-  for (const SequenceLoop& l : closer.loops()) {
+  for (const wifi_sequence::SequenceLoop& l : closer.loops()) {
     loops.push_back({{"id", l.id},
                      {"matched_time_s", l.time_s},
                      {"current_poses", l.current_sequence.size()},
@@ -119,10 +119,10 @@ nlohmann::ordered_json SequenceSummary(const WifiSequenceLoopCloser& closer,
   };
   std::vector<double> verified_m, verified_poses, unverified_m;
   size_t verified_floor_mistakes = 0, unverified_floor_mistakes = 0;
-  for (const SequenceLoop& l : closer.loops()) {
+  for (const wifi_sequence::SequenceLoop& l : closer.loops()) {
     if (l.past_sequence.empty()) continue;
     const uint32_t lo = l.past_sequence.front(), hi = l.past_sequence.back();
-    for (const SequenceCorrespondence& c : l.correspondences) {
+    for (const wifi_sequence::SequenceCorrespondence& c : l.correspondences) {
       const double m = metres(c.current_pose, c.past_pose);
       if (std::isnan(m)) continue;
       const bool verified = l.accepted && c.inlier;
@@ -255,9 +255,9 @@ std::vector<double> LocalisationErrors(const std::vector<LocalisationRecord>& re
   return errors;
 }
 
-RunSummary Summarise(const ReplayPipeline& pipeline, const dataset::Dataset& dataset,
+RunSummary Summarise(const fusion::ReplayPipeline& pipeline, const dataset::Dataset& dataset,
                      const RunInfo& info) {
-  const ReplayPipeline::State& state = pipeline.state();
+  const fusion::ReplayPipeline::State& state = pipeline.state();
   const Ratslam& slam = pipeline.slam();
   const ExperienceMap& map = slam.experience_map();
   RunSummary s;
@@ -388,7 +388,7 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const dataset::Dataset& dat
     j["wifi_revisit_aps_added"] = updates->first;
     j["wifi_revisit_aps_dropped"] = updates->second;
   }
-  if (const std::optional<FloorReport> floors = pipeline.floor_report()) {
+  if (const std::optional<fusion::FloorReport> floors = pipeline.floor_report()) {
     j["barometer"] = {{"pressure_readings", floors->pressure_readings},
                       {"floor_changes", floors->floor_changes},
                       {"frames_floor_unknown", floors->frames_floor_unknown},
@@ -553,10 +553,10 @@ const std::vector<std::string>& SummaryKeys() {
   return keys;
 }
 
-StatusOr<RunSummary> WriteRunOutputs(OutputFolder& folder, const ReplayPipeline& pipeline,
+StatusOr<RunSummary> WriteRunOutputs(OutputFolder& folder, const fusion::ReplayPipeline& pipeline,
                                      const dataset::Dataset& dataset, const RunInfo& info) {
   const ExperienceMap& map = pipeline.slam().experience_map();
-  const ReplayPipeline::State& state = pipeline.state();
+  const fusion::ReplayPipeline::State& state = pipeline.state();
   std::vector<std::pair<std::string, std::string>> files;
 
   std::ostringstream experiences;
@@ -640,12 +640,12 @@ StatusOr<RunSummary> WriteRunOutputs(OutputFolder& folder, const ReplayPipeline&
 
   if (pipeline.wifi_sequence().options().enabled) {
     // Every correspondence of every loop matched, with the scans' times and map positions.
-    const WifiSequenceLoopCloser& closer = pipeline.wifi_sequence();
+    const wifi_sequence::WifiSequenceLoopCloser& closer = pipeline.wifi_sequence();
     std::ostringstream loops;
     loops << "loop_id,matched_time_s,accepted,current_pose,past_pose,current_time_s,"
              "past_time_s,similarity,inlier,residual_m,current_x_m,current_y_m,past_x_m,past_y_m\n";
-    for (const SequenceLoop& l : closer.loops()) {
-      for (const SequenceCorrespondence& c : l.correspondences) {
+    for (const wifi_sequence::SequenceLoop& l : closer.loops()) {
+      for (const wifi_sequence::SequenceCorrespondence& c : l.correspondences) {
         const Pose2 now = pipeline.MapPose(closer.pose(c.current_pose));
         const Pose2 then = pipeline.MapPose(closer.pose(c.past_pose));
         loops << l.id << ',' << Num(l.time_s) << ',' << (l.accepted ? 1 : 0) << ','

@@ -82,7 +82,7 @@ std::vector<double> LocalisationErrors(const std::vector<LocalisationRecord>& re
                                        std::vector<Point2>* truth = nullptr,
                                        const std::vector<double>& session_starts = {});
 
-RunSummary Summarise(const ReplayPipeline& pipeline, const dataset::Dataset& dataset,
+RunSummary Summarise(const fusion::ReplayPipeline& pipeline, const dataset::Dataset& dataset,
                      const RunInfo& info);
 
 // Writes experiences.csv, links.csv, trajectory_tum.txt, odometry_tum.txt (and with ground truth
@@ -93,7 +93,7 @@ RunSummary Summarise(const ReplayPipeline& pipeline, const dataset::Dataset& dat
 // their objective and metrics against it when planned. A test keeps it complete.
 const std::vector<std::string>& SummaryKeys();
 
-StatusOr<RunSummary> WriteRunOutputs(OutputFolder& folder, const ReplayPipeline& pipeline,
+StatusOr<RunSummary> WriteRunOutputs(OutputFolder& folder, const fusion::ReplayPipeline& pipeline,
                                      const dataset::Dataset& dataset, const RunInfo& info);
 
 }  // namespace ratslam

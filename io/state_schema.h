@@ -100,38 +100,38 @@ bool Describe(A& a, std::string& s) {
 }
 
 template <typename A>
-bool Describe(A& a, PoseSignal& s) {
+bool Describe(A& a, wifi_sequence::PoseSignal& s) {
   return a(s.aps) && a(s.quality) &&
          a.Check(s.aps.size() == s.quality.size(), "Wi-Fi sequence signal sizes differ");
 }
 
 template <typename A>
-bool Describe(A& a, SequencePose& p) {
+bool Describe(A& a, wifi_sequence::SequencePose& p) {
   return a(p.time_s) && a(p.travel_m) && a.Object(p.odometry) && a(p.anchor) &&
          a.Object(p.anchor_offset) && a(p.compass_heading_rad);
 }
 
 template <typename A>
-bool Describe(A& a, SequenceCorrespondence& c) {
+bool Describe(A& a, wifi_sequence::SequenceCorrespondence& c) {
   return a(c.current_pose) && a(c.past_pose) && a(c.similarity) && a(c.inlier) && a(c.residual_m);
 }
 
 template <typename A>
-bool Describe(A& a, SequenceLoop& l) {
+bool Describe(A& a, wifi_sequence::SequenceLoop& l) {
   return a(l.id) && a(l.time_s) && a(l.current_sequence) && a(l.past_sequence) &&
          a.Objects(l.correspondences, 25) && a.Object(l.transform) && a(l.dp_cost) &&
          a(l.inliers) && a(l.reversed) && a(l.accepted) && a(l.outcome);
 }
 
 template <typename A>
-bool Describe(A& a, WifiSequenceLoopCloser::State& s) {
+bool Describe(A& a, wifi_sequence::WifiSequenceLoopCloser::State& s) {
   return a.Objects(s.bssids, 8) && a.Objects(s.poses, 81) && a.Objects(s.signals, 16) &&
          a(s.open_sequence) && a(s.open_continues) && a(s.open_start_radius_m) &&
          a(s.open_end_radius_m) && a.Objects(s.loops, 82);
 }
 
 template <typename A>
-bool Describe(A& a, ReplayPipeline::State& s) {
+bool Describe(A& a, fusion::ReplayPipeline::State& s) {
   return a.Object(s.ratslam) && a(s.front_end) && a(s.next_event) && a(s.events_total) &&
          a(s.last_odometry_time_s) && a(s.have_odometry) && a(s.odometry_x_m) &&
          a(s.odometry_y_m) && a(s.odometry_theta_rad) && a.Objects(s.trajectory, 64) &&

@@ -48,9 +48,10 @@ StatusOr<fabmap::TrainedVisualModel> LoadOrTrainVisualModel(
   return fabmap::TrainVisualModel(chosen, features, vocabulary, chow_liu, loader, progress);
 }
 
-StatusOr<std::shared_ptr<const FabmapResources>> LoadFabmapResources(
-    const FrontEndSettings& settings, const dataset::Dataset& dataset, ImageLoader& images) {
-  const FabmapSettings& f = settings.fabmap;
+StatusOr<std::shared_ptr<const fusion::FabmapResources>> LoadFabmapResources(
+    const fusion::FrontEndSettings& settings, const dataset::Dataset& dataset,
+    ImageLoader& images) {
+  const fusion::FabmapSettings& f = settings.fabmap;
   std::optional<fabmap::TrainedVisualModel> visual;
   if (fabmap::UsesVision(f.localiser.localiser.mode)) {
     std::string error;
@@ -63,7 +64,7 @@ StatusOr<std::shared_ptr<const FabmapResources>> LoadFabmapResources(
     }
     visual = *std::move(model);
   }
-  return PrepareFabmapResources(settings, dataset, std::move(visual));
+  return fusion::PrepareFabmapResources(settings, dataset, std::move(visual));
 }
 
 }  // namespace ratslam

@@ -28,8 +28,8 @@ StatusOr<fabmap::TrainedVisualModel> LoadOrTrainVisualModel(
 
 // PrepareFabmapResources with the visual model loaded (or trained) first when the mode uses
 // vision: what a replay of the FABMAP front end needs.
-StatusOr<std::shared_ptr<const FabmapResources>> LoadFabmapResources(
-    const FrontEndSettings& settings, const dataset::Dataset& dataset, ImageLoader& images);
+StatusOr<std::shared_ptr<const fusion::FabmapResources>> LoadFabmapResources(
+    const fusion::FrontEndSettings& settings, const dataset::Dataset& dataset, ImageLoader& images);
 
 }  // namespace ratslam
 

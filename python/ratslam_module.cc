@@ -96,7 +96,7 @@ std::string TomlValue(const py::handle& value) {
 class Config {
  public:
   Config() = default;
-  explicit Config(PipelineOptions options) : options_(std::move(options)) {}
+  explicit Config(fusion::PipelineOptions options) : options_(std::move(options)) {}
   static Config Load(const std::string& path) { return Config(Take(LoadConfigFile(path))); }
   static Config FromToml(const std::string& text) {
     return Config(Take(ParseConfig(text, "<Config.from_toml>")));
@@ -110,7 +110,7 @@ class Config {
     }
     const std::string text =
         "[" + key.substr(0, dot) + "]\n" + key.substr(dot + 1) + " = " + TomlValue(value) + "\n";
-    PipelineOptions changed = Take(ParseConfigOnto(text, "Config.set", options_));
+    fusion::PipelineOptions changed = Take(ParseConfigOnto(text, "Config.set", options_));
     std::string error;
     if (!changed.IsValid(&error)) throw Error("Config.set: " + error);
     options_ = std::move(changed);
@@ -118,10 +118,10 @@ class Config {
   py::object ToDict() const {
     return py::module_::import("tomllib").attr("loads")(PrintConfig(options_, false));
   }
-  const PipelineOptions& options() const { return options_; }
+  const fusion::PipelineOptions& options() const { return options_; }
 
  private:
-  PipelineOptions options_;
+  fusion::PipelineOptions options_;
 };
 
 // One NumPy column from a field of each record.
@@ -161,7 +161,7 @@ py::dict LinkColumns(const ExperienceMap& map) {
 }
 
 // Each odometry step's pose on the final map, and raw dead reckoning.
-py::dict TrajectoryColumns(const ReplayPipeline& pipeline) {
+py::dict TrajectoryColumns(const fusion::ReplayPipeline& pipeline) {
   using T = TrajectoryRecord;
   const ExperienceMap& map = pipeline.slam().experience_map();
   const std::vector<T>& rows = pipeline.state().trajectory;
@@ -183,7 +183,7 @@ py::dict TrajectoryColumns(const ReplayPipeline& pipeline) {
   return c;
 }
 
-py::dict FrameColumns(const ReplayPipeline& pipeline) {
+py::dict FrameColumns(const fusion::ReplayPipeline& pipeline) {
   using F = FrameRecord;
   const std::vector<F>& rows = pipeline.state().frames;
   py::dict c;
@@ -195,7 +195,7 @@ py::dict FrameColumns(const ReplayPipeline& pipeline) {
   return c;
 }
 
-py::dict LocalisationColumns(const ReplayPipeline& pipeline) {
+py::dict LocalisationColumns(const fusion::ReplayPipeline& pipeline) {
   using L = LocalisationRecord;
   const std::vector<L>& rows = pipeline.localisation();
   py::dict c;
@@ -209,7 +209,7 @@ py::dict LocalisationColumns(const ReplayPipeline& pipeline) {
 }
 
 // Everything a finished pipeline holds, as columns.
-py::dict RunColumns(const ReplayPipeline& pipeline) {
+py::dict RunColumns(const fusion::ReplayPipeline& pipeline) {
   py::dict run;
   run["experiences"] = ExperienceColumns(pipeline.slam().experience_map());
   run["links"] = LinkColumns(pipeline.slam().experience_map());
@@ -246,7 +246,7 @@ py::dict Replay(const std::vector<std::string>& data, std::string out,
                 std::optional<double> until_s, bool overwrite) {
   if (data.empty()) throw Error("replay: give at least one data set");
   session::ReplaySessionOptions options;
-  options.pipeline = config ? config->options() : PipelineOptions();
+  options.pipeline = config ? config->options() : fusion::PipelineOptions();
   options.config_path = config ? "(from Python)" : "";
   options.data = data;
   options.load_map = load_map;
@@ -296,19 +296,19 @@ py::dict Replay(const std::vector<std::string>& data, std::string out,
 class Session {
  public:
   explicit Session(const Config& config) : options_(config.options()) {
-    if (options_.sensors.front_end.kind == FrontEndKind::kFabmap) {
+    if (options_.sensors.front_end.kind == fusion::FrontEndKind::kFabmap) {
       throw Error(
           "Session: the FABMAP front end learns its models from a whole data set; use "
           "ratslam.replay");
     }
-    if (options_.sensors.front_end.kind == FrontEndKind::kCustom) {
+    if (options_.sensors.front_end.kind == fusion::FrontEndKind::kCustom) {
       throw Error("Session: a custom front end is a C++ factory; use ratslam.replay from C++");
     }
     if (options_.visual_odometry.enabled) {
       throw Error("Session: feed odometry yourself ([visual_odometry] enabled must be false)");
     }
     dataset_.name = "python-session";
-    pipeline_ = std::make_unique<ReplayPipeline>(options_, dataset_, &images_);
+    pipeline_ = std::make_unique<fusion::ReplayPipeline>(options_, dataset_, &images_);
   }
 
   static std::unique_ptr<Session> Load(const std::string& path, const Config& config, bool localise,
@@ -320,7 +320,7 @@ class Session {
       Check(session->pipeline_->AdoptMap(map.state, lost_after_m).WithContext(path));
     } else {
       // Mapping goes on from the map, whatever data set made it.
-      ReplayPipeline::State state = map.state;
+      fusion::ReplayPipeline::State state = map.state;
       state.events_total = 0;
       state.next_event = 0;
       Check(session->pipeline_->Restore(state).WithContext(path));
@@ -426,7 +426,7 @@ class Session {
     pipeline_->slam().experience_map().CurrentPose(&x, &y, &theta);
     return py::make_tuple(x, y, theta);
   }
-  const ReplayPipeline& pipeline() const { return *pipeline_; }
+  const fusion::ReplayPipeline& pipeline() const { return *pipeline_; }
 
  private:
   // The bound every number of a data-set file meets (kMaxCsvMagnitude): what a file could not
@@ -446,10 +446,10 @@ class Session {
     last_time_s_ = time_s;
   }
 
-  PipelineOptions options_;
+  fusion::PipelineOptions options_;
   dataset::Dataset dataset_;
   dataset::FileImageLoader images_;
-  std::unique_ptr<ReplayPipeline> pipeline_;
+  std::unique_ptr<fusion::ReplayPipeline> pipeline_;
   std::optional<double> last_time_s_;
 };
 
@@ -469,7 +469,7 @@ py::dict NodeColumns(const std::vector<fabmap::EvaluationNode>& nodes) {
 py::dict Evaluate(const std::string& map, const std::string& query, const std::string& out,
                   const std::optional<Config>& config, bool lenient, bool overwrite) {
   session::EvaluationSessionOptions options;
-  options.pipeline = config ? config->options() : PipelineOptions();
+  options.pipeline = config ? config->options() : fusion::PipelineOptions();
   options.config_path = config ? "(from Python)" : "";
   options.map_path = map;
   options.query_path = query;

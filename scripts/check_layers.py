@@ -8,7 +8,7 @@
   - a library in a sub-folder of another library's folder links that parent (a child above its
     parent: folders should say which way the layers go);
   - a header of a folder listed in NAMESPACES_FILE opens a named namespace at its top level
-    other than the folder's (folder = library = namespace).
+    other than the folder's or one nested in it (folder = library = namespace).
 
 Usage: check_layers.py BUILD_DIR SOURCE_DIR [KNOWN_FILE [NAMESPACES_FILE]]
 BUILD_DIR/ratslam_layers.txt (written by CMakeLists.txt at configure time) gives every target's
@@ -110,10 +110,12 @@ def main():
                 with open(os.path.join(source, path), errors="replace") as f:
                     opened = [(n, m.group(1)) for n, line in enumerate(f, 1)
                               if (m := opening.match(line))]
-                if not any(name == namespace for _, name in opened):
+                def own(name):  # the folder's namespace or one nested in it (a detail namespace)
+                    return name == namespace or name.startswith(namespace + "::")
+                if not any(own(name) for _, name in opened):
                     problems.add(f"{path}: does not open namespace {namespace}")
                 for number, name in opened:
-                    if name != namespace:
+                    if not own(name):
                         problems.add(f"{path}:{number}: opens namespace {name}, not {namespace}")
     known = set()
     if known_file:

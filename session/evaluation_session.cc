@@ -170,7 +170,7 @@ Status EvaluationSession::Words(const std::vector<fabmap::EvaluationNode>& nodes
 }
 
 Status EvaluationSession::Prepare() {
-  const FabmapSettings& settings = options_.pipeline.sensors.fabmap;
+  const fusion::FabmapSettings& settings = options_.pipeline.sensors.fabmap;
   const bool vision = fabmap::UsesVision(mode());
   if (vision) {
     auto model = LoadOrTrainVisualModel(settings.visual_model, settings.features,

@@ -29,8 +29,8 @@
 namespace ratslam::session {
 
 struct EvaluationSessionOptions {
-  PipelineOptions pipeline;  // [fabmap...] sections, [evaluation], and [pdr] for phone logs
-  std::string config_path;   // as given, for evaluation.json
+  fusion::PipelineOptions pipeline;  // [fabmap...] sections, [evaluation], and [pdr] for phone logs
+  std::string config_path;           // as given, for evaluation.json
   std::string map_path;
   std::string query_path;    // may name the same data set as map_path: then it is split
   bool lenient = false;      // skip (and count) malformed lines of phone logs and CSVs

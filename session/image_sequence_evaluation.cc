@@ -103,7 +103,7 @@ StatusOr<DescriptorRows> LoadDescriptorRows(const std::string& path, const std::
   d.unit.reserve(m->values.size());
   std::vector<float> unit;
   for (size_t r = 0; r < m->rows; ++r) {
-    if (!UnitDescriptor(m->values.data() + r * m->cols, m->cols, &unit)) {
+    if (!fusion::UnitDescriptor(m->values.data() + r * m->cols, m->cols, &unit)) {
       return Status::Error(path + ": row " + std::to_string(r + 1) +
                            " has no direction (all zeros), so no cosine similarity");
     }
@@ -202,7 +202,7 @@ StatusOr<ImageSequenceEvaluation::Fabmap> MatchByFabmap(
     const std::atomic<bool>* stop) {
   const auto start = std::chrono::steady_clock::now();
   ImageSequenceEvaluation::Fabmap f;
-  const FabmapSettings& settings = options.fabmap_settings;
+  const fusion::FabmapSettings& settings = options.fabmap_settings;
   fabmap::VisualModelOptions model_options = settings.visual_model;
   f.trained_here = model_options.file.empty();
   if (model_options.file.empty() && model_options.training_images.empty()) {

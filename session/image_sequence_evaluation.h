@@ -76,7 +76,7 @@ struct ImageSequenceEvaluationOptions {
   // `fabmap_settings.visual_model` (a saved model or training images), else are trained on the
   // reference images.
   bool fabmap = false;
-  FabmapSettings fabmap_settings;
+  fusion::FabmapSettings fabmap_settings;
 };
 
 // One matcher's answers and their metrics: by sequences and by single frames.

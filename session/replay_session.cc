@@ -11,9 +11,9 @@
 #include "io/map_file.h"
 
 namespace ratslam::session {
-Status CheckSameConfiguration(const MapFile& map, const PipelineOptions& now) {
+Status CheckSameConfiguration(const MapFile& map, const fusion::PipelineOptions& now) {
   if (!map.config.empty()) {
-    StatusOr<PipelineOptions> before = ParseMapConfig(map.config, map.format_version);
+    StatusOr<fusion::PipelineOptions> before = ParseMapConfig(map.config, map.format_version);
     if (!before.ok()) return before.status();
     std::vector<std::string> differences = ConfigDifferences(*before, now);
     // How a bag or a video was read, and where a data set's descriptors are, say nothing
@@ -81,7 +81,7 @@ Status ReplaySession::Load() {
                          "' has no odometry stream: set [visual_odometry] enabled = true to "
                          "take odometry from its images");
   }
-  RATSLAM_RETURN_IF_ERROR(CheckFrontEndInputs(options_.pipeline.sensors, *dataset));
+  RATSLAM_RETURN_IF_ERROR(fusion::CheckFrontEndInputs(options_.pipeline.sensors, *dataset));
   dataset_ = std::move(dataset).value();
   return env_.out->Write("config.toml",
                          "# Resolved configuration of this run (ratslam print-config format).\n" +
@@ -90,10 +90,10 @@ Status ReplaySession::Load() {
 
 Status ReplaySession::Prepare() {
   if (!dataset_) return Status::Error("replay session: Prepare before Load");
-  StatusOr<FrontEndResources> resources =
+  StatusOr<fusion::FrontEndResources> resources =
       LoadFrontEndResources(options_.pipeline.sensors, options_.data, *dataset_, *env_.images);
   if (!resources.ok()) return resources.status();
-  if (options_.pipeline.sensors.front_end.kind == FrontEndKind::kCustom) {
+  if (options_.pipeline.sensors.front_end.kind == fusion::FrontEndKind::kCustom) {
     if (!env_.custom_front_end) {
       return Status::Error(
           "front_end.kind is custom, but no front end was given (a C++ program passes its "
@@ -101,8 +101,8 @@ Status ReplaySession::Prepare() {
     }
     resources->custom = env_.custom_front_end;
   }
-  auto pipeline = std::make_unique<ReplayPipeline>(options_.pipeline, *dataset_, env_.images,
-                                                   std::move(resources).value());
+  auto pipeline = std::make_unique<fusion::ReplayPipeline>(
+      options_.pipeline, *dataset_, env_.images, std::move(resources).value());
   if (!options_.load_map.empty()) {
     const std::string& path = options_.load_map;
     StatusOr<MapFile> map = LoadMapFile(path);
@@ -126,10 +126,10 @@ Status ReplaySession::Prepare() {
 
 Status ReplaySession::Replay(const ReplayCheckpoint& checkpoint) {
   if (!pipeline_) return Status::Error("replay session: Replay before Prepare");
-  ReplayControl control;
+  fusion::ReplayControl control;
   control.until_time_s = options_.until_s;
   control.stop_requested = env_.stop_requested;
-  control.progress = [this](const ReplayProgress& p) {
+  control.progress = [this](const fusion::ReplayProgress& p) {
     env_.progress->Update({"replay", p.events_done, p.events_total, p.data_time_s});
   };
   control.checkpoint = checkpoint.callback;

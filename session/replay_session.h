@@ -32,7 +32,7 @@
 namespace ratslam::session {
 
 struct ReplaySessionOptions {
-  PipelineOptions pipeline;
+  fusion::PipelineOptions pipeline;
   std::string config_path;        // as given by the user, for the summary; empty: defaults
   std::vector<std::string> data;  // one data set, or several sessions of one run
   bool lenient = false;           // skip (and count) malformed lines of phone logs
@@ -56,13 +56,13 @@ struct SessionEnvironment {
   const std::atomic<bool>* stop_requested = nullptr;  // checked between events
   // [front_end] kind = "custom": makes the run's front end (fusion/front_end.h, "Writing a
   // front end"); called again for each restore.
-  FrontEndFactory custom_front_end;
+  fusion::FrontEndFactory custom_front_end;
 };
 
 // Called every `every` events with the pipeline (read only), e.g. to draw animation frames; an
 // error stops the replay like a data error does.
 struct ReplayCheckpoint {
-  std::function<Status(const ReplayPipeline&)> callback;
+  std::function<Status(const fusion::ReplayPipeline&)> callback;
   uint64_t every = 0;  // 0: never
 };
 
@@ -82,7 +82,7 @@ struct ReplayResult {
 // A map resumes (or is localised on) only under the configuration that made it. Maps of
 // format 3 and later carry it, so the error names every key that differs; format 2 maps hold a
 // fingerprint, compared as it was then.
-Status CheckSameConfiguration(const MapFile& map, const PipelineOptions& now);
+Status CheckSameConfiguration(const MapFile& map, const fusion::PipelineOptions& now);
 
 class ReplaySession {
  public:
@@ -102,8 +102,8 @@ class ReplaySession {
   StatusOr<ReplayResult> Run(const ReplayCheckpoint& checkpoint = {});
 
   const ReplaySessionOptions& options() const { return options_; }
-  const dataset::Dataset& dataset() const { return *dataset_; }  // after Load
-  const ReplayPipeline& pipeline() const { return *pipeline_; }  // after Prepare
+  const dataset::Dataset& dataset() const { return *dataset_; }          // after Load
+  const fusion::ReplayPipeline& pipeline() const { return *pipeline_; }  // after Prepare
   const ReplayResult& result() const { return result_; }
 
  private:
@@ -113,7 +113,7 @@ class ReplaySession {
   SilentProgress no_progress_;
   std::unique_ptr<ImageLoader> own_images_;
   std::optional<dataset::Dataset> dataset_;
-  std::unique_ptr<ReplayPipeline> pipeline_;
+  std::unique_ptr<fusion::ReplayPipeline> pipeline_;
   uint64_t fingerprint_ = 0;
   ReplayResult result_;
 };

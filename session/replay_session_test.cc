@@ -144,7 +144,7 @@ TEST_F(ReplaySessionTest, StopRequestInterruptsAndSavesState) {
   ReplaySession session(Options(), {&out, nullptr, nullptr, nullptr, &stop, {}});
   ReplayCheckpoint checkpoint;
   checkpoint.every = 100;
-  checkpoint.callback = [&stop](const ReplayPipeline&) {
+  checkpoint.callback = [&stop](const fusion::ReplayPipeline&) {
     stop.store(true);  // as a signal handler would, after the first 100 events
     return Status::Ok();
   };
@@ -199,14 +199,14 @@ TEST_F(ReplaySessionTest, ResumeChecksConfigurationAndDataSet) {
 
 // A front end of the caller's own: every image a new place (the smallest valid front end; a
 // useful one is in fusion/custom_front_end_test.cc).
-class EveryImageNew : public FrontEnd {
+class EveryImageNew : public fusion::FrontEnd {
  public:
-  StatusOr<std::optional<FrameDecision>> OnImage(double time_s, const GrayImage&) override {
-    FrameDecision d;
+  StatusOr<std::optional<fusion::FrameDecision>> OnImage(double time_s, const GrayImage&) override {
+    fusion::FrameDecision d;
     d.view.time_s = time_s;
     d.view.template_id = count_++;
     d.view.is_new = true;
-    return std::optional<FrameDecision>(d);
+    return std::optional<fusion::FrameDecision>(d);
   }
   bool WantsImages() const override { return true; }
   uint32_t size() const override { return count_; }
@@ -224,7 +224,7 @@ class EveryImageNew : public FrontEnd {
 TEST_F(ReplaySessionTest, CustomFrontEndComesFromTheEnvironment) {
   MemoryFolder out("mem");
   ReplaySessionOptions options = Options();
-  options.pipeline.sensors.front_end.kind = FrontEndKind::kCustom;
+  options.pipeline.sensors.front_end.kind = fusion::FrontEndKind::kCustom;
   options.until_s = 10.0;
   ReplaySession without(options, {&out, nullptr, nullptr, nullptr, nullptr, {}});
   const StatusOr<ReplayResult> refused = without.Run();
@@ -233,7 +233,7 @@ TEST_F(ReplaySessionTest, CustomFrontEndComesFromTheEnvironment) {
             std::string::npos)
       << refused.status().message();
   int made = 0;
-  FrontEndFactory factory = [&made] {
+  fusion::FrontEndFactory factory = [&made] {
     ++made;
     return std::make_unique<EveryImageNew>();
   };

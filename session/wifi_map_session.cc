@@ -44,7 +44,7 @@ Status SamplesFromRun(const std::string& run_folder, const std::vector<std::stri
   const fs::path run = run_folder;
   StatusOr<RunFolder> folder = ReadRunFolder(run.string());
   if (!folder.ok()) return folder.status();
-  StatusOr<PipelineOptions> config = LoadConfigFile((run / "config.toml").string());
+  StatusOr<fusion::PipelineOptions> config = LoadConfigFile((run / "config.toml").string());
   if (!config.ok()) return config.status();
   StatusOr<std::vector<GroundTruthRow>> trajectory =
       ReadTumTrajectory((run / "trajectory_tum.txt").string());

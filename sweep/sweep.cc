@@ -520,12 +520,12 @@ StatusOr<SweepSpec> LoadSweepFile(const std::string& path) {
   spec.timeout_s = settings.timeout_s;
   spec.keep_all = settings.keep == "all";
 
-  PipelineOptions base_options;
+  fusion::PipelineOptions base_options;
   if (!settings.base_config.empty()) {
     const fs::path config = fs::path(settings.base_config).is_absolute()
                                 ? fs::path(settings.base_config)
                                 : base / settings.base_config;
-    StatusOr<PipelineOptions> loaded = LoadConfigFile(config.string());
+    StatusOr<fusion::PipelineOptions> loaded = LoadConfigFile(config.string());
     if (!loaded.ok()) return loaded.status().WithContext(path + ": sweep.base_config");
     base_options = *loaded;
   }
@@ -585,14 +585,14 @@ StatusOr<SweepSpec> LoadSweepFile(const std::string& path) {
 StatusOr<Plan> MakePlan(const SweepSpec& spec) {
   Plan plan;
   plan.spec = spec;
-  StatusOr<PipelineOptions> base = ParseConfig(spec.base_config_text, "base configuration");
+  StatusOr<fusion::PipelineOptions> base = ParseConfig(spec.base_config_text, "base configuration");
   if (!base.ok()) return base.status();
   // Each value alone first, so that an error names the parameter's line.
   for (const Parameter& p : spec.parameters) {
     std::vector<std::string> values = p.values;
     if (values.empty()) values = {Number(p.lo, p.integer), Number(p.hi, p.integer)};
     for (const std::string& v : values) {
-      StatusOr<PipelineOptions> one =
+      StatusOr<fusion::PipelineOptions> one =
           ParseConfigOnto(OverrideText({{p.key, v}}), spec.source, *base);
       if (!one.ok()) {
         return Status::Error(spec.source + ":" + std::to_string(p.line) + ": parameter '" + p.key +
@@ -653,7 +653,7 @@ StatusOr<Plan> MakePlan(const SweepSpec& spec) {
       plan.tasks.push_back(t);
     }
     // The whole combination (relations between keys, e.g. min < max) once per point.
-    StatusOr<PipelineOptions> all =
+    StatusOr<fusion::PipelineOptions> all =
         ParseConfigOnto(OverrideText(points[i]), spec.source, *base);  // base parsed once
     if (!all.ok()) {
       std::string values;
@@ -666,8 +666,9 @@ StatusOr<Plan> MakePlan(const SweepSpec& spec) {
   return plan;
 }
 
-StatusOr<PipelineOptions> TaskConfig(const Plan& plan, const Task& task) {
-  StatusOr<PipelineOptions> base = ParseConfig(plan.spec.base_config_text, "base configuration");
+StatusOr<fusion::PipelineOptions> TaskConfig(const Plan& plan, const Task& task) {
+  StatusOr<fusion::PipelineOptions> base =
+      ParseConfig(plan.spec.base_config_text, "base configuration");
   if (!base.ok()) return base.status();
   return ParseConfigOnto(OverrideText(task.overrides), plan.spec.source, *base);
 }

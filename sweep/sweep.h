@@ -78,7 +78,7 @@ struct Plan {
 // key or value fails with the sweep file's line. The same spec always gives the same plan.
 StatusOr<Plan> MakePlan(const SweepSpec& spec);
 // The configuration of one task: the base with the task's overrides.
-StatusOr<PipelineOptions> TaskConfig(const Plan& plan, const Task& task);
+StatusOr<fusion::PipelineOptions> TaskConfig(const Plan& plan, const Task& task);
 
 // Writes plan.json and tasks.csv into `dir` (created). Refuses a folder holding a different plan.
 Status WritePlan(const Plan& plan, const std::string& dir);

@@ -198,7 +198,7 @@ StatusOr<CollectReport> Collect(const std::string& dir) {
     for (const Task& t : plan->tasks) {
       if (t.point == *report.best_point) best = &t;
     }
-    StatusOr<PipelineOptions> config = TaskConfig(*plan, *best);
+    StatusOr<fusion::PipelineOptions> config = TaskConfig(*plan, *best);
     if (!config.ok()) return config.status();
     std::string header = "# Best point " + std::to_string(*report.best_point) + " of " +
                          spec.source + ": " + spec.aggregate + " " + spec.objective + " = " +

@@ -142,7 +142,7 @@ StatusOr<Running> Start(const Plan& plan, const std::string& dir, int index,
   fs::remove_all(folder, ec);  // a run that never ended starts again from nothing
   fs::create_directories(folder, ec);
   if (ec) return Status::Error(folder + ": cannot create folder: " + ec.message());
-  StatusOr<PipelineOptions> config = TaskConfig(plan, task);
+  StatusOr<fusion::PipelineOptions> config = TaskConfig(plan, task);
   if (!config.ok()) return config.status();
   const std::string config_path = folder + "/config.toml";
   RATSLAM_RETURN_IF_ERROR(

@@ -119,7 +119,7 @@ glob = "data/*"
   EXPECT_EQ(plan->tasks[11].overrides,
             (std::vector<std::pair<std::string, std::string>>{{"fused.recency_templates", "5"},
                                                               {"wifi.match_threshold", "0.6"}}));
-  StatusOr<PipelineOptions> config = TaskConfig(*plan, plan->tasks[11]);
+  StatusOr<fusion::PipelineOptions> config = TaskConfig(*plan, plan->tasks[11]);
   ASSERT_TRUE(config.ok());
   EXPECT_EQ(config->sensors.fused.recency_templates, 5);
   EXPECT_EQ(config->sensors.wifi.match_threshold, 0.6);
@@ -328,7 +328,7 @@ data = ["data/b"]
     sum += nlohmann::json::parse(in).at("map_ate_m").get<double>();
   }
   EXPECT_DOUBLE_EQ(collected->best_objective, sum / 2);
-  StatusOr<PipelineOptions> best = LoadConfigFile((fs::path(dir) / "best.toml").string());
+  StatusOr<fusion::PipelineOptions> best = LoadConfigFile((fs::path(dir) / "best.toml").string());
   ASSERT_TRUE(best.ok()) << best.status().message();
   EXPECT_EQ(best->sensors.wifi.match_threshold, 0.99);
   EXPECT_EQ(best->sensors.fused.recency_s, 10.0);

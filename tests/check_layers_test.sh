@@ -26,6 +26,14 @@ if out=$(/usr/bin/python3 "$source_dir/scripts/check_layers.py" "$tree/build" "$
   "$tree/known.txt" "$tree/namespaces.txt"); then :; fi
 if grep -q "low/a.h" <<< "$(grep namespace <<< "$out")"; then
   echo "flagged a header in its own namespace: $out"; exit 1; fi
+# A namespace nested in the folder's is its own (a detail namespace); one that only shares the
+# prefix of its name is not.
+printf 'namespace low::detail {\n}\nnamespace lower {\n}\n' >> "$tree/src/low/a.h"
+out=$(/usr/bin/python3 "$source_dir/scripts/check_layers.py" "$tree/build" "$tree/src" \
+  "$tree/known.txt" "$tree/namespaces.txt" || true)
+grep -qF "opens namespace lower, not low" <<< "$out" || {
+  echo "missed a namespace that only shares the folder's prefix:"; echo "$out"; exit 1; }
+if grep -q "low::detail" <<< "$out"; then echo "flagged a nested namespace: $out"; exit 1; fi
 printf 'high high\n' > "$tree/namespaces.txt"
 out=$(/usr/bin/python3 "$source_dir/scripts/check_layers.py" "$tree/build" "$tree/src" \
   "$tree/known.txt" "$tree/namespaces.txt" || true)

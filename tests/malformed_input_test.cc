@@ -163,10 +163,10 @@ TEST(MalformedInputTest, WorldFilesNeverCrash) {
 }
 
 TEST(MalformedInputTest, ConfigsNeverCrash) {
-  const std::string text = PrintConfig(PipelineOptions());
+  const std::string text = PrintConfig(fusion::PipelineOptions());
   Random rng(2);
   for (int k = 0; k < 500; ++k) {
-    StatusOr<PipelineOptions> o = ParseConfig(Mutate(text, rng), "fuzz.toml");
+    StatusOr<fusion::PipelineOptions> o = ParseConfig(Mutate(text, rng), "fuzz.toml");
     if (!o.ok()) {
       EXPECT_EQ(o.status().message().rfind("fuzz.toml", 0), 0u) << o.status().message();
     }

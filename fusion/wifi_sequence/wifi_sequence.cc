@@ -8,7 +8,7 @@
 #include "common/circular.h"
 #include "common/median.h"
 
-namespace ratslam {
+namespace ratslam::wifi_sequence {
 
 bool WifiSequenceOptions::IsValid(std::string* error) const {
   if (!schema::CheckFields(*this, error)) return false;
@@ -649,4 +649,4 @@ Status WifiSequenceLoopCloser::SetState(State state) {
   return Status::Ok();
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::wifi_sequence

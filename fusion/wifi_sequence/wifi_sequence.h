@@ -30,7 +30,7 @@
 #include "common/sensor_samples.h"
 #include "common/status.h"
 
-namespace ratslam {
+namespace ratslam::wifi_sequence {
 
 struct WifiSequenceOptions {
   bool enabled = false;  // run sequence loop closure beside the front end
@@ -320,6 +320,6 @@ class WifiSequenceLoopCloser {
   SmoothedSignalMatrix matrix_;
 };
 
-}  // namespace ratslam
+}  // namespace ratslam::wifi_sequence
 
 #endif  // RATSLAM_FUSION_WIFI_SEQUENCE_WIFI_SEQUENCE_H_

@@ -10,7 +10,7 @@
 
 #include "common/random.h"
 
-namespace ratslam {
+namespace ratslam::wifi_sequence {
 namespace {
 
 SparseSignal Signal(std::vector<std::pair<uint32_t, double>> v) { return v; }
@@ -403,4 +403,4 @@ TEST(WifiSequenceLoopCloserTest, BadInputIsAnErrorOrNoLoopNeverACrash) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::wifi_sequence
