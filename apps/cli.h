@@ -122,7 +122,7 @@ inline std::optional<fusion::PipelineOptions> LoadOptions(const Arguments& args,
   auto it = args.values.find("--config");
   if (it == args.values.end()) return fusion::PipelineOptions();
   if (path) *path = it->second;
-  StatusOr<fusion::PipelineOptions> options = LoadConfigFile(it->second);
+  StatusOr<fusion::PipelineOptions> options = io::LoadConfigFile(it->second);
   if (!options.ok()) {
     std::cerr << MessagePrefix() << options.status().message() << "\n";
     return std::nullopt;

@@ -12,16 +12,16 @@ namespace {
 
 TEST(DemoConfigTest, CommittedDemoTomlEqualsBuiltInDemoConfig) {
   StatusOr<fusion::PipelineOptions> committed =
-      LoadConfigFile(std::string(RATSLAM_SOURCE_DIR) + "/configs/demo.toml");
+      io::LoadConfigFile(std::string(RATSLAM_SOURCE_DIR) + "/configs/demo.toml");
   ASSERT_TRUE(committed.ok()) << committed.status().message();
-  EXPECT_EQ(PrintConfig(committed.value()), PrintConfig(DemoPipelineOptions()));
+  EXPECT_EQ(io::PrintConfig(committed.value()), io::PrintConfig(DemoPipelineOptions()));
 }
 
 TEST(DemoConfigTest, CommittedSyntheticTomlEqualsBuiltInSyntheticConfig) {
   StatusOr<fusion::PipelineOptions> committed =
-      LoadConfigFile(std::string(RATSLAM_SOURCE_DIR) + "/configs/synthetic.toml");
+      io::LoadConfigFile(std::string(RATSLAM_SOURCE_DIR) + "/configs/synthetic.toml");
   ASSERT_TRUE(committed.ok()) << committed.status().message();
-  EXPECT_EQ(PrintConfig(committed.value()), PrintConfig(SyntheticPipelineOptions()));
+  EXPECT_EQ(io::PrintConfig(committed.value()), io::PrintConfig(SyntheticPipelineOptions()));
 }
 
 // default.toml is what `ratslam print-config` prints, byte for byte: every key (it once lacked
@@ -31,7 +31,7 @@ TEST(DemoConfigTest, CommittedDefaultTomlIsThePrintedDefaults) {
   std::ifstream in(path);
   ASSERT_TRUE(in) << path;
   const std::string committed((std::istreambuf_iterator<char>(in)), {});
-  EXPECT_EQ(committed, PrintConfig(fusion::PipelineOptions()))
+  EXPECT_EQ(committed, io::PrintConfig(fusion::PipelineOptions()))
       << "regenerate with: ratslam print-config > configs/default.toml";
 }
 

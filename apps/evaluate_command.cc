@@ -146,9 +146,9 @@ int ImageSequenceEvaluate(const Arguments& args, const fusion::PipelineOptions& 
     }
     return fail(e.status());
   }
-  if (Status s = session::WriteImageSequenceOutputs(options, *e, PrintConfig(pipeline),
-                                                    ConfigFingerprint(pipeline), args.Provenance(),
-                                                    out->get());
+  if (Status s = session::WriteImageSequenceOutputs(options, *e, io::PrintConfig(pipeline),
+                                                    io::ConfigFingerprint(pipeline),
+                                                    args.Provenance(), out->get());
       !s.ok()) {
     return fail(s);
   }

@@ -36,7 +36,7 @@ namespace fs = std::filesystem;
 
 std::optional<phone::LocateOptions> LoadLocateOptions(const Arguments& args, const char* command) {
   if (!args.values.count("--config")) return phone::LocateOptions();
-  StatusOr<phone::LocateOptions> o = LoadLocateConfigFile(args.values.at("--config"));
+  StatusOr<phone::LocateOptions> o = io::LoadLocateConfigFile(args.values.at("--config"));
   if (!o.ok()) {
     std::cerr << "ratslam " << command << ": " << o.status().message() << "\n";
     return std::nullopt;
@@ -93,7 +93,7 @@ int WifiMapCommand(const Arguments& parsed) {
   if (!written.ok()) return fail(written);
   nlohmann::ordered_json& j = built->summary;
   j["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  j["run"] = RunObject(args->Provenance(), args->all.at("--data"), std::nullopt, 0);
+  j["run"] = io::RunObject(args->Provenance(), args->all.at("--data"), std::nullopt, 0);
   char human[256];
   std::snprintf(human, sizeof human,
                 "%swrote %s: %zu access points on %zu floor(s), %zu stored cells, from %zu "
@@ -122,12 +122,13 @@ int LocateCommand(const Arguments& parsed) {
   const std::vector<double>& filter_errors = located->filter_errors_m;
   const std::vector<double>& knn_errors = located->knn_errors_m;
   nlohmann::ordered_json& j = located->summary;
-  j["run"] = RunObject(args->Provenance(),
-                       {args->values.at("--wifi-map"), args->values.at("--data")}, std::nullopt, 0);
+  j["run"] =
+      io::RunObject(args->Provenance(), {args->values.at("--wifi-map"), args->values.at("--data")},
+                    std::nullopt, 0);
   const std::string summary = j.dump(2) + "\n";
   StatusOr<std::unique_ptr<DiskFolder>> folder = DiskFolder::Open(args->values.at("--out"));
   if (!folder.ok()) return fail(folder.status());
-  Status written = folder.value()->Write({{"config.toml", PrintLocateConfig(*options)},
+  Status written = folder.value()->Write({{"config.toml", io::PrintLocateConfig(*options)},
                                           {"trajectory_tum.txt", located->TrajectoryTum()},
                                           {"errors.csv", located->ErrorsCsv()},
                                           {"candidates.csv", located->CandidatesCsv()},
@@ -269,14 +270,14 @@ int CallCommand(const Arguments& parsed) {
     return scene;
   };
 
-  j["run"] = RunObject(
+  j["run"] = io::RunObject(
       args->Provenance(),
       {args->values.at("--map"), args->values.at("--wifi-map"), args->values.at("--data")},
       std::nullopt, 0);
   const std::string summary = j.dump(2) + "\n";
   StatusOr<std::unique_ptr<DiskFolder>> folder = DiskFolder::Open(args->values.at("--out"));
   if (!folder.ok()) return fail(folder.status());
-  Status written = folder.value()->Write({{"config.toml", PrintLocateConfig(setup->options)},
+  Status written = folder.value()->Write({{"config.toml", io::PrintLocateConfig(setup->options)},
                                           {"route.csv", call->RouteCsv()},
                                           {"call.json", summary}});
   if (!written.ok()) return fail(written);

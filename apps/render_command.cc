@@ -76,7 +76,7 @@ Status Write(const Arguments& args, const std::string& out, const viewer::SceneB
 
 int RenderExperienceMapCommand(const Arguments& args) {
   const std::string run_folder = args.values.at("--run");
-  StatusOr<RunFolder> run = ReadRunFolder(run_folder);
+  StatusOr<io::RunFolder> run = io::ReadRunFolder(run_folder);
   if (!run.ok()) return Fail(run.status().message());
   viewer::ExperienceMapImageData data;
   data.experiences = run->experiences;
@@ -101,7 +101,7 @@ int RenderExperienceMapCommand(const Arguments& args) {
     fusion::PipelineOptions config;
     const fs::path config_path = fs::path(run_folder) / "config.toml";
     if (IsRegularFile(config_path)) {
-      StatusOr<fusion::PipelineOptions> loaded = LoadConfigFile(config_path.string());
+      StatusOr<fusion::PipelineOptions> loaded = io::LoadConfigFile(config_path.string());
       if (!loaded.ok()) return Fail(loaded.status().message());
       config = *loaded;
     }
@@ -117,7 +117,7 @@ int RenderExperienceMapCommand(const Arguments& args) {
     // The ground truth the run reached: up to its trajectory's end, as replay --render drew it.
     double until_s = run->frames.empty() ? -1.0 : run->frames.back().time_s;
     StatusOr<std::vector<GroundTruthRow>> trajectory =
-        ReadTumTrajectory((fs::path(run_folder) / "trajectory_tum.txt").string());
+        io::ReadTumTrajectory((fs::path(run_folder) / "trajectory_tum.txt").string());
     if (trajectory.ok() && !trajectory->empty()) until_s = trajectory->back().time_s;
     figure = viewer::ExperienceMapFigureOf(std::move(data), *dataset, until_s);
   }
@@ -154,7 +154,7 @@ int RenderExperienceMapCommand(const Arguments& args) {
 
 int RenderTemplateGraphCommand(const Arguments& args) {
   const std::string run_folder = args.values.at("--run");
-  StatusOr<RunFolder> run = ReadRunFolder(run_folder);
+  StatusOr<io::RunFolder> run = io::ReadRunFolder(run_folder);
   if (!run.ok()) return Fail(run.status().message());
   viewer::TemplateGraphImageOptions options;
   TakeSize(args, &options.width_px, &options.height_px);
@@ -181,7 +181,7 @@ int RenderTemplateGraphCommand(const Arguments& args) {
 
 int RenderPoseCellsCommand(const Arguments& args) {
   const std::string& map_path = args.values.at("--map");
-  StatusOr<MapFile> map = LoadMapFile(map_path);
+  StatusOr<io::MapFile> map = io::LoadMapFile(map_path);
   if (!map.ok()) return Fail(map.status().message());
   // The map carries the configuration that made it (format 3 on); --config overrides it.
   std::optional<fusion::PipelineOptions> options;
@@ -193,7 +193,8 @@ int RenderPoseCellsCommand(const Arguments& args) {
     options = LoadOptions(args);
     if (!options) return kExitError;
   } else {
-    StatusOr<fusion::PipelineOptions> from_map = ParseMapConfig(map->config, map->format_version);
+    StatusOr<fusion::PipelineOptions> from_map =
+        io::ParseMapConfig(map->config, map->format_version);
     if (!from_map.ok()) return Fail(map_path + ": " + from_map.status().message());
     options = *from_map;
   }

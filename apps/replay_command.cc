@@ -75,7 +75,7 @@ std::pair<double, double> DataTimeSpan(const dataset::Dataset& d) {
 }
 
 // The end of a run on a terminal: what was built and how good it is, in three lines.
-std::string HumanSummary(const RunSummary& s, const std::string& out) {
+std::string HumanSummary(const io::RunSummary& s, const std::string& out) {
   char line[256];
   std::string text;
   std::snprintf(
@@ -335,26 +335,26 @@ int PrintConfigCommand(const Arguments& parsed) {
   if (locate) {  // the configuration of wifi-map and locate
     phone::LocateOptions o;
     if (args->values.count("--config")) {
-      StatusOr<phone::LocateOptions> loaded = LoadLocateConfigFile(args->values.at("--config"));
+      StatusOr<phone::LocateOptions> loaded = io::LoadLocateConfigFile(args->values.at("--config"));
       if (!loaded.ok()) {
         std::cerr << MessagePrefix() << loaded.status().message() << "\n";
         return kExitError;
       }
       o = *loaded;
     }
-    std::cout << PrintLocateConfig(o);
+    std::cout << io::PrintLocateConfig(o);
     return kExitOk;
   }
   std::string path;
   auto options = LoadOptions(*args, &path);
   if (!options) return kExitError;
-  std::cout << PrintConfig(*options);
+  std::cout << io::PrintConfig(*options);
   return kExitOk;
 }
 
 int ImportOpenRatslamCommand(const Arguments& parsed) {
   const Arguments* args = &parsed;
-  StatusOr<ImportedConfig> imported = ImportOpenRatslamIni(args->positional[0]);
+  StatusOr<io::ImportedConfig> imported = io::ImportOpenRatslamIni(args->positional[0]);
   if (!imported.ok()) {
     std::cerr << MessagePrefix() << imported.status().message() << "\n";
     return kExitError;
@@ -364,7 +364,7 @@ int ImportOpenRatslamCommand(const Arguments& parsed) {
     std::cout << "# " << note << "\n";
     std::cerr << MessagePrefix() << note << "\n";
   }
-  std::cout << PrintConfig(imported->options);
+  std::cout << io::PrintConfig(imported->options);
   return kExitOk;
 }
 

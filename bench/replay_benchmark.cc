@@ -45,7 +45,7 @@ Workload* GetWorkload() {
     StatusOr<dataset::Dataset> d =
         dataset::WriteSyntheticDataset(synthetic, (w->folder.path() / "d").string());
     StatusOr<fusion::PipelineOptions> o =
-        LoadConfigFile(std::string(RATSLAM_SOURCE_DIR) + "/configs/synthetic.toml");
+        io::LoadConfigFile(std::string(RATSLAM_SOURCE_DIR) + "/configs/synthetic.toml");
     if (!d.ok() || !o.ok()) {
       w->error = !d.ok() ? d.status().message() : o.status().message();
       return w;

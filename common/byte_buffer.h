@@ -245,6 +245,12 @@ class DecodeArchive {
   uint32_t version_;
 };
 
+// A string as an object of a schema (e.g. a list of strings through Objects).
+template <typename A>
+bool Describe(A& a, std::string& s) {
+  return a(s);
+}
+
 }  // namespace ratslam
 
 #endif  // RATSLAM_COMMON_BYTE_BUFFER_H_

@@ -66,6 +66,12 @@ inline Point2 ApplyInverse(const RigidAlignment2D& a, const Point2& p) {
 std::optional<RigidAlignment2D> AlignRigid2D(const std::vector<Point2>& estimate,
                                              const std::vector<Point2>& truth);
 
+// How a saved map encodes a pose (the map file's schema: io/state_schema.h).
+template <typename A>
+bool Describe(A& a, Pose2& p) {
+  return a(p.x_m) && a(p.y_m) && a(p.theta_rad);
+}
+
 }  // namespace ratslam
 
 #endif  // RATSLAM_COMMON_GEOMETRY_H_

@@ -12,9 +12,9 @@ std::vector<std::string> FuzzSeeds() {
   fused.sensors.front_end.kind = fusion::FrontEndKind::kFused;
   fused.sensors.fused.use_camera = true;
   fused.sensors.fused.use_compass = true;
-  return {PrintConfig(fusion::PipelineOptions()), PrintConfig(fused, false),
+  return {io::PrintConfig(fusion::PipelineOptions()), io::PrintConfig(fused, false),
           "[front_end]\nkind = \"fabmap\"\n[fabmap]\nmode = \"early\"\n[wifi_words]\nbins = 8\n",
-          PrintLocateConfig(phone::LocateOptions())};
+          io::PrintLocateConfig(phone::LocateOptions())};
 }
 
 }  // namespace ratslam::fuzz
@@ -23,20 +23,20 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace ratslam;
   const std::string text(reinterpret_cast<const char*>(data), size);
   // The same text as a wifi-map / locate configuration: the same invariants.
-  StatusOr<phone::LocateOptions> locate = ParseLocateConfig(text, "fuzz.toml");
+  StatusOr<phone::LocateOptions> locate = io::ParseLocateConfig(text, "fuzz.toml");
   if (!locate.ok() && locate.status().message().rfind("fuzz.toml", 0) != 0) {
     fuzz::InvariantFailed("error does not name the file: " + locate.status().message());
   }
   if (locate.ok()) {
     std::string invalid;
     if (!locate->IsValid(&invalid)) fuzz::InvariantFailed("accepted an invalid config: " + invalid);
-    const std::string printed = PrintLocateConfig(*locate);
-    StatusOr<phone::LocateOptions> back = ParseLocateConfig(printed, "printed.toml");
-    if (!back.ok() || PrintLocateConfig(*back) != printed) {
+    const std::string printed = io::PrintLocateConfig(*locate);
+    StatusOr<phone::LocateOptions> back = io::ParseLocateConfig(printed, "printed.toml");
+    if (!back.ok() || io::PrintLocateConfig(*back) != printed) {
       fuzz::InvariantFailed("locate config print/parse round trip differs");
     }
   }
-  StatusOr<fusion::PipelineOptions> options = ParseConfig(text, "fuzz.toml");
+  StatusOr<fusion::PipelineOptions> options = io::ParseConfig(text, "fuzz.toml");
   if (!options.ok()) {
     if (options.status().message().rfind("fuzz.toml", 0) != 0) {
       fuzz::InvariantFailed("error does not name the file: " + options.status().message());
@@ -44,7 +44,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     // From a file, a text that fails may be recognised as an OpenRatSLAM INI: still an error
     // naming the file.
     const std::string path = fuzz::WriteScratchFile("config.toml", data, size);
-    StatusOr<fusion::PipelineOptions> loaded = LoadConfigFile(path);
+    StatusOr<fusion::PipelineOptions> loaded = io::LoadConfigFile(path);
     if (loaded.ok() || loaded.status().message().rfind(path, 0) != 0) {
       fuzz::InvariantFailed("a file that does not parse loaded, or its error lacks the path");
     }
@@ -52,9 +52,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   }
   std::string error;
   if (!options->IsValid(&error)) fuzz::InvariantFailed("accepted an invalid config: " + error);
-  const std::string printed = PrintConfig(*options);
-  StatusOr<fusion::PipelineOptions> back = ParseConfig(printed, "printed.toml");
+  const std::string printed = io::PrintConfig(*options);
+  StatusOr<fusion::PipelineOptions> back = io::ParseConfig(printed, "printed.toml");
   if (!back.ok()) fuzz::InvariantFailed("printed config does not read: " + back.status().message());
-  if (PrintConfig(*back) != printed) fuzz::InvariantFailed("print/parse round trip differs");
+  if (io::PrintConfig(*back) != printed) fuzz::InvariantFailed("print/parse round trip differs");
   return 0;
 }

@@ -22,7 +22,7 @@ std::vector<std::string> FuzzSeeds() {
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace ratslam;
   const std::string path = fuzz::WriteScratchFile("in.ini", data, size);
-  StatusOr<ImportedConfig> imported = ImportOpenRatslamIni(path);
+  StatusOr<io::ImportedConfig> imported = io::ImportOpenRatslamIni(path);
   if (!imported.ok()) {
     if (imported.status().message().rfind(path, 0) != 0) {
       fuzz::InvariantFailed("error does not name the file: " + imported.status().message());
@@ -32,8 +32,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   std::string error;
   if (!imported->options.IsValid(&error))
     fuzz::InvariantFailed("imported invalid options: " + error);
-  const std::string printed = PrintConfig(imported->options);
-  StatusOr<fusion::PipelineOptions> back = ParseConfig(printed, "printed.toml");
-  if (!back.ok() || PrintConfig(*back) != printed) fuzz::InvariantFailed("TOML round trip failed");
+  const std::string printed = io::PrintConfig(imported->options);
+  StatusOr<fusion::PipelineOptions> back = io::ParseConfig(printed, "printed.toml");
+  if (!back.ok() || io::PrintConfig(*back) != printed)
+    fuzz::InvariantFailed("TOML round trip failed");
   return 0;
 }

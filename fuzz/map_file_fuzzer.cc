@@ -154,10 +154,10 @@ std::vector<std::string> FuzzSeeds() {
       fusion::ReplayControl control;
       control.until_time_s = until;
       if (!pipeline->Run(control).ok()) InvariantFailed("the seed replay failed");
-      MapFile map;
+      io::MapFile map;
       map.dataset_name = Shared().dataset.name;
       map.state = pipeline->Snapshot();
-      seeds.push_back(EncodeMapFile(map));
+      seeds.push_back(io::EncodeMapFile(map));
     }
   }
   return seeds;
@@ -169,7 +169,7 @@ namespace {
 
 int DecodeAndRun(const std::string& bytes) {
   using namespace ratslam;
-  StatusOr<MapFile> map = DecodeMapFile(bytes, "fuzz.map");
+  StatusOr<io::MapFile> map = io::DecodeMapFile(bytes, "fuzz.map");
   if (!map.ok()) return 0;
   fuzz::Setup& setup = fuzz::Shared();
   for (size_t i = 0; i < setup.options.size(); ++i) {
@@ -181,7 +181,7 @@ int DecodeAndRun(const std::string& bytes) {
     fusion::ReplayControl control;
     control.until_time_s = stop < events.size() ? events[stop].time_s : events.back().time_s;
     (void)pipeline->Run(control);
-    const RunSummary summary = Summarise(*pipeline, setup.dataset, RunInfo{});
+    const io::RunSummary summary = io::Summarise(*pipeline, setup.dataset, io::RunInfo{});
     if (summary.json.empty()) fuzz::InvariantFailed("empty summary");
   }
   return 0;

@@ -44,7 +44,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const fs::path folder =
       fuzz::WriteScratchFolder("run", parts, {std::begin(fuzz::kFiles), std::end(fuzz::kFiles)});
   StatusOr<std::vector<GroundTruthRow>> trajectory =
-      ReadTumTrajectory((folder / "trajectory_tum.txt").string());
+      io::ReadTumTrajectory((folder / "trajectory_tum.txt").string());
   if (!trajectory.ok()) {
     if (trajectory.status().message().rfind(folder.string(), 0) != 0) {
       fuzz::InvariantFailed("TUM error does not name the file: " + trajectory.status().message());
@@ -58,7 +58,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       }
     }
   }
-  StatusOr<RunFolder> run = ReadRunFolder(folder.string());
+  StatusOr<io::RunFolder> run = io::ReadRunFolder(folder.string());
   if (!run.ok()) {
     if (run.status().message().rfind(folder.string(), 0) != 0) {
       fuzz::InvariantFailed("error does not name a file of the run: " + run.status().message());

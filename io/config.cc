@@ -17,7 +17,7 @@
 #include "common/toml_binder.h"
 #include "dataset/dataset_loader.h"
 
-namespace ratslam {
+namespace ratslam::io {
 namespace {
 
 constexpr size_t kMaxConfigBytes = 1 << 20;  // a config is a few kB; a megabyte is not a config
@@ -25,7 +25,7 @@ constexpr size_t kMaxConfigBytes = 1 << 20;  // a config is a few kB; a megabyte
 using schema::TomlWhere;
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::io
 
 // The enums of the configuration, read and printed by their names.
 namespace ratslam::schema {
@@ -64,7 +64,7 @@ struct TomlCodec<phone::ScanLikelihood>
     : EnumCodec<phone::ScanLikelihood, phone::ScanLikelihoodFromString> {};
 }  // namespace ratslam::schema
 
-namespace ratslam {
+namespace ratslam::io {
 namespace {
 
 // Line of `section.key` in the parsed file, for validity errors found after reading.
@@ -725,4 +725,4 @@ StatusOr<ImportedConfig> ImportOpenRatslamIni(const std::string& path) {
   return imported;
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::io

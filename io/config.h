@@ -11,7 +11,7 @@
 #include "fusion/replay_pipeline.h"
 #include "phone/locate_options.h"
 
-namespace ratslam {
+namespace ratslam::io {
 
 // Parses TOML text; `source_name` is used in error messages ("file:line: ...").
 StatusOr<fusion::PipelineOptions> ParseConfig(const std::string& text,
@@ -64,6 +64,6 @@ struct ImportedConfig {
 // keys onto our options (starting from our defaults) and reports every key it did not use.
 StatusOr<ImportedConfig> ImportOpenRatslamIni(const std::string& path);
 
-}  // namespace ratslam
+}  // namespace ratslam::io
 
 #endif  // RATSLAM_IO_CONFIG_H_

@@ -12,7 +12,7 @@
 #include "common/scratch_dir.h"
 #include "tests/generated_block.h"
 
-namespace ratslam {
+namespace ratslam::io {
 namespace {
 
 // One fresh folder per test process (two checkouts testing at once never collide).
@@ -410,9 +410,9 @@ TEST(ConfigTest, AnOpenRatslamIniPassedAsConfigSaysHowToConvertIt) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::io
 
-namespace ratslam {
+namespace ratslam::io {
 namespace {
 
 // docs/config.md's key tables are made from the field lists that read and print configurations,
@@ -426,4 +426,4 @@ TEST(ConfigReferenceTest, DocsCarryTheCurrentKeyTables) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::io

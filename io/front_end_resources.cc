@@ -5,7 +5,7 @@
 #include "dataset/descriptor_file.h"
 #include "io/visual_model_file.h"
 
-namespace ratslam {
+namespace ratslam::io {
 
 namespace fs = std::filesystem;
 
@@ -72,4 +72,4 @@ StatusOr<fusion::FrontEndResources> LoadFrontEndResources(
   return resources;
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::io

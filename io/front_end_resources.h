@@ -11,7 +11,7 @@
 #include "dataset/image_loader.h"
 #include "fusion/front_end.h"
 
-namespace ratslam {
+namespace ratslam::io {
 
 // The descriptors of `dataset`, loaded from the sessions `data_paths` (as given to
 // LoadSessions) by DescriptorOptions::file: a relative name inside each session's folder (a
@@ -27,6 +27,6 @@ StatusOr<fusion::FrontEndResources> LoadFrontEndResources(
     const fusion::FrontEndSettings& settings, const std::vector<std::string>& data_paths,
     const dataset::Dataset& dataset, ImageLoader& images);
 
-}  // namespace ratslam
+}  // namespace ratslam::io
 
 #endif  // RATSLAM_IO_FRONT_END_RESOURCES_H_

@@ -12,7 +12,7 @@
 #include "common/text_file.h"
 #include "io/state_schema.h"
 
-namespace ratslam {
+namespace ratslam::io {
 namespace {
 
 constexpr char kMagic[8] = {'R', 'S', 'L', 'M', 'A', 'P', '\0', '\1'};
@@ -73,4 +73,4 @@ StatusOr<MapFile> LoadMapFile(const std::string& path) {
   return DecodeMapFile(*bytes, path);
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::io

@@ -12,7 +12,7 @@
 #include "common/status.h"
 #include "fusion/replay_pipeline.h"
 
-namespace ratslam {
+namespace ratslam::io {
 
 // The version written, and the oldest one read. A field added in a new version is listed in
 // state_schema.h as `(a.version() < N || a(field))`, so older files load with its default.
@@ -52,6 +52,6 @@ StatusOr<MapFile> DecodeMapFile(const std::string& bytes, const std::string& sou
 Status SaveMapFile(const MapFile& map, const std::string& path);
 StatusOr<MapFile> LoadMapFile(const std::string& path);
 
-}  // namespace ratslam
+}  // namespace ratslam::io
 
 #endif  // RATSLAM_IO_MAP_FILE_H_

@@ -8,7 +8,7 @@
 #include "common/scratch_dir.h"
 #include "io/state_schema.h"
 
-namespace ratslam {
+namespace ratslam::io {
 namespace {
 
 // One fresh folder per test process (two checkouts testing at once never collide).
@@ -201,4 +201,4 @@ TEST(MapFileTest, SchemaListsEveryMemberOfEverySavedStruct) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::io

@@ -4,7 +4,7 @@
 
 #include "common/version.h"
 
-namespace ratslam {
+namespace ratslam::io {
 
 std::string FingerprintHex(uint64_t fingerprint) {
   char text[20];
@@ -31,4 +31,4 @@ nlohmann::ordered_json RunObject(const RunProvenance& provenance,
   return run;
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::io

@@ -12,7 +12,7 @@
 
 #include "common/provenance.h"
 
-namespace ratslam {
+namespace ratslam::io {
 
 // `seed`: none when nothing in the run draws random numbers outside the configuration's own
 // seeds (written as null).
@@ -23,6 +23,6 @@ nlohmann::ordered_json RunObject(const RunProvenance& provenance,
 // A fingerprint as 16 hex digits, as summary.json writes it.
 std::string FingerprintHex(uint64_t fingerprint);
 
-}  // namespace ratslam
+}  // namespace ratslam::io
 
 #endif  // RATSLAM_IO_PROVENANCE_JSON_H_

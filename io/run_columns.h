@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-namespace ratslam {
+namespace ratslam::io {
 
 struct RunCsvColumns {
   std::vector<std::string> required;
@@ -44,6 +44,6 @@ inline const RunCsvColumns kLocalisationColumns = {
 inline const RunCsvColumns kFrameColumns = {
     {"time_s", "template_id", "new_template", "experience_id"}, {"source", "recent"}};
 
-}  // namespace ratslam
+}  // namespace ratslam::io
 
 #endif  // RATSLAM_IO_RUN_COLUMNS_H_

@@ -16,7 +16,7 @@
 #include "io/provenance_json.h"
 #include "io/run_columns.h"
 
-namespace ratslam {
+namespace ratslam::io {
 namespace {
 
 std::string Num(double value) { return ShortestNumber(value); }
@@ -687,4 +687,4 @@ StatusOr<RunSummary> WriteRunOutputs(OutputFolder& folder, const fusion::ReplayP
   return summary;
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::io

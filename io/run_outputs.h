@@ -13,7 +13,7 @@
 #include "common/status.h"
 #include "fusion/replay_pipeline.h"
 
-namespace ratslam {
+namespace ratslam::io {
 
 struct RunInfo {
   double wall_seconds = 0.0;     // of this process's replay (not of earlier resumed parts)
@@ -96,6 +96,6 @@ const std::vector<std::string>& SummaryKeys();
 StatusOr<RunSummary> WriteRunOutputs(OutputFolder& folder, const fusion::ReplayPipeline& pipeline,
                                      const dataset::Dataset& dataset, const RunInfo& info);
 
-}  // namespace ratslam
+}  // namespace ratslam::io
 
 #endif  // RATSLAM_IO_RUN_OUTPUTS_H_

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <vector>
 
-namespace ratslam {
+namespace ratslam::io {
 namespace {
 
 // Truth along a line at 1 m/s; the localised frames are the truth turned by 90 degrees and
@@ -49,9 +49,9 @@ TEST(LocalisationErrorsTest, RigidFitThenDistanceAndNoFitToAHandful) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::io
 
-namespace ratslam {
+namespace ratslam::io {
 namespace {
 
 // Two sessions photograph places a..e under the same names (the second also z, which the first
@@ -92,4 +92,4 @@ TEST(CrossSessionPlacesTest, ScoresByTheNamesakeInTheTemplatesSession) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::io

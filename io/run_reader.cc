@@ -11,7 +11,7 @@
 #include "dataset/csv.h"
 #include "io/run_columns.h"
 
-namespace ratslam {
+namespace ratslam::io {
 namespace {
 namespace fs = std::filesystem;
 
@@ -194,4 +194,4 @@ StatusOr<std::vector<GroundTruthRow>> ReadTumTrajectory(const std::string& path)
   return rows;
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::io

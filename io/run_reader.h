@@ -11,7 +11,7 @@
 #include "ratslam/experience_map.h"
 #include "ratslam/records.h"
 
-namespace ratslam {
+namespace ratslam::io {
 
 struct RunFolder {
   std::vector<Experience> experiences;
@@ -32,6 +32,6 @@ StatusOr<RunFolder> ReadRunFolder(const std::string& folder);
 // the file, line and field: a missing or non-finite field, or a time not after the previous one.
 StatusOr<std::vector<GroundTruthRow>> ReadTumTrajectory(const std::string& path);
 
-}  // namespace ratslam
+}  // namespace ratslam::io
 
 #endif  // RATSLAM_IO_RUN_READER_H_

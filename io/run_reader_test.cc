@@ -10,7 +10,7 @@
 
 #include "common/scratch_dir.h"
 
-namespace ratslam {
+namespace ratslam::io {
 namespace {
 
 namespace fs = std::filesystem;
@@ -68,4 +68,4 @@ TEST(ReadTumTrajectoryTest, BadFilesNameLineAndField) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::io

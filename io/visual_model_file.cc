@@ -7,7 +7,7 @@
 
 #include "common/text_file.h"
 
-namespace ratslam {
+namespace ratslam::io {
 
 StatusOr<std::vector<std::string>> ListImages(const std::string& folder) {
   namespace fs = std::filesystem;
@@ -67,4 +67,4 @@ StatusOr<std::shared_ptr<const fusion::FabmapResources>> LoadFabmapResources(
   return fusion::PrepareFabmapResources(settings, dataset, std::move(visual));
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::io

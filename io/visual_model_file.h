@@ -14,7 +14,7 @@
 #include "fusion/fabmap/visual_model.h"
 #include "fusion/front_end.h"
 
-namespace ratslam {
+namespace ratslam::io {
 
 // Sorted image files (jpg, jpeg, png, pgm) under `folder`, recursively.
 StatusOr<std::vector<std::string>> ListImages(const std::string& folder);
@@ -31,6 +31,6 @@ StatusOr<fabmap::TrainedVisualModel> LoadOrTrainVisualModel(
 StatusOr<std::shared_ptr<const fusion::FabmapResources>> LoadFabmapResources(
     const fusion::FrontEndSettings& settings, const dataset::Dataset& dataset, ImageLoader& images);
 
-}  // namespace ratslam
+}  // namespace ratslam::io
 
 #endif  // RATSLAM_IO_VISUAL_MODEL_FILE_H_

@@ -97,11 +97,11 @@ class Config {
  public:
   Config() = default;
   explicit Config(fusion::PipelineOptions options) : options_(std::move(options)) {}
-  static Config Load(const std::string& path) { return Config(Take(LoadConfigFile(path))); }
+  static Config Load(const std::string& path) { return Config(Take(io::LoadConfigFile(path))); }
   static Config FromToml(const std::string& text) {
-    return Config(Take(ParseConfig(text, "<Config.from_toml>")));
+    return Config(Take(io::ParseConfig(text, "<Config.from_toml>")));
   }
-  std::string Toml() const { return PrintConfig(options_); }
+  std::string Toml() const { return io::PrintConfig(options_); }
   // `key` is "section.name" as in the TOML file; the value is checked as a file's would be.
   void Set(const std::string& key, const py::handle& value) {
     const size_t dot = key.find('.');
@@ -110,13 +110,13 @@ class Config {
     }
     const std::string text =
         "[" + key.substr(0, dot) + "]\n" + key.substr(dot + 1) + " = " + TomlValue(value) + "\n";
-    fusion::PipelineOptions changed = Take(ParseConfigOnto(text, "Config.set", options_));
+    fusion::PipelineOptions changed = Take(io::ParseConfigOnto(text, "Config.set", options_));
     std::string error;
     if (!changed.IsValid(&error)) throw Error("Config.set: " + error);
     options_ = std::move(changed);
   }
   py::object ToDict() const {
-    return py::module_::import("tomllib").attr("loads")(PrintConfig(options_, false));
+    return py::module_::import("tomllib").attr("loads")(io::PrintConfig(options_, false));
   }
   const fusion::PipelineOptions& options() const { return options_; }
 
@@ -168,7 +168,7 @@ py::dict TrajectoryColumns(const fusion::ReplayPipeline& pipeline) {
   std::vector<Pose2> poses;
   for (const T& r : rows) {
     Pose2 p;
-    RecordPose(map, r, &p.x_m, &p.y_m, &p.theta_rad);
+    io::RecordPose(map, r, &p.x_m, &p.y_m, &p.theta_rad);
     poses.push_back(p);
   }
   py::dict c;
@@ -314,7 +314,7 @@ class Session {
   static std::unique_ptr<Session> Load(const std::string& path, const Config& config, bool localise,
                                        double lost_after_m) {
     auto session = std::make_unique<Session>(config);
-    MapFile map = Take(LoadMapFile(path));
+    io::MapFile map = Take(io::LoadMapFile(path));
     Check(session::CheckSameConfiguration(map, session->options_).WithContext(path));
     if (localise) {
       Check(session->pipeline_->AdoptMap(map.state, lost_after_m).WithContext(path));
@@ -390,12 +390,12 @@ class Session {
   }
 
   void SaveMap(const std::string& path) const {
-    MapFile map;
-    map.config_fingerprint = ConfigFingerprint(options_);
+    io::MapFile map;
+    map.config_fingerprint = io::ConfigFingerprint(options_);
     map.dataset_name = dataset_.name;
-    map.config = PrintConfig(options_, false);
+    map.config = io::PrintConfig(options_, false);
     map.state = pipeline_->Snapshot();
-    Check(SaveMapFile(map, path));
+    Check(io::SaveMapFile(map, path));
   }
 
   py::dict Summary() const {
@@ -512,7 +512,7 @@ py::dict Evaluate(const std::string& map, const std::string& query, const std::s
 py::dict LocatePhone(const std::string& wifi_map, const std::string& data,
                      const std::optional<std::string>& config, bool lenient) {
   const phone::LocateOptions options =
-      config ? Take(LoadLocateConfigFile(*config)) : phone::LocateOptions();
+      config ? Take(io::LoadLocateConfigFile(*config)) : phone::LocateOptions();
   const session::PhoneSetup setup = Take(session::SetUpPhone(options, wifi_map, data, lenient));
   StatusOr<session::LocateResult> result = [&] {
     py::gil_scoped_release release;
@@ -549,7 +549,7 @@ py::dict WifiMap(const std::vector<std::string>& data, const std::string& out,
                  const std::optional<std::string>& run, const std::optional<std::string>& config,
                  bool lenient, bool overwrite) {
   const phone::LocateOptions options =
-      config ? Take(LoadLocateConfigFile(*config)) : phone::LocateOptions();
+      config ? Take(io::LoadLocateConfigFile(*config)) : phone::LocateOptions();
   Check(CheckReplaceable(out, overwrite, "out"));
   const session::WifiMapInput input{data, run, lenient};
   StatusOr<session::BuiltWifiMap> built = [&] {
@@ -569,7 +569,7 @@ py::dict WifiMap(const std::vector<std::string>& data, const std::string& out,
 py::dict Call(const std::string& map, const std::string& wifi_map, const std::string& data,
               double at, const std::optional<std::string>& config, bool lenient) {
   const phone::LocateOptions options =
-      config ? Take(LoadLocateConfigFile(*config)) : phone::LocateOptions();
+      config ? Take(io::LoadLocateConfigFile(*config)) : phone::LocateOptions();
   const session::RobotMap robot = Take(session::LoadRobotMap(map));
   const session::PhoneSetup setup = Take(session::SetUpPhone(options, wifi_map, data, lenient));
   StatusOr<session::CallResult> result = [&] {

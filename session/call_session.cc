@@ -16,7 +16,7 @@ namespace ratslam::session {
 StatusOr<RobotMap> LoadRobotMap(const std::string& path) {
   RobotMap m;
   if (IsDirectory(path)) {
-    StatusOr<RunFolder> run = ReadRunFolder(path);
+    StatusOr<io::RunFolder> run = io::ReadRunFolder(path);
     if (!run.ok()) return run.status();
     m.experiences = std::move(run->experiences);
     m.links = std::move(run->links);
@@ -27,7 +27,7 @@ StatusOr<RobotMap> LoadRobotMap(const std::string& path) {
       }
     }
   } else {
-    StatusOr<MapFile> map = LoadMapFile(path);
+    StatusOr<io::MapFile> map = io::LoadMapFile(path);
     if (!map.ok()) return map.status();
     const ExperienceMap::State& state = map->state.ratslam.experience_map;
     m.experiences = state.experiences;

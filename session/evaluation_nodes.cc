@@ -50,7 +50,7 @@ StatusOr<std::vector<EvaluationNode>> ImageFolderNodes(const std::string& path,
   if (floors.empty()) floors.push_back(path);
   std::vector<EvaluationNode> nodes;
   for (size_t f = 0; f < floors.size(); ++f) {
-    auto images = ListImages(floors[f]);
+    auto images = io::ListImages(floors[f]);
     if (!images.ok()) return images.status();
     const int floor = FloorOfFolder(fs::path(floors[f]).filename().string(), static_cast<int>(f));
     for (size_t i = 0; i < images->size(); ++i) {

@@ -115,7 +115,7 @@ fabmap::FabmapMode EvaluationSession::mode() const {
 Status EvaluationSession::Load() {
   std::string error;
   if (!options_.pipeline.IsValid(&error)) return Status::Error("configuration: " + error);
-  RATSLAM_RETURN_IF_ERROR(out_->Write("config.toml", PrintConfig(options_.pipeline)));
+  RATSLAM_RETURN_IF_ERROR(out_->Write("config.toml", io::PrintConfig(options_.pipeline)));
   const bool vision = fabmap::UsesVision(mode());
   dataset::PhoneLogOptions phone;
   phone.lenient = options_.lenient;
@@ -173,11 +173,11 @@ Status EvaluationSession::Prepare() {
   const fusion::FabmapSettings& settings = options_.pipeline.sensors.fabmap;
   const bool vision = fabmap::UsesVision(mode());
   if (vision) {
-    auto model = LoadOrTrainVisualModel(settings.visual_model, settings.features,
-                                        settings.vocabulary, settings.localiser.chow_liu, *images_,
-                                        [this](size_t done, size_t total) {
-                                          progress_->Update({"training images", done, total});
-                                        });
+    auto model = io::LoadOrTrainVisualModel(settings.visual_model, settings.features,
+                                            settings.vocabulary, settings.localiser.chow_liu,
+                                            *images_, [this](size_t done, size_t total) {
+                                              progress_->Update({"training images", done, total});
+                                            });
     if (!model.ok()) return model.status();
     progress_->Finish();
     visual_ = *std::move(model);
@@ -434,8 +434,8 @@ Status EvaluationSession::WriteOutputs() {
   j["wall_time_s"] = result_.wall_time_s;
   std::vector<std::string> inputs = {options_.map_path};
   if (options_.query_path != options_.map_path) inputs.push_back(options_.query_path);
-  j["run"] =
-      RunObject(options_.provenance, inputs, std::nullopt, ConfigFingerprint(options_.pipeline));
+  j["run"] = io::RunObject(options_.provenance, inputs, std::nullopt,
+                           io::ConfigFingerprint(options_.pipeline));
   result_.json = j.dump(2) + "\n";
 
   // Numbers in shortest round-trip form; error_m is numeric (inf for another floor, empty for a

@@ -209,8 +209,8 @@ StatusOr<ImageSequenceEvaluation::Fabmap> MatchByFabmap(
     model_options.training_images = options.reference_folder;
   }
   StatusOr<fabmap::TrainedVisualModel> model =
-      LoadOrTrainVisualModel(model_options, settings.features, settings.vocabulary,
-                             settings.localiser.chow_liu, *loader, {});
+      io::LoadOrTrainVisualModel(model_options, settings.features, settings.vocabulary,
+                                 settings.localiser.chow_liu, *loader, {});
   if (!model.ok()) return model.status();
   f.vocabulary = model->vocabulary.size();
   std::vector<fabmap::Observation> reference_words, query_words;
@@ -515,8 +515,8 @@ Status WriteImageSequenceOutputs(const ImageSequenceEvaluationOptions& options,
   j["match_seconds"] = e.match_seconds;
   j["query_time_ms"] =
       e.query_files.empty() ? 0.0 : 1000.0 * e.match_seconds / e.query_files.size();
-  j["run"] = RunObject(provenance, {options.reference_folder, options.query_folder}, std::nullopt,
-                       config_fingerprint);
+  j["run"] = io::RunObject(provenance, {options.reference_folder, options.query_folder},
+                           std::nullopt, config_fingerprint);
   std::ostringstream csv;
   csv << "query,file,truth,sequence_match,sequence_confidence,sequence_correct,single_match,"
          "single_confidence,single_correct";

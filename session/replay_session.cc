@@ -11,11 +11,11 @@
 #include "io/map_file.h"
 
 namespace ratslam::session {
-Status CheckSameConfiguration(const MapFile& map, const fusion::PipelineOptions& now) {
+Status CheckSameConfiguration(const io::MapFile& map, const fusion::PipelineOptions& now) {
   if (!map.config.empty()) {
-    StatusOr<fusion::PipelineOptions> before = ParseMapConfig(map.config, map.format_version);
+    StatusOr<fusion::PipelineOptions> before = io::ParseMapConfig(map.config, map.format_version);
     if (!before.ok()) return before.status();
-    std::vector<std::string> differences = ConfigDifferences(*before, now);
+    std::vector<std::string> differences = io::ConfigDifferences(*before, now);
     // How a bag or a video was read, and where a data set's descriptors are, say nothing
     // about the map.
     std::erase_if(differences, [](const std::string& d) {
@@ -27,7 +27,7 @@ Status CheckSameConfiguration(const MapFile& map, const fusion::PipelineOptions&
     for (const std::string& d : differences) keys += "\n  " + d;
     return Status::Error("the map was made with a different configuration (map -> now):" + keys);
   }
-  StatusOr<uint64_t> then = FingerprintAsOfMapVersion(now, map.format_version);
+  StatusOr<uint64_t> then = io::FingerprintAsOfMapVersion(now, map.format_version);
   if (!then.ok()) {
     return then.status().WithContext("the map was made with a different configuration");
   }
@@ -48,7 +48,7 @@ ReplaySession::ReplaySession(ReplaySessionOptions options, SessionEnvironment en
     own_images_ = std::make_unique<dataset::FileImageLoader>();
     env_.images = own_images_.get();
   }
-  fingerprint_ = ConfigFingerprint(options_.pipeline);
+  fingerprint_ = io::ConfigFingerprint(options_.pipeline);
 }
 
 ReplaySession::~ReplaySession() = default;
@@ -85,13 +85,13 @@ Status ReplaySession::Load() {
   dataset_ = std::move(dataset).value();
   return env_.out->Write("config.toml",
                          "# Resolved configuration of this run (ratslam print-config format).\n" +
-                             PrintConfig(options_.pipeline));
+                             io::PrintConfig(options_.pipeline));
 }
 
 Status ReplaySession::Prepare() {
   if (!dataset_) return Status::Error("replay session: Prepare before Load");
   StatusOr<fusion::FrontEndResources> resources =
-      LoadFrontEndResources(options_.pipeline.sensors, options_.data, *dataset_, *env_.images);
+      io::LoadFrontEndResources(options_.pipeline.sensors, options_.data, *dataset_, *env_.images);
   if (!resources.ok()) return resources.status();
   if (options_.pipeline.sensors.front_end.kind == fusion::FrontEndKind::kCustom) {
     if (!env_.custom_front_end) {
@@ -105,7 +105,7 @@ Status ReplaySession::Prepare() {
       options_.pipeline, *dataset_, env_.images, std::move(resources).value());
   if (!options_.load_map.empty()) {
     const std::string& path = options_.load_map;
-    StatusOr<MapFile> map = LoadMapFile(path);
+    StatusOr<io::MapFile> map = io::LoadMapFile(path);
     if (!map.ok()) return map.status();
     RATSLAM_RETURN_IF_ERROR(CheckSameConfiguration(*map, options_.pipeline).WithContext(path));
     if (options_.localise) {
@@ -147,7 +147,7 @@ Status ReplaySession::Replay(const ReplayCheckpoint& checkpoint) {
 
 Status ReplaySession::WriteOutputs() {
   if (!pipeline_) return Status::Error("replay session: WriteOutputs before Prepare");
-  RunInfo info;
+  io::RunInfo info;
   info.wall_seconds = result_.wall_seconds;
   info.frames_this_run = result_.frames_this_run;
   info.interrupted = result_.interrupted;
@@ -157,7 +157,7 @@ Status ReplaySession::WriteOutputs() {
   info.lost_after_m = options_.lost_after_m;
   info.provenance = options_.provenance;
   info.inputs = options_.data;
-  StatusOr<RunSummary> summary = WriteRunOutputs(*env_.out, *pipeline_, *dataset_, info);
+  StatusOr<io::RunSummary> summary = io::WriteRunOutputs(*env_.out, *pipeline_, *dataset_, info);
   if (summary.ok()) {
     result_.summary = std::move(summary).value();
     result_.outputs = Status::Ok();
@@ -175,12 +175,12 @@ Status ReplaySession::SaveMap() {
     path = env_.out->Path("interrupted.map");
   }
   if (path.empty()) return Status::Ok();
-  MapFile map;
+  io::MapFile map;
   map.config_fingerprint = fingerprint_;
   map.dataset_name = dataset_->name;
-  map.config = PrintConfig(options_.pipeline, false);
+  map.config = io::PrintConfig(options_.pipeline, false);
   map.state = pipeline_->Snapshot();
-  result_.save = SaveMapFile(map, path);
+  result_.save = io::SaveMapFile(map, path);
   if (result_.save.ok()) result_.saved_map = path;
   return result_.save;
 }

@@ -67,13 +67,13 @@ struct ReplayCheckpoint {
 };
 
 struct ReplayResult {
-  std::optional<RunSummary> summary;  // present when the outputs were written
-  Status replay;                      // the replay itself (a data error stops it early)
-  Status outputs;                     // writing the run's files
-  Status save;                        // saving the map, when one was saved
-  std::string saved_map;              // where the state was saved; empty when not saved
-  bool interrupted = false;           // a stop was requested
-  bool finished = false;              // the data set was replayed to its end
+  std::optional<io::RunSummary> summary;  // present when the outputs were written
+  Status replay;                          // the replay itself (a data error stops it early)
+  Status outputs;                         // writing the run's files
+  Status save;                            // saving the map, when one was saved
+  std::string saved_map;                  // where the state was saved; empty when not saved
+  bool interrupted = false;               // a stop was requested
+  bool finished = false;                  // the data set was replayed to its end
   uint64_t frames_this_run = 0;
   double wall_seconds = 0.0;  // of the replay stage
   bool ok() const { return replay.ok() && outputs.ok() && save.ok(); }
@@ -82,7 +82,7 @@ struct ReplayResult {
 // A map resumes (or is localised on) only under the configuration that made it. Maps of
 // format 3 and later carry it, so the error names every key that differs; format 2 maps hold a
 // fingerprint, compared as it was then.
-Status CheckSameConfiguration(const MapFile& map, const fusion::PipelineOptions& now);
+Status CheckSameConfiguration(const io::MapFile& map, const fusion::PipelineOptions& now);
 
 class ReplaySession {
  public:

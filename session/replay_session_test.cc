@@ -118,7 +118,7 @@ TEST_F(ReplaySessionTest, OutputFailureStillSavesTheMap) {
   EXPECT_FALSE(out.written.count("experiences.csv"));  // all or nothing
   EXPECT_TRUE(result->save.ok()) << result->save.message();
   EXPECT_EQ(result->saved_map, options.save_map);
-  EXPECT_TRUE(LoadMapFile(options.save_map).ok());
+  EXPECT_TRUE(io::LoadMapFile(options.save_map).ok());
 }
 
 // Without --save-map, a failure to write the outputs saves interrupted.map beside them so that
@@ -154,7 +154,7 @@ TEST_F(ReplaySessionTest, StopRequestInterruptsAndSavesState) {
   EXPECT_FALSE(result->finished);
   EXPECT_EQ(session.pipeline().state().next_event, 100u);
   EXPECT_EQ(nlohmann::json::parse(out.written["summary.json"])["interrupted"], true);
-  StatusOr<MapFile> map = LoadMapFile(result->saved_map);
+  StatusOr<io::MapFile> map = io::LoadMapFile(result->saved_map);
   ASSERT_TRUE(map.ok()) << map.status().message();
   EXPECT_EQ(map->state.next_event, 100u);
 }

@@ -42,12 +42,12 @@ Status SamplesFromRun(const std::string& run_folder, const std::vector<std::stri
                       bool lenient, std::vector<phone::WifiMapSample>* samples, size_t* scans,
                       phone::WifiGpMap* frame_of) {
   const fs::path run = run_folder;
-  StatusOr<RunFolder> folder = ReadRunFolder(run.string());
+  StatusOr<io::RunFolder> folder = io::ReadRunFolder(run.string());
   if (!folder.ok()) return folder.status();
-  StatusOr<fusion::PipelineOptions> config = LoadConfigFile((run / "config.toml").string());
+  StatusOr<fusion::PipelineOptions> config = io::LoadConfigFile((run / "config.toml").string());
   if (!config.ok()) return config.status();
   StatusOr<std::vector<GroundTruthRow>> trajectory =
-      ReadTumTrajectory((run / "trajectory_tum.txt").string());
+      io::ReadTumTrajectory((run / "trajectory_tum.txt").string());
   if (!trajectory.ok()) return trajectory.status();
   dataset::PhoneLogOptions phone;
   phone.lenient = lenient;

@@ -501,7 +501,7 @@ StatusOr<SweepSpec> LoadSweepFile(const std::string& path) {
   // their first part against the keys the command's summary can have.
   {
     const std::vector<std::string>& keys =
-        settings.command == "evaluate" ? session::EvaluationKeys() : SummaryKeys();
+        settings.command == "evaluate" ? session::EvaluationKeys() : io::SummaryKeys();
     const std::set<std::string> known(keys.begin(), keys.end());
     const std::string file = settings.command == "evaluate" ? "evaluation.json" : "summary.json";
     for (const std::string& m : spec.metrics) {
@@ -525,11 +525,11 @@ StatusOr<SweepSpec> LoadSweepFile(const std::string& path) {
     const fs::path config = fs::path(settings.base_config).is_absolute()
                                 ? fs::path(settings.base_config)
                                 : base / settings.base_config;
-    StatusOr<fusion::PipelineOptions> loaded = LoadConfigFile(config.string());
+    StatusOr<fusion::PipelineOptions> loaded = io::LoadConfigFile(config.string());
     if (!loaded.ok()) return loaded.status().WithContext(path + ": sweep.base_config");
     base_options = *loaded;
   }
-  spec.base_config_text = PrintConfig(base_options, false);
+  spec.base_config_text = io::PrintConfig(base_options, false);
 
   // [[datasets]]: `data = [...]` is one run over those sessions; `glob = "..."` is one run per
   // matching file or folder.
@@ -585,7 +585,8 @@ StatusOr<SweepSpec> LoadSweepFile(const std::string& path) {
 StatusOr<Plan> MakePlan(const SweepSpec& spec) {
   Plan plan;
   plan.spec = spec;
-  StatusOr<fusion::PipelineOptions> base = ParseConfig(spec.base_config_text, "base configuration");
+  StatusOr<fusion::PipelineOptions> base =
+      io::ParseConfig(spec.base_config_text, "base configuration");
   if (!base.ok()) return base.status();
   // Each value alone first, so that an error names the parameter's line.
   for (const Parameter& p : spec.parameters) {
@@ -593,7 +594,7 @@ StatusOr<Plan> MakePlan(const SweepSpec& spec) {
     if (values.empty()) values = {Number(p.lo, p.integer), Number(p.hi, p.integer)};
     for (const std::string& v : values) {
       StatusOr<fusion::PipelineOptions> one =
-          ParseConfigOnto(OverrideText({{p.key, v}}), spec.source, *base);
+          io::ParseConfigOnto(OverrideText({{p.key, v}}), spec.source, *base);
       if (!one.ok()) {
         return Status::Error(spec.source + ":" + std::to_string(p.line) + ": parameter '" + p.key +
                              "' = " + v + ": " +
@@ -654,7 +655,7 @@ StatusOr<Plan> MakePlan(const SweepSpec& spec) {
     }
     // The whole combination (relations between keys, e.g. min < max) once per point.
     StatusOr<fusion::PipelineOptions> all =
-        ParseConfigOnto(OverrideText(points[i]), spec.source, *base);  // base parsed once
+        io::ParseConfigOnto(OverrideText(points[i]), spec.source, *base);  // base parsed once
     if (!all.ok()) {
       std::string values;
       for (const auto& [key, value] : points[i])
@@ -668,9 +669,9 @@ StatusOr<Plan> MakePlan(const SweepSpec& spec) {
 
 StatusOr<fusion::PipelineOptions> TaskConfig(const Plan& plan, const Task& task) {
   StatusOr<fusion::PipelineOptions> base =
-      ParseConfig(plan.spec.base_config_text, "base configuration");
+      io::ParseConfig(plan.spec.base_config_text, "base configuration");
   if (!base.ok()) return base.status();
-  return ParseConfigOnto(OverrideText(task.overrides), plan.spec.source, *base);
+  return io::ParseConfigOnto(OverrideText(task.overrides), plan.spec.source, *base);
 }
 
 Status WritePlan(const Plan& plan, const std::string& dir) {

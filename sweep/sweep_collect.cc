@@ -205,7 +205,8 @@ StatusOr<CollectReport> Collect(const std::string& dir) {
                          schema::TomlNumber(report.best_objective) + " over " +
                          std::to_string(spec.datasets.size()) + " data set(s)\n";
     for (const auto& [key, value] : best->overrides) header += "#   " + key + " = " + value + "\n";
-    files.push_back({(fs::path(dir) / "best.toml").string(), header + "\n" + PrintConfig(*config)});
+    files.push_back(
+        {(fs::path(dir) / "best.toml").string(), header + "\n" + io::PrintConfig(*config)});
   }
   RATSLAM_RETURN_IF_ERROR(WriteFilesAtomically(files));
   return report;

@@ -146,7 +146,7 @@ StatusOr<Running> Start(const Plan& plan, const std::string& dir, int index,
   if (!config.ok()) return config.status();
   const std::string config_path = folder + "/config.toml";
   RATSLAM_RETURN_IF_ERROR(
-      WriteFileAtomically(config_path, PrintConfig(*config), /*flush_to_disk=*/false));
+      WriteFileAtomically(config_path, io::PrintConfig(*config), /*flush_to_disk=*/false));
   std::vector<std::string> args = {program, plan.spec.command, "--config", config_path};
   const std::vector<std::string>& data = plan.spec.datasets[task.dataset];
   if (plan.spec.command == "evaluate") {

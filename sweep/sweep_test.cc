@@ -328,7 +328,8 @@ data = ["data/b"]
     sum += nlohmann::json::parse(in).at("map_ate_m").get<double>();
   }
   EXPECT_DOUBLE_EQ(collected->best_objective, sum / 2);
-  StatusOr<fusion::PipelineOptions> best = LoadConfigFile((fs::path(dir) / "best.toml").string());
+  StatusOr<fusion::PipelineOptions> best =
+      io::LoadConfigFile((fs::path(dir) / "best.toml").string());
   ASSERT_TRUE(best.ok()) << best.status().message();
   EXPECT_EQ(best->sensors.wifi.match_threshold, 0.99);
   EXPECT_EQ(best->sensors.fused.recency_s, 10.0);
@@ -696,7 +697,7 @@ data = ["data/a"]
     ASSERT_TRUE(p.objective.has_value());
     EXPECT_DOUBLE_EQ(*p.objective, expected);
     // Every key a real summary has is one a sweep file may name (SummaryKeys is complete).
-    const std::vector<std::string>& keys = SummaryKeys();
+    const std::vector<std::string>& keys = io::SummaryKeys();
     for (const auto& [key, value] : summary.items()) {
       EXPECT_NE(std::find(keys.begin(), keys.end(), key), keys.end()) << key;
     }

@@ -101,7 +101,7 @@ TEST(FaultInjectionTest, KillDuringSaveNeverLeavesATornMap) {
     ASSERT_TRUE(bytes == early_bytes || bytes == late_bytes)
         << "kill " << k << " left a map of " << bytes.size() << " bytes that is neither";
     (bytes == early_bytes ? old_maps : new_maps) += 1;
-    EXPECT_TRUE(LoadMapFile(map.string()).ok());
+    EXPECT_TRUE(io::LoadMapFile(map.string()).ok());
   }
   EXPECT_GT(killed_mid_run, 0);
   // The next complete save removes whatever temporary files the killed saves left.

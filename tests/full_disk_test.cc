@@ -75,7 +75,7 @@ TEST_F(FullDiskTest, ReplayOutputsFailButTheMapIsSavedElsewhere) {
   EXPECT_NE(r.err.find("No space left"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find((disk_ / "run").string()), std::string::npos) << r.err;
   ASSERT_TRUE(fs::exists(map)) << r.err;
-  EXPECT_TRUE(LoadMapFile(map.string()).ok());
+  EXPECT_TRUE(io::LoadMapFile(map.string()).ok());
   EXPECT_FALSE(fs::exists(disk_ / "run" / "summary.json"));  // all outputs or none
   ExpectNoEmptyOrTemporaryFiles(disk_);
 }

@@ -56,10 +56,10 @@ TEST(MalformedInputTest, MapFilesNeverCrash) {
     ASSERT_TRUE(slam.OnView({i * 0.1, i % 25, i < 25, 0.0}).ok());
     ASSERT_TRUE(slam.OnOdometry({i * 0.1, 0.5, 0.05}).ok());
   }
-  MapFile map;
+  io::MapFile map;
   map.state.ratslam = slam.GetState();
   map.state.front_end = "front end bytes";
-  const std::string bytes = EncodeMapFile(map);
+  const std::string bytes = io::EncodeMapFile(map);
   Random rng(1);
   int errors = 0, refused = 0, restored = 0;
   // The checksum refuses every mutated file as it is (checked on the first 200); with the
@@ -69,10 +69,10 @@ TEST(MalformedInputTest, MapFilesNeverCrash) {
     std::string mutated = Mutate(body, rng);
     if (k < 200 && mutated != body) {
       std::string unchecked = mutated + bytes.substr(bytes.size() - 4);
-      EXPECT_FALSE(DecodeMapFile(unchecked, "fuzz").ok()) << k;
+      EXPECT_FALSE(io::DecodeMapFile(unchecked, "fuzz").ok()) << k;
     }
     AppendChecksum(&mutated);
-    StatusOr<MapFile> decoded = DecodeMapFile(mutated, "fuzz");
+    StatusOr<io::MapFile> decoded = io::DecodeMapFile(mutated, "fuzz");
     if (!decoded.ok()) {
       ++errors;
       continue;
@@ -163,10 +163,10 @@ TEST(MalformedInputTest, WorldFilesNeverCrash) {
 }
 
 TEST(MalformedInputTest, ConfigsNeverCrash) {
-  const std::string text = PrintConfig(fusion::PipelineOptions());
+  const std::string text = io::PrintConfig(fusion::PipelineOptions());
   Random rng(2);
   for (int k = 0; k < 500; ++k) {
-    StatusOr<fusion::PipelineOptions> o = ParseConfig(Mutate(text, rng), "fuzz.toml");
+    StatusOr<fusion::PipelineOptions> o = io::ParseConfig(Mutate(text, rng), "fuzz.toml");
     if (!o.ok()) {
       EXPECT_EQ(o.status().message().rfind("fuzz.toml", 0), 0u) << o.status().message();
     }

@@ -244,7 +244,7 @@ TEST_F(ReplayEndToEndTest, SaveMapRefusesToReplaceAFileWithoutOverwrite) {
       RunRatslam(ReplayArgs(out) + " --until 20 --overwrite --save-map " + map.string(), root_)
           .exit_code,
       0);
-  EXPECT_TRUE(LoadMapFile(map.string()).ok());
+  EXPECT_TRUE(io::LoadMapFile(map.string()).ok());
 }
 
 // Inputs that are not regular files (a FIFO, a device) are refused at once instead of blocking
@@ -279,12 +279,12 @@ TEST_F(ReplayEndToEndTest, EveryMapReaderRefusesADanglingLink) {
   const fs::path map = out / "run.map";
   ASSERT_EQ(RunRatslam(ReplayArgs(out) + " --until 60 --save-map " + map.string(), root_).exit_code,
             0);
-  StatusOr<MapFile> loaded = LoadMapFile(map.string());
+  StatusOr<io::MapFile> loaded = io::LoadMapFile(map.string());
   ASSERT_TRUE(loaded.ok()) << loaded.status().message();
   ASSERT_FALSE(loaded->state.ratslam.experience_map.links.empty());
   loaded->state.ratslam.experience_map.links.front().to = 100000;
   const fs::path bad = root_ / "dangling.map";
-  ASSERT_TRUE(SaveMapFile(*loaded, bad.string()).ok());
+  ASSERT_TRUE(io::SaveMapFile(*loaded, bad.string()).ok());
   for (const std::string& command :
        {"route --map " + bad.string() + " --to 0",
         ReplayArgs(root_ / "dangling_resume") + " --load-map " + bad.string()}) {
