@@ -19,9 +19,10 @@
 #include "io/config.h"
 #include "ratslam/experience_map.h"
 #include "render/renderer.h"
+#include "sim/world.h"
 #include "viewer/figure_output.h"
 
-namespace ratslam {
+namespace ratslam::apps {
 
 inline constexpr int kExitOk = 0;
 inline constexpr int kExitError = 1;
@@ -211,12 +212,9 @@ int SweepCollectCommand(const Arguments& args);
 int SweepSubmitCommand(const Arguments& args);
 // Simulates `world` into the replay data set `out` (with world.toml, simulation.json and
 // ground_truth.png); `dataset` receives it.
-namespace sim {
-struct World;
-}
 Status SimulateWorld(const sim::World& world, uint64_t seed, const std::string& out, bool quiet,
                      dataset::Dataset* dataset);
 
-}  // namespace ratslam
+}  // namespace ratslam::apps
 
 #endif  // RATSLAM_APPS_CLI_H_

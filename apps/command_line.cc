@@ -12,7 +12,7 @@
 #include "common/toml_binder.h"
 #include "common/version.h"
 
-namespace ratslam {
+namespace ratslam::apps {
 namespace {
 
 // What an option's value must be.
@@ -832,4 +832,4 @@ std::string BashCompletion() {
   return s.str();
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::apps

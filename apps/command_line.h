@@ -11,7 +11,7 @@
 
 #include "apps/cli.h"
 
-namespace ratslam {
+namespace ratslam::apps {
 
 // A parsed command line: the command's path ("replay", "render pose-cells", "sweep run") and
 // its arguments, already checked (required options present, numbers whole and in range, values
@@ -43,6 +43,6 @@ std::string CommandReference();
 // completion)`.
 std::string BashCompletion();
 
-}  // namespace ratslam
+}  // namespace ratslam::apps
 
 #endif  // RATSLAM_APPS_COMMAND_LINE_H_

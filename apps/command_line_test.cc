@@ -14,7 +14,7 @@
 #include "common/version.h"
 #include "tests/generated_block.h"
 
-namespace ratslam {
+namespace ratslam::apps {
 namespace {
 
 struct Outcome {
@@ -257,4 +257,4 @@ TEST(CommandLineTest, BashCompletionCompletes) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::apps

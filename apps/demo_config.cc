@@ -1,6 +1,6 @@
 #include "apps/demo_config.h"
 
-namespace ratslam {
+namespace ratslam::apps {
 
 fusion::PipelineOptions DemoPipelineOptions() {
   // As configs/sim-fused.toml (see the comments there).
@@ -38,4 +38,4 @@ fusion::PipelineOptions SyntheticPipelineOptions() {
 
 dataset::SyntheticOptions DemoSyntheticOptions() { return dataset::SyntheticOptions(); }
 
-}  // namespace ratslam
+}  // namespace ratslam::apps

@@ -9,7 +9,7 @@
 #include "dataset/synthetic_dataset.h"
 #include "fusion/replay_pipeline.h"
 
-namespace ratslam {
+namespace ratslam::apps {
 
 // Camera (12x9) + Wi-Fi + compass with the b_out rule, for the simulated worlds.
 fusion::PipelineOptions DemoPipelineOptions();
@@ -19,6 +19,6 @@ std::string DemoWorldName();
 fusion::PipelineOptions SyntheticPipelineOptions();
 dataset::SyntheticOptions DemoSyntheticOptions();
 
-}  // namespace ratslam
+}  // namespace ratslam::apps
 
 #endif  // RATSLAM_APPS_DEMO_CONFIG_H_

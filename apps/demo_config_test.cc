@@ -7,7 +7,7 @@
 
 #include "io/config.h"
 
-namespace ratslam {
+namespace ratslam::apps {
 namespace {
 
 TEST(DemoConfigTest, CommittedDemoTomlEqualsBuiltInDemoConfig) {
@@ -43,4 +43,4 @@ TEST(DemoConfigTest, DemoOptionsAreValid) {
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::apps

@@ -19,7 +19,7 @@
 #include "session/image_sequence_evaluation.h"
 #include "viewer/localisation_figure.h"
 
-namespace ratslam {
+namespace ratslam::apps {
 namespace {
 
 // One matcher of the image-sequence benchmark: its name in the table, its label in the figure.
@@ -315,4 +315,4 @@ int EvaluateCommand(const Arguments& parsed) {
   return kExitOk;
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::apps

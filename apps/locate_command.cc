@@ -29,7 +29,7 @@
 #include "viewer/figures.h"
 #include "viewer/localisation_figure.h"
 
-namespace ratslam {
+namespace ratslam::apps {
 namespace {
 
 namespace fs = std::filesystem;
@@ -298,4 +298,4 @@ int CallCommand(const Arguments& parsed) {
   return kExitOk;
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::apps

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <iostream>
 
-namespace ratslam {
+namespace ratslam::apps {
 
 ProgressPrinter::ProgressPrinter(std::FILE* stream, bool quiet, int terminal, const Clock* clock)
     : stream_(stream),
@@ -112,4 +112,4 @@ void PrintOutcome(bool json_flag, bool quiet, const std::string& json, const std
   }
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::apps

@@ -13,7 +13,7 @@
 #include "common/clock.h"
 #include "common/progress.h"
 
-namespace ratslam {
+namespace ratslam::apps {
 
 class ProgressPrinter : public ProgressSink {
  public:
@@ -50,6 +50,6 @@ class ProgressPrinter : public ProgressSink {
 // (unless --json).
 void PrintOutcome(bool json_flag, bool quiet, const std::string& json, const std::string& human);
 
-}  // namespace ratslam
+}  // namespace ratslam::apps
 
 #endif  // RATSLAM_APPS_PROGRESS_H_

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-namespace ratslam {
+namespace ratslam::apps {
 namespace {
 
 class FakeClock : public Clock {
@@ -131,4 +131,4 @@ TEST(ProgressPrinterTest, QuietPrintsNothingAndAnInterruptedPhaseSaysWhereItStop
 }
 
 }  // namespace
-}  // namespace ratslam
+}  // namespace ratslam::apps

@@ -23,8 +23,10 @@ namespace {
 // the folder is locked, a folder holding an earlier run's outputs is refused without --overwrite,
 // the command writes into the guard's staging folder, and its outputs appear in --out together
 // when it ends (kept aside in incomplete-run/ when it fails).
-int RunGuarded(int (*handler)(const ratslam::Arguments&), const ratslam::Arguments& args) {
+int RunGuarded(int (*handler)(const ratslam::apps::Arguments&),
+               const ratslam::apps::Arguments& args) {
   using namespace ratslam;
+  using namespace ratslam::apps;
   const std::string folder = args.Value("--out");
   const bool overwrite = args.values.count("--overwrite") > 0;
   std::vector<std::string> inputs;
@@ -81,6 +83,7 @@ int RunGuarded(int (*handler)(const ratslam::Arguments&), const ratslam::Argumen
 
 int Dispatch(int argc, char** argv) {
   using namespace ratslam;
+  using namespace ratslam::apps;
   std::variant<ParsedCommand, int> parsed = ParseCommandLine(argc, argv, std::cout, std::cerr);
   if (const int* code = std::get_if<int>(&parsed)) return *code;
   ParsedCommand& command = std::get<ParsedCommand>(parsed);
@@ -121,9 +124,9 @@ int main(int argc, char** argv) {
   try {
     return Dispatch(argc, argv);
   } catch (const std::bad_alloc&) {
-    std::cerr << ratslam::MessagePrefix() << "out of memory\n";
+    std::cerr << ratslam::apps::MessagePrefix() << "out of memory\n";
   } catch (const std::exception& e) {
-    std::cerr << ratslam::MessagePrefix() << "internal error: " << e.what() << "\n";
+    std::cerr << ratslam::apps::MessagePrefix() << "internal error: " << e.what() << "\n";
   }
-  return ratslam::kExitInternal;
+  return ratslam::apps::kExitInternal;
 }

@@ -18,7 +18,7 @@
 #include "viewer/run_images.h"
 #include "viewer/similarity.h"
 
-namespace ratslam {
+namespace ratslam::apps {
 namespace {
 
 namespace fs = std::filesystem;
@@ -308,4 +308,4 @@ int RenderWifiMapCommand(const Arguments& args) {
   return status.ok() ? kExitOk : Fail(status.message());
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::apps

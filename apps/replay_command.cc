@@ -42,7 +42,7 @@
 #include "viewer/figures.h"
 #include "viewer/run_images.h"
 
-namespace ratslam {
+namespace ratslam::apps {
 namespace {
 
 namespace fs = std::filesystem;
@@ -417,4 +417,4 @@ int SynthesizeCommand(const Arguments& parsed) {
                     args->Value("--bag"), args->Value("--video"));
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::apps

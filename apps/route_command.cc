@@ -19,7 +19,7 @@
 #include "session/call_session.h"
 #include "viewer/figures.h"
 
-namespace ratslam {
+namespace ratslam::apps {
 namespace {
 
 // A route over a map's experience graph: its nodes' positions, the distances from the start,
@@ -201,4 +201,4 @@ int RouteCommand(const Arguments& args) {
   return kExitOk;
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::apps

@@ -14,7 +14,7 @@
 #include "sim/simulator.h"
 #include "viewer/world_figure.h"
 
-namespace ratslam {
+namespace ratslam::apps {
 
 namespace fs = std::filesystem;
 
@@ -85,4 +85,4 @@ int SimulateCommand(const Arguments& parsed) {
   return kExitOk;
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::apps

@@ -6,7 +6,7 @@
 
 #include "apps/cli.h"
 
-namespace ratslam {
+namespace ratslam::apps {
 namespace {
 
 std::atomic<bool> g_stop_requested{false};
@@ -34,4 +34,4 @@ void StopOnSignalsGuarded() {
   std::signal(SIGTERM, OnGuardedSignal);
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::apps

@@ -18,7 +18,7 @@
 #include "sweep/sweep.h"
 #include "viewer/sweep_figures.h"
 
-namespace ratslam {
+namespace ratslam::apps {
 namespace {
 
 std::atomic<bool> g_sweep_stop{false};
@@ -218,4 +218,4 @@ int SweepCollectCommand(const Arguments& parsed) {
   return kExitOk;
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::apps

@@ -8,7 +8,7 @@
 
 #include "viewer/figures.h"
 
-namespace ratslam {
+namespace ratslam::apps {
 
 Status WriteWifiSequenceImages(render::SceneRenderer* renderer,
                                const fusion::ReplayPipeline& pipeline, const std::string& folder,
@@ -83,4 +83,4 @@ Status WriteWifiSequenceImages(render::SceneRenderer* renderer,
       "wifi_sequence_pairs.png");
 }
 
-}  // namespace ratslam
+}  // namespace ratslam::apps

@@ -10,7 +10,7 @@
 #include "render/renderer.h"
 #include "viewer/figure_output.h"
 
-namespace ratslam {
+namespace ratslam::apps {
 
 // Writes wifi_sequence_similarity.png (the smoothed similarity of every pair of scans, at most
 // 1000 x 1000 cells, with each loop's correspondences marked: verified, rejected) and
@@ -21,6 +21,6 @@ Status WriteWifiSequenceImages(render::SceneRenderer* renderer,
                                const fusion::ReplayPipeline& pipeline, const std::string& folder,
                                const std::vector<viewer::FigureFormat>& formats, double width_mm);
 
-}  // namespace ratslam
+}  // namespace ratslam::apps
 
 #endif  // RATSLAM_APPS_WIFI_SEQUENCE_IMAGES_H_

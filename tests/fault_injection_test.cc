@@ -55,7 +55,8 @@ int Wait(pid_t pid) {
 
 TEST(FaultInjectionTest, KillDuringSaveNeverLeavesATornMap) {
   ScratchDir dir("ratslam_fault");
-  ASSERT_TRUE(dataset::WriteSyntheticDataset(DemoSyntheticOptions(), (dir / "data").string()).ok());
+  ASSERT_TRUE(
+      dataset::WriteSyntheticDataset(apps::DemoSyntheticOptions(), (dir / "data").string()).ok());
   const std::string config = std::string(RATSLAM_SOURCE_DIR) + "/configs/synthetic.toml";
   auto replay = [&](double until, const fs::path& map) {
     return std::vector<std::string>{"replay",

@@ -85,7 +85,7 @@ class ReplayEndToEndTest : public ::testing::Test {
     fs::remove_all(root_);
     fs::create_directories(root_);
     StatusOr<dataset::Dataset> d =
-        dataset::WriteSyntheticDataset(DemoSyntheticOptions(), (root_ / "data").string());
+        dataset::WriteSyntheticDataset(apps::DemoSyntheticOptions(), (root_ / "data").string());
     ASSERT_TRUE(d.ok()) << d.status().message();
     config_ = (fs::path(RATSLAM_SOURCE_DIR) / "configs" / "synthetic.toml").string();
   }
@@ -1160,9 +1160,9 @@ TEST_F(ReplayEndToEndTest, RouteIsTheShortestPathOverTheExperienceGraph) {
 // with ground truth through the map run's own alignment (an oracle independent of the
 // localisation run) far better than chance. A session in another world recognises nothing.
 TEST_F(ReplayEndToEndTest, LocalisationOnASavedMapFollowsTheNextSession) {
-  dataset::SyntheticOptions map_options = DemoSyntheticOptions();
+  dataset::SyntheticOptions map_options = apps::DemoSyntheticOptions();
   map_options.laps = 2;
-  dataset::SyntheticOptions next = DemoSyntheticOptions();
+  dataset::SyntheticOptions next = apps::DemoSyntheticOptions();
   next.laps = 1;
   next.noise_seed = 7;
   next.start_m = 60.0;
