@@ -476,17 +476,22 @@ namespace {
 constexpr const char* kOpenRatslamKeysWithoutEquivalent[] = {
     "enable",     "vt_window_width", "vt_window_height", "media_path",
     "image_file", "exp_map_size",    "posecells_size"};
-}  // namespace
 
-StatusOr<ImportedConfig> ImportOpenRatslamIni(const std::string& path) {
-  StatusOr<std::string> text = ReadRegularFile(path, "INI file", kMaxConfigBytes);
-  if (!text.ok()) return text.status();
-  std::istringstream in(*text);
-  ImportedConfig imported;
-  fusion::PipelineOptions& o = imported.options;
-  // OpenRatSLAM relaxes every link exp_loops times after each action.
-  o.ratslam.experience_map.relaxation_scheme = RelaxationScheme::kFull;
-  using Setter = std::function<Status(double)>;
+using IniSetter = std::function<Status(double)>;
+
+// OpenRatSLAM key -> our field, the field's name in our validation messages, and
+// OpenRatSLAM's own default, which an INI that leaves the key out gets (ratslam_ros branch;
+// ../shared/reference/openratslam-facts.md, section 2). vt_shift_match 25 in steps of 5 is
+// what New College, which sets neither, searches.
+struct IniKey {
+  const char* name;
+  IniSetter set;
+  const char* field;  // as PipelineOptions::IsValid names it
+  double openratslam_default;
+};
+
+// The keys, each setting its field of `o` (which must outlive the setters).
+std::vector<IniKey> OpenRatslamKeys(fusion::PipelineOptions& o) {
   auto whole = [](int& field) {
     return [&field](double v) {
       if (v != std::floor(v) || !(std::abs(v) <= std::numeric_limits<int>::max())) {
@@ -510,17 +515,7 @@ StatusOr<ImportedConfig> ImportOpenRatslamIni(const std::string& path) {
       return Status::Ok();
     };
   };
-  // OpenRatSLAM key -> our field, the field's name in our validation messages, and
-  // OpenRatSLAM's own default, which an INI that leaves the key out gets (ratslam_ros branch;
-  // ../shared/reference/openratslam-facts.md, section 2). vt_shift_match 25 in steps of 5 is
-  // what New College, which sets neither, searches.
-  struct Key {
-    const char* name;
-    Setter set;
-    const char* field;  // as PipelineOptions::IsValid names it
-    double openratslam_default;
-  };
-  const std::vector<Key> keys = {
+  return {
       {"pc_dim_xy", whole(o.ratslam.pose_cells.dim_xy_cells), "pose_cells.dim_xy_cells", 21},
       {"pc_dim_th", whole(o.ratslam.pose_cells.dim_theta_cells), "pose_cells.dim_theta_cells", 36},
       {"pc_cell_x_size", real(o.ratslam.pose_cells.cell_size_m), "pose_cells.cell_size_m", 1.0},
@@ -610,8 +605,50 @@ StatusOr<ImportedConfig> ImportOpenRatslamIni(const std::string& path) {
        },
        "camera.panoramic", 0},
   };
-  std::map<std::string, Setter> setters;
-  for (const Key& k : keys) {
+}
+
+// For a validation error of imported values: the INI lines that set the values the message is
+// about, or that OpenRatSLAM's default was used for them ("; path:line: key = value, ...").
+std::string IniLinesAbout(const std::string& error, const std::vector<IniKey>& keys,
+                          const std::map<std::string, std::string>& set_at) {
+  std::string about;
+  for (const IniKey& k : keys) {
+    const std::string field = k.field;
+    const std::string short_field = field.substr(field.find('.') + 1);
+    const bool named =
+        error.rfind(field, 0) == 0 || error.find(" " + short_field) != std::string::npos;
+    if (!named) continue;
+    about += about.empty() ? "; " : ", ";
+    if (auto at = set_at.find(k.name); at != set_at.end()) {
+      about += at->second;
+    } else {
+      about += std::string(k.name) + " not set (OpenRatSLAM's default " +
+               ShortestNumber(k.openratslam_default) + ")";
+    }
+  }
+  return about;
+}
+
+// `s` without leading and trailing spaces and tabs.
+std::string TrimBlanks(const std::string& s) {
+  const auto b = s.find_first_not_of(" \t");
+  const auto e = s.find_last_not_of(" \t");
+  return b == std::string::npos ? std::string() : s.substr(b, e - b + 1);
+}
+
+}  // namespace
+
+StatusOr<ImportedConfig> ImportOpenRatslamIni(const std::string& path) {
+  StatusOr<std::string> text = ReadRegularFile(path, "INI file", kMaxConfigBytes);
+  if (!text.ok()) return text.status();
+  std::istringstream in(*text);
+  ImportedConfig imported;
+  fusion::PipelineOptions& o = imported.options;
+  // OpenRatSLAM relaxes every link exp_loops times after each action.
+  o.ratslam.experience_map.relaxation_scheme = RelaxationScheme::kFull;
+  const std::vector<IniKey> keys = OpenRatslamKeys(o);
+  std::map<std::string, IniSetter> setters;
+  for (const IniKey& k : keys) {
     setters[k.name] = k.set;
     (void)k.set(k.openratslam_default);  // every default is valid for its setter
   }
@@ -640,13 +677,8 @@ StatusOr<ImportedConfig> ImportOpenRatslamIni(const std::string& path) {
     }
     const auto eq = line.find('=');
     if (eq == std::string::npos) return Status::Error(where + ": expected key=value");
-    auto trim = [](std::string s) {
-      const auto b = s.find_first_not_of(" \t");
-      const auto e = s.find_last_not_of(" \t");
-      return b == std::string::npos ? std::string() : s.substr(b, e - b + 1);
-    };
-    const std::string key = trim(line.substr(0, eq));
-    const std::string value = trim(line.substr(eq + 1));
+    const std::string key = TrimBlanks(line.substr(0, eq));
+    const std::string value = TrimBlanks(line.substr(eq + 1));
     if (key == "topic_root") {
       topic_root = value;
       topic_root_at = where + ": [" + section + "] " + key + " = " + value;
@@ -702,23 +734,7 @@ StatusOr<ImportedConfig> ImportOpenRatslamIni(const std::string& path) {
   }
   std::string error;
   if (!o.IsValid(&error)) {
-    // Name the INI lines that set the values the message is about, or say that OpenRatSLAM's
-    // default was used for them.
-    std::string about;
-    for (const Key& k : keys) {
-      const std::string field = k.field;
-      const std::string short_field = field.substr(field.find('.') + 1);
-      const bool named =
-          error.rfind(field, 0) == 0 || error.find(" " + short_field) != std::string::npos;
-      if (!named) continue;
-      about += about.empty() ? "; " : ", ";
-      if (auto at = set_at.find(k.name); at != set_at.end()) {
-        about += at->second;
-      } else {
-        about += std::string(k.name) + " not set (OpenRatSLAM's default " +
-                 ShortestNumber(k.openratslam_default) + ")";
-      }
-    }
+    std::string about = IniLinesAbout(error, keys, set_at);
     if (error.rfind("bag.", 0) == 0) about += "; " + topic_root_at;
     return Status::Error(path + ": imported values are invalid: " + error + about);
   }

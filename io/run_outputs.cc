@@ -255,115 +255,91 @@ std::vector<double> LocalisationErrors(const std::vector<LocalisationRecord>& re
   return errors;
 }
 
-RunSummary Summarise(const fusion::ReplayPipeline& pipeline, const dataset::Dataset& dataset,
-                     const RunInfo& info) {
+namespace {
+
+// What ground truth says about the run: the map's, trajectory's and odometry's ATE, and how far
+// apart the true positions of every loop-closing template match are (a match to another floor
+// infinitely far).
+void ScoreAgainstGroundTruth(const fusion::ReplayPipeline& pipeline,
+                             const dataset::Dataset& dataset, RunSummary* summary) {
+  RunSummary& s = *summary;
   const fusion::ReplayPipeline::State& state = pipeline.state();
   const Ratslam& slam = pipeline.slam();
   const ExperienceMap& map = slam.experience_map();
-  RunSummary s;
-  s.frames = state.frames.size();
-  s.templates = slam.local_view().size();
-  s.experiences = map.num_experiences();
-  s.links = map.num_links();
-  s.loop_closures = slam.counters().loop_closures;
-
-  if (!dataset.ground_truth.empty()) {
-    // The experience map: every experience against the true position at its creation.
-    std::vector<Point2> estimate, truth;
-    // (A localisation run's experiences were made on another data set's clock.)
-    for (const Experience& e : map.experiences()) {
-      if (pipeline.localising()) break;
-      if (auto gt = dataset::GroundTruthAt(dataset, e.time_s)) {
-        estimate.push_back({e.x_m, e.y_m});
-        truth.push_back({gt->x_m, gt->y_m});
-      }
-    }
-    if (auto a = AlignRigid2D(estimate, truth)) s.map_ate_m = a->rmse_m;
-    // The corrected trajectory and raw odometry, at the times the TUM files hold (so evo on
-    // trajectory_tum.txt and ground_truth_tum.txt reproduces these numbers).
-    std::vector<Point2> corrected, odometry;
-    truth.clear();
-    for (size_t i = 0; i < state.trajectory.size(); ++i) {
-      const TrajectoryRecord& r = state.trajectory[i];
-      if (!InTumFiles(state.trajectory, i)) continue;
-      if (auto gt = dataset::GroundTruthAt(dataset, r.time_s)) {
-        double x, y, theta;
-        RecordPose(map, r, &x, &y, &theta);
-        corrected.push_back({x, y});
-        odometry.push_back({r.odometry_x_m, r.odometry_y_m});
-        truth.push_back({gt->x_m, gt->y_m});
-      }
-    }
-    if (auto a = AlignRigid2D(corrected, truth)) s.trajectory_ate_m = a->rmse_m;
-    if (auto a = AlignRigid2D(odometry, truth)) s.odometry_ate_m = a->rmse_m;
-    s.ate_points = truth.size();
-
-    // Every template match: how far is the true position now from the true position where the
-    // matched template was stored? A match to another floor is a floor mistake, infinitely far
-    // (a miss at every d, as in the localisation benchmark).
-    const auto session_of = [&](double t) {
-      size_t k = 0;
-      while (k + 1 < dataset.session_start_times_s.size() &&
-             t >= dataset.session_start_times_s[k + 1]) {
-        ++k;
-      }
-      return k;
-    };
-    for (const FrameRecord& f : state.frames) {
-      if (pipeline.localising()) break;    // templates stored on another data set's clock
-      if (f.is_new || f.recent) continue;  // only matches that can close a loop
-      const double created_s = slam.local_view().at(f.template_id).created_time_s;
-      const auto now = dataset::GroundTruthAt(dataset, f.time_s);
-      const auto then = dataset::GroundTruthAt(dataset, created_s);
-      if (!now || !then) continue;
-      ++s.evaluated_matches;
-      // Floors are known only where the ground-truth points around a time agree. A match with
-      // either end between points on different floors (on the stairs) cannot be judged: it is
-      // counted as unverified and left out of the rates.
-      const std::optional<int> floor_now = dataset::KnownFloorAt(dataset, f.time_s);
-      const std::optional<int> floor_then = dataset::KnownFloorAt(dataset, created_s);
-      if (!floor_now || !floor_then) {
-        ++s.floor_unverified_matches;
-        continue;
-      }
-      const bool other_floor = *floor_now != *floor_then;
-      const double distance = other_floor ? std::numeric_limits<double>::infinity()
-                                          : std::hypot(now->x_m - then->x_m, now->y_m - then->y_m);
-      s.match_distances_m.push_back(distance);
-      if (other_floor) ++s.floor_mistakes;
-      if (session_of(f.time_s) != session_of(slam.local_view().at(f.template_id).created_time_s)) {
-        s.cross_session_distances_m.push_back(distance);
-      }
+  // The experience map: every experience against the true position at its creation.
+  std::vector<Point2> estimate, truth;
+  // (A localisation run's experiences were made on another data set's clock.)
+  for (const Experience& e : map.experiences()) {
+    if (pipeline.localising()) break;
+    if (auto gt = dataset::GroundTruthAt(dataset, e.time_s)) {
+      estimate.push_back({e.x_m, e.y_m});
+      truth.push_back({gt->x_m, gt->y_m});
     }
   }
+  if (auto a = AlignRigid2D(estimate, truth)) s.map_ate_m = a->rmse_m;
+  // The corrected trajectory and raw odometry, at the times the TUM files hold (so evo on
+  // trajectory_tum.txt and ground_truth_tum.txt reproduces these numbers).
+  std::vector<Point2> corrected, odometry;
+  truth.clear();
+  for (size_t i = 0; i < state.trajectory.size(); ++i) {
+    const TrajectoryRecord& r = state.trajectory[i];
+    if (!InTumFiles(state.trajectory, i)) continue;
+    if (auto gt = dataset::GroundTruthAt(dataset, r.time_s)) {
+      double x, y, theta;
+      RecordPose(map, r, &x, &y, &theta);
+      corrected.push_back({x, y});
+      odometry.push_back({r.odometry_x_m, r.odometry_y_m});
+      truth.push_back({gt->x_m, gt->y_m});
+    }
+  }
+  if (auto a = AlignRigid2D(corrected, truth)) s.trajectory_ate_m = a->rmse_m;
+  if (auto a = AlignRigid2D(odometry, truth)) s.odometry_ate_m = a->rmse_m;
+  s.ate_points = truth.size();
 
-  nlohmann::ordered_json j;
-  j["dataset"] = dataset.name;
-  if (!dataset.folder.empty()) j["data_folder"] = info.provenance.Recorded(dataset.folder);
-  // Malformed phone-log lines that --lenient skipped (absent: none).
-  if (dataset.skipped_malformed_lines > 0) {
-    j["skipped_malformed_lines"] = dataset.skipped_malformed_lines;
+  // Every template match: how far is the true position now from the true position where the
+  // matched template was stored? A match to another floor is a floor mistake, infinitely far
+  // (a miss at every d, as in the localisation benchmark).
+  const auto session_of = [&](double t) {
+    size_t k = 0;
+    while (k + 1 < dataset.session_start_times_s.size() &&
+           t >= dataset.session_start_times_s[k + 1]) {
+      ++k;
+    }
+    return k;
+  };
+  for (const FrameRecord& f : state.frames) {
+    if (pipeline.localising()) break;    // templates stored on another data set's clock
+    if (f.is_new || f.recent) continue;  // only matches that can close a loop
+    const double created_s = slam.local_view().at(f.template_id).created_time_s;
+    const auto now = dataset::GroundTruthAt(dataset, f.time_s);
+    const auto then = dataset::GroundTruthAt(dataset, created_s);
+    if (!now || !then) continue;
+    ++s.evaluated_matches;
+    // Floors are known only where the ground-truth points around a time agree. A match with
+    // either end between points on different floors (on the stairs) cannot be judged: it is
+    // counted as unverified and left out of the rates.
+    const std::optional<int> floor_now = dataset::KnownFloorAt(dataset, f.time_s);
+    const std::optional<int> floor_then = dataset::KnownFloorAt(dataset, created_s);
+    if (!floor_now || !floor_then) {
+      ++s.floor_unverified_matches;
+      continue;
+    }
+    const bool other_floor = *floor_now != *floor_then;
+    const double distance = other_floor ? std::numeric_limits<double>::infinity()
+                                        : std::hypot(now->x_m - then->x_m, now->y_m - then->y_m);
+    s.match_distances_m.push_back(distance);
+    if (other_floor) ++s.floor_mistakes;
+    if (session_of(f.time_s) != session_of(slam.local_view().at(f.template_id).created_time_s)) {
+      s.cross_session_distances_m.push_back(distance);
+    }
   }
-  j["frames"] = s.frames;
-  j["templates"] = s.templates;
-  j["experiences"] = s.experiences;
-  // Where the robot is at the end (the experience map's current experience, after the last
-  // odometry step; frames.csv's last row may predate it). Absent before the first experience.
-  if (map.current()) j["current_experience"] = *map.current();
-  j["links"] = s.links;
-  j["loop_closures"] = s.loop_closures;
-  if (map.options().relaxation_scheme == RelaxationScheme::kIncremental) {
-    j["relaxation_capped_passes"] = map.relaxation_capped_passes();
-  }
-  if (map.options().relaxation_scheme != RelaxationScheme::kLeastSquares) {
-    j["relaxation_link_updates"] = map.relaxation_link_updates();
-  }
-  j["odometry_steps"] = state.trajectory.size();
-  j["view_injections"] = slam.counters().injections;
-  j["refused_ambiguous_links"] = slam.counters().refused_ambiguous;
-  j["wifi_scans"] = state.wifi_scans_seen;
-  j["compass_readings"] = state.compass_readings_seen;
-  j["images_unused"] = state.images_skipped;
+}
+
+// The front end's counts and reports: frames by decision source, FABMAP's Wi-Fi learning, RSSI
+// offsets, revisit updates and the barometer.
+void AddFrontEndReports(const fusion::ReplayPipeline& pipeline, nlohmann::ordered_json* json) {
+  nlohmann::ordered_json& j = *json;
+  const fusion::ReplayPipeline::State& state = pipeline.state();
   size_t by_source[3] = {0, 0, 0};
   size_t recent = 0;
   for (const FrameRecord& f : state.frames) {
@@ -397,17 +373,13 @@ RunSummary Summarise(const fusion::ReplayPipeline& pipeline, const dataset::Data
                       {"floor_offset_changes", floors->floor_offset_changes},
                       {"session_floor_offsets", floors->session_floor_offsets}};
   }
-  if (dataset.session_start_times_s.size() > 1) {
-    j["sessions"] = dataset.session_start_times_s.size();
-    std::vector<std::string> names;
-    for (size_t i = 0; i < dataset.session_start_times_s.size(); ++i) {
-      names.push_back(dataset.SessionName(i));
-    }
-    j["session_names"] = names;
-  }
-  if (pipeline.wifi_sequence().options().enabled) {
-    j["wifi_sequence"] = SequenceSummary(pipeline.wifi_sequence(), map, dataset);
-  }
+}
+
+// Cross-session place recognition scored by frame (absent when no frame can be scored).
+void AddCrossSessionPlaces(const fusion::ReplayPipeline& pipeline, const dataset::Dataset& dataset,
+                           nlohmann::ordered_json* json) {
+  nlohmann::ordered_json& j = *json;
+  const fusion::ReplayPipeline::State& state = pipeline.state();
   if (const CrossSessionPlaces places = ScoreCrossSessionPlaces(state.frames, dataset);
       places.frames > 0) {
     const auto share = [](size_t n, size_t of) {
@@ -428,6 +400,108 @@ RunSummary Summarise(const fusion::ReplayPipeline& pipeline, const dataset::Data
     p["precision_within_frames"] = precision;
     j["cross_session_places"] = p;
   }
+}
+
+// A localisation run on a saved map: lost frames, recognitions and, with ground truth, errors.
+nlohmann::ordered_json LocalisationJson(const fusion::ReplayPipeline& pipeline,
+                                        const dataset::Dataset& dataset, const RunInfo& info,
+                                        RunSummary* summary) {
+  RunSummary& s = *summary;
+  const Ratslam& slam = pipeline.slam();
+  const std::vector<LocalisationRecord>& records = pipeline.localisation();
+  size_t lost = 0;
+  std::vector<uint32_t> visited;
+  for (const LocalisationRecord& r : records) {
+    lost += r.lost;
+    if (r.experience_id >= 0) visited.push_back(static_cast<uint32_t>(r.experience_id));
+  }
+  std::sort(visited.begin(), visited.end());
+  visited.erase(std::unique(visited.begin(), visited.end()), visited.end());
+  s.lost_fraction =
+      records.empty() ? 1.0 : static_cast<double>(lost) / static_cast<double>(records.size());
+  nlohmann::ordered_json l;
+  l["map"] = info.localised_on;
+  l["frames"] = records.size();
+  l["lost_fraction"] = *s.lost_fraction;
+  l["lost_after_m"] = info.lost_after_m;
+  l["recognitions"] = slam.localisation_counters().recognitions;
+  l["relocalisations"] = slam.localisation_counters().relocalisations;
+  l["experiences_recognised"] = visited.size();
+  l["unmapped_views"] = slam.localisation_counters().unmapped_views;
+  if (!dataset.ground_truth.empty()) {
+    s.localisation_errors_m =
+        LocalisationErrors(records, dataset.ground_truth, nullptr, dataset.session_start_times_s);
+    std::vector<double> known;
+    for (double e : s.localisation_errors_m) {
+      if (!std::isnan(e)) known.push_back(e);
+    }
+    l["error_points"] = known.size();
+    if (!known.empty()) {
+      std::nth_element(known.begin(), known.begin() + known.size() / 2, known.end());
+      s.localisation_median_error_m = known[known.size() / 2];
+      l["median_error_m"] = *s.localisation_median_error_m;
+      l["error_alignment"] = "rigid least-squares fit of the frames not lost to ground truth";
+    }
+  }
+  return l;
+}
+
+}  // namespace
+
+RunSummary Summarise(const fusion::ReplayPipeline& pipeline, const dataset::Dataset& dataset,
+                     const RunInfo& info) {
+  const fusion::ReplayPipeline::State& state = pipeline.state();
+  const Ratslam& slam = pipeline.slam();
+  const ExperienceMap& map = slam.experience_map();
+  RunSummary s;
+  s.frames = state.frames.size();
+  s.templates = slam.local_view().size();
+  s.experiences = map.num_experiences();
+  s.links = map.num_links();
+  s.loop_closures = slam.counters().loop_closures;
+
+  if (!dataset.ground_truth.empty()) ScoreAgainstGroundTruth(pipeline, dataset, &s);
+
+  nlohmann::ordered_json j;
+  j["dataset"] = dataset.name;
+  if (!dataset.folder.empty()) j["data_folder"] = info.provenance.Recorded(dataset.folder);
+  // Malformed phone-log lines that --lenient skipped (absent: none).
+  if (dataset.skipped_malformed_lines > 0) {
+    j["skipped_malformed_lines"] = dataset.skipped_malformed_lines;
+  }
+  j["frames"] = s.frames;
+  j["templates"] = s.templates;
+  j["experiences"] = s.experiences;
+  // Where the robot is at the end (the experience map's current experience, after the last
+  // odometry step; frames.csv's last row may predate it). Absent before the first experience.
+  if (map.current()) j["current_experience"] = *map.current();
+  j["links"] = s.links;
+  j["loop_closures"] = s.loop_closures;
+  if (map.options().relaxation_scheme == RelaxationScheme::kIncremental) {
+    j["relaxation_capped_passes"] = map.relaxation_capped_passes();
+  }
+  if (map.options().relaxation_scheme != RelaxationScheme::kLeastSquares) {
+    j["relaxation_link_updates"] = map.relaxation_link_updates();
+  }
+  j["odometry_steps"] = state.trajectory.size();
+  j["view_injections"] = slam.counters().injections;
+  j["refused_ambiguous_links"] = slam.counters().refused_ambiguous;
+  j["wifi_scans"] = state.wifi_scans_seen;
+  j["compass_readings"] = state.compass_readings_seen;
+  j["images_unused"] = state.images_skipped;
+  AddFrontEndReports(pipeline, &j);
+  if (dataset.session_start_times_s.size() > 1) {
+    j["sessions"] = dataset.session_start_times_s.size();
+    std::vector<std::string> names;
+    for (size_t i = 0; i < dataset.session_start_times_s.size(); ++i) {
+      names.push_back(dataset.SessionName(i));
+    }
+    j["session_names"] = names;
+  }
+  if (pipeline.wifi_sequence().options().enabled) {
+    j["wifi_sequence"] = SequenceSummary(pipeline.wifi_sequence(), map, dataset);
+  }
+  AddCrossSessionPlaces(pipeline, dataset, &j);
   j["events_done"] = state.next_event;
   j["events_total"] = state.events_total;
   j["finished"] = pipeline.finished();
@@ -439,44 +513,7 @@ RunSummary Summarise(const fusion::ReplayPipeline& pipeline, const dataset::Data
   j["config"] = info.config_path.empty() ? "(defaults)" : info.config_path;
   j["config_fingerprint"] = FingerprintHex(info.config_fingerprint);
   if (!info.resumed_from.empty()) j["resumed_from"] = info.resumed_from;
-  if (pipeline.localising()) {
-    const std::vector<LocalisationRecord>& records = pipeline.localisation();
-    size_t lost = 0;
-    std::vector<uint32_t> visited;
-    for (const LocalisationRecord& r : records) {
-      lost += r.lost;
-      if (r.experience_id >= 0) visited.push_back(static_cast<uint32_t>(r.experience_id));
-    }
-    std::sort(visited.begin(), visited.end());
-    visited.erase(std::unique(visited.begin(), visited.end()), visited.end());
-    s.lost_fraction =
-        records.empty() ? 1.0 : static_cast<double>(lost) / static_cast<double>(records.size());
-    nlohmann::ordered_json l;
-    l["map"] = info.localised_on;
-    l["frames"] = records.size();
-    l["lost_fraction"] = *s.lost_fraction;
-    l["lost_after_m"] = info.lost_after_m;
-    l["recognitions"] = slam.localisation_counters().recognitions;
-    l["relocalisations"] = slam.localisation_counters().relocalisations;
-    l["experiences_recognised"] = visited.size();
-    l["unmapped_views"] = slam.localisation_counters().unmapped_views;
-    if (!dataset.ground_truth.empty()) {
-      s.localisation_errors_m =
-          LocalisationErrors(records, dataset.ground_truth, nullptr, dataset.session_start_times_s);
-      std::vector<double> known;
-      for (double e : s.localisation_errors_m) {
-        if (!std::isnan(e)) known.push_back(e);
-      }
-      l["error_points"] = known.size();
-      if (!known.empty()) {
-        std::nth_element(known.begin(), known.begin() + known.size() / 2, known.end());
-        s.localisation_median_error_m = known[known.size() / 2];
-        l["median_error_m"] = *s.localisation_median_error_m;
-        l["error_alignment"] = "rigid least-squares fit of the frames not lost to ground truth";
-      }
-    }
-    j["localisation"] = l;
-  }
+  if (pipeline.localising()) j["localisation"] = LocalisationJson(pipeline, dataset, info, &s);
   // A replay draws no random number outside its configuration's own seeds.
   j["run"] = RunObject(info.provenance, info.inputs, std::nullopt, info.config_fingerprint);
   if (s.map_ate_m) j["map_ate_m"] = *s.map_ate_m;

@@ -134,37 +134,12 @@ StatusOr<WifiGpOptions> FitHyperparameters(const std::vector<std::vector<Trainin
   return best;
 }
 
-}  // namespace
-
-StatusOr<WifiGpMap> WifiGpMap::Build(const std::vector<WifiMapSample>& samples,
-                                     const WifiGpOptions& options) {
-  std::string error;
-  if (!options.IsValid(&error)) return Status::Error("Wi-Fi map options: " + error);
-  if (samples.empty()) return Status::Error("Wi-Fi map: no scan with a position to learn from");
-  WifiGpMap map;
-  map.options_ = options;
-  map.training_ = samples;
-  // Per AP, the samples that heard it (the strongest reading of a BSSID heard twice).
-  std::vector<std::map<size_t, double>> heard_by;
-  for (size_t i = 0; i < samples.size(); ++i) {
-    const WifiMapSample& s = samples[i];
-    if (!std::isfinite(s.position.x) || !std::isfinite(s.position.y) ||
-        std::abs(s.position.x) > 1e7 || std::abs(s.position.y) > 1e7) {
-      return Status::Error("Wi-Fi map: sample " + std::to_string(i) + " has no finite position");
-    }
-    for (const auto& [bssid, rssi] : s.readings) {
-      if (!std::isfinite(rssi)) {
-        return Status::Error("Wi-Fi map: sample " + std::to_string(i) + " has a non-finite RSSI");
-      }
-      auto [it, added] = map.index_.emplace(bssid, map.bssids_.size());
-      if (added) {
-        map.bssids_.push_back(bssid);
-        heard_by.emplace_back();
-      }
-      auto [at, first] = heard_by[it->second].emplace(i, rssi);
-      if (!first) at->second = std::max(at->second, rssi);
-    }
-  }
+// Training sets per AP and floor: heard bins, and bins within unheard_reach_m of one (an AP not
+// heard counts as unheard_rssi_dbm), as bin centroid, mean RSSI and sample count. `heard_by[ap]`
+// maps each sample that heard the AP to its RSSI.
+std::vector<std::vector<TrainingSet>> TrainingSetsOf(
+    const std::vector<WifiMapSample>& samples,
+    const std::vector<std::map<size_t, double>>& heard_by, const WifiGpOptions& options) {
   // Samples binned per floor.
   std::map<int, std::map<Key, Bin>> bins;
   for (size_t i = 0; i < samples.size(); ++i) {
@@ -173,10 +148,8 @@ StatusOr<WifiGpMap> WifiGpMap::Build(const std::vector<WifiMapSample>& samples,
     b.sum_y += samples[i].position.y;
     b.samples.push_back(i);
   }
-  // Training sets per AP and floor: heard bins, and bins within unheard_reach_m of one (an AP
-  // not heard counts as unheard_rssi_dbm), as bin centroid, mean RSSI and sample count.
-  std::vector<std::vector<TrainingSet>> sets(map.bssids_.size());
-  for (size_t ap = 0; ap < map.bssids_.size(); ++ap) {
+  std::vector<std::vector<TrainingSet>> sets(heard_by.size());
+  for (size_t ap = 0; ap < heard_by.size(); ++ap) {
     std::map<int, std::vector<Key>> heard_bins;  // per floor
     for (const auto& [i, rssi] : heard_by[ap]) {
       heard_bins[samples[i].floor].push_back(CellOf(samples[i].position, options.bin_size_m));
@@ -211,22 +184,17 @@ StatusOr<WifiGpMap> WifiGpMap::Build(const std::vector<WifiMapSample>& samples,
       sets[ap].push_back(std::move(set));
     }
   }
-  if (options.fit_hyperparameters) {
-    WifiGpFitReport report;
-    StatusOr<WifiGpOptions> fitted = FitHyperparameters(sets, options, &report);
-    if (!fitted.ok()) return fitted.status();
-    map.options_ = *fitted;
-    map.fit_ = report;
-  }
-  const WifiGpOptions& o = map.options_;
-  const double noise2 = o.noise_sigma_dbm * o.noise_sigma_dbm;
-  const double signal2 = o.signal_sigma_dbm * o.signal_sigma_dbm;
-  const double reach = 4.0 * o.length_scale_m;  // kernel below e^-8 beyond
+  return sets;
+}
+
+// Grid cells the maps of `sets` would need at most, from each grid's bounding box (heard bins
+// plus the margin): checked before any is built (a cell of 1 cm once started and ran the machine
+// out of memory).
+double GridCellsNeeded(const std::vector<std::vector<TrainingSet>>& sets,
+                       const WifiGpOptions& options) {
   const double cell = options.cell_size_m;
-  // Memory and time up front, from each grid's bounding box (heard bins plus the margin): a cell
-  // of 1 cm once started and ran the machine out of memory.
   double total_cells = 0.0;
-  for (size_t ap = 0; ap < map.bssids_.size(); ++ap) {
+  for (size_t ap = 0; ap < sets.size(); ++ap) {
     for (const TrainingSet& set : sets[ap]) {
       int min_x = std::numeric_limits<int>::max(), min_y = min_x;
       int max_x = std::numeric_limits<int>::min(), max_y = max_x;
@@ -242,6 +210,146 @@ StatusOr<WifiGpMap> WifiGpMap::Build(const std::vector<WifiMapSample>& samples,
       total_cells += std::ceil(width_m / cell + 1) * std::ceil(height_m / cell + 1);
     }
   }
+  return total_cells;
+}
+
+// One AP's map on one floor: the cells within grid_margin_m of a heard bin, each predicted by a
+// local GP fitted per tile to the training points within reach of the tile. `fitted` holds the
+// GP's hyperparameters (fitted or as configured), `options` the grid's layout.
+StatusOr<WifiGpMap::Grid> PredictGrid(const TrainingSet& set, const WifiGpOptions& fitted,
+                                      const WifiGpOptions& options, const std::string& bssid) {
+  const WifiGpOptions& o = fitted;
+  const double noise2 = o.noise_sigma_dbm * o.noise_sigma_dbm;
+  const double signal2 = o.signal_sigma_dbm * o.signal_sigma_dbm;
+  const double reach = 4.0 * o.length_scale_m;  // kernel below e^-8 beyond
+  const double cell = options.cell_size_m;
+  const int floor = set.floor;
+  const std::vector<Key>& keys = set.heard_bins;
+  const std::vector<Point2>& points = set.points;
+  const std::vector<double>& values = set.values;
+  std::vector<double> noise;
+  for (double n : set.counts) noise.push_back(noise2 / n);
+  // Cells to store: within grid_margin_m of a heard bin's centre.
+  std::set<Key> cells;
+  const int margin = static_cast<int>(std::ceil(options.grid_margin_m / cell)) + 1;
+  for (const Key& k : keys) {
+    const Point2 c{(k.first + 0.5) * options.bin_size_m, (k.second + 0.5) * options.bin_size_m};
+    const Key center = CellOf(c, cell);
+    for (int dx = -margin; dx <= margin; ++dx) {
+      for (int dy = -margin; dy <= margin; ++dy) {
+        const Point2 q{(center.first + dx + 0.5) * cell, (center.second + dy + 0.5) * cell};
+        if (std::hypot(q.x - c.x, q.y - c.y) <= options.grid_margin_m) {
+          cells.insert({center.first + dx, center.second + dy});
+        }
+      }
+    }
+  }
+  WifiGpMap::Grid grid;
+  grid.floor = floor;
+  int max_x = std::numeric_limits<int>::min(), max_y = max_x;
+  grid.min_x = grid.min_y = std::numeric_limits<int>::max();
+  for (const Key& k : cells) {
+    grid.min_x = std::min(grid.min_x, k.first);
+    grid.min_y = std::min(grid.min_y, k.second);
+    max_x = std::max(max_x, k.first);
+    max_y = std::max(max_y, k.second);
+  }
+  grid.width = max_x - grid.min_x + 1;
+  grid.height = max_y - grid.min_y + 1;
+  const size_t size = static_cast<size_t>(grid.width) * grid.height;
+  grid.mean_dbm.assign(size, std::numeric_limits<float>::quiet_NaN());
+  grid.variance_dbm2.assign(size, std::numeric_limits<float>::quiet_NaN());
+  // One local GP per tile, from the training points within reach of the tile.
+  std::map<Key, std::vector<Key>> tiles;
+  for (const Key& k : cells) {
+    tiles[{static_cast<int>(std::floor(static_cast<double>(k.first) / kTileCells)),
+           static_cast<int>(std::floor(static_cast<double>(k.second) / kTileCells))}]
+        .push_back(k);
+  }
+  for (const auto& [tile, tile_cells] : tiles) {
+    const double x0 = tile.first * kTileCells * cell - reach,
+                 x1 = (tile.first + 1) * kTileCells * cell + reach;
+    const double y0 = tile.second * kTileCells * cell - reach,
+                 y1 = (tile.second + 1) * kTileCells * cell + reach;
+    std::vector<Point2> p;
+    std::vector<double> v, n;
+    for (size_t i = 0; i < points.size(); ++i) {
+      if (points[i].x < x0 || points[i].x > x1 || points[i].y < y0 || points[i].y > y1) {
+        continue;
+      }
+      p.push_back(points[i]);
+      v.push_back(values[i]);
+      n.push_back(noise[i]);
+    }
+    std::optional<GaussianProcess2D> gp;
+    if (!p.empty()) {
+      StatusOr<GaussianProcess2D> fit =
+          GaussianProcess2D::Fit(p, v, n, o.unheard_rssi_dbm, signal2, o.length_scale_m);
+      if (!fit.ok()) return fit.status().WithContext("Wi-Fi map: AP " + bssid);
+      gp = std::move(fit.value());
+    }
+    for (const Key& k : tile_cells) {
+      const Point2 q{(k.first + 0.5) * cell, (k.second + 0.5) * cell};
+      double mean = options.unheard_rssi_dbm, variance = signal2;
+      if (gp) {
+        mean = gp->Mean(q);
+        std::optional<double> here;
+        if (options.signal_dependent_variance) {
+          // Eq. 12 on eq. 1's scale, back in dBm^2 (an SQ unit is half a dB).
+          here = SignalDependentVariance(2.0 * (mean + 100.0)) / 4.0;
+        }
+        variance = gp->Variance(q, here);
+      }
+      const size_t at =
+          static_cast<size_t>(k.second - grid.min_y) * grid.width + (k.first - grid.min_x);
+      grid.mean_dbm[at] = static_cast<float>(mean);
+      grid.variance_dbm2[at] = static_cast<float>(variance);
+    }
+  }
+  return grid;
+}
+
+}  // namespace
+
+StatusOr<WifiGpMap> WifiGpMap::Build(const std::vector<WifiMapSample>& samples,
+                                     const WifiGpOptions& options) {
+  std::string error;
+  if (!options.IsValid(&error)) return Status::Error("Wi-Fi map options: " + error);
+  if (samples.empty()) return Status::Error("Wi-Fi map: no scan with a position to learn from");
+  WifiGpMap map;
+  map.options_ = options;
+  map.training_ = samples;
+  // Per AP, the samples that heard it (the strongest reading of a BSSID heard twice).
+  std::vector<std::map<size_t, double>> heard_by;
+  for (size_t i = 0; i < samples.size(); ++i) {
+    const WifiMapSample& s = samples[i];
+    if (!std::isfinite(s.position.x) || !std::isfinite(s.position.y) ||
+        std::abs(s.position.x) > 1e7 || std::abs(s.position.y) > 1e7) {
+      return Status::Error("Wi-Fi map: sample " + std::to_string(i) + " has no finite position");
+    }
+    for (const auto& [bssid, rssi] : s.readings) {
+      if (!std::isfinite(rssi)) {
+        return Status::Error("Wi-Fi map: sample " + std::to_string(i) + " has a non-finite RSSI");
+      }
+      auto [it, added] = map.index_.emplace(bssid, map.bssids_.size());
+      if (added) {
+        map.bssids_.push_back(bssid);
+        heard_by.emplace_back();
+      }
+      auto [at, first] = heard_by[it->second].emplace(i, rssi);
+      if (!first) at->second = std::max(at->second, rssi);
+    }
+  }
+  const std::vector<std::vector<TrainingSet>> sets = TrainingSetsOf(samples, heard_by, options);
+  if (options.fit_hyperparameters) {
+    WifiGpFitReport report;
+    StatusOr<WifiGpOptions> fitted = FitHyperparameters(sets, options, &report);
+    if (!fitted.ok()) return fitted.status();
+    map.options_ = *fitted;
+    map.fit_ = report;
+  }
+  const double cell = options.cell_size_m;
+  const double total_cells = GridCellsNeeded(sets, options);
   if (total_cells > kMaxWifiMapCells) {
     char text[320];
     std::snprintf(text, sizeof text,
@@ -255,90 +363,9 @@ StatusOr<WifiGpMap> WifiGpMap::Build(const std::vector<WifiMapSample>& samples,
   map.grids_.resize(map.bssids_.size());
   for (size_t ap = 0; ap < map.bssids_.size(); ++ap) {
     for (const TrainingSet& set : sets[ap]) {
-      const int floor = set.floor;
-      const std::vector<Key>& keys = set.heard_bins;
-      const std::vector<Point2>& points = set.points;
-      const std::vector<double>& values = set.values;
-      std::vector<double> noise;
-      for (double n : set.counts) noise.push_back(noise2 / n);
-      // Cells to store: within grid_margin_m of a heard bin's centre.
-      std::set<Key> cells;
-      const int margin = static_cast<int>(std::ceil(options.grid_margin_m / cell)) + 1;
-      for (const Key& k : keys) {
-        const Point2 c{(k.first + 0.5) * options.bin_size_m, (k.second + 0.5) * options.bin_size_m};
-        const Key center = CellOf(c, cell);
-        for (int dx = -margin; dx <= margin; ++dx) {
-          for (int dy = -margin; dy <= margin; ++dy) {
-            const Point2 q{(center.first + dx + 0.5) * cell, (center.second + dy + 0.5) * cell};
-            if (std::hypot(q.x - c.x, q.y - c.y) <= options.grid_margin_m) {
-              cells.insert({center.first + dx, center.second + dy});
-            }
-          }
-        }
-      }
-      Grid grid;
-      grid.floor = floor;
-      int max_x = std::numeric_limits<int>::min(), max_y = max_x;
-      grid.min_x = grid.min_y = std::numeric_limits<int>::max();
-      for (const Key& k : cells) {
-        grid.min_x = std::min(grid.min_x, k.first);
-        grid.min_y = std::min(grid.min_y, k.second);
-        max_x = std::max(max_x, k.first);
-        max_y = std::max(max_y, k.second);
-      }
-      grid.width = max_x - grid.min_x + 1;
-      grid.height = max_y - grid.min_y + 1;
-      const size_t size = static_cast<size_t>(grid.width) * grid.height;
-      grid.mean_dbm.assign(size, std::numeric_limits<float>::quiet_NaN());
-      grid.variance_dbm2.assign(size, std::numeric_limits<float>::quiet_NaN());
-      // One local GP per tile, from the training points within reach of the tile.
-      std::map<Key, std::vector<Key>> tiles;
-      for (const Key& k : cells) {
-        tiles[{static_cast<int>(std::floor(static_cast<double>(k.first) / kTileCells)),
-               static_cast<int>(std::floor(static_cast<double>(k.second) / kTileCells))}]
-            .push_back(k);
-      }
-      for (const auto& [tile, tile_cells] : tiles) {
-        const double x0 = tile.first * kTileCells * cell - reach,
-                     x1 = (tile.first + 1) * kTileCells * cell + reach;
-        const double y0 = tile.second * kTileCells * cell - reach,
-                     y1 = (tile.second + 1) * kTileCells * cell + reach;
-        std::vector<Point2> p;
-        std::vector<double> v, n;
-        for (size_t i = 0; i < points.size(); ++i) {
-          if (points[i].x < x0 || points[i].x > x1 || points[i].y < y0 || points[i].y > y1) {
-            continue;
-          }
-          p.push_back(points[i]);
-          v.push_back(values[i]);
-          n.push_back(noise[i]);
-        }
-        std::optional<GaussianProcess2D> gp;
-        if (!p.empty()) {
-          StatusOr<GaussianProcess2D> fit =
-              GaussianProcess2D::Fit(p, v, n, o.unheard_rssi_dbm, signal2, o.length_scale_m);
-          if (!fit.ok()) return fit.status().WithContext("Wi-Fi map: AP " + map.bssids_[ap]);
-          gp = std::move(fit.value());
-        }
-        for (const Key& k : tile_cells) {
-          const Point2 q{(k.first + 0.5) * cell, (k.second + 0.5) * cell};
-          double mean = options.unheard_rssi_dbm, variance = signal2;
-          if (gp) {
-            mean = gp->Mean(q);
-            std::optional<double> here;
-            if (options.signal_dependent_variance) {
-              // Eq. 12 on eq. 1's scale, back in dBm^2 (an SQ unit is half a dB).
-              here = SignalDependentVariance(2.0 * (mean + 100.0)) / 4.0;
-            }
-            variance = gp->Variance(q, here);
-          }
-          const size_t at =
-              static_cast<size_t>(k.second - grid.min_y) * grid.width + (k.first - grid.min_x);
-          grid.mean_dbm[at] = static_cast<float>(mean);
-          grid.variance_dbm2[at] = static_cast<float>(variance);
-        }
-      }
-      map.grids_[ap].push_back(std::move(grid));
+      StatusOr<Grid> grid = PredictGrid(set, map.options_, options, map.bssids_[ap]);
+      if (!grid.ok()) return grid.status();
+      map.grids_[ap].push_back(std::move(grid.value()));
     }
   }
   map.IndexCoverage();

@@ -249,20 +249,14 @@ void FittedTitle(render::Scene& scene, render::ScenePoint position, const std::s
   DrawTitle(scene, position, FitTitle(text, height_px, max_width_px), color);
 }
 
-render::Scene ExperienceMapScene(const ExperienceMapImageData& data,
-                                 const ExperienceMapImageOptions& options,
-                                 WorldToImage* transform) {
-  render::Scene scene(options.width_px, options.height_px, kWhite);
-  const float w = static_cast<float>(options.width_px), h = static_cast<float>(options.height_px);
-  const float margin = 30;
-  const FittedText title = FitTitle(options.title.empty() ? "experience map" : options.title, 18,
-                                    w - 2 * margin, /*max_lines=*/2);
-  const float top_band = 66 + title.ExtraHeightPx();
-  // The bottom band holds the scale bar and the legend; the legend moves to a row of its own
-  // when both do not fit side by side (small images).
-  float bottom_band = 60;
+namespace {
 
-  // World bounds over experiences and ground truth.
+// World bounds over experiences and ground truth (or the options' fixed bounds); a square of 2 m
+// around the origin when there is nothing to bound.
+struct MapBounds {
+  double min_x, max_x, min_y, max_y;
+};
+MapBounds BoundsOf(const ExperienceMapImageData& data, const ExperienceMapImageOptions& options) {
   double min_x = std::numeric_limits<double>::infinity(), max_x = -min_x;
   double min_y = min_x, max_y = -min_x;
   auto include = [&](double x, double y) {
@@ -282,9 +276,14 @@ render::Scene ExperienceMapScene(const ExperienceMapImageData& data,
     min_x = min_y = -1;
     max_x = max_y = 1;
   }
-  const double span_x = std::max(max_x - min_x, 1e-3), span_y = std::max(max_y - min_y, 1e-3);
-  // Legend items (a sample and a label each), flowed right to left into rows; the first row sits
-  // beside the scale bar when it fits there, further rows stack above it.
+  return {min_x, max_x, min_y, max_y};
+}
+
+// Legend items (a sample and a label each) of an experience map: ground truth, loop closures,
+// Wi-Fi sequence links when there are any, and the colour key (time bar or sessions).
+std::vector<LegendItem> MapLegendItems(const ExperienceMapImageData& data,
+                                       const ExperienceMapImageOptions& options, double t_first,
+                                       double t_last) {
   std::vector<LegendItem> items;
   const ExperienceMapImageData& legend_data = options.legend_data ? *options.legend_data : data;
   if (legend_data.ground_truth.size() > 1) {
@@ -308,16 +307,6 @@ render::Scene ExperienceMapScene(const ExperienceMapImageData& data,
                        s.Line({x, y}, {x + 30, y}, 3.0f, kWifiSequence);
                        s.Text({x + 38, y + 5}, "Wi-Fi sequence link", 14, kInk);
                      }});
-  }
-  // The time range of the colours (shared between panels when the options fix it).
-  double t_first = std::numeric_limits<double>::infinity(), t_last = -t_first;
-  for (const Experience& e : data.experiences) {
-    t_first = std::min(t_first, e.time_s);
-    t_last = std::max(t_last, e.time_s);
-  }
-  if (options.time_range_s) {
-    t_first = options.time_range_s->first;
-    t_last = options.time_range_s->second;
   }
   if (options.coloring == MapColoring::kTime && std::isfinite(t_first)) {
     // The end labels are centred on the bar's ends: room for half the last one.
@@ -345,23 +334,17 @@ render::Scene ExperienceMapScene(const ExperienceMapImageData& data,
            }});
     }
   }
-  const float row_width = w - 2 * margin;
-  const std::vector<std::vector<size_t>> rows = FlowRows(items, row_width);
-  auto row_length = [&](const std::vector<size_t>& row) { return RowLength(items, row); };
-  constexpr float kScaleBarRoom = 160;  // the scale bar and its label
-  const bool first_row_beside_bar =
-      row_length(rows.front()) + kScaleBarRoom < row_width && rows.size() == 1;
-  const size_t stacked_rows = first_row_beside_bar ? 0 : rows.size();
-  bottom_band += 46 * stacked_rows;
-  const double plot_w = w - 2 * margin, plot_h = h - top_band - bottom_band;
-  WorldToImage to_image;
-  to_image.scale_px_per_m = std::min(plot_w / span_x, plot_h / span_y);
-  to_image.center_x_m = 0.5 * (min_x + max_x);
-  to_image.center_y_m = 0.5 * (min_y + max_y);
-  to_image.center_x_px = margin + 0.5 * plot_w;
-  to_image.center_y_px = top_band + 0.5 * plot_h;
-  if (transform) *transform = to_image;
+  return items;
+}
 
+// The map itself: ground truth, odometry links coloured by time or session, experiences, loop
+// closures over them and the current pose. Strokes thin out for large maps. Returns the number of
+// loop closures and how many of them Wi-Fi sequences made.
+std::pair<size_t, size_t> DrawExperienceGraph(render::Scene& scene,
+                                              const ExperienceMapImageData& data,
+                                              const ExperienceMapImageOptions& options,
+                                              const WorldToImage& to_image, double t_first,
+                                              double t_last, float w, float h) {
   // Time or session of each experience, for colouring.
   auto session_of = [&](double t) {
     const auto& starts = options.session_start_times_s;
@@ -423,6 +406,62 @@ render::Scene ExperienceMapScene(const ExperienceMapImageData& data,
         {c.x - dx * size * 0.6f + dy * size * 0.5f, c.y - dy * size * 0.6f - dx * size * 0.5f},
         {0, 0, 0, 255});
   }
+
+  return {loop_closures, sequence_links};
+}
+
+}  // namespace
+
+render::Scene ExperienceMapScene(const ExperienceMapImageData& data,
+                                 const ExperienceMapImageOptions& options,
+                                 WorldToImage* transform) {
+  render::Scene scene(options.width_px, options.height_px, kWhite);
+  const float w = static_cast<float>(options.width_px), h = static_cast<float>(options.height_px);
+  const float margin = 30;
+  const FittedText title = FitTitle(options.title.empty() ? "experience map" : options.title, 18,
+                                    w - 2 * margin, /*max_lines=*/2);
+  const float top_band = 66 + title.ExtraHeightPx();
+  // The bottom band holds the scale bar and the legend; the legend moves to a row of its own
+  // when both do not fit side by side (small images).
+  float bottom_band = 60;
+
+  const MapBounds bounds = BoundsOf(data, options);
+  const double min_x = bounds.min_x, max_x = bounds.max_x;
+  const double min_y = bounds.min_y, max_y = bounds.max_y;
+  const double span_x = std::max(max_x - min_x, 1e-3), span_y = std::max(max_y - min_y, 1e-3);
+  // The time range of the colours (shared between panels when the options fix it).
+  double t_first = std::numeric_limits<double>::infinity(), t_last = -t_first;
+  for (const Experience& e : data.experiences) {
+    t_first = std::min(t_first, e.time_s);
+    t_last = std::max(t_last, e.time_s);
+  }
+  if (options.time_range_s) {
+    t_first = options.time_range_s->first;
+    t_last = options.time_range_s->second;
+  }
+  // Legend items flowed right to left into rows; the first row sits beside the scale bar when it
+  // fits there, further rows stack above it.
+  const std::vector<LegendItem> items = MapLegendItems(data, options, t_first, t_last);
+  const float row_width = w - 2 * margin;
+  const std::vector<std::vector<size_t>> rows = FlowRows(items, row_width);
+  auto row_length = [&](const std::vector<size_t>& row) { return RowLength(items, row); };
+  constexpr float kScaleBarRoom = 160;  // the scale bar and its label
+  const bool first_row_beside_bar =
+      row_length(rows.front()) + kScaleBarRoom < row_width && rows.size() == 1;
+  const size_t stacked_rows = first_row_beside_bar ? 0 : rows.size();
+  bottom_band += 46 * stacked_rows;
+  const double plot_w = w - 2 * margin, plot_h = h - top_band - bottom_band;
+  WorldToImage to_image;
+  to_image.scale_px_per_m = std::min(plot_w / span_x, plot_h / span_y);
+  to_image.center_x_m = 0.5 * (min_x + max_x);
+  to_image.center_y_m = 0.5 * (min_y + max_y);
+  to_image.center_x_px = margin + 0.5 * plot_w;
+  to_image.center_y_px = top_band + 0.5 * plot_h;
+  if (transform) *transform = to_image;
+
+  const size_t n_links = data.links.size();
+  const auto [loop_closures, sequence_links] =
+      DrawExperienceGraph(scene, data, options, to_image, t_first, t_last, w, h);
 
   // Title, and the counts on a line of their own.
   DrawTitle(scene, {margin, 26}, title);
