@@ -11,6 +11,7 @@
 
 #include "common/scratch_dir.h"
 #include "dataset/dataset_loader.h"
+#include "tests/test_paths.h"
 
 namespace ratslam::dataset {
 namespace {
@@ -184,7 +185,7 @@ TEST(IpinLogTest, StepsBecomeOdometryRows) {
 
 // On a real log: the walk's path length from dead reckoning is close to the ground truth's.
 TEST(IpinLogTest, RealLogDeadReckoningDistanceMatchesGroundTruth) {
-  const fs::path log = fs::path(RATSLAM_SHARED_DATA_DIR) / "ipin2023-t3" /
+  const fs::path log = fs::path(ratslam::test_paths::SharedDataDir()) / "ipin2023-t3" /
                        "IPIN2023_T3_TrainingTrial01_repetition01.txt";
   if (!fs::exists(log)) GTEST_SKIP() << "missing " << log;
   PhoneLogReport report;
@@ -208,7 +209,7 @@ TEST(IpinLogTest, RealLogDeadReckoningDistanceMatchesGroundTruth) {
 // Parsing runs no dead reckoning: one parsed log becomes data sets under two PDR settings
 // without being read again, and the parse keeps every raw sample.
 TEST(IpinLogTest, ParsedLogIsReckonedAfterwardsUnderAnySettings) {
-  const fs::path log = fs::path(RATSLAM_SHARED_DATA_DIR) / "ipin2023-t3" /
+  const fs::path log = fs::path(ratslam::test_paths::SharedDataDir()) / "ipin2023-t3" /
                        "IPIN2023_T3_TrainingTrial01_repetition01.txt";
   if (!fs::exists(log)) GTEST_SKIP() << "missing " << log;
   StatusOr<PhoneLog> parsed = ParseIpinLog(log.string(), {});

@@ -8,6 +8,7 @@
 
 #include "common/scratch_dir.h"
 #include "dataset/dataset_loader.h"
+#include "tests/test_paths.h"
 
 namespace ratslam::dataset {
 namespace {
@@ -97,8 +98,8 @@ TEST(MicrosoftLogTest, FloorNamesAndRotationVectors) {
 }
 
 TEST(MicrosoftLogTest, RealWalkHasWifiAndWaypoints) {
-  const fs::path folder =
-      fs::path(RATSLAM_SHARED_DATA_DIR) / "msft-ilc20-site1" / "F1" / "path_data_files";
+  const fs::path folder = fs::path(ratslam::test_paths::SharedDataDir()) / "msft-ilc20-site1" /
+                          "F1" / "path_data_files";
   if (!fs::exists(folder)) GTEST_SKIP() << "missing " << folder;
   const fs::path walk = *fs::directory_iterator(folder);
   StatusOr<Dataset> d = LoadDataset(walk.string(), {});

@@ -19,6 +19,7 @@
 #include "dataset/dataset_loader.h"
 #include "dataset/mcap.h"
 #include "dataset/ros2_messages.h"
+#include "tests/test_paths.h"
 
 namespace ratslam::dataset {
 namespace {
@@ -62,7 +63,7 @@ class Rosbag2Test : public ::testing::Test {
   // Runs the fixture script; false (with the reason in *why) when it cannot run here.
   bool MakeFixtures(const fs::path& out, const std::string& data, std::string* why) {
     const fs::path log = folder_ / "fixtures.log";
-    const std::string command = "bash " + std::string(RATSLAM_SOURCE_DIR) +
+    const std::string command = "bash " + std::string(ratslam::test_paths::SourceDir()) +
                                 "/scripts/ros2_fixtures.sh " + out.string() + " " + data + " 2>" +
                                 log.string();
     const int rc = std::system(command.c_str());

@@ -19,6 +19,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "dataset/dataset_loader.h"
+#include "tests/test_paths.h"
 
 namespace ratslam::dataset {
 namespace {
@@ -301,9 +302,9 @@ TEST_F(RosbagTest, TruncatedAndCorruptedBagsAreErrorsNotPartialDataSets) {
   // A message whose image data claims 4 GB in a 20 kB bag: librosbag resized the vector to the
   // claimed length before finding the bytes missing (rosbag_fuzzer: out of memory). The layout
   // of each message is checked first now.
-  e = ReadError(
-      std::string(RATSLAM_SOURCE_DIR) + "/fuzz/regressions/rosbag_fuzzer/oom-image-data-length-4gb",
-      {"", "", "/r/pose", ""});
+  e = ReadError(std::string(ratslam::test_paths::SourceDir()) +
+                    "/fuzz/regressions/rosbag_fuzzer/oom-image-data-length-4gb",
+                {"", "", "/r/pose", ""});
   EXPECT_NE(e.find("sensor_msgs/CompressedImage on /r/camera/image/compressed holds a field "
                    "longer than the message"),
             std::string::npos)

@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "common/scratch_dir.h"
+#include "tests/test_paths.h"
 
 namespace ratslam::dataset {
 namespace {
@@ -83,7 +84,8 @@ TEST(UjiIndoorLocTest, OutOfRangeAndFractionalLabelsAreRefused) {
 }
 
 TEST(UjiIndoorLocTest, RealTrainingFile) {
-  const fs::path p = fs::path(RATSLAM_SHARED_DATA_DIR) / "ujiindoorloc" / "trainingData.csv";
+  const fs::path p =
+      fs::path(ratslam::test_paths::SharedDataDir()) / "ujiindoorloc" / "trainingData.csv";
   if (!fs::exists(p)) GTEST_SKIP() << "missing " << p;
   UjiReadReport report;
   StatusOr<std::vector<LabelledScan>> scans = ReadUjiIndoorLoc(p.string(), false, &report);

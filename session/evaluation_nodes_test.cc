@@ -7,11 +7,14 @@
 #include <string>
 #include <vector>
 
+#include "tests/test_paths.h"
+
 namespace ratslam::session {
 namespace {
 
 TEST(EvaluationNodesTest, LoadsAnImageFolderWithFloors) {
-  const std::string path = std::string(RATSLAM_SHARED_DATA_DIR) + "/multifloor-corridors";
+  const std::string path =
+      std::string(ratslam::test_paths::SharedDataDir()) + "/multifloor-corridors";
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "missing " << path;
   fabmap::EvaluationOptions options;
   options.frame_spacing_m = 0.5;
@@ -30,7 +33,8 @@ TEST(EvaluationNodesTest, BadPathsAndOptionsAreErrors) {
   ASSERT_FALSE(missing.ok());
   EXPECT_NE(missing.status().message().find("/no/such/place"), std::string::npos);
   options.map_fraction = 1.5;
-  EXPECT_FALSE(LoadEvaluationNodes(RATSLAM_SOURCE_DIR, true, false, options, {}).ok());
+  EXPECT_FALSE(
+      LoadEvaluationNodes(ratslam::test_paths::SourceDir(), true, false, options, {}).ok());
 }
 
 // Map scans along a corridor; two query sessions walk it, one with a phone 10 dB lower and one

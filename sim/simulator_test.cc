@@ -11,6 +11,7 @@
 #include "sim/propagation.h"
 #include "sim/textures.h"
 #include "sim/world.h"
+#include "tests/test_paths.h"
 
 namespace ratslam::sim {
 namespace {
@@ -308,7 +309,7 @@ namespace {
 // Every key a world table declares (world.h) is named in that table's row of configs/README.md,
 // and each rule holds for the built-in worlds.
 TEST(WorldSchemaTest, ReadmeNamesEveryWorldKeyAndBuiltInWorldsKeepTheRules) {
-  std::ifstream in(std::string(RATSLAM_SOURCE_DIR) + "/configs/README.md");
+  std::ifstream in(std::string(ratslam::test_paths::SourceDir()) + "/configs/README.md");
   ASSERT_TRUE(in);
   std::map<std::string, std::string> rows;  // "[camera]" or "[[walls]]" -> its README row
   std::string line;

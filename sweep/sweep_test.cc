@@ -20,6 +20,7 @@
 #include "dataset/dataset.h"
 #include "io/config.h"
 #include "io/run_outputs.h"
+#include "tests/test_paths.h"
 
 extern char** environ;
 
@@ -239,11 +240,13 @@ TEST(SweepPlanTest, DataPathsTheSystemCannotLookUpAreMissingDataSets) {
 // A fake worker: crashes for data set "crash", hangs for "hang", and runs the real program
 // otherwise; every start is appended to a log so that repeats can be counted.
 std::string FakeProgram(const std::string& log) {
-  const std::string path = Write("fake_ratslam.sh", "#!/bin/sh\necho \"$*\" >> " + log +
-                                                        "\ncase \"$*\" in\n"
-                                                        "  */crash\\ *) kill -SEGV $$ ;;\n"
-                                                        "  */hang\\ *) sleep 60 ;;\n"
-                                                        "esac\nexec " RATSLAM_PROGRAM " \"$@\"\n");
+  const std::string path =
+      Write("fake_ratslam.sh", "#!/bin/sh\necho \"$*\" >> " + log +
+                                   "\ncase \"$*\" in\n"
+                                   "  */crash\\ *) kill -SEGV $$ ;;\n"
+                                   "  */hang\\ *) sleep 60 ;;\n"
+                                   "esac\nexec " +
+                                   ratslam::test_paths::RatslamBinary() + " \"$@\"\n");
   fs::permissions(path, fs::perms::owner_all);
   return path;
 }
@@ -417,10 +420,10 @@ data = ["data/a"]
 )");
   const std::string dir = (Scratch().path() / "sweep-task").string();
   ASSERT_TRUE(WritePlan(*MakePlan(*LoadSweepFile(path)), dir).ok());
-  StatusOr<TaskOutcome> one = RunTask(dir, 1, RATSLAM_PROGRAM);
+  StatusOr<TaskOutcome> one = RunTask(dir, 1, ratslam::test_paths::RatslamBinary());
   ASSERT_TRUE(one.ok()) << one.status().message();
   EXPECT_EQ(one->status, "ok");
-  EXPECT_FALSE(RunTask(dir, 2, RATSLAM_PROGRAM).ok());  // no such task
+  EXPECT_FALSE(RunTask(dir, 2, ratslam::test_paths::RatslamBinary()).ok());  // no such task
   StatusOr<std::vector<TaskOutcome>> outcomes = ReadOutcomes(dir);
   EXPECT_EQ((*outcomes)[0].status, "pending");
   EXPECT_EQ((*outcomes)[1].status, "ok");
@@ -437,7 +440,8 @@ data = ["data/a"]
 )");
   const std::string dir = (Scratch().path() / "sweep-slurm").string();
   ASSERT_TRUE(WritePlan(*MakePlan(*LoadSweepFile(path)), dir).ok());
-  ASSERT_TRUE(RunTasks(dir, 1, 2, RATSLAM_PROGRAM).ok());  // tasks 1 and 2 done
+  ASSERT_TRUE(
+      RunTasks(dir, 1, 2, ratslam::test_paths::RatslamBinary()).ok());  // tasks 1 and 2 done
   SlurmOptions options;
   options.program = "/opt/it's here/ratslam";
   options.max_parallel = 2;
@@ -456,7 +460,7 @@ data = ["data/a"]
   jobs = WriteSlurmScripts(dir, options);
   ASSERT_TRUE(jobs.ok());
   EXPECT_EQ(jobs->array_spec, "0-2%2");
-  ASSERT_TRUE(RunTasks(dir, 0, 5, RATSLAM_PROGRAM).ok());
+  ASSERT_TRUE(RunTasks(dir, 0, 5, ratslam::test_paths::RatslamBinary()).ok());
   EXPECT_FALSE(WriteSlurmScripts(dir, options).ok());  // nothing pending
 }
 
@@ -516,9 +520,9 @@ awk -v x="$x" -v d="$d" 'BEGIN { printf "{\"map_ate_m\": %.12f}\n", (x-0.37)^2 +
 
 // The shipped sweep files plan (every value valid for the configuration they vary).
 TEST(SweepPlanTest, ShippedSweepFilesPlan) {
-  const fs::path data = fs::path(RATSLAM_SHARED_DATA_DIR) / "ipin2023-t3";
+  const fs::path data = fs::path(ratslam::test_paths::SharedDataDir()) / "ipin2023-t3";
   if (!fs::exists(data)) GTEST_SKIP() << "missing " << data;
-  const fs::path sweeps = fs::path(RATSLAM_SOURCE_DIR) / "configs" / "sweeps";
+  const fs::path sweeps = fs::path(ratslam::test_paths::SourceDir()) / "configs" / "sweeps";
   const std::map<std::string, size_t> expected = {{"ipin2023-wifi-compass.toml", 2160},
                                                   {"ipin2023-wifi-compass-halving.toml", 2160},
                                                   {"ipin2023-wifi-compass-holdout.toml", 11}};
@@ -533,21 +537,21 @@ TEST(SweepPlanTest, ShippedSweepFilesPlan) {
 
 // command = "evaluate" runs the FABMAP benchmark per task and reads evaluation.json.
 TEST(SweepRunTest, EvaluateSweepsReadTheBenchmarksMetrics) {
-  const fs::path site = fs::path(RATSLAM_SHARED_DATA_DIR) / "msft-ilc20-site1";
+  const fs::path site = fs::path(ratslam::test_paths::SharedDataDir()) / "msft-ilc20-site1";
   if (!fs::exists(site)) GTEST_SKIP() << "missing " << site;
-  const std::string path =
-      Write("evaluate.toml",
-            "[sweep]\ncommand = \"evaluate\"\nbase_config = \"" + std::string(RATSLAM_SOURCE_DIR) +
-                "/configs/msft-ilc20-wifi.toml\"\n"
-                "objective = \"correct_within_m.5\"\n"
-                "goal = \"maximize\"\n[[datasets]]\ndata = [\"" +
-                site.string() + "\"]\n[parameters]\n\"wifi_words.bins\" = [1, 8]\n");
+  const std::string path = Write(
+      "evaluate.toml", "[sweep]\ncommand = \"evaluate\"\nbase_config = \"" +
+                           std::string(ratslam::test_paths::SourceDir()) +
+                           "/configs/msft-ilc20-wifi.toml\"\n"
+                           "objective = \"correct_within_m.5\"\n"
+                           "goal = \"maximize\"\n[[datasets]]\ndata = [\"" +
+                           site.string() + "\"]\n[parameters]\n\"wifi_words.bins\" = [1, 8]\n");
   const std::string dir = (Scratch().path() / "sweep-evaluate").string();
   StatusOr<Plan> plan = MakePlan(*LoadSweepFile(path));
   ASSERT_TRUE(plan.ok()) << plan.status().message();
   ASSERT_TRUE(WritePlan(*plan, dir).ok());
   RunOptions options;
-  options.program = RATSLAM_PROGRAM;
+  options.program = ratslam::test_paths::RatslamBinary();
   options.jobs = 2;
   StatusOr<RunReport> report = RunSweep(dir, options);
   ASSERT_TRUE(report.ok()) << report.status().message();
@@ -624,8 +628,8 @@ data = ["data/a"]
 )");
   const std::string dir = (Scratch().path() / "sweep-kill").string();
   ASSERT_TRUE(WritePlan(*MakePlan(*LoadSweepFile(path)), dir).ok());
-  std::string program = RATSLAM_PROGRAM, run = "run", folder = dir, jobs = "--jobs", two = "2",
-              quiet = "--quiet", sweep = "sweep";
+  std::string program = ratslam::test_paths::RatslamBinary(), run = "run", folder = dir,
+              jobs = "--jobs", two = "2", quiet = "--quiet", sweep = "sweep";
   char* argv[] = {program.data(), sweep.data(), run.data(),   folder.data(),
                   jobs.data(),    two.data(),   quiet.data(), nullptr};
   pid_t runner = -1;
@@ -684,7 +688,7 @@ data = ["data/a"]
   const std::string dir = (Scratch().path() / "sweep-expression").string();
   ASSERT_TRUE(WritePlan(*MakePlan(*spec), dir).ok());
   RunOptions options;
-  options.program = RATSLAM_PROGRAM;
+  options.program = ratslam::test_paths::RatslamBinary();
   ASSERT_TRUE(RunSweep(dir, options).ok());
   StatusOr<CollectReport> collected = Collect(dir);
   ASSERT_TRUE(collected.ok());

@@ -16,6 +16,7 @@
 #include "dataset/descriptor_file.h"
 #include "dataset/synthetic_dataset.h"
 #include "tests/run_ratslam.h"
+#include "tests/test_paths.h"
 
 namespace ratslam {
 namespace {
@@ -71,7 +72,8 @@ class DescriptorEndToEndTest : public ::testing::Test {
                                               (folder / "descriptors.npy").string())
                       .ok());
     }
-    std::string toml = Slurp(fs::path(RATSLAM_SOURCE_DIR) / "configs" / "synthetic.toml");
+    std::string toml =
+        Slurp(fs::path(ratslam::test_paths::SourceDir()) / "configs" / "synthetic.toml");
     const std::string from = "kind = \"classic_camera\"";
     toml.replace(toml.find(from), from.size(), "kind = \"descriptors\"");
     ASSERT_EQ(toml.find("[descriptors]"), std::string::npos);

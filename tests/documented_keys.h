@@ -11,6 +11,8 @@
 #include <sstream>
 #include <string>
 
+#include "tests/test_paths.h"
+
 namespace ratslam::e2e {
 
 // The keys of `j` (of nested objects and of objects in arrays too) that neither page names in
@@ -19,7 +21,7 @@ inline std::set<std::string> UndocumentedKeys(const nlohmann::json& j) {
   static const std::string doc = [] {
     std::stringstream s;
     for (const char* page : {"/configs/README.md", "/docs/config.md"}) {
-      std::ifstream in(std::string(RATSLAM_SOURCE_DIR) + page);
+      std::ifstream in(std::string(ratslam::test_paths::SourceDir()) + page);
       s << in.rdbuf();
     }
     return s.str();

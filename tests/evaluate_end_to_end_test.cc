@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "tests/documented_keys.h"
+#include "tests/test_paths.h"
 #include "tests/uji_long_term_fixture.h"
 
 namespace {
@@ -61,20 +62,22 @@ std::string ConfigWith(const std::string& config, const std::string& from, const
 // `ratslam evaluate` with one data set as map and queries; its evaluation.json.
 nlohmann::json EvaluateOneSet(const std::string& config, const fs::path& data,
                               const fs::path& dir) {
-  const std::string command =
-      std::string(RATSLAM_BINARY) + " evaluate --quiet --overwrite --config " + config + " --map " +
-      data.string() + " --query " + data.string() + " --out " + dir.string() + " > /dev/null";
+  const std::string command = std::string(ratslam::test_paths::RatslamBinary()) +
+                              " evaluate --quiet --overwrite --config " + config + " --map " +
+                              data.string() + " --query " + data.string() + " --out " +
+                              dir.string() + " > /dev/null";
   EXPECT_EQ(std::system(command.c_str()), 0) << command;
   std::ifstream in(dir / "evaluation.json");
   return nlohmann::json::parse(in);
 }
 
 TEST(EvaluateEndToEndTest, MicrosoftWalksWifiOnly) {
-  const fs::path data = fs::path(RATSLAM_SHARED_DATA_DIR) / "msft-ilc20-site1";
+  const fs::path data = fs::path(ratslam::test_paths::SharedDataDir()) / "msft-ilc20-site1";
   if (!fs::exists(data)) GTEST_SKIP() << "missing " << data;
   const fs::path out = Scratch("evaluate_msft");
-  const std::string command = std::string(RATSLAM_BINARY) +
-                              " evaluate --quiet --format png,pdf --config " + RATSLAM_SOURCE_DIR +
+  const std::string command = std::string(ratslam::test_paths::RatslamBinary()) +
+                              " evaluate --quiet --format png,pdf --config " +
+                              ratslam::test_paths::SourceDir() +
                               "/configs/msft-ilc20-wifi.toml --map " + data.string() + " --query " +
                               data.string() + " --out " + out.string() + " > /dev/null";
   ASSERT_EQ(std::system(command.c_str()), 0) << command;
@@ -209,7 +212,8 @@ TEST(EvaluateEndToEndTest, MicrosoftWalksWifiOnly) {
 // mistakes away (33.4 % measured) while keeping 85 % of the arg-max's share within 5 m (92 %
 // measured) and rejecting at most a fifth of the near queries (12.1 % measured).
 TEST(EvaluateEndToEndTest, UjiByUserSplitsByUserAndLearntThresholdCutsFloorMistakes) {
-  const fs::path data = fs::path(RATSLAM_SHARED_DATA_DIR) / "ujiindoorloc" / "trainingData.csv";
+  const fs::path data =
+      fs::path(ratslam::test_paths::SharedDataDir()) / "ujiindoorloc" / "trainingData.csv";
   if (!fs::exists(data)) GTEST_SKIP() << "missing " << data;
   // The oracle: rows in time order (ties in file order), pairs by first row, pair k in the map
   // when floor((k+1) 0.4) > floor(k 0.4).
@@ -285,7 +289,7 @@ TEST(EvaluateEndToEndTest, UjiByUserSplitsByUserAndLearntThresholdCutsFloorMista
   const fs::path out = Scratch("evaluate_uji_by_user");
   const fs::path argmax = Scratch("evaluate_uji_by_user_argmax");
   const std::string config =
-      RATSLAM_SOURCE_DIR + std::string("/configs/ujiindoorloc-wifi-by-user.toml");
+      ratslam::test_paths::SourceDir() + std::string("/configs/ujiindoorloc-wifi-by-user.toml");
   const std::string argmax_config =
       ConfigWith(config, "calibrate_new_place = true", "calibrate_new_place = false", argmax);
   ASSERT_FALSE(argmax_config.empty());
@@ -321,10 +325,11 @@ TEST(EvaluateEndToEndTest, UjiByUserSplitsByUserAndLearntThresholdCutsFloorMista
 // point (measured: 65.0 % against 62.4 %) and be at least k-NN's of the same run (64.2 %), with
 // no more floor mistakes than the arg-max (4.4 % against 5.0 %).
 TEST(EvaluateEndToEndTest, UjiByPositionPosteriorVoteBeatsTheBestPlace) {
-  const fs::path data = fs::path(RATSLAM_SHARED_DATA_DIR) / "ujiindoorloc" / "trainingData.csv";
+  const fs::path data =
+      fs::path(ratslam::test_paths::SharedDataDir()) / "ujiindoorloc" / "trainingData.csv";
   if (!fs::exists(data)) GTEST_SKIP() << "missing " << data;
   const std::string config =
-      RATSLAM_SOURCE_DIR + std::string("/configs/ujiindoorloc-wifi-by-position.toml");
+      ratslam::test_paths::SourceDir() + std::string("/configs/ujiindoorloc-wifi-by-position.toml");
   const fs::path vote = Scratch("evaluate_uji_by_position");
   const fs::path best = Scratch("evaluate_uji_by_position_best");
   const std::string best_config =
@@ -376,13 +381,14 @@ TEST(EvaluateEndToEndTest, UjiByPositionPosteriorVoteBeatsTheBestPlace) {
 // With every row: 79.7 % (b = 8 exclusive) and 83.9 % (the shipped b = 16 incremental). We
 // require 90 % of map rows in the tree and 60 % within 5 m, far above the 9.8 % of the bug.
 TEST(EvaluateEndToEndTest, FingerprintRowsAllLearnTheWifiTree) {
-  const fs::path data = fs::path(RATSLAM_SHARED_DATA_DIR) / "ujiindoorloc" / "trainingData.csv";
+  const fs::path data =
+      fs::path(ratslam::test_paths::SharedDataDir()) / "ujiindoorloc" / "trainingData.csv";
   if (!fs::exists(data)) GTEST_SKIP() << "missing " << data;
   const fs::path out = Scratch("evaluate_uji");
-  const std::string command = std::string(RATSLAM_BINARY) + " evaluate --quiet --config " +
-                              RATSLAM_SOURCE_DIR + "/configs/ujiindoorloc-wifi.toml --map " +
-                              data.string() + " --query " + data.string() + " --out " +
-                              out.string() + " > /dev/null";
+  const std::string command =
+      std::string(ratslam::test_paths::RatslamBinary()) + " evaluate --quiet --config " +
+      ratslam::test_paths::SourceDir() + "/configs/ujiindoorloc-wifi.toml --map " + data.string() +
+      " --query " + data.string() + " --out " + out.string() + " > /dev/null";
   ASSERT_EQ(std::system(command.c_str()), 0) << command;
   std::ifstream in(out / "evaluation.json");
   const nlohmann::json j = nlohmann::json::parse(in);
@@ -485,11 +491,11 @@ TEST(EvaluateEndToEndTest, LongTermLibraryLayout) {
   const fs::path root = Scratch("evaluate_long_term");
   ratslam::fixture::WriteLongTermLibrary(root);
   const fs::path out = root / "out";
-  const std::string command = std::string(RATSLAM_BINARY) + " evaluate --quiet --config " +
-                              RATSLAM_SOURCE_DIR + "/configs/ujiindoorloc-wifi.toml --map " +
-                              (root / "db/01/trn01rss.csv").string() + " --query " +
-                              (root / "db/12/tst01rss.csv").string() + " --out " + out.string() +
-                              " > /dev/null";
+  const std::string command =
+      std::string(ratslam::test_paths::RatslamBinary()) + " evaluate --quiet --config " +
+      ratslam::test_paths::SourceDir() + "/configs/ujiindoorloc-wifi.toml --map " +
+      (root / "db/01/trn01rss.csv").string() + " --query " +
+      (root / "db/12/tst01rss.csv").string() + " --out " + out.string() + " > /dev/null";
   ASSERT_EQ(std::system(command.c_str()), 0) << command;
   std::ifstream in(out / "evaluation.json");
   const nlohmann::json j = nlohmann::json::parse(in);
@@ -528,7 +534,7 @@ TEST(EvaluateEndToEndTest, LongTermLibraryLayout) {
   // situation is then the month-01 one minus two APs, where every query is 1.5 m from a place.
   EXPECT_GT(j["baselines"]["fingerprint"]["rejection_rate"].get<double>(), 0.0);
   const std::string base_config =
-      RATSLAM_SOURCE_DIR + std::string("/configs/ujiindoorloc-wifi.toml");
+      ratslam::test_paths::SourceDir() + std::string("/configs/ujiindoorloc-wifi.toml");
   {
     std::ifstream base(base_config);
     std::ofstream(root / "neutral.toml")
@@ -547,7 +553,7 @@ TEST(EvaluateEndToEndTest, LongTermLibraryLayout) {
 
 TEST(EvaluateEndToEndTest, BadInputIsAClearError) {
   const fs::path out = Scratch("evaluate_bad");
-  const std::string command = std::string(RATSLAM_BINARY) +
+  const std::string command = std::string(ratslam::test_paths::RatslamBinary()) +
                               " evaluate --quiet --map /no/such/data --query /no/such/data --out " +
                               out.string() + " 2> " + (out.string() + ".err");
   EXPECT_NE(std::system(command.c_str()), 0);
@@ -563,15 +569,15 @@ TEST(EvaluateEndToEndTest, BadInputIsAClearError) {
 // against 27.0 m for dead reckoning. We require the map to beat dead reckoning and most
 // matches to be right.
 TEST(EvaluateEndToEndTest, FabmapFrontEndOnPhoneLogs) {
-  const fs::path data = fs::path(RATSLAM_SHARED_DATA_DIR) / "ipin2023-t3";
+  const fs::path data = fs::path(ratslam::test_paths::SharedDataDir()) / "ipin2023-t3";
   const fs::path a = data / "IPIN2023_T3_TrainingTrial01_repetition01.txt";
   const fs::path b = data / "IPIN2023_T3_TrainingTrial01_repetition02.txt";
   if (!fs::exists(a) || !fs::exists(b)) GTEST_SKIP() << "missing " << a << " or " << b;
   const fs::path out = Scratch("fabmap_front_end");
-  const std::string command = std::string(RATSLAM_BINARY) + " replay --quiet --config " +
-                              RATSLAM_SOURCE_DIR + "/configs/ipin2023-fabmap-wifi.toml --data " +
-                              a.string() + " --data " + b.string() + " --out " + out.string() +
-                              " > /dev/null";
+  const std::string command = std::string(ratslam::test_paths::RatslamBinary()) +
+                              " replay --quiet --config " + ratslam::test_paths::SourceDir() +
+                              "/configs/ipin2023-fabmap-wifi.toml --data " + a.string() +
+                              " --data " + b.string() + " --out " + out.string() + " > /dev/null";
   ASSERT_EQ(std::system(command.c_str()), 0) << command;
   std::ifstream in(out / "summary.json");
   const nlohmann::json s = nlohmann::json::parse(in);

@@ -20,6 +20,7 @@
 #include "dataset/synthetic_dataset.h"
 #include "io/map_file.h"
 #include "tests/run_ratslam.h"
+#include "tests/test_paths.h"
 
 extern char** environ;
 
@@ -32,7 +33,7 @@ using e2e::Slurp;
 // Starts `ratslam` with `args` (output to /dev/null); returns its pid.
 pid_t Spawn(const std::vector<std::string>& args) {
   std::vector<char*> argv;
-  std::string binary = RATSLAM_BINARY;
+  std::string binary = ratslam::test_paths::RatslamBinary();
   argv.push_back(binary.data());
   std::vector<std::string> copy = args;
   for (std::string& a : copy) argv.push_back(a.data());
@@ -57,7 +58,8 @@ TEST(FaultInjectionTest, KillDuringSaveNeverLeavesATornMap) {
   ScratchDir dir("ratslam_fault");
   ASSERT_TRUE(
       dataset::WriteSyntheticDataset(apps::DemoSyntheticOptions(), (dir / "data").string()).ok());
-  const std::string config = std::string(RATSLAM_SOURCE_DIR) + "/configs/synthetic.toml";
+  const std::string config =
+      std::string(ratslam::test_paths::SourceDir()) + "/configs/synthetic.toml";
   auto replay = [&](double until, const fs::path& map) {
     return std::vector<std::string>{"replay",
                                     "--quiet",

@@ -13,6 +13,7 @@
 #include "common/scratch_dir.h"
 #include "io/map_file.h"
 #include "tests/run_ratslam.h"
+#include "tests/test_paths.h"
 
 namespace ratslam {
 namespace {
@@ -66,7 +67,8 @@ TEST_F(FullDiskTest, ReplayOutputsFailButTheMapIsSavedElsewhere) {
   // Fill the small disk almost completely, so that the outputs cannot fit.
   (void)std::system(("head -c 150000 /dev/zero > " + (disk_ / "filler").string()).c_str());
   const fs::path map = scratch_ / "elsewhere.map";
-  const std::string config = std::string(RATSLAM_SOURCE_DIR) + "/configs/sim-fused.toml";
+  const std::string config =
+      std::string(ratslam::test_paths::SourceDir()) + "/configs/sim-fused.toml";
   const Result r =
       RunRatslam("replay --quiet --config " + config + " --data " + data.string() + " --out " +
                      (disk_ / "run").string() + " --save-map " + map.string(),

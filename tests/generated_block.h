@@ -12,13 +12,15 @@
 #include <sstream>
 #include <string>
 
+#include "tests/test_paths.h"
+
 namespace ratslam::e2e {
 
 // `doc` is relative to the source folder; its block lies between "<!-- `marker`: begin -->\n"
 // and "<!-- `marker`: end -->".
 inline void ExpectGeneratedBlock(const std::string& doc, const std::string& marker,
                                  const std::string& generated) {
-  const std::string path = std::string(RATSLAM_SOURCE_DIR) + "/" + doc;
+  const std::string path = std::string(ratslam::test_paths::SourceDir()) + "/" + doc;
   std::ifstream in(path);
   ASSERT_TRUE(in) << path << " not found";
   std::stringstream s;

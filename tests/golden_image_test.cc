@@ -11,6 +11,7 @@
 #include <filesystem>
 
 #include "render/renderer.h"
+#include "tests/test_paths.h"
 #include "viewer/figures.h"
 
 namespace ratslam {
@@ -22,7 +23,8 @@ void ExpectMatchesGolden(const render::Scene& scene, const std::string& name) {
   if (!renderer.ok()) GTEST_SKIP() << "OSMesa unavailable: " << renderer.status().message();
   StatusOr<render::RgbaImage> actual = renderer.value()->Render(scene);
   ASSERT_TRUE(actual.ok()) << actual.status().message();
-  const fs::path golden = fs::path(RATSLAM_SOURCE_DIR) / "tests" / "golden" / (name + ".png");
+  const fs::path golden =
+      fs::path(ratslam::test_paths::SourceDir()) / "tests" / "golden" / (name + ".png");
   if (std::getenv("RATSLAM_UPDATE_GOLDEN")) {
     ASSERT_TRUE(render::WritePng(actual.value(), golden.string()).ok());
     GTEST_SKIP() << "updated " << golden;

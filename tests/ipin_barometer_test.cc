@@ -16,6 +16,7 @@
 
 #include "dataset/ipin_log.h"
 #include "sensors/barometer.h"
+#include "tests/test_paths.h"
 
 namespace ratslam {
 namespace {
@@ -52,7 +53,7 @@ FloorScore ScoreLog(const fs::path& path) {
 }
 
 TEST(IpinBarometerTest, FloorsFromPressureOnTheTrainingLogs) {
-  const fs::path data = fs::path(RATSLAM_SHARED_DATA_DIR) / "ipin2023-t3";
+  const fs::path data = fs::path(ratslam::test_paths::SharedDataDir()) / "ipin2023-t3";
   const fs::path route51 = data / "IPIN2023_T3_TrainingTrial51_repetition02.txt";
   if (!fs::exists(route51)) GTEST_SKIP() << "missing " << route51;
   size_t single_floor_logs = 0, single_floor_changes = 0;

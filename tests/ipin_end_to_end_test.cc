@@ -25,22 +25,23 @@
 #include "dataset/dataset_loader.h"
 #include "tests/documented_keys.h"
 #include "tests/run_ratslam.h"
+#include "tests/test_paths.h"
 
 namespace ratslam {
 namespace {
 namespace fs = std::filesystem;
 
 TEST(IpinEndToEndTest, WifiRatslamClosesOutAndBackLoops) {
-  const fs::path data = fs::path(RATSLAM_SHARED_DATA_DIR) / "ipin2023-t3";
+  const fs::path data = fs::path(ratslam::test_paths::SharedDataDir()) / "ipin2023-t3";
   const fs::path a = data / "IPIN2023_T3_TrainingTrial01_repetition01.txt";
   const fs::path b = data / "IPIN2023_T3_TrainingTrial01_repetition02.txt";
   if (!fs::exists(a) || !fs::exists(b)) GTEST_SKIP() << "missing " << a << " or " << b;
   const fs::path out =
       fs::temp_directory_path() / ("ratslam_ipin_e2e_" + std::to_string(::getpid()));
-  const std::string command = std::string(RATSLAM_BINARY) + " replay --quiet --config " +
-                              RATSLAM_SOURCE_DIR + "/configs/ipin2023-wifi-compass.toml --data " +
-                              a.string() + " --data " + b.string() + " --out " + out.string() +
-                              " > /dev/null";
+  const std::string command = std::string(ratslam::test_paths::RatslamBinary()) +
+                              " replay --quiet --config " + ratslam::test_paths::SourceDir() +
+                              "/configs/ipin2023-wifi-compass.toml --data " + a.string() +
+                              " --data " + b.string() + " --out " + out.string() + " > /dev/null";
   ASSERT_EQ(std::system(command.c_str()), 0) << command;
   std::ifstream in(out / "summary.json");
   const nlohmann::json s = nlohmann::json::parse(in);
@@ -134,7 +135,7 @@ TEST(IpinEndToEndTest, WifiRatslamClosesOutAndBackLoops) {
   EXPECT_EQ(tum["ground_truth_tum.txt"].size(), s["ate_points"].get<size_t>());
   // The Wi-Fi similarity matrix of the same walks (the Wi-Fi loop-closure paper's figure 9).
   const fs::path png = out / "wifi_similarity.png";
-  const std::string render = std::string(RATSLAM_BINARY) +
+  const std::string render = std::string(ratslam::test_paths::RatslamBinary()) +
                              " render similarity --sensor wifi --data " + a.string() + " --data " +
                              b.string() + " --out " + png.string() + " 2> /dev/null";
   const int status = std::system(render.c_str());
@@ -149,16 +150,16 @@ TEST(IpinEndToEndTest, WifiRatslamClosesOutAndBackLoops) {
 // at start-up, naming the missing stream and a config that fits. A Wi-Fi config stopped before
 // the first scan: it ran, but processed no frame, so it exits 1 too.
 TEST(IpinEndToEndTest, RunsThatCannotDoAnythingSaySo) {
-  const fs::path log = fs::path(RATSLAM_SHARED_DATA_DIR) / "ipin2023-t3" /
+  const fs::path log = fs::path(ratslam::test_paths::SharedDataDir()) / "ipin2023-t3" /
                        "IPIN2023_T3_TrainingTrial01_repetition01.txt";
   if (!fs::exists(log)) GTEST_SKIP() << "missing " << log;
   const fs::path out =
       fs::temp_directory_path() / ("ratslam_ipin_empty_" + std::to_string(::getpid()));
   const std::string err = (out.string() + ".err");
   const auto run = [&](const std::string& args) {
-    const std::string command = std::string(RATSLAM_BINARY) + " replay --quiet " + args +
-                                " --data " + log.string() + " --out " + out.string() +
-                                " > /dev/null 2> " + err;
+    const std::string command = std::string(ratslam::test_paths::RatslamBinary()) +
+                                " replay --quiet " + args + " --data " + log.string() + " --out " +
+                                out.string() + " > /dev/null 2> " + err;
     const int status = std::system(command.c_str());
     std::ifstream in(err);
     return std::make_pair(WEXITSTATUS(status), std::string(std::istreambuf_iterator<char>(in), {}));
@@ -167,7 +168,7 @@ TEST(IpinEndToEndTest, RunsThatCannotDoAnythingSaySo) {
   EXPECT_EQ(code, 1);
   EXPECT_NE(message.find("needs camera images"), std::string::npos) << message;
   EXPECT_NE(message.find("configs/ipin2023-wifi-compass.toml"), std::string::npos) << message;
-  std::tie(code, message) = run(std::string("--config ") + RATSLAM_SOURCE_DIR +
+  std::tie(code, message) = run(std::string("--config ") + ratslam::test_paths::SourceDir() +
                                 "/configs/ipin2023-wifi.toml --until 0.5");  // first scan: 0.65 s
   EXPECT_EQ(code, 1);
   EXPECT_NE(message.find("processed no frame"), std::string::npos) << message;
@@ -188,7 +189,7 @@ TEST(IpinEndToEndTest, RunsThatCannotDoAnythingSaySo) {
 // (floor -2) and 01 (floor 0), the later walks' floors are found relative to route 51's by Wi-Fi
 // votes; route 21's must come out two floors below route 51's start, as the ground truth says.
 TEST(IpinEndToEndTest, BarometerKeepsMatchesOnTheirFloors) {
-  const fs::path data = fs::path(RATSLAM_SHARED_DATA_DIR) / "ipin2023-t3";
+  const fs::path data = fs::path(ratslam::test_paths::SharedDataDir()) / "ipin2023-t3";
   std::vector<fs::path> logs;
   for (const char* name : {"51_repetition02", "21_repetition01", "21_repetition02",
                            "01_repetition01", "01_repetition02"}) {
@@ -198,7 +199,8 @@ TEST(IpinEndToEndTest, BarometerKeepsMatchesOnTheirFloors) {
   const fs::path root =
       fs::temp_directory_path() / ("ratslam_ipin_floors_" + std::to_string(::getpid()));
   fs::create_directories(root);
-  std::ifstream config_in(std::string(RATSLAM_SOURCE_DIR) + "/configs/ipin2023-wifi-compass.toml");
+  std::ifstream config_in(std::string(ratslam::test_paths::SourceDir()) +
+                          "/configs/ipin2023-wifi-compass.toml");
   std::stringstream config_text;
   config_text << config_in.rdbuf();
   std::string without = config_text.str();
@@ -208,9 +210,10 @@ TEST(IpinEndToEndTest, BarometerKeepsMatchesOnTheirFloors) {
   std::ofstream(root / "without.toml") << without;
   auto replay = [&](bool barometer, size_t walks, const std::string& name) {
     std::string command =
-        std::string(RATSLAM_BINARY) + " replay --quiet --config " +
-        (barometer ? std::string(RATSLAM_SOURCE_DIR) + "/configs/ipin2023-wifi-compass.toml"
-                   : (root / "without.toml").string());
+        std::string(ratslam::test_paths::RatslamBinary()) + " replay --quiet --config " +
+        (barometer
+             ? std::string(ratslam::test_paths::SourceDir()) + "/configs/ipin2023-wifi-compass.toml"
+             : (root / "without.toml").string());
     for (size_t i = 0; i < walks; ++i) command += " --data " + logs[i].string();
     command += " --out " + (root / name).string() + " > /dev/null";
     EXPECT_EQ(std::system(command.c_str()), 0) << command;
@@ -263,7 +266,8 @@ TEST(IpinEndToEndTest, BarometerKeepsMatchesOnTheirFloors) {
 
   // The FABMAP front end under the same rule (measured: 1 floor mistake without, 0 with).
   auto fabmap = [&](bool barometer, const std::string& name) {
-    std::ifstream in(std::string(RATSLAM_SOURCE_DIR) + "/configs/ipin2023-fabmap-wifi.toml");
+    std::ifstream in(std::string(ratslam::test_paths::SourceDir()) +
+                     "/configs/ipin2023-fabmap-wifi.toml");
     std::stringstream text;
     text << in.rdbuf();
     std::string config = text.str();
@@ -271,8 +275,8 @@ TEST(IpinEndToEndTest, BarometerKeepsMatchesOnTheirFloors) {
     EXPECT_NE(on, std::string::npos);
     if (!barometer && on != std::string::npos) config.replace(on, 20, "use_barometer = false");
     std::ofstream(root / (name + ".toml")) << config;
-    std::string command = std::string(RATSLAM_BINARY) + " replay --quiet --config " +
-                          (root / (name + ".toml")).string();
+    std::string command = std::string(ratslam::test_paths::RatslamBinary()) +
+                          " replay --quiet --config " + (root / (name + ".toml")).string();
     for (const fs::path& log : logs) command += " --data " + log.string();
     command += " --out " + (root / name).string() + " > /dev/null";
     EXPECT_EQ(std::system(command.c_str()), 0) << command;
@@ -289,15 +293,15 @@ TEST(IpinEndToEndTest, BarometerKeepsMatchesOnTheirFloors) {
 // A run stopped on the stairs of route 51 and resumed from its saved map ends exactly where an
 // uninterrupted run ends: the barometer's tracker, the levels and the floors are in the state.
 TEST(IpinEndToEndTest, BarometerStateResumesBitForBit) {
-  const fs::path log = fs::path(RATSLAM_SHARED_DATA_DIR) / "ipin2023-t3" /
+  const fs::path log = fs::path(ratslam::test_paths::SharedDataDir()) / "ipin2023-t3" /
                        "IPIN2023_T3_TrainingTrial51_repetition02.txt";
   if (!fs::exists(log)) GTEST_SKIP() << "missing " << log;
   const fs::path root =
       fs::temp_directory_path() / ("ratslam_ipin_resume_" + std::to_string(::getpid()));
   fs::create_directories(root);
-  const std::string base = std::string(RATSLAM_BINARY) + " replay --quiet --config " +
-                           RATSLAM_SOURCE_DIR + "/configs/ipin2023-wifi-compass.toml --data " +
-                           log.string();
+  const std::string base = std::string(ratslam::test_paths::RatslamBinary()) +
+                           " replay --quiet --config " + ratslam::test_paths::SourceDir() +
+                           "/configs/ipin2023-wifi-compass.toml --data " + log.string();
   auto run = [&](const std::string& extra, const std::string& name) {
     const std::string command = base + extra + " --out " + (root / name).string() + " > /dev/null";
     EXPECT_EQ(std::system(command.c_str()), 0) << command;
@@ -322,7 +326,7 @@ TEST(IpinEndToEndTest, BarometerStateResumesBitForBit) {
 }
 
 TEST(IpinEndToEndTest, OnlineRssiOffsetFindsTheSecondPhonesOffset) {
-  const fs::path data = fs::path(RATSLAM_SHARED_DATA_DIR) / "ipin2023-t3";
+  const fs::path data = fs::path(ratslam::test_paths::SharedDataDir()) / "ipin2023-t3";
   for (const char* trial : {"02", "23"}) {
     std::vector<std::string> paths;
     for (const char* rep : {"01", "02", "03", "04"}) {
@@ -389,8 +393,8 @@ TEST(IpinEndToEndTest, OnlineRssiOffsetFindsTheSecondPhonesOffset) {
       fs::create_directories(root);
       const fs::path config = root / "config.toml";
       // The shipped config has the offset on; both runs set it themselves.
-      const std::string shipped =
-          e2e::Slurp(std::string(RATSLAM_SOURCE_DIR) + "/configs/ipin2023-wifi-compass.toml");
+      const std::string shipped = e2e::Slurp(std::string(ratslam::test_paths::SourceDir()) +
+                                             "/configs/ipin2023-wifi-compass.toml");
       ASSERT_NE(shipped.find("\nonline_rssi_offset = true\n"), std::string::npos);
       std::string without;
       std::istringstream lines(shipped);
@@ -403,8 +407,9 @@ TEST(IpinEndToEndTest, OnlineRssiOffsetFindsTheSecondPhonesOffset) {
       ASSERT_FALSE(toml.empty());
       std::ofstream(config) << toml;
       const fs::path out = root / (std::string(trial) + (online ? "_on" : "_off"));
-      std::string command = std::string(RATSLAM_BINARY) + " replay --quiet --overwrite --config " +
-                            config.string() + " --out " + out.string();
+      std::string command = std::string(ratslam::test_paths::RatslamBinary()) +
+                            " replay --quiet --overwrite --config " + config.string() + " --out " +
+                            out.string();
       for (const std::string& p : paths) command += " --data " + p;
       ASSERT_EQ(std::system((command + " > /dev/null").c_str()), 0) << command;
       std::ifstream in(out / "summary.json");
@@ -438,7 +443,7 @@ TEST(IpinEndToEndTest, OnlineRssiOffsetFindsTheSecondPhonesOffset) {
 // truth alone; measured 2.3 m and 3.0 m, the 3-NN fingerprint answer on a map of the first
 // walk's scans at their true positions 3.6 m and 3.8 m).
 TEST(IpinEndToEndTest, PhoneLogsLocaliseOnASavedMap) {
-  const fs::path data = fs::path(RATSLAM_SHARED_DATA_DIR) / "ipin2023-t3";
+  const fs::path data = fs::path(ratslam::test_paths::SharedDataDir()) / "ipin2023-t3";
   std::vector<fs::path> logs;
   for (const char* rep : {"01", "02", "03"}) {
     logs.push_back(data / ("IPIN2023_T3_TrainingTrial22_repetition" + std::string(rep) + ".txt"));
@@ -447,12 +452,12 @@ TEST(IpinEndToEndTest, PhoneLogsLocaliseOnASavedMap) {
   const fs::path root =
       fs::temp_directory_path() / ("ratslam_ipin_localise_" + std::to_string(::getpid()));
   fs::create_directories(root);
-  const std::string config =
-      std::string(" --config ") + RATSLAM_SOURCE_DIR + "/configs/ipin2023-wifi-compass.toml";
+  const std::string config = std::string(" --config ") + ratslam::test_paths::SourceDir() +
+                             "/configs/ipin2023-wifi-compass.toml";
   const fs::path map = root / "route22.map";
-  std::string command = std::string(RATSLAM_BINARY) + " replay --quiet" + config + " --data " +
-                        logs[0].string() + " --out " + (root / "map").string() + " --save-map " +
-                        map.string() + " > /dev/null";
+  std::string command = std::string(ratslam::test_paths::RatslamBinary()) + " replay --quiet" +
+                        config + " --data " + logs[0].string() + " --out " +
+                        (root / "map").string() + " --save-map " + map.string() + " > /dev/null";
   ASSERT_EQ(std::system(command.c_str()), 0) << command;
 
   StatusOr<dataset::Dataset> d = dataset::LoadSessions({logs[0].string()}, {});
@@ -473,8 +478,8 @@ TEST(IpinEndToEndTest, PhoneLogsLocaliseOnASavedMap) {
 
   for (size_t k = 1; k < logs.size(); ++k) {
     const fs::path out = root / ("rep" + std::to_string(k));
-    command = std::string(RATSLAM_BINARY) + " replay --quiet" + config + " --data " +
-              logs[k].string() + " --load-map " + map.string() + " --localise --out " +
+    command = std::string(ratslam::test_paths::RatslamBinary()) + " replay --quiet" + config +
+              " --data " + logs[k].string() + " --load-map " + map.string() + " --localise --out " +
               out.string() + " > /dev/null";
     ASSERT_EQ(std::system(command.c_str()), 0) << command;
     std::ifstream in(out / "summary.json");

@@ -25,6 +25,7 @@
 #include "phone/wifi_gp_map.h"
 #include "tests/documented_keys.h"
 #include "tests/run_ratslam.h"
+#include "tests/test_paths.h"
 
 namespace ratslam {
 namespace {
@@ -33,7 +34,7 @@ using e2e::Result;
 using e2e::RunRatslam;
 
 TEST(IpinLocateTest, AParticleFilterLocatesAnotherPhoneInTheWifiMap) {
-  const fs::path data = fs::path(RATSLAM_SHARED_DATA_DIR) / "ipin2023-t3";
+  const fs::path data = fs::path(ratslam::test_paths::SharedDataDir()) / "ipin2023-t3";
   auto log = [&](const char* rep) {
     return data / (std::string("IPIN2023_T3_TrainingTrial22_repetition") + rep + ".txt");
   };
@@ -151,7 +152,7 @@ TEST(IpinLocateTest, AParticleFilterLocatesAnotherPhoneInTheWifiMap) {
 // against the run's own CSVs (independently of the planner): every candidate's experience is on
 // it, consecutive experiences are linked, and its length is the sum of its segments.
 TEST(IpinLocateTest, ARunsMapLocatesThePhoneAndTheRobotIsCalled) {
-  const fs::path data = fs::path(RATSLAM_SHARED_DATA_DIR) / "ipin2023-t3";
+  const fs::path data = fs::path(ratslam::test_paths::SharedDataDir()) / "ipin2023-t3";
   auto log = [&](const char* rep) {
     return (data / (std::string("IPIN2023_T3_TrainingTrial22_repetition") + rep + ".txt")).string();
   };
@@ -162,10 +163,11 @@ TEST(IpinLocateTest, ARunsMapLocatesThePhoneAndTheRobotIsCalled) {
   fs::create_directories(root);
   const std::string run = (root / "run").string(), map_file = (root / "run.map").string();
   const std::string both = " --data " + log("01") + " --data " + log("02");
-  const Result replayed = RunRatslam("replay --quiet --config " + std::string(RATSLAM_SOURCE_DIR) +
-                                         "/configs/ipin2023-wifi-compass.toml" + both + " --out " +
-                                         run + " --save-map " + map_file,
-                                     root);
+  const Result replayed =
+      RunRatslam("replay --quiet --config " + std::string(ratslam::test_paths::SourceDir()) +
+                     "/configs/ipin2023-wifi-compass.toml" + both + " --out " + run +
+                     " --save-map " + map_file,
+                 root);
   ASSERT_EQ(replayed.exit_code, 0) << replayed.err;
   const std::string wifi = (root / "run.wifimap").string();
   const Result built = RunRatslam("wifi-map --run " + run + both + " --out " + wifi, root);

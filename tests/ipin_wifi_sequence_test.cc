@@ -24,6 +24,7 @@
 #include "dataset/csv.h"
 #include "dataset/dataset_loader.h"
 #include "tests/documented_keys.h"
+#include "tests/test_paths.h"
 
 namespace ratslam {
 namespace {
@@ -31,8 +32,8 @@ namespace fs = std::filesystem;
 
 nlohmann::json Replay(const std::string& config, const std::vector<fs::path>& logs,
                       const fs::path& out, const std::string& extra = "") {
-  std::string command =
-      std::string(RATSLAM_BINARY) + " replay --quiet " + extra + " --config " + config;
+  std::string command = std::string(ratslam::test_paths::RatslamBinary()) + " replay --quiet " +
+                        extra + " --config " + config;
   for (const fs::path& log : logs) command += " --data " + log.string();
   command += " --out " + out.string() + " > /dev/null";
   EXPECT_EQ(std::system(command.c_str()), 0) << command;
@@ -45,7 +46,7 @@ nlohmann::json Replay(const std::string& config, const std::vector<fs::path>& lo
 
 // The four repetitions of an IPIN 2023 training route, in order.
 std::vector<fs::path> RouteLogs(const std::string& route) {
-  const fs::path data = fs::path(RATSLAM_SHARED_DATA_DIR) / "ipin2023-t3";
+  const fs::path data = fs::path(ratslam::test_paths::SharedDataDir()) / "ipin2023-t3";
   std::vector<fs::path> logs;
   for (const char* rep : {"01", "02", "03", "04"}) {
     logs.push_back(data / ("IPIN2023_T3_TrainingTrial" + route + "_repetition" + rep + ".txt"));
@@ -64,7 +65,7 @@ TEST_P(IpinWifiSequenceTest, VerifiedSequencesCloseLoopsOnRealWalks) {
       fs::temp_directory_path() /
       ("ratslam_ipin_sequence_" + std::string(GetParam()) + "_" + std::to_string(::getpid()));
   const std::string config =
-      std::string(RATSLAM_SOURCE_DIR) + "/configs/ipin2023-wifi-sequence-alone.toml";
+      std::string(ratslam::test_paths::SourceDir()) + "/configs/ipin2023-wifi-sequence-alone.toml";
   const nlohmann::json with = Replay(config, logs, out / "with", "--render --format png,svg");
   // Figs. 9 and 10 beside the usual images, as PNG and as SVG (--format).
   for (const char* name : {"wifi_sequence_similarity", "wifi_sequence_pairs"}) {
@@ -171,7 +172,7 @@ TEST_P(IpinSequenceBesideBoutTest, NeverWorseThanBoutAlone) {
   const fs::path out =
       fs::temp_directory_path() /
       ("ratslam_ipin_beside_bout_" + std::string(GetParam()) + "_" + std::to_string(::getpid()));
-  const std::string configs = std::string(RATSLAM_SOURCE_DIR) + "/configs/";
+  const std::string configs = std::string(ratslam::test_paths::SourceDir()) + "/configs/";
   const nlohmann::json bout = Replay(configs + "ipin2023-wifi-compass.toml", logs, out / "bout");
   const nlohmann::json both = Replay(configs + "ipin2023-wifi-sequence.toml", logs, out / "both");
   ASSERT_TRUE(both.contains("wifi_sequence"));

@@ -13,13 +13,14 @@
 
 #include "tests/documented_keys.h"
 #include "tests/run_ratslam.h"
+#include "tests/test_paths.h"
 
 namespace ratslam::e2e {
 namespace {
 
 namespace fs = std::filesystem;
 
-fs::path Nordland() { return fs::path(RATSLAM_SHARED_DATA_DIR) / "nordland-64x32"; }
+fs::path Nordland() { return fs::path(ratslam::test_paths::SharedDataDir()) / "nordland-64x32"; }
 
 class NordlandTest : public ::testing::Test {
  protected:
@@ -87,7 +88,8 @@ TEST_F(NordlandTest, SequencesBeatSingleFramesAcrossSeasons) {
 // independent SeqSLAM-style search reached on images; visual FABMAP runs on the same queries;
 // no answer of either is a blank frame.
 TEST_F(NordlandTest, DescriptorsFromAFileAreMatchedBySequences) {
-  const std::string script = std::string(RATSLAM_SOURCE_DIR) + "/scripts/image_descriptors.py";
+  const std::string script =
+      std::string(ratslam::test_paths::SourceDir()) + "/scripts/image_descriptors.py";
   for (const char* season : {"summer", "winter"}) {
     const std::string make = "/usr/bin/python3 " + script + " " + (Nordland() / season).string() +
                              " " + (scratch_ / (std::string(season) + ".npy")).string() +
@@ -168,11 +170,12 @@ TEST_F(NordlandTest, UnpairableFoldersAndBadGroundTruthAreClearErrors) {
 TEST_F(NordlandTest, RatslamMapsWinterOntoTheSummerMapBySequences) {
   const fs::path data = scratch_ / "data";
   const std::string make =
-      "bash " + (fs::path(RATSLAM_SOURCE_DIR) / "scripts" / "nordland_dataset.sh").string() + " " +
-      Nordland().string() + " " + data.string() + " > /dev/null";
+      "bash " +
+      (fs::path(ratslam::test_paths::SourceDir()) / "scripts" / "nordland_dataset.sh").string() +
+      " " + Nordland().string() + " " + data.string() + " > /dev/null";
   ASSERT_EQ(std::system(make.c_str()), 0) << make;
   const std::string config =
-      (fs::path(RATSLAM_SOURCE_DIR) / "configs" / "nordland-replay.toml").string();
+      (fs::path(ratslam::test_paths::SourceDir()) / "configs" / "nordland-replay.toml").string();
   std::ifstream config_in(config);
   const std::string text((std::istreambuf_iterator<char>(config_in)),
                          std::istreambuf_iterator<char>());

@@ -29,6 +29,7 @@
 #include "render/renderer.h"
 #include "tests/documented_keys.h"
 #include "tests/run_ratslam.h"
+#include "tests/test_paths.h"
 
 namespace ratslam {
 namespace {
@@ -87,7 +88,7 @@ class ReplayEndToEndTest : public ::testing::Test {
     StatusOr<dataset::Dataset> d =
         dataset::WriteSyntheticDataset(apps::DemoSyntheticOptions(), (root_ / "data").string());
     ASSERT_TRUE(d.ok()) << d.status().message();
-    config_ = (fs::path(RATSLAM_SOURCE_DIR) / "configs" / "synthetic.toml").string();
+    config_ = (fs::path(ratslam::test_paths::SourceDir()) / "configs" / "synthetic.toml").string();
   }
   static void TearDownTestSuite() { fs::remove_all(root_); }
   // Replays the demo data with a config given as TOML text; returns the summary.
@@ -182,7 +183,8 @@ TEST_F(ReplayEndToEndTest, ASecondRunIntoAFolderInUseFailsAtOnce) {
 TEST_F(ReplayEndToEndTest, ARunEndsWithTheSweepRunnerThatStartedIt) {
   const fs::path out = root_ / "orphan";
   const fs::path pid_file = root_ / "orphan.pid";
-  const std::string script = "RATSLAM_END_WITH_PARENT=$$ " + std::string(RATSLAM_BINARY) + " " +
+  const std::string script = "RATSLAM_END_WITH_PARENT=$$ " +
+                             std::string(ratslam::test_paths::RatslamBinary()) + " " +
                              ReplayArgs(out) + " --animate 1 >/dev/null 2>&1 & echo $! > " +
                              pid_file.string() + "; sleep 2; kill -KILL $$";
   (void)std::system(("bash -c '" + script + "'").c_str());
@@ -199,10 +201,11 @@ TEST_F(ReplayEndToEndTest, ARunEndsWithTheSweepRunnerThatStartedIt) {
   const nlohmann::json summary = Summary(out);
   EXPECT_EQ(summary.value("interrupted", false), true) << summary.dump();
   // A run whose parent is already gone when it starts stops at once.
-  const int status = std::system(("RATSLAM_END_WITH_PARENT=1 " + std::string(RATSLAM_BINARY) +
-                                  " replay --quiet --data " + (root_ / "data").string() +
-                                  " --out " + (root_ / "orphan_late").string())
-                                     .c_str());
+  const int status =
+      std::system(("RATSLAM_END_WITH_PARENT=1 " +
+                   std::string(ratslam::test_paths::RatslamBinary()) + " replay --quiet --data " +
+                   (root_ / "data").string() + " --out " + (root_ / "orphan_late").string())
+                      .c_str());
   EXPECT_TRUE(WIFSIGNALED(status) || WEXITSTATUS(status) != 0) << status;
   EXPECT_FALSE(fs::exists(root_ / "orphan_late" / "summary.json"));
 }
@@ -549,7 +552,7 @@ TEST_F(ReplayEndToEndTest, Ros2BagsReplayToTheFolderReplaysMap) {
   const fs::path dir = root_ / "ros2";
   const Result made = RunRatslam("synthesize --out " + (dir / "data").string(), root_);
   ASSERT_EQ(made.exit_code, 0) << made.err;
-  const std::string command = "bash " + std::string(RATSLAM_SOURCE_DIR) +
+  const std::string command = "bash " + std::string(ratslam::test_paths::SourceDir()) +
                               "/scripts/ros2_fixtures.sh " + (dir / "bags").string() + " " +
                               (dir / "data").string() + " 2>" + (dir / "fixtures.log").string();
   const int rc = std::system(command.c_str());
@@ -689,7 +692,7 @@ void ExpectOldMapResumesUnderItsOwnValuesOnly(const fs::path& root, const std::s
   const std::string tag = fs::path(fixture_name).stem().string();
   const fs::path whole = root / ("whole_" + tag), rest = root / ("rest_" + tag);
   const std::string fixture =
-      (fs::path(RATSLAM_SOURCE_DIR) / "tests" / "data" / fixture_name).string();
+      (fs::path(ratslam::test_paths::SourceDir()) / "tests" / "data" / fixture_name).string();
   const std::string then = AsMadeByFormat(format, config, root / (tag + "-then.toml"));
   ASSERT_FALSE(then.empty());
   auto args = [&](const std::string& c, const fs::path& out) {
@@ -738,7 +741,8 @@ TEST_F(ReplayEndToEndTest, FormatFourMapResumesWithoutTheOrientationTestOnly) {
 // which defaults to off. Turning the loop closer on is refused, naming the key, and so are
 // today's relaxation tolerances.
 TEST_F(ReplayEndToEndTest, FormatFiveMapResumesWithWifiSequenceOffOnly) {
-  const fs::path fixture = fs::path(RATSLAM_SOURCE_DIR) / "tests" / "data" / "map-v5-synthetic.map";
+  const fs::path fixture =
+      fs::path(ratslam::test_paths::SourceDir()) / "tests" / "data" / "map-v5-synthetic.map";
   const std::string then = AsMadeByFormat(5, config_, root_ / "v5-then.toml");
   ASSERT_FALSE(then.empty());
   auto args = [&](const std::string& c, const fs::path& out) {
@@ -774,7 +778,8 @@ TEST_F(ReplayEndToEndTest, MapFromThePreviousReleaseRefusesAKeyItCouldNotHaveUse
   ASSERT_FALSE(text.empty());
   std::ofstream(config) << text;
   const std::string fixture =
-      (fs::path(RATSLAM_SOURCE_DIR) / "tests" / "data" / "map-v2-synthetic.map").string();
+      (fs::path(ratslam::test_paths::SourceDir()) / "tests" / "data" / "map-v2-synthetic.map")
+          .string();
   const Result r = RunRatslam("replay --quiet --config " + config.string() + " --data " +
                                   (root_ / "data").string() + " --out " +
                                   (root_ / "v2_online").string() + " --load-map " + fixture,
@@ -829,14 +834,15 @@ class SimulatedSaveResumeTest : public ::testing::Test {
 ScratchDir* SimulatedSaveResumeTest::root_ = nullptr;
 
 TEST_F(SimulatedSaveResumeTest, FusedFrontEnd) {
-  ExpectResumeEqualsWhole((fs::path(RATSLAM_SOURCE_DIR) / "configs" / "demo.toml").string(), 250.0);
+  ExpectResumeEqualsWhole(
+      (fs::path(ratslam::test_paths::SourceDir()) / "configs" / "demo.toml").string(), 250.0);
 }
 
 // Time memory keeps a per-template time of the last decay update (map format 5): a resumed run
 // must carry it, or the decay after the split would restore from the wrong time.
 TEST_F(SimulatedSaveResumeTest, FusedFrontEndWithTimeMemory) {
   const fs::path config = root_->path() / "demo-time-memory.toml";
-  std::string text = Slurp(fs::path(RATSLAM_SOURCE_DIR) / "configs" / "demo.toml");
+  std::string text = Slurp(fs::path(ratslam::test_paths::SourceDir()) / "configs" / "demo.toml");
   const std::string key = "memory = \"frames\"";
   ASSERT_NE(text.find(key), std::string::npos);
   text.replace(text.find(key), key.size(), "memory = \"time\"");
@@ -849,13 +855,15 @@ TEST_F(SimulatedSaveResumeTest, FusedFrontEndFromAMapOfThePreviousRelease) {
   // which relaxed every link.
   const fs::path& dir = root_->path();
   const std::string config = AsMadeByFormat(
-      2, (fs::path(RATSLAM_SOURCE_DIR) / "configs" / "demo.toml").string(), dir / "demo-full.toml");
+      2, (fs::path(ratslam::test_paths::SourceDir()) / "configs" / "demo.toml").string(),
+      dir / "demo-full.toml");
   ASSERT_FALSE(config.empty());
   const fs::path whole = dir / "v2_whole", rest = dir / "v2_rest";
   ASSERT_EQ(RunRatslam(Args(config, whole), dir).exit_code, 0);
   const Result r = RunRatslam(
       Args(config, rest) + " --load-map " +
-          (fs::path(RATSLAM_SOURCE_DIR) / "tests" / "data" / "map-v2-fused.map").string(),
+          (fs::path(ratslam::test_paths::SourceDir()) / "tests" / "data" / "map-v2-fused.map")
+              .string(),
       dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   ExpectSameRun(whole, rest);
@@ -916,7 +924,7 @@ TEST_F(SimulatedSaveResumeTest, FusedFrontEndWithOnlineRssiOffset) {
   const fs::path data = SecondPhoneData(root_->path());
   const fs::path config = root_->path() / "demo-offset.toml";
   const std::string toml = e2e::WithLinesInSection(
-      Slurp(fs::path(RATSLAM_SOURCE_DIR) / "configs" / "demo.toml"), "fused",
+      Slurp(fs::path(ratslam::test_paths::SourceDir()) / "configs" / "demo.toml"), "fused",
       "online_rssi_offset = true\nrssi_offset_min_estimates = 3\n");
   ASSERT_FALSE(toml.empty());
   std::ofstream(config) << toml;
@@ -1034,7 +1042,8 @@ TEST_F(ReplayEndToEndTest, RenderWritesImagesFromRunsAndMaps) {
   EXPECT_EQ(Slurp(own), Slurp(cells));
   const Result v2 = RunRatslam(
       "render pose-cells --map " +
-          (fs::path(RATSLAM_SOURCE_DIR) / "tests" / "data" / "map-v2-synthetic.map").string() +
+          (fs::path(ratslam::test_paths::SourceDir()) / "tests" / "data" / "map-v2-synthetic.map")
+              .string() +
           " --out " + (root_ / "v2.png").string(),
       root_);
   EXPECT_NE(v2.exit_code, 0);

@@ -1,5 +1,5 @@
-// Helpers for the end-to-end tests, which run the `ratslam` program (RATSLAM_BINARY) as a user
-// would and read what it wrote.
+// Helpers for the end-to-end tests, which run the `ratslam` program (test_paths::RatslamBinary())
+// as a user would and read what it wrote.
 #ifndef RATSLAM_TESTS_RUN_RATSLAM_H_
 #define RATSLAM_TESTS_RUN_RATSLAM_H_
 
@@ -10,6 +10,8 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+
+#include "tests/test_paths.h"
 
 namespace ratslam::e2e {
 
@@ -44,7 +46,8 @@ inline Result RunRatslam(const std::string& arguments, const std::filesystem::pa
   const std::filesystem::path err = scratch / "stderr.txt", out = scratch / "stdout.txt";
   const std::string command =
       (limit_s > 0 ? "timeout -s KILL " + std::to_string(limit_s) + " " : std::string()) +
-      std::string(RATSLAM_BINARY) + " " + arguments + " > " + out.string() + " 2> " + err.string();
+      std::string(ratslam::test_paths::RatslamBinary()) + " " + arguments + " > " + out.string() +
+      " 2> " + err.string();
   const int status = std::system(command.c_str());
   return {WEXITSTATUS(status), Slurp(err), Slurp(out)};
 }

@@ -12,6 +12,8 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "tests/test_paths.h"
+
 namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -48,14 +50,14 @@ class SimulatedScenarios : public ::testing::Test {
   static fs::path World(const std::string& name) {
     const fs::path out = root_ / ("sim-" + name);
     if (!fs::exists(out / "manifest.toml")) {
-      Run(std::string(RATSLAM_BINARY) + " simulate --quiet --world " + name + " --out " +
-          out.string());
+      Run(std::string(ratslam::test_paths::RatslamBinary()) + " simulate --quiet --world " + name +
+          " --out " + out.string());
     }
     return out;
   }
   // configs/sim-fused.toml with the [fused] sensor switches set.
   static json Replay(const std::string& world, bool camera, bool wifi, bool compass) {
-    std::string text = Read(fs::path(RATSLAM_SOURCE_DIR) / "configs/sim-fused.toml");
+    std::string text = Read(fs::path(ratslam::test_paths::SourceDir()) / "configs/sim-fused.toml");
     auto set = [&](const std::string& key, bool on) {
       text = SetLine(text, key + " =", key + (on ? " = true" : " = false"));
     };
@@ -67,13 +69,13 @@ class SimulatedScenarios : public ::testing::Test {
     const fs::path config = root_ / (tag + ".toml");
     std::ofstream(config) << text;
     const fs::path out = root_ / ("replay-" + tag);
-    Run(std::string(RATSLAM_BINARY) + " replay --quiet --config " + config.string() + " --data " +
-        World(world).string() + " --out " + out.string());
+    Run(std::string(ratslam::test_paths::RatslamBinary()) + " replay --quiet --config " +
+        config.string() + " --data " + World(world).string() + " --out " + out.string());
     return json::parse(Read(out / "summary.json"));
   }
   // configs/sim-fabmap.toml in `mode`, the vocabulary learnt once from the office's images.
   static json Evaluate(const std::string& world, const std::string& mode) {
-    std::string text = Read(fs::path(RATSLAM_SOURCE_DIR) / "configs/sim-fabmap.toml");
+    std::string text = Read(fs::path(ratslam::test_paths::SourceDir()) / "configs/sim-fabmap.toml");
     text = SetLine(text, "mode =", "mode = \"" + mode + "\"");
     const fs::path model = root_ / "visual_model.bin";
     if (fs::exists(model)) {
@@ -86,8 +88,9 @@ class SimulatedScenarios : public ::testing::Test {
     std::ofstream(config) << text;
     const fs::path out = root_ / ("evaluate-" + world + "-" + mode);
     const fs::path data = World(world);
-    Run(std::string(RATSLAM_BINARY) + " evaluate --quiet --config " + config.string() + " --map " +
-        data.string() + " --query " + data.string() + " --out " + out.string());
+    Run(std::string(ratslam::test_paths::RatslamBinary()) + " evaluate --quiet --config " +
+        config.string() + " --map " + data.string() + " --query " + data.string() + " --out " +
+        out.string());
     if (!fs::exists(model) && fs::exists(out / "visual_model.bin")) {
       fs::copy_file(out / "visual_model.bin", model);
     }

@@ -6,6 +6,7 @@
 
 #include "common/random.h"
 #include "dataset/image_loader.h"
+#include "tests/test_paths.h"
 
 namespace ratslam::fabmap {
 namespace {
@@ -110,8 +111,8 @@ TEST(VocabularyTest, TooFewDescriptorsIsAnError) {
 }
 
 TEST(VocabularyTest, FeaturesFromARealCorridorImage) {
-  const std::string path =
-      std::string(RATSLAM_SHARED_DATA_DIR) + "/multifloor-corridors/floor1/frame00001.jpg";
+  const std::string path = std::string(ratslam::test_paths::SharedDataDir()) +
+                           "/multifloor-corridors/floor1/frame00001.jpg";
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "missing " << path;
   dataset::FileImageLoader loader;
   const auto image = loader.Load(path);
