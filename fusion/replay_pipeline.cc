@@ -200,13 +200,19 @@ Status ReplayPipeline::FeedImage(double time_s, const GrayImage& image) {
     ++state_.images_skipped;
     return Status::Ok();
   }
-  StatusOr<std::optional<FrameDecision>> decision = front_end_->OnImage(time_s, image);
+  StatusOr<std::optional<FrameDecision>> decision = [&] {
+    StageTimer timer(stage_times_ ? &stage_times_->front_end_s : nullptr);
+    return front_end_->OnImage(time_s, image);
+  }();
   if (!decision.ok()) return decision.status();
   return decision.value() ? Apply(*decision.value()) : Status::Ok();
 }
 
 Status ReplayPipeline::FeedDescriptor(double time_s, const std::vector<float>& values) {
-  StatusOr<std::optional<FrameDecision>> decision = front_end_->OnDescriptor(time_s, values);
+  StatusOr<std::optional<FrameDecision>> decision = [&] {
+    StageTimer timer(stage_times_ ? &stage_times_->front_end_s : nullptr);
+    return front_end_->OnDescriptor(time_s, values);
+  }();
   if (!decision.ok()) return decision.status();
   return decision.value() ? Apply(*decision.value()) : Status::Ok();
 }
@@ -241,7 +247,10 @@ Status ReplayPipeline::FeedPressure(const PressureSample& sample) {
 
 Status ReplayPipeline::FeedWifi(const WifiScan& scan) {
   ++state_.wifi_scans_seen;
-  StatusOr<std::optional<FrameDecision>> decision = front_end_->OnWifi(scan);
+  StatusOr<std::optional<FrameDecision>> decision = [&] {
+    StageTimer timer(stage_times_ ? &stage_times_->front_end_s : nullptr);
+    return front_end_->OnWifi(scan);
+  }();
   if (!decision.ok()) return decision.status();
   if (decision.value()) RATSLAM_RETURN_IF_ERROR(Apply(*decision.value()));
   return options_.wifi_sequence.enabled && !localising() ? AddSequencePose(scan) : Status::Ok();
@@ -380,6 +389,7 @@ Status ReplayPipeline::Restore(const State& state) {
   RATSLAM_RETURN_IF_ERROR(CheckRecords(state));
   auto slam = std::make_unique<Ratslam>(options_.ratslam);
   RATSLAM_RETURN_IF_ERROR(slam->SetState(state.ratslam));
+  slam->AttachStageTimes(stage_times_);
   std::unique_ptr<FrontEnd> front_end = CreateFrontEnd(options_.sensors, resources_);
   RATSLAM_RETURN_IF_ERROR(front_end->DecodeState(state.front_end));
   auto wifi_sequence =

@@ -143,6 +143,13 @@ class ReplayPipeline {
   // refuses (time going backwards, pressure outside 100-1,100 hPa).
   Status FeedPressure(const PressureSample& sample);
 
+  // From now on, add the time of the front end and of the spine's stages to `times` (null: stop
+  // timing); `times` must outlive the timing.
+  void AttachStageTimes(StageTimes* times) {
+    stage_times_ = times;
+    slam_->AttachStageTimes(times);
+  }
+
   bool finished() const { return state_.next_event >= events_.size(); }
   const Ratslam& slam() const { return *slam_; }
   const State& state() const { return state_; }
@@ -207,6 +214,7 @@ class ReplayPipeline {
   State state_;                                   // the parts not held by slam_ and camera_
   std::vector<LocalisationRecord> localisation_;  // localisation runs only (not saved)
   double lost_after_m_ = 0.0;
+  StageTimes* stage_times_ = nullptr;
 };
 
 }  // namespace ratslam::fusion

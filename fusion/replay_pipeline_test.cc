@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <numbers>
 #include <optional>
@@ -153,6 +154,60 @@ TEST(ReplayPipelineTest, StopAndResumeEqualsOneRunForTheFusedFrontEnd) {
   }
   EXPECT_EQ(whole.state().frames.size(), second.state().frames.size());
   EXPECT_EQ(whole.Snapshot().front_end, second.Snapshot().front_end);
+}
+
+TEST(ReplayPipelineTest, StageTimesSplitTheRunAndChangeNothing) {
+  const dataset::Dataset data = SquareLoop();
+  NoImages images;
+  ReplayPipeline untimed(WifiOptions(), data, &images);
+  ASSERT_TRUE(untimed.Run({}).ok());
+
+  // Timed for the first half (through a restore, which makes a new spine), then not.
+  StageTimes times;
+  ReplayPipeline first(WifiOptions(), data, &images);
+  first.AttachStageTimes(&times);
+  ReplayControl half;
+  half.until_time_s = 60.0;
+  ASSERT_TRUE(first.Run(half).ok());
+  const StageTimes first_half = times;
+  ReplayPipeline timed(WifiOptions(), data, &images);
+  timed.AttachStageTimes(&times);
+  ASSERT_TRUE(timed.Restore(first.Snapshot()).ok());
+  half.until_time_s = 110.0;
+  const auto start = std::chrono::steady_clock::now();
+  ASSERT_TRUE(timed.Run(half).ok());
+  const double wall_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const StageTimes after_half = times;
+  // The stages ran on both sides of the restore, and the second run's stages fit in its wall
+  // time.
+  auto sum = [](const StageTimes& t) {
+    return t.front_end_s + t.pose_cells_s + t.experience_map_s;
+  };
+  EXPECT_GT(first_half.front_end_s, 0.0);
+  EXPECT_GT(first_half.pose_cells_s, 0.0);
+  EXPECT_GT(first_half.experience_map_s, 0.0);
+  EXPECT_GT(after_half.front_end_s, first_half.front_end_s);
+  EXPECT_GT(after_half.pose_cells_s, first_half.pose_cells_s);
+  EXPECT_GT(after_half.experience_map_s, first_half.experience_map_s);
+  EXPECT_LE(sum(after_half) - sum(first_half), wall_s);
+  timed.AttachStageTimes(nullptr);
+  ASSERT_TRUE(timed.Run({}).ok());
+  EXPECT_EQ(times.front_end_s, after_half.front_end_s);
+  EXPECT_EQ(times.pose_cells_s, after_half.pose_cells_s);
+  EXPECT_EQ(times.experience_map_s, after_half.experience_map_s);
+
+  // Timing a frame changes none of it.
+  const auto& a = untimed.slam().experience_map().experiences();
+  const auto& b = timed.slam().experience_map().experiences();
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].x_m, b[i].x_m);
+    EXPECT_EQ(a[i].y_m, b[i].y_m);
+    EXPECT_EQ(a[i].theta_rad, b[i].theta_rad);
+  }
+  EXPECT_EQ(untimed.Snapshot().front_end, timed.Snapshot().front_end);
+  EXPECT_EQ(untimed.state().frames.size(), timed.state().frames.size());
 }
 
 TEST(ReplayPipelineTest, RestoreRefusesStatesThatDoNotFit) {

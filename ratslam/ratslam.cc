@@ -70,6 +70,7 @@ Status Ratslam::OnView(const ViewDecision& decision) {
     }
   }
   if (injection.value()) {
+    StageTimer timer(stage_times_ ? &stage_times_->pose_cells_s : nullptr);
     pose_cells_.Inject(injection.value()->position, injection.value()->energy);
     ++counters_.injections;
   }
@@ -86,7 +87,11 @@ StatusOr<ActionKind> Ratslam::OnOdometry(const OdometryStep& step) {
     return Status::Error("odometry step at t=" + std::to_string(step.time_s) + " is not finite");
   }
   ++counters_.odometry_steps;
-  pose_cells_.Step(step.forward_m, step.rotation_rad);
+  {
+    StageTimer timer(stage_times_ ? &stage_times_->pose_cells_s : nullptr);
+    pose_cells_.Step(step.forward_m, step.rotation_rad);
+  }
+  StageTimer timer(stage_times_ ? &stage_times_->experience_map_s : nullptr);
   experience_map_.Integrate(step.forward_m, step.rotation_rad);
   return Act(step.time_s);
 }

@@ -4,6 +4,7 @@
 #ifndef RATSLAM_RATSLAM_H_
 #define RATSLAM_RATSLAM_H_
 
+#include <chrono>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -61,6 +62,33 @@ enum class ActionKind {
   kRecognised  // frozen map: moved to an existing experience, no link made
 };
 
+// Seconds spent in each stage of a run, summed while attached (Ratslam::AttachStageTimes,
+// ReplayPipeline::AttachStageTimes): where the time of a frame goes, for benchmarks and profiles.
+// Nothing is timed while none is attached.
+struct StageTimes {
+  double front_end_s = 0.0;       // the front end deciding the view (template matching)
+  double pose_cells_s = 0.0;      // pose-cell injection and path integration
+  double experience_map_s = 0.0;  // experience-map integration, the action and relaxation
+};
+
+// Adds the seconds from its construction to its destruction to `*sum`; does nothing for null.
+class StageTimer {
+ public:
+  explicit StageTimer(double* sum) : sum_(sum) {
+    if (sum_) start_ = std::chrono::steady_clock::now();
+  }
+  ~StageTimer() {
+    if (sum_)
+      *sum_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  }
+  StageTimer(const StageTimer&) = delete;
+  StageTimer& operator=(const StageTimer&) = delete;
+
+ private:
+  double* sum_;
+  std::chrono::steady_clock::time_point start_;
+};
+
 class Ratslam {
  public:
   struct Counters {
@@ -115,6 +143,10 @@ class Ratslam {
   // No current experience, or dead reckoned further than `after_m` from it.
   bool Lost(double after_m) const;
 
+  // From now on, add the time of each stage to `times` (null: stop timing). `times` must outlive
+  // the timing.
+  void AttachStageTimes(StageTimes* times) { stage_times_ = times; }
+
   const PoseCellNetwork& pose_cells() const { return pose_cells_; }
   const LocalViewCells& local_view() const { return local_view_; }
   const ExperienceMap& experience_map() const { return experience_map_; }
@@ -148,6 +180,7 @@ class Ratslam {
   std::optional<double> compass_heading_rad_;
   std::optional<size_t> frozen_templates_;    // templates of the frozen map
   std::optional<double> relocalise_after_m_;  // FreezeMap's
+  StageTimes* stage_times_ = nullptr;
   LocalisationCounters localisation_counters_;
 };
 
