@@ -123,6 +123,9 @@ class FrontEnd {
   // A new session (another walk, perhaps another phone) starts at `start_s`; called before each
   // Wi-Fi scan with its session's start (repeats are no news). Default: nothing.
   virtual void OnSessionStart(double /*start_s*/) {}
+  // Whether the walker moved just before the next Wi-Fi scan (odometry travelled within the
+  // PDR's max_step_interval_s); called before each scan in a replay. Default: nothing.
+  virtual void OnWalking(bool /*walking*/) {}
   // What this front end has to say about the run so far, for summaries (default: nothing).
   virtual FrontEndReport Report() const { return {}; }
   // Localisation on a saved map: the templates stored so far were made by another run on

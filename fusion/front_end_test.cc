@@ -438,6 +438,39 @@ TEST(FusedFrontEndTest, OnlineRssiOffsetBridgesTwoPhones) {
   EXPECT_FALSE(CreateFrontEnd(settings)->DecodeState(state).ok());
 }
 
+// The second phone reads 10 dB lower while walking, and 16 dB lower during the 15 scans before
+// its walk, while it stands at the corridor's start and is waved (body shadow, the gesture). An
+// offset learnt from every scan is the standing scans' -16 dB until the walking estimates
+// outnumber them; learnt only from walking scans it is the walk's -10 dB from its tenth scan on.
+TEST(FusedFrontEndTest, OnlineRssiOffsetCanLearnFromWalkingScansOnly) {
+  for (bool walking_only : {false, true}) {
+    FrontEndSettings settings;
+    settings.front_end.kind = FrontEndKind::kFused;
+    settings.fused.recency_s = 0.0;
+    settings.fused.online_rssi_offset = true;
+    settings.fused.rssi_offset_walking_only = walking_only;
+    std::unique_ptr<FrontEnd> f = CreateFrontEnd(settings);
+    for (int i = 0; i < 40; ++i) {  // the first phone maps the corridor
+      f->OnSessionStart(0.0);
+      f->OnWalking(true);
+      ASSERT_TRUE(f->OnWifi(CorridorScan(2.0 * i, 2.0 * i, 0.0)).ok());
+    }
+    auto scan = [&](double t, double x, double shift_db, bool walking) {
+      f->OnSessionStart(1000.0);
+      f->OnWalking(walking);
+      WifiScan s = CorridorScan(t, x, 0.0);
+      for (WifiReading& r : s.readings) r.rssi_dbm += shift_db;
+      ASSERT_TRUE(f->OnWifi(s).ok());
+    };
+    for (int i = 0; i < 15; ++i) scan(1000.0 + i, 0.0, -16.0, false);
+    for (int i = 0; i < 10; ++i) scan(1020.0 + 2.0 * i, 2.0 * i, -10.0, true);
+    const std::vector<double> offsets = f->Report().rssi_offsets_db;
+    ASSERT_EQ(offsets.size(), 2u);
+    // Within half a dB: a scan's best template is a few metres off now and then.
+    EXPECT_NEAR(offsets[1], walking_only ? -10.0 : -16.0, 0.5) << walking_only;
+  }
+}
+
 // Localising on a saved map, the map's templates are the reference: a scan that matches one of
 // them is that place, even when a template made since (a place the map does not hold, here the
 // same corridor spot read 8 dB lower before any offset was known) matches it better. While

@@ -41,7 +41,10 @@ class FusedFrontEnd : public FrontEnd {
     readings.reserve(scan.readings.size());
     for (const WifiReading& r : scan.readings) readings.emplace_back(r.bssid, r.rssi_dbm);
     newest_scan_ = wifi_.MakeFingerprint(readings);
-    if (options_.online_rssi_offset) offset_.Calibrate(wifi_.state().fingerprints, &newest_scan_);
+    if (options_.online_rssi_offset) {
+      offset_.Calibrate(wifi_.state().fingerprints, &newest_scan_,
+                        walking_ || !options_.rssi_offset_walking_only);
+    }
     newest_scan_time_s_ = scan.time_s;
     newest_scan_followed_ = false;
     // One floor vote per scan (a scan re-used by several camera frames votes once).
@@ -58,6 +61,7 @@ class FusedFrontEnd : public FrontEnd {
   }
 
   void OnCompass(double, double heading_rad) override { heading_rad_ = heading_rad; }
+  void OnWalking(bool walking) override { walking_ = walking; }
 
   Status OnPressure(double time_s, double pressure_hpa) override {
     return floors_.OnPressure(time_s, pressure_hpa);
@@ -330,6 +334,7 @@ class FusedFrontEnd : public FrontEnd {
   bool newest_scan_followed_ = false;  // the newest scan updated a template (revisit_update_weight)
   uint64_t aps_added_ = 0, aps_dropped_ = 0;  // by revisit_update_weight, so far
   std::optional<double> heading_rad_;
+  bool walking_ = true;                // before the next scan (OnWalking; true if never told)
   sensors::RssiOffsetTracker offset_;  // [fused] online_rssi_offset: see sensors/rssi_offset.h
   FloorRule floors_;                   // [barometer] use_barometer: see fusion/floor_rule.h
 };

@@ -56,6 +56,10 @@ struct FusedOptions {
   bool online_rssi_offset = false;
   int rssi_offset_min_common_aps = 5;  // an estimate needs this many APs in common
   int rssi_offset_min_estimates = 10;  // estimates before the offset is applied
+  // Estimate the offset only from scans taken while walking (odometry moved just before the
+  // scan: FrontEnd::OnWalking), not while the phone stands or is waved in a calibration gesture
+  // (the PDR counts no steps then), when the body's shadow and the gesture bias the RSSI.
+  bool rssi_offset_walking_only = false;
   // Maps that keep up with access points changing after them (long-term data): a scan whose
   // Wi-Fi match to an old template (a revisit, past the recency of eqs. 10-11) reaches this
   // weight updates that template's fingerprint (WifiFingerprintMatcher::FollowRevisit: the APs
@@ -91,6 +95,11 @@ struct FusedOptions {
     v("rssi_offset_min_estimates", rssi_offset_min_estimates,
       "offset estimates of a session before its median is applied",
       schema::Unit("scans").AtLeast(1));
+    v("rssi_offset_walking_only", rssi_offset_walking_only,
+      "estimate the offset only from scans taken while walking (odometry moved within the PDR's "
+      "max_step_interval_s before the scan), not while standing or making the calibration "
+      "gesture",
+      schema::Any());
     v("revisit_update_weight", revisit_update_weight,
       "a revisit whose Wi-Fi match reaches this weight (eq. 6) updates the template's "
       "fingerprint once per scan: the scan's APs it lacks are added, its APs above "

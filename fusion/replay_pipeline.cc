@@ -247,6 +247,7 @@ Status ReplayPipeline::FeedPressure(const PressureSample& sample) {
 
 Status ReplayPipeline::FeedWifi(const WifiScan& scan) {
   ++state_.wifi_scans_seen;
+  front_end_->OnWalking(WalkingAt(scan.time_s));
   StatusOr<std::optional<FrameDecision>> decision = [&] {
     StageTimer timer(stage_times_ ? &stage_times_->front_end_s : nullptr);
     return front_end_->OnWifi(scan);
@@ -254,6 +255,18 @@ Status ReplayPipeline::FeedWifi(const WifiScan& scan) {
   if (!decision.ok()) return decision.status();
   if (decision.value()) RATSLAM_RETURN_IF_ERROR(Apply(*decision.value()));
   return options_.wifi_sequence.enabled && !localising() ? AddSequencePose(scan) : Status::Ok();
+}
+
+bool ReplayPipeline::WalkingAt(double time_s) const {
+  // The newest odometry step moved, and came within a step interval of the scan (a walker's
+  // odometry has a row per step; a standing one has none, or rows that do not move).
+  const std::vector<TrajectoryRecord>& t = state_.trajectory;
+  if (t.size() < 2) return false;
+  const TrajectoryRecord& last = t.back();
+  const TrajectoryRecord& before = t[t.size() - 2];
+  const bool moved =
+      last.odometry_x_m != before.odometry_x_m || last.odometry_y_m != before.odometry_y_m;
+  return moved && time_s - last.time_s <= options_.pdr.max_step_interval_s;
 }
 
 Pose2 ReplayPipeline::MapPose(const wifi_sequence::SequencePose& pose) const {

@@ -201,6 +201,8 @@ class ReplayPipeline {
   void AnnounceSession(double time_s);
   Status Apply(const FrameDecision& decision);
   Status AddSequencePose(const WifiScan& scan);
+  // Whether the odometry moved just before `time_s` (FrontEnd::OnWalking).
+  bool WalkingAt(double time_s) const;
   Status LinkLoop(const std::optional<wifi_sequence::SequenceLoop>& loop, double time_s);
 
   PipelineOptions options_;

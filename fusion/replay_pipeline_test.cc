@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <numbers>
 #include <optional>
 #include <string>
@@ -208,6 +209,51 @@ TEST(ReplayPipelineTest, StageTimesSplitTheRunAndChangeNothing) {
   }
   EXPECT_EQ(untimed.Snapshot().front_end, timed.Snapshot().front_end);
   EXPECT_EQ(untimed.state().frames.size(), timed.state().frames.size());
+}
+
+// A front end that notes what the pipeline says about walking before each scan.
+class WalkingNotes : public FrontEnd {
+ public:
+  explicit WalkingNotes(std::vector<std::pair<double, bool>>* notes) : notes_(notes) {}
+  StatusOr<std::optional<FrameDecision>> OnImage(double, const GrayImage&) override {
+    return std::optional<FrameDecision>();
+  }
+  void OnWalking(bool walking) override { walking_ = walking; }
+  StatusOr<std::optional<FrameDecision>> OnWifi(const WifiScan& scan) override {
+    notes_->emplace_back(scan.time_s, walking_);
+    return std::optional<FrameDecision>();
+  }
+  bool WantsImages() const override { return false; }
+  uint32_t size() const override { return 0; }
+  std::string EncodeState() const override { return {}; }
+  Status DecodeState(const std::string&) override { return Status::Ok(); }
+
+ private:
+  std::vector<std::pair<double, bool>>* notes_;
+  bool walking_ = false;
+};
+
+// Walking before a scan: the newest odometry step moved, within the PDR's longest step interval
+// (2 s) of the scan. Standing still with odometry rows of zero speed (0-10 s), walking (10-20 s),
+// then no rows at all (a phone's PDR writes none while its walker stands).
+TEST(ReplayPipelineTest, TellsTheFrontEndWhetherTheWalkerMovedBeforeEachScan) {
+  dataset::Dataset data;
+  data.name = "stand-walk-stand";
+  for (int i = 0; i <= 200; ++i) data.odometry.push_back({0.1 * i, i > 100 ? 1.0 : 0.0, 0.0});
+  for (int t = 0; t < 30; ++t) data.wifi.push_back({t + 0.5, {{"aa", -50.0}}});
+  std::vector<std::pair<double, bool>> notes;
+  PipelineOptions options;
+  options.sensors.front_end.kind = FrontEndKind::kCustom;
+  FrontEndResources resources;
+  resources.custom = [&notes] { return std::make_unique<WalkingNotes>(&notes); };
+  NoImages images;
+  ReplayPipeline pipeline(options, data, &images, resources);
+  ASSERT_TRUE(pipeline.Run({}).ok());
+  ASSERT_EQ(notes.size(), 30u);
+  for (const auto& [time_s, walking] : notes) {
+    const bool expected = time_s > 10.0 && time_s < 20.0 + 2.0;
+    EXPECT_EQ(walking, expected) << "scan at " << time_s << " s";
+  }
 }
 
 TEST(ReplayPipelineTest, RestoreRefusesStatesThatDoNotFit) {

@@ -374,6 +374,7 @@ constexpr AddedKey kKeysAddedAfter[] = {
     {9, "evaluation.answer_places"},
     {9, "evaluation.answer_temperature"},
     {9, "sequence.centred"},
+    {9, "fused.rssi_offset_walking_only"},
 };
 
 // Whole sections added after a map format version: older maps resume only with every key at its

@@ -47,20 +47,28 @@ std::vector<double> RssiOffsetTracker::OffsetsDb() const {
   return all;
 }
 
-void RssiOffsetTracker::Calibrate(const std::vector<Fingerprint>& stored, Fingerprint* scan) {
+void RssiOffsetTracker::Calibrate(const std::vector<Fingerprint>& stored, Fingerprint* scan,
+                                  bool learn) {
+  if (learn) Estimate(stored, *scan);
+  const double offset = CurrentOffset();
+  if (offset == 0.0) return;
+  for (float& rssi : scan->rssi_dbm) rssi = static_cast<float>(rssi - offset);
+}
+
+void RssiOffsetTracker::Estimate(const std::vector<Fingerprint>& stored, const Fingerprint& scan) {
   double best_spread = std::numeric_limits<double>::infinity(), best_median = 0.0;
   std::vector<double> d;
   for (uint32_t t = 0; t < templates_before_session_ && t < stored.size(); ++t) {
     if (t >= calibrated_.size() || !calibrated_[t]) continue;
     const Fingerprint& f = stored[t];
     d.clear();
-    for (size_t a = 0, b = 0; a < scan->ap_ids.size() && b < f.ap_ids.size();) {
-      if (scan->ap_ids[a] < f.ap_ids[b]) {
+    for (size_t a = 0, b = 0; a < scan.ap_ids.size() && b < f.ap_ids.size();) {
+      if (scan.ap_ids[a] < f.ap_ids[b]) {
         ++a;
-      } else if (f.ap_ids[b] < scan->ap_ids[a]) {
+      } else if (f.ap_ids[b] < scan.ap_ids[a]) {
         ++b;
       } else {
-        d.push_back(static_cast<double>(scan->rssi_dbm[a++]) - f.rssi_dbm[b++]);
+        d.push_back(static_cast<double>(scan.rssi_dbm[a++]) - f.rssi_dbm[b++]);
       }
     }
     if (d.size() < static_cast<size_t>(min_common_aps_)) continue;
@@ -79,9 +87,6 @@ void RssiOffsetTracker::Calibrate(const std::vector<Fingerprint>& stored, Finger
     }
   }
   if (std::isfinite(best_spread)) estimates_db_.push_back(best_median);
-  const double offset = CurrentOffset();
-  if (offset == 0.0) return;
-  for (float& rssi : scan->rssi_dbm) rssi = static_cast<float>(rssi - offset);
 }
 
 void RssiOffsetTracker::Encode(ByteWriter* w) const {

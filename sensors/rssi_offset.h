@@ -51,8 +51,9 @@ class RssiOffsetTracker {
   // sessions hold the first `templates` templates.
   void OnSessionStart(double start_s, uint32_t templates);
   // One estimate from `scan` against `stored` (by template id; only the earlier sessions'
-  // calibrated templates are read), then the scan in reference units.
-  void Calibrate(const std::vector<Fingerprint>& stored, Fingerprint* scan);
+  // calibrated templates are read), then the scan in reference units. With `learn` false the
+  // scan only gets the offset known so far (a scan not to learn from: the phone standing still).
+  void Calibrate(const std::vector<Fingerprint>& stored, Fingerprint* scan, bool learn = true);
   // A template was stored from this session's (calibrated) scan.
   void AddTemplate() { calibrated_.push_back(InReferenceUnits() ? 1 : 0); }
 
@@ -68,6 +69,8 @@ class RssiOffsetTracker {
 
  private:
   bool InReferenceUnits() const;
+  // Adds one estimate from `scan`, when a template shares enough APs with it.
+  void Estimate(const std::vector<Fingerprint>& stored, const Fingerprint& scan);
 
   int min_common_aps_;
   int min_estimates_;
