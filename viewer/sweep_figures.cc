@@ -200,6 +200,37 @@ render::Scene SweepParameterScene(const SweepFigureData& data, int width_px) {
   return scene;
 }
 
+// The heat map's colour scale beside its cells: the objective along the bar (higher values up),
+// coloured as the cells are (bright is better), with ticks and labels at the sweep's worst and
+// best values.
+void ColourBar(render::Scene& scene, const SweepFigureData& data, const Range& range, float left,
+               float top, float height) {
+  constexpr float kBarWidth = 18;
+  constexpr int kSteps = 64;
+  auto colour = [&](double v) {
+    double t = range.Fraction(v);
+    if (!data.minimize) t = 1.0 - t;
+    return SequentialColor(1.0 - t);
+  };
+  const float step_h = height / kSteps;
+  for (int k = 0; k < kSteps; ++k) {
+    const double v = range.lo + (range.hi - range.lo) * (k + 0.5) / kSteps;
+    scene.Rect(left, top + height - step_h * (k + 1), kBarWidth, step_h + 0.5f, colour(v));
+  }
+  std::optional<double> lo, hi;
+  for (const SweepFigurePoint& p : data.points) {
+    if (!p.objective) continue;
+    lo = lo ? std::min(*lo, *p.objective) : *p.objective;
+    hi = hi ? std::max(*hi, *p.objective) : *p.objective;
+  }
+  if (!lo) return;
+  for (double v : {*lo, *hi}) {
+    const float y = top + height * static_cast<float>(1.0 - range.Fraction(v));
+    scene.Line({left + kBarWidth, y}, {left + kBarWidth + 6, y}, 1.5f, kInk);
+    scene.Text({left + kBarWidth + 10, y + 5}, Short(v), 13, kInk);
+  }
+}
+
 render::Scene SweepHeatmapScene(const SweepFigureData& data, int a, int b, int width_px) {
   std::vector<std::string> xs, ys;
   for (const SweepFigurePoint& p : data.points) {
@@ -212,11 +243,14 @@ render::Scene SweepHeatmapScene(const SweepFigureData& data, int a, int b, int w
   const float left = 150;
   // A given width sets the cells' width (at least wide enough for a 4-digit label).
   const float cell_w =
-      width_px > 0 ? std::max(44.0f, (width_px - left - 60) / static_cast<float>(columns.size()))
+      width_px > 0 ? std::max(44.0f, (width_px - left - 110) / static_cast<float>(columns.size()))
                    : std::max(60.0f, 560.0f / columns.size());
   const float cell_h = std::max(34.0f, 380.0f / rows.size());
   const float width = cell_w * columns.size(), height = cell_h * rows.size();
-  const int scene_w = std::max(width_px > 0 ? width_px : 760, static_cast<int>(left + width + 60));
+  // Room on the right for the colour bar and its labels.
+  const float bar_room = 110;
+  const int scene_w =
+      std::max(width_px > 0 ? width_px : 760, static_cast<int>(left + width + bar_room));
   const std::vector<std::string> lines =
       SubtitleLines("best " + Goal(data) + " over the other parameters", scene_w);
   const float top = 120 + 20.0f * (lines.size() - 1);
@@ -238,7 +272,7 @@ render::Scene SweepHeatmapScene(const SweepFigureData& data, int a, int b, int w
         scene.Rect(cx + 1, cy + 1, cell_w - 2, cell_h - 2, kGrid);
         continue;
       }
-      // Dark is good whichever the goal.
+      // Bright is good whichever the goal (the colour bar shows the scale).
       double t = range.Fraction(*best);
       if (!data.minimize) t = 1.0 - t;
       scene.Rect(cx + 1, cy + 1, cell_w - 2, cell_h - 2, SequentialColor(1.0 - t));
@@ -257,6 +291,7 @@ render::Scene SweepHeatmapScene(const SweepFigureData& data, int a, int b, int w
   scene.Text({left + width / 2, top + height + 50}, data.keys[a], 15, kInk,
              render::TextAnchor::kCenter);
   scene.Text({20, top - 16}, data.keys[b], 15, kInk);
+  ColourBar(scene, data, range, left + width + 24, top, height);
   return scene;
 }
 

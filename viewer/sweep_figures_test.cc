@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <optional>
+#include <vector>
 
 namespace ratslam::viewer {
 namespace {
@@ -25,6 +27,43 @@ SweepFigureData Example() {
               {{"2", "y", "0"}, std::nullopt, 1.0}};
   d.best = 2;
   return d;
+}
+
+// The colour bar is the rectangles furthest right: bright (the cells' colour for good values) at
+// the better end, higher values up, labelled at the sweep's worst and best values beside it.
+TEST(SweepFiguresTest, HeatmapHasAColourBarBrightAtTheBetterEnd) {
+  for (bool minimize : {true, false}) {
+    SweepFigureData data = Example();
+    data.minimize = minimize;
+    const render::Scene scene = SweepHeatmapScene(data, 0, 1);
+    float bar_left = 0;
+    for (const render::SceneShape& s : scene.shapes()) {
+      if (s.kind == render::SceneShape::Kind::kRect) bar_left = std::max(bar_left, s.points[0].x);
+    }
+    std::vector<const render::SceneShape*> bar;
+    for (const render::SceneShape& s : scene.shapes()) {
+      if (s.kind == render::SceneShape::Kind::kRect && s.points[0].x == bar_left) bar.push_back(&s);
+    }
+    ASSERT_GE(bar.size(), 16u);
+    std::sort(bar.begin(), bar.end(),
+              [](auto* a, auto* b) { return a->points[0].y < b->points[0].y; });
+    auto brightness = [](const render::Rgba& c) { return c.r + c.g + c.b; };
+    const int top = brightness(bar.front()->color), bottom = brightness(bar.back()->color);
+    if (minimize) {
+      EXPECT_GT(bottom, top) << "lower values are better: bright at the bottom";
+    } else {
+      EXPECT_GT(top, bottom) << "higher values are better: bright at the top";
+    }
+    // Labels at the worst and best values (2.5 and 7), right of the bar, 7 above 2.5.
+    std::optional<float> y_low, y_high;
+    for (const render::SceneText& t : scene.texts()) {
+      if (t.position.x <= bar_left) continue;
+      if (t.text == "2.5") y_low = t.position.y;
+      if (t.text == "7") y_high = t.position.y;
+    }
+    ASSERT_TRUE(y_low && y_high);
+    EXPECT_LT(*y_high, *y_low);
+  }
 }
 
 TEST(SweepFiguresTest, HeatmapCellsHoldTheBestOverTheOtherParameters) {
