@@ -503,8 +503,7 @@ render::Scene TemplateGraphScene(const std::vector<TemplateGraphPoint>& points,
   }
   if (!std::isfinite(t0)) t0 = 0, t1 = 1;
   if (t1 <= t0) t1 = t0 + 1;
-  const render::Rgba source_colors[] = {
-      {31, 119, 180, 255}, {44, 160, 44, 255}, {150, 150, 150, 255}};
+  const render::Rgba source_colors[] = {{31, 119, 180, 255}, {44, 160, 44, 255}, {70, 70, 70, 255}};
   static constexpr render::Rgba kExperienceColor{230, 110, 0, 255};
   // Legend, only for what the graph contains, in rows under the title.
   bool present[3] = {false, false, false};
@@ -571,14 +570,19 @@ render::Scene TemplateGraphScene(const std::vector<TemplateGraphPoint>& points,
   DrawAxes(scene, upper, "", "template id");
   DrawAxes(scene, lower, "time (s)", "experience id");
   const bool many = points.size() > 20000;
-  for (const TemplateGraphPoint& p : points) {
-    const render::Rgba c = source_colors[static_cast<int>(p.source)];
-    const render::ScenePoint at = upper.Map(p.time_s, p.template_id);
-    if (p.source == DecisionSource::kNew) {
-      scene.Disc(at, many ? 1.0f : 1.8f, c, 8);
-    } else {
-      scene.Ring(at, many ? 1.2f : 2.2f, many ? 2.2f : 3.6f, 0, 2 * std::numbers::pi_v<float>, c,
-                 10);
+  // Matches first, new templates over them: a template's later matches start a second after it
+  // was made, so their rings would otherwise cover the dot that shows where it was made.
+  for (bool new_templates : {false, true}) {
+    for (const TemplateGraphPoint& p : points) {
+      if ((p.source == DecisionSource::kNew) != new_templates) continue;
+      const render::Rgba c = source_colors[static_cast<int>(p.source)];
+      const render::ScenePoint at = upper.Map(p.time_s, p.template_id);
+      if (new_templates) {
+        scene.Disc(at, many ? 1.0f : 2.0f, c, 8);
+      } else {
+        scene.Ring(at, many ? 1.2f : 2.2f, many ? 2.2f : 3.6f, 0, 2 * std::numbers::pi_v<float>, c,
+                   10);
+      }
     }
   }
   for (const TemplateGraphPoint& p : points) {

@@ -226,6 +226,33 @@ TEST(FittedTitleTest, TwoLinesKeepTheWholeTitle) {
   EXPECT_GT(legend_top - 14, title_bottom);  // the legend's text sits below the title's
 }
 
+// A template's later matches (rings) start a second after it was made: the dot of the new
+// template is drawn over them, where it stays visible, not under them.
+TEST(TemplateGraphSceneTest, NewTemplatesAreDrawnOverTheirMatches) {
+  std::vector<TemplateGraphPoint> points;
+  for (int i = 0; i < 20; ++i) {
+    points.push_back({static_cast<double>(i), static_cast<uint32_t>(i / 5), i / 5,
+                      i % 5 == 0 ? DecisionSource::kNew : DecisionSource::kWifi});
+  }
+  const render::Scene scene = TemplateGraphScene(points, {});
+  const render::Rgba new_color = {70, 70, 70, 255};
+  auto is_new_dot = [&](const render::SceneShape& s) {
+    return s.kind == render::SceneShape::Kind::kDisc && s.color.r == new_color.r &&
+           s.color.g == new_color.g && s.color.b == new_color.b;
+  };
+  size_t last_ring = 0, first_dot = scene.shapes().size(), dots = 0;
+  for (size_t i = 0; i < scene.shapes().size(); ++i) {
+    const render::SceneShape& s = scene.shapes()[i];
+    if (s.kind == render::SceneShape::Kind::kRing && s.points[0].y > 100) last_ring = i;
+    if (is_new_dot(s) && s.points[0].y > 100) {
+      first_dot = std::min(first_dot, i);
+      ++dots;
+    }
+  }
+  EXPECT_EQ(dots, 4u);  // one per template (the legend's sits above the plots)
+  EXPECT_GT(first_dot, last_ring);
+}
+
 // The session legend reads the sessions' names, not their numbers.
 TEST(ExperienceMapSceneTest, SessionLegendNamesTheSessions) {
   ExperienceMapImageOptions options;
