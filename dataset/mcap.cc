@@ -292,74 +292,100 @@ const McapChannel* McapReader::Channel(uint16_t id) const {
   return it != channels_.end() && it->id == id ? &*it : nullptr;
 }
 
-StatusOr<std::unique_ptr<McapReader>> McapReader::Open(const std::string& path) {
-  auto reader = std::unique_ptr<McapReader>(new McapReader());
-  reader->path_ = path;
-  RATSLAM_RETURN_IF_ERROR(OpenRegularFile(path, "MCAP file", &reader->file_));
-  std::ifstream& file = reader->file_;
-  file.seekg(0, std::ios::end);
-  const uint64_t file_size = static_cast<uint64_t>(file.tellg());
-  reader->file_size_ = file_size;
-  auto read_at = [&](uint64_t offset, uint64_t n, uint8_t* out) {
-    file.clear();
-    file.seekg(static_cast<std::streamoff>(offset));
+// Open's work: the file's footer, then its data section and its summary section walked record
+// by record into the reader's index. Errors name the file and the byte offset of the record.
+class McapReader::Opener {
+ public:
+  explicit Opener(McapReader* reader)
+      : reader_(reader), path_(reader->path_), file_(reader->file_), scanner_(reader) {}
+
+  Status Run() {
+    file_.seekg(0, std::ios::end);
+    file_size_ = static_cast<uint64_t>(file_.tellg());
+    reader_->file_size_ = file_size_;
+    uint8_t magic[8];
+    if (file_size_ < 8 || !ReadAt(0, 8, magic) || std::memcmp(magic, kMagic, 8) != 0) {
+      return Status::Error(path_ + ": not an MCAP file (it does not start with MCAP's magic)");
+    }
+    RATSLAM_RETURN_IF_ERROR(ReadFooter());
+    const uint64_t data_end = summary_start_ != 0 ? summary_start_ : footer_offset_;
+    StatusOr<uint64_t> scanned =
+        Walk(8, data_end, kDataEnd,
+             [this](uint8_t op, uint64_t at, uint64_t length, const std::string& where) {
+               return DataRecord(op, at, length, where);
+             });
+    if (!scanned.ok()) return scanned.status();
+    if (first_) return ErrorAt(8, "no Header record");
+    if (summary_start_ != 0) RATSLAM_RETURN_IF_ERROR(ReadSummary());
+    for (const auto& [id, channel] : scanner_.channels_) reader_->channels_.push_back(channel);
+    std::stable_sort(
+        reader_->messages_.begin(), reader_->messages_.end(),
+        [](const McapMessage& a, const McapMessage& b) { return a.log_time_ns < b.log_time_ns; });
+    return Status::Ok();
+  }
+
+ private:
+  bool ReadAt(uint64_t offset, uint64_t n, uint8_t* out) {
+    file_.clear();
+    file_.seekg(static_cast<std::streamoff>(offset));
     return static_cast<bool>(
-        file.read(reinterpret_cast<char*>(out), static_cast<std::streamsize>(n)));
-  };
-  auto error_at = [&](uint64_t offset, const std::string& what) {
-    return Status::Error(path + ": byte " + std::to_string(offset) + ": " + what);
-  };
-  uint8_t magic[8];
-  if (file_size < 8 || !read_at(0, 8, magic) || std::memcmp(magic, kMagic, 8) != 0) {
-    return Status::Error(path + ": not an MCAP file (it does not start with MCAP's magic)");
+        file_.read(reinterpret_cast<char*>(out), static_cast<std::streamsize>(n)));
   }
+
+  Status ErrorAt(uint64_t offset, const std::string& what) const {
+    return Status::Error(path_ + ": byte " + std::to_string(offset) + ": " + what);
+  }
+
   // The footer and the closing magic end every complete file.
-  const uint64_t footer_offset = file_size - 8 - kRecordHeaderBytes - kFooterContentBytes;
-  uint8_t tail[kRecordHeaderBytes + kFooterContentBytes + 8];
-  if (file_size < 8 + sizeof tail || !read_at(footer_offset, sizeof tail, tail) ||
-      std::memcmp(tail + kRecordHeaderBytes + kFooterContentBytes, kMagic, 8) != 0 ||
-      tail[0] != kFooter) {
-    return Status::Error(
-        path +
-        ": truncated MCAP file (it does not end with a Footer record and the "
-        "magic; a recording that was cut off can be repaired with `mcap recover`)");
+  Status ReadFooter() {
+    footer_offset_ = file_size_ - 8 - kRecordHeaderBytes - kFooterContentBytes;
+    uint8_t tail[kRecordHeaderBytes + kFooterContentBytes + 8];
+    if (file_size_ < 8 + sizeof tail || !ReadAt(footer_offset_, sizeof tail, tail) ||
+        std::memcmp(tail + kRecordHeaderBytes + kFooterContentBytes, kMagic, 8) != 0 ||
+        tail[0] != kFooter) {
+      return Status::Error(
+          path_ +
+          ": truncated MCAP file (it does not end with a Footer record and the "
+          "magic; a recording that was cut off can be repaired with `mcap recover`)");
+    }
+    Fields footer(tail + kRecordHeaderBytes, kFooterContentBytes,
+                  path_ + ": byte " + std::to_string(footer_offset_) + " (Footer record)");
+    uint64_t footer_length = 0;
+    for (int k = 0; k < 8; ++k) footer_length |= uint64_t{tail[1 + k]} << (8 * k);
+    RATSLAM_RETURN_IF_ERROR(footer.Int("summary_start", &summary_start_));
+    RATSLAM_RETURN_IF_ERROR(footer.Int("summary_offset_start", &summary_offset_start_));
+    if (footer_length != kFooterContentBytes) {
+      return ErrorAt(footer_offset_,
+                     "Footer record of " + std::to_string(footer_length) + " bytes (20 expected)");
+    }
+    if (summary_start_ != 0 && (summary_start_ < 8 || summary_start_ > footer_offset_)) {
+      return ErrorAt(footer_offset_, "Footer's summary_start " + std::to_string(summary_start_) +
+                                         " lies outside the file's records");
+    }
+    if (summary_offset_start_ != 0 &&
+        (summary_offset_start_ < summary_start_ || summary_offset_start_ > footer_offset_)) {
+      return ErrorAt(footer_offset_, "Footer's summary_offset_start " +
+                                         std::to_string(summary_offset_start_) +
+                                         " lies outside the summary section");
+    }
+    return Status::Ok();
   }
-  Fields footer(tail + kRecordHeaderBytes, kFooterContentBytes,
-                path + ": byte " + std::to_string(footer_offset) + " (Footer record)");
-  uint64_t footer_length = 0, summary_start = 0, summary_offset_start = 0;
-  for (int k = 0; k < 8; ++k) footer_length |= uint64_t{tail[1 + k]} << (8 * k);
-  RATSLAM_RETURN_IF_ERROR(footer.Int("summary_start", &summary_start));
-  RATSLAM_RETURN_IF_ERROR(footer.Int("summary_offset_start", &summary_offset_start));
-  if (footer_length != kFooterContentBytes) {
-    return error_at(footer_offset,
-                    "Footer record of " + std::to_string(footer_length) + " bytes (20 expected)");
-  }
-  if (summary_start != 0 && (summary_start < 8 || summary_start > footer_offset)) {
-    return error_at(footer_offset, "Footer's summary_start " + std::to_string(summary_start) +
-                                       " lies outside the file's records");
-  }
-  if (summary_offset_start != 0 &&
-      (summary_offset_start < summary_start || summary_offset_start > footer_offset)) {
-    return error_at(footer_offset, "Footer's summary_offset_start " +
-                                       std::to_string(summary_offset_start) +
-                                       " lies outside the summary section");
-  }
-  Scanner scanner(reader.get());
-  std::vector<uint8_t> content;
-  // Walks the records in [begin, end); `visit` sees each with its content read (chunks are
-  // handled by the caller's visit too). Stops after `stop_op` when given.
-  auto walk = [&](uint64_t begin, uint64_t end, int stop_op, auto&& visit) -> StatusOr<uint64_t> {
+
+  // Walks the records in [begin, end); `visit` sees each (op, offset, content length, where).
+  // Stops after `stop_op` when given.
+  template <typename Visit>
+  StatusOr<uint64_t> Walk(uint64_t begin, uint64_t end, int stop_op, Visit&& visit) {
     uint64_t at = begin;
     while (at < end) {
       uint8_t header[kRecordHeaderBytes];
-      if (end - at < kRecordHeaderBytes || !read_at(at, kRecordHeaderBytes, header)) {
-        return error_at(at, "record header runs past the end of its section");
+      if (end - at < kRecordHeaderBytes || !ReadAt(at, kRecordHeaderBytes, header)) {
+        return ErrorAt(at, "record header runs past the end of its section");
       }
       const uint8_t op = header[0];
       uint64_t length = 0;
       for (int k = 0; k < 8; ++k) length |= uint64_t{header[1 + k]} << (8 * k);
       const std::string where =
-          path + ": byte " + std::to_string(at) + " (" + OpcodeName(op) + " record)";
+          path_ + ": byte " + std::to_string(at) + " (" + OpcodeName(op) + " record)";
       if (length > end - at - kRecordHeaderBytes) {
         return Status::Error(where + ": length " + std::to_string(length) +
                              " runs past the end of its section");
@@ -369,198 +395,224 @@ StatusOr<std::unique_ptr<McapReader>> McapReader::Open(const std::string& path) 
       if (op == stop_op) return at;
     }
     return at;
-  };
-  auto read_content = [&](uint64_t at, uint64_t length, uint64_t limit, const std::string& where,
-                          std::vector<uint8_t>* out) {
+  }
+
+  // The content of the record at `at` into content_, refused over `limit` bytes.
+  Status ReadContent(uint64_t at, uint64_t length, uint64_t limit, const std::string& where) {
     if (length > limit) {
       return Status::Error(where + ": " + std::to_string(length) + " bytes is over the " +
                            std::to_string(limit) + " such a record may have here");
     }
-    out->resize(length);
-    if (length > 0 && !read_at(at + kRecordHeaderBytes, length, out->data())) {
+    content_.resize(length);
+    if (length > 0 && !ReadAt(at + kRecordHeaderBytes, length, content_.data())) {
       return Status::Error(where + ": cannot read its content");
     }
     return Status::Ok();
-  };
+  }
 
-  bool first = true;
-  const uint64_t data_end = summary_start != 0 ? summary_start : footer_offset;
-  StatusOr<uint64_t> scanned = walk(
-      8, data_end, kDataEnd,
-      [&](uint8_t op, uint64_t at, uint64_t length, const std::string& where) -> Status {
-        if (first != (op == kHeader)) {
-          return Status::Error(
-              where + (first ? ": the first record must be a Header" : ": a second Header record"));
-        }
-        first = false;
-        if (op == kHeader) {
-          RATSLAM_RETURN_IF_ERROR(read_content(at, length, kMaxSmallRecordBytes, where, &content));
-          Fields f(content.data(), content.size(), where);
-          return f.String("profile", &reader->profile_);
-        }
-        if (op == kMessage) {
-          // Only the fixed fields: the payload stays in the file until asked for.
-          constexpr uint64_t kFixed = 2 + 4 + 8 + 8;
-          if (length < kFixed) {
-            return Status::Error(where + ": " + std::to_string(length) +
-                                 " bytes, fewer than a message's fixed fields");
-          }
-          RATSLAM_RETURN_IF_ERROR(read_content(at, kFixed, kFixed, where, &content));
-          const size_t before = reader->messages_.size();
-          RATSLAM_RETURN_IF_ERROR(
-              scanner.Record(op, content.data(), kFixed, at, at + kRecordHeaderBytes, -1, where));
-          reader->messages_[before].data_size = length - kFixed;
-          return Status::Ok();
-        }
-        if (op == kChunk) {
-          RATSLAM_RETURN_IF_ERROR(read_content(at, length, length, where, &content));
-          Fields f(content.data(), content.size(), where);
-          ChunkInfo chunk;
-          uint64_t start_time = 0, end_time = 0;
-          RATSLAM_RETURN_IF_ERROR(f.Int("message_start_time", &start_time));
-          RATSLAM_RETURN_IF_ERROR(f.Int("message_end_time", &end_time));
-          RATSLAM_RETURN_IF_ERROR(f.Int("uncompressed_size", &chunk.uncompressed_size));
-          RATSLAM_RETURN_IF_ERROR(f.Int("uncompressed_crc", &chunk.uncompressed_crc));
-          RATSLAM_RETURN_IF_ERROR(f.String("compression", &chunk.compression));
-          RATSLAM_RETURN_IF_ERROR(f.Int("records length", &chunk.records_size));
-          if (chunk.records_size != f.remaining()) {
-            return Status::Error(where + ": records length " + std::to_string(chunk.records_size) +
-                                 " but " + std::to_string(f.remaining()) + " bytes follow");
-          }
-          chunk.record_offset = at;
-          chunk.records_offset = at + kRecordHeaderBytes + f.at();
-          StatusOr<std::vector<uint8_t>> records = Decompress(
-              chunk.compression, f.here(), chunk.records_size, chunk.uncompressed_size, where);
-          if (!records.ok()) return records.status();
-          if (chunk.uncompressed_crc != 0) {
-            const uint32_t crc = static_cast<uint32_t>(
-                crc32(crc32(0, nullptr, 0), records->data(), static_cast<uInt>(records->size())));
-            if (crc != chunk.uncompressed_crc) {
-              return Status::Error(where + ": uncompressed_crc does not match its records");
-            }
-          }
-          const int64_t index = static_cast<int64_t>(reader->chunks_.size());
-          reader->chunks_.push_back(chunk);
-          return scanner.ChunkRecords(*records, index, where);
-        }
-        if (op == kSchema || op == kChannel) {
-          RATSLAM_RETURN_IF_ERROR(read_content(at, length, kMaxSmallRecordBytes, where, &content));
-          return scanner.Record(op, content.data(), content.size(), at, at + kRecordHeaderBytes, -1,
-                                where);
-        }
-        if (op == kFooter) return Status::Error(where + ": a Footer inside the data section");
-        return Status::Ok();
-      });
-  if (!scanned.ok()) return scanned.status();
-  if (first) return error_at(8, "no Header record");
+  // One record of the data section.
+  Status DataRecord(uint8_t op, uint64_t at, uint64_t length, const std::string& where) {
+    if (first_ != (op == kHeader)) {
+      return Status::Error(
+          where + (first_ ? ": the first record must be a Header" : ": a second Header record"));
+    }
+    first_ = false;
+    if (op == kHeader) {
+      RATSLAM_RETURN_IF_ERROR(ReadContent(at, length, kMaxSmallRecordBytes, where));
+      Fields f(content_.data(), content_.size(), where);
+      return f.String("profile", &reader_->profile_);
+    }
+    if (op == kMessage) {
+      // Only the fixed fields: the payload stays in the file until asked for.
+      constexpr uint64_t kFixed = 2 + 4 + 8 + 8;
+      if (length < kFixed) {
+        return Status::Error(where + ": " + std::to_string(length) +
+                             " bytes, fewer than a message's fixed fields");
+      }
+      RATSLAM_RETURN_IF_ERROR(ReadContent(at, kFixed, kFixed, where));
+      const size_t before = reader_->messages_.size();
+      RATSLAM_RETURN_IF_ERROR(
+          scanner_.Record(op, content_.data(), kFixed, at, at + kRecordHeaderBytes, -1, where));
+      reader_->messages_[before].data_size = length - kFixed;
+      return Status::Ok();
+    }
+    if (op == kChunk) return ChunkRecord(at, length, where);
+    if (op == kSchema || op == kChannel) {
+      RATSLAM_RETURN_IF_ERROR(ReadContent(at, length, kMaxSmallRecordBytes, where));
+      return scanner_.Record(op, content_.data(), content_.size(), at, at + kRecordHeaderBytes, -1,
+                             where);
+    }
+    if (op == kFooter) return Status::Error(where + ": a Footer inside the data section");
+    return Status::Ok();
+  }
 
-  if (summary_start != 0) {
-    reader->has_summary_ = true;
-    const uint64_t summary_end = summary_offset_start != 0 ? summary_offset_start : footer_offset;
-    std::map<uint64_t, const ChunkInfo*> chunk_at;
-    for (const ChunkInfo& c : reader->chunks_) chunk_at[c.record_offset] = &c;
-    Scanner summary(reader.get());
-    summary.schemas_ = scanner.schemas_;  // a summary may repeat channels without their schemas
-    const size_t messages_before = reader->messages_.size();
-    StatusOr<uint64_t> checked = walk(
-        summary_start, summary_end, -1,
-        [&](uint8_t op, uint64_t at, uint64_t length, const std::string& where) -> Status {
-          if (op == kMessage || op == kChunk || op == kHeader || op == kDataEnd) {
-            return Status::Error(where + ": not a record the summary section may hold");
-          }
-          if (op != kSchema && op != kChannel && op != kChunkIndex && op != kStatistics) {
-            return Status::Ok();
-          }
-          RATSLAM_RETURN_IF_ERROR(read_content(at, length, kMaxSmallRecordBytes, where, &content));
-          if (op == kSchema || op == kChannel) {
-            RATSLAM_RETURN_IF_ERROR(summary.Record(op, content.data(), content.size(), at,
-                                                   at + kRecordHeaderBytes, -1, where));
-            return Status::Ok();
-          }
-          Fields f(content.data(), content.size(), where);
-          if (op == kChunkIndex) {
-            uint64_t start = 0, end = 0, offset = 0, length_field = 0, index_length = 0;
-            uint64_t compressed = 0, uncompressed = 0;
-            std::string compression;
-            RATSLAM_RETURN_IF_ERROR(f.Int("message_start_time", &start));
-            RATSLAM_RETURN_IF_ERROR(f.Int("message_end_time", &end));
-            RATSLAM_RETURN_IF_ERROR(f.Int("chunk_start_offset", &offset));
-            RATSLAM_RETURN_IF_ERROR(f.Int("chunk_length", &length_field));
-            RATSLAM_RETURN_IF_ERROR(f.Skip32("message_index_offsets"));
-            RATSLAM_RETURN_IF_ERROR(f.Int("message_index_length", &index_length));
-            RATSLAM_RETURN_IF_ERROR(f.String("compression", &compression));
-            RATSLAM_RETURN_IF_ERROR(f.Int("compressed_size", &compressed));
-            RATSLAM_RETURN_IF_ERROR(f.Int("uncompressed_size", &uncompressed));
-            auto chunk = chunk_at.find(offset);
-            if (chunk == chunk_at.end()) {
-              return Status::Error(where + ": chunk_start_offset " + std::to_string(offset) +
-                                   " is not where a chunk starts");
-            }
-            if (compressed != chunk->second->records_size ||
-                uncompressed != chunk->second->uncompressed_size ||
-                compression != chunk->second->compression) {
-              return Status::Error(where + ": the chunk at byte " + std::to_string(offset) +
-                                   " has other sizes or compression than its index says");
-            }
-            return Status::Ok();
-          }
-          uint64_t message_count = 0, start = 0, end = 0;
-          uint16_t schema_count = 0;
-          uint32_t channel_count = 0, attachment_count = 0, metadata_count = 0, chunk_count = 0;
-          uint32_t map_bytes = 0;
-          RATSLAM_RETURN_IF_ERROR(f.Int("message_count", &message_count));
-          RATSLAM_RETURN_IF_ERROR(f.Int("schema_count", &schema_count));
-          RATSLAM_RETURN_IF_ERROR(f.Int("channel_count", &channel_count));
-          RATSLAM_RETURN_IF_ERROR(f.Int("attachment_count", &attachment_count));
-          RATSLAM_RETURN_IF_ERROR(f.Int("metadata_count", &metadata_count));
-          RATSLAM_RETURN_IF_ERROR(f.Int("chunk_count", &chunk_count));
-          RATSLAM_RETURN_IF_ERROR(f.Int("message_start_time", &start));
-          RATSLAM_RETURN_IF_ERROR(f.Int("message_end_time", &end));
-          RATSLAM_RETURN_IF_ERROR(f.Int("channel_message_counts", &map_bytes));
-          if (message_count != messages_before) {
-            return Status::Error(where + ": message_count " + std::to_string(message_count) +
-                                 " but the data section holds " + std::to_string(messages_before));
-          }
-          if (chunk_count != reader->chunks_.size()) {
-            return Status::Error(where + ": chunk_count " + std::to_string(chunk_count) +
-                                 " but the data section holds " +
-                                 std::to_string(reader->chunks_.size()));
-          }
-          if (map_bytes != f.remaining() || map_bytes % 10 != 0) {
-            return Status::Error(where + ": channel_message_counts of " +
-                                 std::to_string(map_bytes) + " bytes does not fit the record");
-          }
-          std::map<uint16_t, uint64_t> counted;
-          for (const McapMessage& m : reader->messages_) ++counted[m.channel_id];
-          while (f.remaining() > 0) {
-            uint16_t id = 0;
-            uint64_t count = 0;
-            RATSLAM_RETURN_IF_ERROR(f.Int("channel_message_counts channel", &id));
-            RATSLAM_RETURN_IF_ERROR(f.Int("channel_message_counts count", &count));
-            const uint64_t seen = counted.count(id) ? counted[id] : 0;
-            if (count != seen) {
-              return Status::Error(where + ": channel " + std::to_string(id) + " has " +
-                                   std::to_string(count) + " messages by the statistics, " +
-                                   std::to_string(seen) + " in the data section");
-            }
-          }
-          return Status::Ok();
-        });
+  // A Chunk of the data section: decompressed, checked and its records scanned.
+  Status ChunkRecord(uint64_t at, uint64_t length, const std::string& where) {
+    RATSLAM_RETURN_IF_ERROR(ReadContent(at, length, length, where));
+    Fields f(content_.data(), content_.size(), where);
+    ChunkInfo chunk;
+    uint64_t start_time = 0, end_time = 0;
+    RATSLAM_RETURN_IF_ERROR(f.Int("message_start_time", &start_time));
+    RATSLAM_RETURN_IF_ERROR(f.Int("message_end_time", &end_time));
+    RATSLAM_RETURN_IF_ERROR(f.Int("uncompressed_size", &chunk.uncompressed_size));
+    RATSLAM_RETURN_IF_ERROR(f.Int("uncompressed_crc", &chunk.uncompressed_crc));
+    RATSLAM_RETURN_IF_ERROR(f.String("compression", &chunk.compression));
+    RATSLAM_RETURN_IF_ERROR(f.Int("records length", &chunk.records_size));
+    if (chunk.records_size != f.remaining()) {
+      return Status::Error(where + ": records length " + std::to_string(chunk.records_size) +
+                           " but " + std::to_string(f.remaining()) + " bytes follow");
+    }
+    chunk.record_offset = at;
+    chunk.records_offset = at + kRecordHeaderBytes + f.at();
+    StatusOr<std::vector<uint8_t>> records =
+        Decompress(chunk.compression, f.here(), chunk.records_size, chunk.uncompressed_size, where);
+    if (!records.ok()) return records.status();
+    if (chunk.uncompressed_crc != 0) {
+      const uint32_t crc = static_cast<uint32_t>(
+          crc32(crc32(0, nullptr, 0), records->data(), static_cast<uInt>(records->size())));
+      if (crc != chunk.uncompressed_crc) {
+        return Status::Error(where + ": uncompressed_crc does not match its records");
+      }
+    }
+    const int64_t index = static_cast<int64_t>(reader_->chunks_.size());
+    reader_->chunks_.push_back(chunk);
+    return scanner_.ChunkRecords(*records, index, where);
+  }
+
+  // The summary section: its schemas, channels, chunk indexes and statistics must agree with
+  // the data section.
+  Status ReadSummary() {
+    reader_->has_summary_ = true;
+    const uint64_t summary_end =
+        summary_offset_start_ != 0 ? summary_offset_start_ : footer_offset_;
+    for (const ChunkInfo& c : reader_->chunks_) chunk_at_[c.record_offset] = &c;
+    Scanner summary(reader_);
+    summary.schemas_ = scanner_.schemas_;  // a summary may repeat channels without their schemas
+    messages_before_ = reader_->messages_.size();
+    StatusOr<uint64_t> checked =
+        Walk(summary_start_, summary_end, -1,
+             [&](uint8_t op, uint64_t at, uint64_t length, const std::string& where) {
+               return SummaryRecord(summary, op, at, length, where);
+             });
     if (!checked.ok()) return checked.status();
     for (const auto& [id, channel] : summary.channels_) {
-      auto [seen, inserted] = scanner.channels_.emplace(id, channel);
+      auto [seen, inserted] = scanner_.channels_.emplace(id, channel);
       if (!inserted && (seen->second.topic != channel.topic ||
                         seen->second.schema_name != channel.schema_name)) {
-        return Status::Error(path + ": summary section: channel " + std::to_string(id) + " is " +
+        return Status::Error(path_ + ": summary section: channel " + std::to_string(id) + " is " +
                              channel.topic + " there and " + seen->second.topic +
                              " in the data section");
       }
     }
+    return Status::Ok();
   }
-  for (const auto& [id, channel] : scanner.channels_) reader->channels_.push_back(channel);
-  std::stable_sort(
-      reader->messages_.begin(), reader->messages_.end(),
-      [](const McapMessage& a, const McapMessage& b) { return a.log_time_ns < b.log_time_ns; });
+
+  Status SummaryRecord(Scanner& summary, uint8_t op, uint64_t at, uint64_t length,
+                       const std::string& where) {
+    if (op == kMessage || op == kChunk || op == kHeader || op == kDataEnd) {
+      return Status::Error(where + ": not a record the summary section may hold");
+    }
+    if (op != kSchema && op != kChannel && op != kChunkIndex && op != kStatistics) {
+      return Status::Ok();
+    }
+    RATSLAM_RETURN_IF_ERROR(ReadContent(at, length, kMaxSmallRecordBytes, where));
+    if (op == kSchema || op == kChannel) {
+      RATSLAM_RETURN_IF_ERROR(summary.Record(op, content_.data(), content_.size(), at,
+                                             at + kRecordHeaderBytes, -1, where));
+      return Status::Ok();
+    }
+    Fields f(content_.data(), content_.size(), where);
+    return op == kChunkIndex ? CheckChunkIndex(f, where) : CheckStatistics(f, where);
+  }
+
+  Status CheckChunkIndex(Fields& f, const std::string& where) const {
+    uint64_t start = 0, end = 0, offset = 0, length_field = 0, index_length = 0;
+    uint64_t compressed = 0, uncompressed = 0;
+    std::string compression;
+    RATSLAM_RETURN_IF_ERROR(f.Int("message_start_time", &start));
+    RATSLAM_RETURN_IF_ERROR(f.Int("message_end_time", &end));
+    RATSLAM_RETURN_IF_ERROR(f.Int("chunk_start_offset", &offset));
+    RATSLAM_RETURN_IF_ERROR(f.Int("chunk_length", &length_field));
+    RATSLAM_RETURN_IF_ERROR(f.Skip32("message_index_offsets"));
+    RATSLAM_RETURN_IF_ERROR(f.Int("message_index_length", &index_length));
+    RATSLAM_RETURN_IF_ERROR(f.String("compression", &compression));
+    RATSLAM_RETURN_IF_ERROR(f.Int("compressed_size", &compressed));
+    RATSLAM_RETURN_IF_ERROR(f.Int("uncompressed_size", &uncompressed));
+    auto chunk = chunk_at_.find(offset);
+    if (chunk == chunk_at_.end()) {
+      return Status::Error(where + ": chunk_start_offset " + std::to_string(offset) +
+                           " is not where a chunk starts");
+    }
+    if (compressed != chunk->second->records_size ||
+        uncompressed != chunk->second->uncompressed_size ||
+        compression != chunk->second->compression) {
+      return Status::Error(where + ": the chunk at byte " + std::to_string(offset) +
+                           " has other sizes or compression than its index says");
+    }
+    return Status::Ok();
+  }
+
+  Status CheckStatistics(Fields& f, const std::string& where) const {
+    uint64_t message_count = 0, start = 0, end = 0;
+    uint16_t schema_count = 0;
+    uint32_t channel_count = 0, attachment_count = 0, metadata_count = 0, chunk_count = 0;
+    uint32_t map_bytes = 0;
+    RATSLAM_RETURN_IF_ERROR(f.Int("message_count", &message_count));
+    RATSLAM_RETURN_IF_ERROR(f.Int("schema_count", &schema_count));
+    RATSLAM_RETURN_IF_ERROR(f.Int("channel_count", &channel_count));
+    RATSLAM_RETURN_IF_ERROR(f.Int("attachment_count", &attachment_count));
+    RATSLAM_RETURN_IF_ERROR(f.Int("metadata_count", &metadata_count));
+    RATSLAM_RETURN_IF_ERROR(f.Int("chunk_count", &chunk_count));
+    RATSLAM_RETURN_IF_ERROR(f.Int("message_start_time", &start));
+    RATSLAM_RETURN_IF_ERROR(f.Int("message_end_time", &end));
+    RATSLAM_RETURN_IF_ERROR(f.Int("channel_message_counts", &map_bytes));
+    if (message_count != messages_before_) {
+      return Status::Error(where + ": message_count " + std::to_string(message_count) +
+                           " but the data section holds " + std::to_string(messages_before_));
+    }
+    if (chunk_count != reader_->chunks_.size()) {
+      return Status::Error(where + ": chunk_count " + std::to_string(chunk_count) +
+                           " but the data section holds " +
+                           std::to_string(reader_->chunks_.size()));
+    }
+    if (map_bytes != f.remaining() || map_bytes % 10 != 0) {
+      return Status::Error(where + ": channel_message_counts of " + std::to_string(map_bytes) +
+                           " bytes does not fit the record");
+    }
+    std::map<uint16_t, uint64_t> counted;
+    for (const McapMessage& m : reader_->messages_) ++counted[m.channel_id];
+    while (f.remaining() > 0) {
+      uint16_t id = 0;
+      uint64_t count = 0;
+      RATSLAM_RETURN_IF_ERROR(f.Int("channel_message_counts channel", &id));
+      RATSLAM_RETURN_IF_ERROR(f.Int("channel_message_counts count", &count));
+      const uint64_t seen = counted.count(id) ? counted[id] : 0;
+      if (count != seen) {
+        return Status::Error(where + ": channel " + std::to_string(id) + " has " +
+                             std::to_string(count) + " messages by the statistics, " +
+                             std::to_string(seen) + " in the data section");
+      }
+    }
+    return Status::Ok();
+  }
+
+  McapReader* reader_;
+  const std::string& path_;
+  std::ifstream& file_;
+  uint64_t file_size_ = 0;
+  uint64_t footer_offset_ = 0, summary_start_ = 0, summary_offset_start_ = 0;
+  Scanner scanner_;                                // the data section's schemas and channels
+  std::vector<uint8_t> content_;                   // the record being read
+  bool first_ = true;                              // no record of the data section read yet
+  std::map<uint64_t, const ChunkInfo*> chunk_at_;  // by the Chunk record's offset
+  size_t messages_before_ = 0;                     // messages in the data section
+};
+
+StatusOr<std::unique_ptr<McapReader>> McapReader::Open(const std::string& path) {
+  auto reader = std::unique_ptr<McapReader>(new McapReader());
+  reader->path_ = path;
+  RATSLAM_RETURN_IF_ERROR(OpenRegularFile(path, "MCAP file", &reader->file_));
+  RATSLAM_RETURN_IF_ERROR(Opener(reader.get()).Run());
   return reader;
 }
 

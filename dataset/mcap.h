@@ -71,6 +71,7 @@ class McapReader {
     std::string compression;
   };
   class Scanner;
+  class Opener;
 
   StatusOr<const std::vector<uint8_t>*> Decompressed(int64_t chunk);
 
