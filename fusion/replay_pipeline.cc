@@ -324,7 +324,7 @@ Status ReplayPipeline::LinkLoop(const std::optional<wifi_sequence::SequenceLoop>
                                 double time_s) {
   if (!loop || !loop->accepted) return Status::Ok();
   bool added = false;
-  size_t joined = 0, inliers = 0;
+  size_t joined = 0, inliers = 0;  // inliers with both anchors; of them, places already joined
   for (const wifi_sequence::SequenceCorrespondence& c : loop->correspondences) {
     if (!c.inlier) continue;
     const wifi_sequence::SequencePose& now = wifi_sequence_->pose(c.current_pose);
@@ -350,7 +350,18 @@ Status ReplayPipeline::LinkLoop(const std::optional<wifi_sequence::SequenceLoop>
     if (!linked.ok()) return linked.status();
     added |= linked.value();
   }
-  if (joined > 0) {
+  if (!added) {
+    // Nothing reached the map: say so, so that summaries count only loops that linked places.
+    std::string why = "no inlier has an experience yet";
+    if (inliers > 0 && joined == inliers) {
+      why = "the map already joins those places";
+    } else if (inliers > 0) {
+      why = std::to_string(joined) + " of " + std::to_string(inliers) +
+            " left out where the map already joins the places, the rest join experiences "
+            "linked already";
+    }
+    wifi_sequence_->SetOutcome(loop->id, std::string(wifi_sequence::kNoLinkOutcome) + ": " + why);
+  } else if (joined > 0) {
     wifi_sequence_->SetOutcome(loop->id, "accepted; " + std::to_string(joined) + " of " +
                                              std::to_string(inliers) +
                                              " links left out: the map already joins those places");

@@ -84,15 +84,17 @@ nlohmann::ordered_json ErrorStatistics(const std::vector<double>& v) {
 nlohmann::ordered_json SequenceSummary(const wifi_sequence::WifiSequenceLoopCloser& closer,
                                        const ExperienceMap& map, const dataset::Dataset& dataset) {
   nlohmann::ordered_json j;
-  size_t accepted = 0, links = 0, verified = 0;
+  size_t accepted = 0, linked = 0, links = 0, verified = 0;
   for (const wifi_sequence::SequenceLoop& l : closer.loops()) {
     accepted += l.accepted;
+    linked += l.accepted && l.outcome.rfind(wifi_sequence::kNoLinkOutcome, 0) != 0;
     if (l.accepted) verified += l.inliers;
   }
   for (const Link& l : map.links()) links += l.wifi_sequence;
   j["poses"] = closer.size();
   j["loops_matched"] = closer.loops().size();
   j["loops_accepted"] = accepted;
+  j["loops_linked"] = linked;
   j["verified_correspondences"] = verified;
   j["links"] = links;
   nlohmann::ordered_json loops = nlohmann::ordered_json::array();

@@ -92,6 +92,10 @@ TEST_P(IpinWifiSequenceTest, VerifiedSequencesCloseLoopsOnRealWalks) {
   const nlohmann::json& w = with["wifi_sequence"];
   EXPECT_EQ(with["loop_closures"], 0);  // nothing by appearance with front end none
   EXPECT_GE(w["loops_accepted"].get<int>(), 2);
+  // Alone, nothing has joined the places before: every accepted loop links (the map's links
+  // made by sequences are counted from the map, the linked loops from the loops' outcomes).
+  EXPECT_EQ(w["loops_linked"], w["loops_accepted"]);
+  EXPECT_GE(w["links"].get<int>(), w["loops_linked"].get<int>());
   EXPECT_GE(w["verified_correspondences"].get<int>(), 20);
   EXPECT_FALSE(without.contains("wifi_sequence"));  // off: no loop closer in the summary
 
@@ -176,7 +180,12 @@ TEST_P(IpinSequenceBesideBoutTest, NeverWorseThanBoutAlone) {
   const nlohmann::json bout = Replay(configs + "ipin2023-wifi-compass.toml", logs, out / "bout");
   const nlohmann::json both = Replay(configs + "ipin2023-wifi-sequence.toml", logs, out / "both");
   ASSERT_TRUE(both.contains("wifi_sequence"));
-  EXPECT_GE(both["wifi_sequence"]["loops_accepted"].get<int>(), 1);  // the closer did find loops
+  const nlohmann::json& w = both["wifi_sequence"];
+  EXPECT_GE(w["loops_accepted"].get<int>(), 1);  // the closer did find loops
+  // A loop links when at least one of its links reached the map, and each adds one or more.
+  EXPECT_LE(w["loops_linked"].get<int>(), w["loops_accepted"].get<int>());
+  EXPECT_LE(w["loops_linked"].get<int>(), w["links"].get<int>());
+  EXPECT_EQ(w["loops_linked"].get<int>() == 0, w["links"].get<int>() == 0);
   // A centimetre of slack: the maps may differ by relaxation order, not by a pulled closure.
   EXPECT_LE(both["map_ate_m"].get<double>(), bout["map_ate_m"].get<double>() + 0.01);
   fs::remove_all(out);

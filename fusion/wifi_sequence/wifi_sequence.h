@@ -261,6 +261,10 @@ struct SequenceLoop {
   std::string outcome;  // "accepted" or why not
 };
 
+// The start of an accepted loop's outcome when none of its links reached the experience map
+// (the front end had joined those places already).
+inline constexpr char kNoLinkOutcome[] = "accepted; no link made";
+
 class WifiSequenceLoopCloser {
  public:
   struct State {
@@ -289,8 +293,8 @@ class WifiSequenceLoopCloser {
   size_t size() const { return state_.poses.size(); }
   const SequencePose& pose(size_t i) const { return state_.poses[i]; }
   const std::vector<SequenceLoop>& loops() const { return state_.loops; }
-  // Replaces loop `id`'s outcome (what became of an accepted loop's links); unknown ids are
-  // ignored.
+  // Replaces loop `id`'s outcome (what became of an accepted loop's links: kNoLinkOutcome
+  // first when none reached the map); unknown ids are ignored.
   void SetOutcome(uint32_t id, std::string outcome) {
     for (SequenceLoop& l : state_.loops) {
       if (l.id == id) l.outcome = std::move(outcome);
