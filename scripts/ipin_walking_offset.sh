@@ -5,9 +5,9 @@
 # are left out), on the IPIN 2023 routes (four repetitions of each as one multi-session run,
 # configs/ipin2023-wifi-compass.toml and configs/ipin2023-wifi.toml). Beside them an oracle
 # offset: each later repetition's scans paired with repetition 01's scans within 2 m by ground
-# truth (POSI points, linearly interpolated; same floor), the median over pairs of the median
-# RSSI difference over their common APs (at least 5). The oracle pairs only scans between the
-# first and last POSI point, so it is the walking offset.
+# truth (POSI points, linearly interpolated, same floor: scripts/ipin_nearest_scan.py's reader),
+# the median over pairs of the median RSSI difference over their common APs (at least 5). The
+# oracle pairs only scans between the first and last POSI point, so it is the walking offset.
 # Usage: scripts/ipin_walking_offset.sh [DATA_DIR] [OUT_DIR]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -36,28 +36,13 @@ import json, math, statistics, sys
 data, out = sys.argv[1], sys.argv[2]
 routes = ["01", "02", "03", "21", "22", "23"]
 
+sys.path.insert(0, "scripts")
+from ipin_nearest_scan import load  # scans with interpolated ground truth, stairs left out
+
+
 def scans_with_truth(route, rep):
-    posi, scans = [], {}
-    with open(f"{data}/IPIN2023_T3_TrainingTrial{route}_repetition{rep}.txt", errors="replace") as f:
-        for line in f:
-            if line.startswith("POSI;"):
-                p = line.split(";")
-                posi.append((float(p[1]), float(p[3]), float(p[4]), int(p[5])))
-            elif line.startswith("WIFI;"):
-                p = line.split(";")
-                scans.setdefault(float(p[1]), {})[p[4]] = float(p[6])
-    lat0 = posi[0][1]
-    result = []
-    for t, readings in sorted(scans.items()):
-        for a, b in zip(posi, posi[1:]):
-            if a[0] <= t <= b[0]:
-                if a[3] != b[3]:
-                    break  # stairs
-                w = (t - a[0]) / (b[0] - a[0])
-                lat, lon = a[1] + w * (b[1] - a[1]), a[2] + w * (b[2] - a[2])
-                result.append((lon * 111320 * math.cos(math.radians(lat0)), lat * 110540, a[3], readings))
-                break
-    return result
+    path = f"{data}/IPIN2023_T3_TrainingTrial{route}_repetition{rep}.txt"
+    return [(x, y, floor, readings) for _, (x, y), floor, readings in load(path)]
 
 def oracle(route, rep):
     reference = scans_with_truth(route, "01")
