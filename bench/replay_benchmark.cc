@@ -16,6 +16,7 @@
 #include "dataset/synthetic_dataset.h"
 #include "fusion/replay_pipeline.h"
 #include "io/config.h"
+#include "tests/test_paths.h"
 
 namespace ratslam {
 namespace {
@@ -46,7 +47,7 @@ Workload* GetWorkload() {
     StatusOr<dataset::Dataset> d =
         dataset::WriteSyntheticDataset(synthetic, (w->folder.path() / "d").string());
     StatusOr<fusion::PipelineOptions> o =
-        io::LoadConfigFile(std::string(RATSLAM_SOURCE_DIR) + "/configs/synthetic.toml");
+        io::LoadConfigFile(test_paths::SourceDir() + "/configs/synthetic.toml");
     if (!d.ok() || !o.ok()) {
       w->error = !d.ok() ? d.status().message() : o.status().message();
       return w;
