@@ -243,6 +243,7 @@ StatusOr<CollectReport> Collect(const std::string& dir) {
       {"ok", report.ok},
       {"failed", report.failed},
       {"pending", report.pending},
+      {"eliminated", report.eliminated},
       {"best_point", report.best_point ? json(*report.best_point) : json()},
       {"best_objective", report.best_point ? json(report.best_objective) : json()}};
   std::vector<std::pair<std::string, std::string>> files = {

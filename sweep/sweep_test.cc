@@ -510,6 +510,13 @@ awk -v x="$x" -v d="$d" 'BEGIN { printf "{\"map_ate_m\": %.12f}\n", (x-0.37)^2 +
   ASSERT_TRUE(collected.ok()) << collected.status().message();
   EXPECT_EQ(collected->ok, 72);
   EXPECT_EQ(collected->eliminated, 28 * 9 - 72);
+  // results.json counts them, and names each such run.
+  std::ifstream results(fs::path(dir) / "results.json");
+  const nlohmann::json j = nlohmann::json::parse(results);
+  EXPECT_EQ(j.at("eliminated").get<int>(), 28 * 9 - 72);
+  int named = 0;
+  for (const nlohmann::json& run : j.at("runs")) named += run.at("status") == "eliminated";
+  EXPECT_EQ(named, 28 * 9 - 72);
   ASSERT_TRUE(collected->best_point.has_value());
   EXPECT_EQ(*collected->best_point, 10);
   // Resuming a finished halving runs nothing.
