@@ -507,9 +507,198 @@ std::string WifiGpMap::Encode() const {
   return std::move(w.bytes());
 }
 
+// Reads a Wi-Fi map file's parts in their order (header, options, frame and walls, grids,
+// samples), checking every count and value; each error names the file.
+class WifiGpMap::Decoder {
+ public:
+  Decoder(std::string_view file, const std::string& name) : r_(file, name), name_(name) {}
+
+  StatusOr<WifiGpMap> Run() {
+    RATSLAM_RETURN_IF_ERROR(Header());
+    RATSLAM_RETURN_IF_ERROR(Options());
+    RATSLAM_RETURN_IF_ERROR(Frame());
+    RATSLAM_RETURN_IF_ERROR(Grids());
+    RATSLAM_RETURN_IF_ERROR(Samples());
+    if (!r_.AtEnd()) return Fail("trailing bytes");
+    map_.IndexCoverage();
+    return std::move(map_);
+  }
+
+ private:
+  // The reader's own error (it names the byte) before `what`.
+  Status Fail(const std::string& what) const {
+    return Status::Error(name_ + ": " + (r_.error().empty() ? what : r_.error()));
+  }
+
+  Status Header() {
+    std::string magic;
+    if (!r_.String(&magic) || magic != kMagic) return Fail("not a Wi-Fi map file");
+    if (!r_.Pod(&version_)) return Fail("truncated");
+    if (version_ < 1 || version_ > kVersion) {
+      return Fail("Wi-Fi map format " + std::to_string(version_) + " (this program reads 1 to " +
+                  std::to_string(kVersion) + ")");
+    }
+    return Status::Ok();
+  }
+
+  Status Options() {
+    bool ok = true;
+    map_.options_.VisitFields([&](const char* name, auto& field, const char*, const auto&) {
+      using T = std::decay_t<decltype(field)>;
+      if (version_ == 1 &&
+          (std::string(name) == "fit_hyperparameters" || std::string(name) == "fit_length_scale")) {
+        return;  // added in format 2
+      }
+      if constexpr (std::is_same_v<T, bool>) {
+        ok = ok && r_.Bool(&field);
+      } else {
+        ok = ok && r_.Pod(&field);
+      }
+    });
+    std::string invalid;
+    if (!ok) return Fail("truncated options");
+    if (!map_.options_.IsValid(&invalid)) return Fail("options: " + invalid);
+    return Status::Ok();
+  }
+
+  // The geographic reference, the map frame and walls (format 2 on), and the number of APs (read
+  // before the reference is checked).
+  Status Frame() {
+    bool has_reference = false;
+    double latitude = 0, longitude = 0;
+    if (!r_.Bool(&has_reference) || !r_.Pod(&latitude) || !r_.Pod(&longitude)) {
+      return Fail("truncated");
+    }
+    if (version_ >= 2) {
+      RATSLAM_RETURN_IF_ERROR(Alignment());
+      RATSLAM_RETURN_IF_ERROR(Walls());
+    }
+    if (!r_.Count(16, &aps_)) return Fail("truncated");
+    if (has_reference) {
+      if (!(std::abs(latitude) <= 90) || !(std::abs(longitude) <= 180)) {
+        return Fail("geographic reference out of range");
+      }
+      map_.reference_ = std::make_pair(latitude, longitude);
+    }
+    return Status::Ok();
+  }
+
+  Status Alignment() {
+    bool has_alignment = false;
+    RigidAlignment2D a;
+    if (!(r_.Pod(&map_.compass_to_map_rad_) && r_.Bool(&has_alignment) && r_.Pod(&a.rotation_rad) &&
+          r_.Pod(&a.translation_x_m) && r_.Pod(&a.translation_y_m) && r_.Pod(&a.rmse_m))) {
+      return Fail("truncated frame");
+    }
+    if (!(std::abs(map_.compass_to_map_rad_) <= 7.0) || !(std::abs(a.rotation_rad) <= 7.0) ||
+        !(std::abs(a.translation_x_m) <= 1e7) || !(std::abs(a.translation_y_m) <= 1e7) ||
+        !(a.rmse_m >= 0 && a.rmse_m <= 1e7)) {
+      return Fail("map frame out of range");
+    }
+    if (has_alignment) map_.truth_from_map_ = a;
+    return Status::Ok();
+  }
+
+  Status Walls() {
+    size_t walls = 0;
+    if (!r_.Count(36, &walls)) return Fail("truncated walls");
+    map_.walls_.resize(walls);
+    for (WallSegment& wall : map_.walls_) {
+      int32_t floor = 0;
+      if (!(r_.Pod(&floor) && r_.Pod(&wall.a.x) && r_.Pod(&wall.a.y) && r_.Pod(&wall.b.x) &&
+            r_.Pod(&wall.b.y))) {
+        return Fail("truncated walls");
+      }
+      wall.floor = floor;
+      for (double v : {wall.a.x, wall.a.y, wall.b.x, wall.b.y}) {
+        if (!(std::abs(v) <= 1e7)) return Fail("a wall's end is not finite or out of range");
+      }
+    }
+    return Status::Ok();
+  }
+
+  // Per AP: its BSSID (once in the file) and its grids, one per floor.
+  Status Grids() {
+    map_.grids_.resize(aps_);
+    for (size_t ap = 0; ap < aps_; ++ap) {
+      std::string bssid;
+      size_t grids = 0;
+      if (!r_.String(&bssid) || !r_.Count(36, &grids)) return Fail("truncated");
+      if (!map_.index_.emplace(bssid, map_.bssids_.size()).second) {
+        return Fail("BSSID " + bssid + " appears twice");
+      }
+      map_.bssids_.push_back(bssid);
+      for (size_t k = 0; k < grids; ++k) {
+        StatusOr<Grid> g = OneGrid(bssid);
+        if (!g.ok()) return g.status();
+        map_.grids_[ap].push_back(std::move(*g));
+      }
+    }
+    return Status::Ok();
+  }
+
+  StatusOr<Grid> OneGrid(const std::string& bssid) {
+    Grid g;
+    if (!(r_.Pod(&g.floor) && r_.Pod(&g.min_x) && r_.Pod(&g.min_y) && r_.Pod(&g.width) &&
+          r_.Pod(&g.height) && r_.PodVector(&g.mean_dbm) && r_.PodVector(&g.variance_dbm2))) {
+      return Fail("truncated grid");
+    }
+    const int64_t cells = static_cast<int64_t>(g.width) * g.height;
+    if (g.width <= 0 || g.height <= 0 || std::abs(int64_t{g.min_x}) > 1e8 ||
+        std::abs(int64_t{g.min_y}) > 1e8 || cells != static_cast<int64_t>(g.mean_dbm.size()) ||
+        g.mean_dbm.size() != g.variance_dbm2.size()) {
+      return Fail("grid of AP " + bssid + " has a size that does not fit its cells");
+    }
+    for (size_t c = 0; c < g.mean_dbm.size(); ++c) {
+      const float m = g.mean_dbm[c], v = g.variance_dbm2[c];
+      if (std::isnan(m) != std::isnan(v) ||
+          (!std::isnan(m) && (!std::isfinite(m) || !std::isfinite(v) || v < 0))) {
+        return Fail("grid of AP " + bssid + " has an invalid cell");
+      }
+    }
+    return g;
+  }
+
+  // The training samples: positions and readings by AP number.
+  Status Samples() {
+    size_t samples = 0;
+    if (!r_.Count(24, &samples)) return Fail("truncated samples");
+    map_.training_.resize(samples);
+    for (WifiMapSample& s : map_.training_) {
+      int32_t floor = 0;
+      size_t readings = 0;
+      if (!(r_.Pod(&s.position.x) && r_.Pod(&s.position.y) && r_.Pod(&floor) &&
+            r_.Count(12, &readings))) {
+        return Fail("truncated sample");
+      }
+      if (!std::isfinite(s.position.x) || !std::isfinite(s.position.y) ||
+          std::abs(s.position.x) > 1e7 || std::abs(s.position.y) > 1e7) {
+        return Fail("a sample's position is not finite");
+      }
+      s.floor = floor;
+      for (size_t k = 0; k < readings; ++k) {
+        uint32_t ap = 0;
+        double rssi = 0;
+        if (!(r_.Pod(&ap) && r_.Pod(&rssi))) return Fail("truncated sample");
+        if (ap >= map_.bssids_.size() || !std::isfinite(rssi) || std::abs(rssi) > 1000) {
+          return Fail("a sample's reading refers to no AP or is out of range");
+        }
+        s.readings.emplace_back(map_.bssids_[ap], rssi);
+      }
+    }
+    return Status::Ok();
+  }
+
+  ByteReader r_;
+  const std::string& name_;
+  uint32_t version_ = 0;
+  size_t aps_ = 0;
+  WifiGpMap map_;
+};
+
 StatusOr<WifiGpMap> WifiGpMap::Decode(const std::string& bytes, const std::string& name) {
   std::string_view file(bytes);
-  {
+  {  // Format 3 on ends in a checksum of everything before it.
     ByteReader header(file, name);
     std::string magic;
     uint32_t version = 0;
@@ -520,133 +709,7 @@ StatusOr<WifiGpMap> WifiGpMap::Decode(const std::string& bytes, const std::strin
       file = *body;
     }
   }
-  ByteReader r(file, name);
-  auto fail = [&](const std::string& what) {
-    return Status::Error(name + ": " + (r.error().empty() ? what : r.error()));
-  };
-  std::string magic;
-  uint32_t version = 0;
-  if (!r.String(&magic) || magic != kMagic) return fail("not a Wi-Fi map file");
-  if (!r.Pod(&version)) return fail("truncated");
-  if (version < 1 || version > kVersion) {
-    return fail("Wi-Fi map format " + std::to_string(version) + " (this program reads 1 to " +
-                std::to_string(kVersion) + ")");
-  }
-  WifiGpMap map;
-  bool ok = true;
-  map.options_.VisitFields([&](const char* name, auto& field, const char*, const auto&) {
-    using T = std::decay_t<decltype(field)>;
-    if (version == 1 &&
-        (std::string(name) == "fit_hyperparameters" || std::string(name) == "fit_length_scale")) {
-      return;  // added in format 2
-    }
-    if constexpr (std::is_same_v<T, bool>) {
-      ok = ok && r.Bool(&field);
-    } else {
-      ok = ok && r.Pod(&field);
-    }
-  });
-  std::string invalid;
-  if (!ok) return fail("truncated options");
-  if (!map.options_.IsValid(&invalid)) return fail("options: " + invalid);
-  bool has_reference = false;
-  double latitude = 0, longitude = 0;
-  size_t aps = 0;
-  if (!r.Bool(&has_reference) || !r.Pod(&latitude) || !r.Pod(&longitude)) return fail("truncated");
-  if (version >= 2) {
-    bool has_alignment = false;
-    RigidAlignment2D a;
-    if (!(r.Pod(&map.compass_to_map_rad_) && r.Bool(&has_alignment) && r.Pod(&a.rotation_rad) &&
-          r.Pod(&a.translation_x_m) && r.Pod(&a.translation_y_m) && r.Pod(&a.rmse_m))) {
-      return fail("truncated frame");
-    }
-    if (!(std::abs(map.compass_to_map_rad_) <= 7.0) || !(std::abs(a.rotation_rad) <= 7.0) ||
-        !(std::abs(a.translation_x_m) <= 1e7) || !(std::abs(a.translation_y_m) <= 1e7) ||
-        !(a.rmse_m >= 0 && a.rmse_m <= 1e7)) {
-      return fail("map frame out of range");
-    }
-    if (has_alignment) map.truth_from_map_ = a;
-    size_t walls = 0;
-    if (!r.Count(36, &walls)) return fail("truncated walls");
-    map.walls_.resize(walls);
-    for (WallSegment& wall : map.walls_) {
-      int32_t floor = 0;
-      if (!(r.Pod(&floor) && r.Pod(&wall.a.x) && r.Pod(&wall.a.y) && r.Pod(&wall.b.x) &&
-            r.Pod(&wall.b.y))) {
-        return fail("truncated walls");
-      }
-      wall.floor = floor;
-      for (double v : {wall.a.x, wall.a.y, wall.b.x, wall.b.y}) {
-        if (!(std::abs(v) <= 1e7)) return fail("a wall's end is not finite or out of range");
-      }
-    }
-  }
-  if (!r.Count(16, &aps)) return fail("truncated");
-  if (has_reference) {
-    if (!(std::abs(latitude) <= 90) || !(std::abs(longitude) <= 180)) {
-      return fail("geographic reference out of range");
-    }
-    map.reference_ = std::make_pair(latitude, longitude);
-  }
-  map.grids_.resize(aps);
-  for (size_t ap = 0; ap < aps; ++ap) {
-    std::string bssid;
-    size_t grids = 0;
-    if (!r.String(&bssid) || !r.Count(36, &grids)) return fail("truncated");
-    if (!map.index_.emplace(bssid, map.bssids_.size()).second) {
-      return fail("BSSID " + bssid + " appears twice");
-    }
-    map.bssids_.push_back(bssid);
-    for (size_t k = 0; k < grids; ++k) {
-      Grid g;
-      if (!(r.Pod(&g.floor) && r.Pod(&g.min_x) && r.Pod(&g.min_y) && r.Pod(&g.width) &&
-            r.Pod(&g.height) && r.PodVector(&g.mean_dbm) && r.PodVector(&g.variance_dbm2))) {
-        return fail("truncated grid");
-      }
-      const int64_t cells = static_cast<int64_t>(g.width) * g.height;
-      if (g.width <= 0 || g.height <= 0 || std::abs(int64_t{g.min_x}) > 1e8 ||
-          std::abs(int64_t{g.min_y}) > 1e8 || cells != static_cast<int64_t>(g.mean_dbm.size()) ||
-          g.mean_dbm.size() != g.variance_dbm2.size()) {
-        return fail("grid of AP " + bssid + " has a size that does not fit its cells");
-      }
-      for (size_t c = 0; c < g.mean_dbm.size(); ++c) {
-        const float m = g.mean_dbm[c], v = g.variance_dbm2[c];
-        if (std::isnan(m) != std::isnan(v) ||
-            (!std::isnan(m) && (!std::isfinite(m) || !std::isfinite(v) || v < 0))) {
-          return fail("grid of AP " + bssid + " has an invalid cell");
-        }
-      }
-      map.grids_[ap].push_back(std::move(g));
-    }
-  }
-  size_t samples = 0;
-  if (!r.Count(24, &samples)) return fail("truncated samples");
-  map.training_.resize(samples);
-  for (WifiMapSample& s : map.training_) {
-    int32_t floor = 0;
-    size_t readings = 0;
-    if (!(r.Pod(&s.position.x) && r.Pod(&s.position.y) && r.Pod(&floor) &&
-          r.Count(12, &readings))) {
-      return fail("truncated sample");
-    }
-    if (!std::isfinite(s.position.x) || !std::isfinite(s.position.y) ||
-        std::abs(s.position.x) > 1e7 || std::abs(s.position.y) > 1e7) {
-      return fail("a sample's position is not finite");
-    }
-    s.floor = floor;
-    for (size_t k = 0; k < readings; ++k) {
-      uint32_t ap = 0;
-      double rssi = 0;
-      if (!(r.Pod(&ap) && r.Pod(&rssi))) return fail("truncated sample");
-      if (ap >= map.bssids_.size() || !std::isfinite(rssi) || std::abs(rssi) > 1000) {
-        return fail("a sample's reading refers to no AP or is out of range");
-      }
-      s.readings.emplace_back(map.bssids_[ap], rssi);
-    }
-  }
-  if (!r.AtEnd()) return fail("trailing bytes");
-  map.IndexCoverage();
-  return map;
+  return Decoder(file, name).Run();
 }
 
 StatusOr<WifiGpMap> WifiGpMap::Load(const std::string& path) {

@@ -109,6 +109,7 @@ class WifiGpMap {
   static StatusOr<WifiGpMap> Load(const std::string& path);
 
  private:
+  class Decoder;  // reads a file's parts in order (wifi_gp_map.cc)
   void IndexCoverage();
   WifiGpOptions options_;
   std::vector<WifiMapSample> training_;
