@@ -437,102 +437,87 @@ std::optional<double> ObjectiveOf(const json& summary, const std::string& object
   return e->Evaluate([&](const std::string& name) { return Metric(summary, name); });
 }
 
-StatusOr<SweepSpec> LoadSweepFile(const std::string& path) {
-  StatusOr<std::string> text = ReadRegularFile(path, "sweep file", kMaxSweepBytes);
-  if (!text.ok()) return text.status();
-  StatusOr<toml::table> parsed = schema::ParseToml(*text, path);
-  if (!parsed.ok()) return parsed.status();
-  const fs::path base = fs::absolute(path).parent_path();
-  SweepSpec spec;
-  spec.source = path;
-  schema::TableBinder top(*parsed, "the sweep file", "", path);
-  SweepSettings settings;
+namespace {
+
+// [sweep]: its settings checked into `spec` (the base configuration aside). `parsed` holds the
+// table; errors name its key's line.
+Status ReadSweepSettings(const toml::table& parsed, schema::TableBinder& top,
+                         const std::string& path, SweepSettings* settings, SweepSpec* spec) {
   if (const toml::table* t = top.Table("sweep")) {
     schema::TableBinder binder(*t, "[sweep]", "sweep.", path);
-    settings.VisitFields(binder);
+    settings->VisitFields(binder);
     RATSLAM_RETURN_IF_ERROR(binder.Finish());
   } else {
     return Status::Error(path + ": missing [sweep] table");
   }
-  const toml::table& sweep_table = *(*parsed)["sweep"].as_table();
+  const SweepSettings& s = *settings;
+  const toml::table& sweep_table = *parsed["sweep"].as_table();
   auto fail_at = [&](const char* key, const std::string& message) {
     return Status::Error(schema::TomlWhere(path, sweep_table.get(key)) + ": sweep." + key + ": " +
                          message);
   };
-  if (settings.command != "replay" && settings.command != "evaluate") {
+  if (s.command != "replay" && s.command != "evaluate") {
     return fail_at("command", "must be replay or evaluate");
   }
-  spec.command = settings.command;
-  if (settings.method != "grid" && settings.method != "random") {
+  spec->command = s.command;
+  if (s.method != "grid" && s.method != "random")
     return fail_at("method", "must be grid or random");
-  }
-  if (settings.method == "random" && settings.samples < 1) {
+  if (s.method == "random" && s.samples < 1) {
     return fail_at("samples", "random needs samples >= 1");
   }
-  if (settings.aggregate != "mean" && settings.aggregate != "worst") {
+  if (s.aggregate != "mean" && s.aggregate != "worst") {
     return fail_at("aggregate", "must be mean or worst");
   }
-  if (settings.goal != "minimize" && settings.goal != "maximize") {
+  if (s.goal != "minimize" && s.goal != "maximize") {
     return fail_at("goal", "must be minimize or maximize");
   }
-  if (settings.keep != "small" && settings.keep != "all") {
-    return fail_at("keep", "must be small or all");
-  }
-  if (settings.search != "all" && settings.search != "halving") {
+  if (s.keep != "small" && s.keep != "all") return fail_at("keep", "must be small or all");
+  if (s.search != "all" && s.search != "halving") {
     return fail_at("search", "must be all or halving");
   }
-  spec.search = settings.search;
-  spec.halving_rate = settings.halving_rate;
-  spec.method = settings.method;
-  spec.samples = settings.samples;
-  spec.seed = settings.seed;
-  spec.metrics = settings.metrics;
-  StatusOr<Expression> objective = Expression::Parse(settings.objective);
+  spec->search = s.search;
+  spec->halving_rate = s.halving_rate;
+  spec->method = s.method;
+  spec->samples = s.samples;
+  spec->seed = s.seed;
+  spec->metrics = s.metrics;
+  StatusOr<Expression> objective = Expression::Parse(s.objective);
   if (!objective.ok()) return fail_at("objective", objective.status().message());
   // The objective's metrics first, then the others asked for.
   std::vector<std::string> metrics;
   for (const std::string& m : objective->Metrics()) {
-    if (std::find(spec.metrics.begin(), spec.metrics.end(), m) == spec.metrics.end()) {
+    if (std::find(spec->metrics.begin(), spec->metrics.end(), m) == spec->metrics.end()) {
       metrics.push_back(m);
     }
   }
-  spec.metrics.insert(spec.metrics.begin(), metrics.begin(), metrics.end());
+  spec->metrics.insert(spec->metrics.begin(), metrics.begin(), metrics.end());
   // A misspelt metric once ran every task and ranked nothing: the names are checked now, by
   // their first part against the keys the command's summary can have.
-  {
-    const std::vector<std::string>& keys =
-        settings.command == "evaluate" ? session::EvaluationKeys() : io::SummaryKeys();
-    const std::set<std::string> known(keys.begin(), keys.end());
-    const std::string file = settings.command == "evaluate" ? "evaluation.json" : "summary.json";
-    for (const std::string& m : spec.metrics) {
-      const std::string top = m.substr(0, m.find('.'));
-      if (known.count(top)) continue;
-      const std::vector<std::string> in_expression = objective->Metrics();
-      const bool in_objective =
-          std::find(in_expression.begin(), in_expression.end(), m) != in_expression.end();
-      return fail_at(in_objective ? "objective" : "metrics",
-                     "'" + m + "' is not a key of " + file + schema::DidYouMean(top, known));
-    }
+  const std::vector<std::string>& keys =
+      s.command == "evaluate" ? session::EvaluationKeys() : io::SummaryKeys();
+  const std::set<std::string> known(keys.begin(), keys.end());
+  const std::string file = s.command == "evaluate" ? "evaluation.json" : "summary.json";
+  for (const std::string& m : spec->metrics) {
+    const std::string first = m.substr(0, m.find('.'));
+    if (known.count(first)) continue;
+    const std::vector<std::string> in_expression = objective->Metrics();
+    const bool in_objective =
+        std::find(in_expression.begin(), in_expression.end(), m) != in_expression.end();
+    return fail_at(in_objective ? "objective" : "metrics",
+                   "'" + m + "' is not a key of " + file + schema::DidYouMean(first, known));
   }
-  spec.objective = settings.objective;
-  spec.aggregate = settings.aggregate;
-  spec.goal = settings.goal;
-  spec.timeout_s = settings.timeout_s;
-  spec.keep_all = settings.keep == "all";
+  spec->objective = s.objective;
+  spec->aggregate = s.aggregate;
+  spec->goal = s.goal;
+  spec->timeout_s = s.timeout_s;
+  spec->keep_all = s.keep == "all";
+  return Status::Ok();
+}
 
-  fusion::PipelineOptions base_options;
-  if (!settings.base_config.empty()) {
-    const fs::path config = fs::path(settings.base_config).is_absolute()
-                                ? fs::path(settings.base_config)
-                                : base / settings.base_config;
-    StatusOr<fusion::PipelineOptions> loaded = io::LoadConfigFile(config.string());
-    if (!loaded.ok()) return loaded.status().WithContext(path + ": sweep.base_config");
-    base_options = *loaded;
-  }
-  spec.base_config_text = io::PrintConfig(base_options, false);
-
-  // [[datasets]]: `data = [...]` is one run over those sessions; `glob = "..."` is one run per
-  // matching file or folder.
+// [[datasets]]: `data = [...]` is one run over those sessions; `glob = "..."` is one run per
+// matching file or folder. Relative paths are from `base`, the sweep file's folder.
+Status ReadDatasets(schema::TableBinder& top, const std::string& path, const fs::path& base,
+                    SweepSpec* spec) {
   for (const toml::table* entry : top.Tables("datasets")) {
     schema::TableBinder binder(*entry, "[[datasets]]", "datasets.", path);
     std::vector<std::string> data;
@@ -547,7 +532,7 @@ StatusOr<SweepSpec> LoadSweepFile(const std::string& path) {
     if (!pattern.empty()) {
       StatusOr<std::vector<std::string>> matches = Expand(pattern, base, where);
       if (!matches.ok()) return matches.status();
-      for (const std::string& m : *matches) spec.datasets.push_back({m});
+      for (const std::string& m : *matches) spec->datasets.push_back({m});
       continue;
     }
     std::vector<std::string> sessions;
@@ -556,28 +541,61 @@ StatusOr<SweepSpec> LoadSweepFile(const std::string& path) {
       if (!matches.ok()) return matches.status();
       sessions.insert(sessions.end(), matches->begin(), matches->end());
     }
-    spec.datasets.push_back(sessions);
+    spec->datasets.push_back(sessions);
   }
-  if (spec.datasets.empty()) return Status::Error(path + ": no [[datasets]]");
-  if (spec.command == "evaluate") {
-    for (const auto& d : spec.datasets) {
+  if (spec->datasets.empty()) return Status::Error(path + ": no [[datasets]]");
+  if (spec->command == "evaluate") {
+    for (const auto& d : spec->datasets) {
       if (d.size() > 2) {
         return Status::Error(path + ": evaluate takes data = [map] or [map, query], not " +
                              std::to_string(d.size()) + " data sets");
       }
     }
   }
-  if (const toml::table* parameters = top.Table("parameters")) {
-    for (const auto& [key, node] : *parameters) {
-      StatusOr<Parameter> p = ReadParameter(std::string(key.str()), node, path);
-      if (!p.ok()) return p.status();
-      if (spec.method == "grid" && p->values.empty()) {
-        return Status::Error(schema::TomlWhere(path, &node) + ": parameter '" + p->key +
-                             "': uniform and log_uniform ranges need method = \"random\"");
-      }
-      spec.parameters.push_back(*p);
+  return Status::Ok();
+}
+
+// [parameters]: each key's values or range (a grid needs values).
+Status ReadParameters(schema::TableBinder& top, const std::string& path, SweepSpec* spec) {
+  const toml::table* parameters = top.Table("parameters");
+  if (!parameters) return Status::Ok();
+  for (const auto& [key, node] : *parameters) {
+    StatusOr<Parameter> p = ReadParameter(std::string(key.str()), node, path);
+    if (!p.ok()) return p.status();
+    if (spec->method == "grid" && p->values.empty()) {
+      return Status::Error(schema::TomlWhere(path, &node) + ": parameter '" + p->key +
+                           "': uniform and log_uniform ranges need method = \"random\"");
     }
+    spec->parameters.push_back(*p);
   }
+  return Status::Ok();
+}
+
+}  // namespace
+
+StatusOr<SweepSpec> LoadSweepFile(const std::string& path) {
+  StatusOr<std::string> text = ReadRegularFile(path, "sweep file", kMaxSweepBytes);
+  if (!text.ok()) return text.status();
+  StatusOr<toml::table> parsed = schema::ParseToml(*text, path);
+  if (!parsed.ok()) return parsed.status();
+  const fs::path base = fs::absolute(path).parent_path();
+  SweepSpec spec;
+  spec.source = path;
+  schema::TableBinder top(*parsed, "the sweep file", "", path);
+  SweepSettings settings;
+  RATSLAM_RETURN_IF_ERROR(ReadSweepSettings(*parsed, top, path, &settings, &spec));
+  fusion::PipelineOptions base_options;
+  if (!settings.base_config.empty()) {
+    const fs::path config = fs::path(settings.base_config).is_absolute()
+                                ? fs::path(settings.base_config)
+                                : base / settings.base_config;
+    StatusOr<fusion::PipelineOptions> loaded = io::LoadConfigFile(config.string());
+    if (!loaded.ok()) return loaded.status().WithContext(path + ": sweep.base_config");
+    base_options = *loaded;
+  }
+  spec.base_config_text = io::PrintConfig(base_options, false);
+  RATSLAM_RETURN_IF_ERROR(ReadDatasets(top, path, base, &spec));
+  RATSLAM_RETURN_IF_ERROR(ReadParameters(top, path, &spec));
   RATSLAM_RETURN_IF_ERROR(top.Finish());
   return spec;
 }
