@@ -187,7 +187,7 @@ const std::vector<CommandSpec>& Commands() {
        "configs/synthetic.toml).",
        {Text("--out", "D", "output folder", true), kOverwrite,
         Whole("--seed", "S", "random seed", 0, kSeedMax),
-        Whole("--laps", "N", "laps of the loop", 1, 1000),
+        Whole("--laps", "N", "laps of the loop", 1, 1000), kQuiet,
         Whole("--noise-seed", "S",
               "seed of the sensor noise alone (default: from --seed): another session of the "
               "same world",

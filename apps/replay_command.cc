@@ -262,14 +262,16 @@ int ReplayCommand(const Arguments& parsed) {
 
 int Synthesize(const dataset::SyntheticOptions& options, const std::string& folder,
                const std::string& shown_folder, const std::string& bag_path,
-               const std::string& video_path) {
+               const std::string& video_path, bool quiet) {
   StatusOr<dataset::Dataset> d = dataset::WriteSyntheticDataset(options, folder);
   if (!d.ok()) {
     std::cerr << MessagePrefix() << d.status().message() << "\n";
     return kExitError;
   }
-  std::cerr << MessagePrefix() << "wrote " << d->images.size() << " frames of '" << d->name
-            << "' to " << shown_folder << "\n";
+  if (!quiet) {
+    std::cerr << MessagePrefix() << "wrote " << d->images.size() << " frames of '" << d->name
+              << "' to " << shown_folder << "\n";
+  }
   if (!bag_path.empty()) {
     // OpenRatSLAM's topic names under the root "synthetic" (what topic_root=synthetic implies).
     const dataset::BagTopics topics{"/synthetic/camera/image/compressed", "/synthetic/odom",
@@ -282,9 +284,11 @@ int Synthesize(const dataset::SyntheticOptions& options, const std::string& fold
       std::cerr << MessagePrefix() << s.message() << "\n";
       return kExitError;
     }
-    std::cerr << MessagePrefix() << "wrote the same frames as a ROS bag to " << bag_path << " ("
-              << topics.image_topic << ", " << topics.odometry_topic << ", "
-              << topics.ground_truth_topic << ")\n";
+    if (!quiet) {
+      std::cerr << MessagePrefix() << "wrote the same frames as a ROS bag to " << bag_path << " ("
+                << topics.image_topic << ", " << topics.odometry_topic << ", "
+                << topics.ground_truth_topic << ")\n";
+    }
   }
   if (!video_path.empty()) {
     StatusOr<dataset::Dataset> written = dataset::ReadDataset(folder);
@@ -295,8 +299,10 @@ int Synthesize(const dataset::SyntheticOptions& options, const std::string& fold
       std::cerr << MessagePrefix() << s.message() << "\n";
       return kExitError;
     }
-    std::cerr << MessagePrefix() << "wrote the same frames as a video to " << video_path
-              << " with OpenRatSLAM's odometry log beside it\n";
+    if (!quiet) {
+      std::cerr << MessagePrefix() << "wrote the same frames as a video to " << video_path
+                << " with OpenRatSLAM's odometry log beside it\n";
+    }
   }
   return kExitOk;
 }
@@ -414,7 +420,7 @@ int SynthesizeCommand(const Arguments& parsed) {
   }
   if (args->Has("--start-m")) options.start_m = args->Number("--start-m");
   return Synthesize(options, args->values.at("--out"), args->Shown(args->values.at("--out")),
-                    args->Value("--bag"), args->Value("--video"));
+                    args->Value("--bag"), args->Value("--video"), args->quiet);
 }
 
 }  // namespace ratslam::apps

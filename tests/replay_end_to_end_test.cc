@@ -544,6 +544,23 @@ TEST_F(ReplayEndToEndTest, BagReplayGivesTheFolderReplaysMap) {
   EXPECT_LT(Summary(dir / "localised")["localisation"]["lost_fraction"].get<double>(), 0.1);
 }
 
+// `synthesize --quiet` writes the same data set and says nothing; without it, one line naming
+// the frames written.
+TEST_F(ReplayEndToEndTest, SynthesizeQuietWritesTheSameFilesSilently) {
+  const fs::path dir = root_ / "quiet";
+  const Result loud = RunRatslam("synthesize --laps 1 --out " + (dir / "loud").string(), root_);
+  const Result quiet =
+      RunRatslam("synthesize --laps 1 --quiet --out " + (dir / "quiet").string(), root_);
+  ASSERT_EQ(loud.exit_code, 0) << loud.err;
+  ASSERT_EQ(quiet.exit_code, 0) << quiet.err;
+  EXPECT_EQ(quiet.err, "");
+  EXPECT_EQ(quiet.out, "");
+  EXPECT_NE(loud.err.find("wrote 1212 frames"), std::string::npos) << loud.err;
+  for (const char* name : {"images.csv", "odometry.csv", "ground_truth.csv", "manifest.toml"}) {
+    EXPECT_EQ(Slurp(dir / "loud" / name), Slurp(dir / "quiet" / name)) << name;
+  }
+}
+
 // The synthetic loop written as ROS 2 bags by independent writers (scripts/ros2_fixtures.sh:
 // Foxglove's MCAP writer and CDR serialiser, SQLite) replays to the folder's map bit for bit: an
 // MCAP file with zstd chunks, one with no chunks and no summary (read by scanning), and a rosbag2
