@@ -16,6 +16,7 @@ namespace {
 
 constexpr render::Rgba kDot{70, 110, 170, 200};
 constexpr render::Rgba kBest{215, 40, 40, 255};
+constexpr float kLabelGapPx = 6.0f;  // least space between two tick labels
 
 std::optional<double> AsNumber(const std::string& text) {
   double v = 0.0;
@@ -178,12 +179,16 @@ render::Scene SweepParameterScene(const SweepFigureData& data, int width_px) {
     const ValueAxis axis(values);
     ValueTicks(scene, range, left, top, panel_w, panel_h);
     scene.Text({left - 8, top - 12}, ValueAxisTitle(data), 14, kInk);
-    const auto& distinct = axis.distinct();
-    const size_t every = std::max<size_t>(1, distinct.size() / 8);
-    for (size_t i = 0; i < distinct.size(); i += every) {
-      const float x = left + panel_w * static_cast<float>(axis(distinct[i]));
+    // A tick at every value; labels left to right, each only where it clears the last one drawn
+    // (values close together on a numeric axis printed over each other).
+    float last_label_right = -std::numeric_limits<float>::infinity();
+    for (const std::string& value : axis.distinct()) {
+      const float x = left + panel_w * static_cast<float>(axis(value));
       scene.Line({x, top + panel_h}, {x, top + panel_h + 5}, 1.0f, kInk);
-      scene.Text({x, top + panel_h + 22}, distinct[i], 13, kInk, render::TextAnchor::kCenter);
+      const float half = render::TextWidthPx(value, 13) / 2;
+      if (x - half < last_label_right + kLabelGapPx) continue;
+      scene.Text({x, top + panel_h + 22}, value, 13, kInk, render::TextAnchor::kCenter);
+      last_label_right = x + half;
     }
     scene.Text({left + panel_w / 2, top + panel_h + 48}, data.keys[k], 15, kInk,
                render::TextAnchor::kCenter);

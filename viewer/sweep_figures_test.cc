@@ -4,7 +4,11 @@
 
 #include <algorithm>
 #include <optional>
+#include <string>
+#include <utility>
 #include <vector>
+
+#include "render/image.h"
 
 namespace ratslam::viewer {
 namespace {
@@ -96,6 +100,44 @@ TEST(SweepFiguresTest, TheValueAxisNamesTheObjectiveAndItsUnit) {
   EXPECT_TRUE(HasText(SweepParameterScene(d), "match_rate_within_m.5"));
   d.objective = "map_ate_m + 0.05 * templates";
   EXPECT_TRUE(HasText(SweepParetoScene(d), "map_ate_m + 0.05 * templates"));
+}
+
+// Parameter values close together on a numeric axis (a log-odds grid from -40 to 5) get a tick
+// each but labels that never overlap: the labels once ran together into "-10.0-5.0-2.00.0".
+TEST(SweepFiguresTest, ParameterLabelsNeverOverlap) {
+  SweepFigureData d;
+  d.title = "t";
+  d.objective = "ate";
+  d.keys = {"threshold"};
+  const std::vector<std::string> values = {"-40.0", "-20.0", "-10.0", "-5.0",
+                                           "-2.0",  "0.0",   "2.0",   "5.0"};
+  for (size_t i = 0; i < values.size(); ++i) {
+    d.points.push_back({{values[i]}, 10.0 - static_cast<double>(i), 1.0});
+  }
+  d.best = 0;
+  const render::Scene scene = SweepParameterScene(d);
+  std::vector<std::pair<float, float>> spans;  // the drawn value labels, left to right
+  for (const render::SceneText& t : scene.texts()) {
+    if (std::find(values.begin(), values.end(), t.text) == values.end()) continue;
+    const float half = render::TextWidthPx(t.text, t.height_px) / 2;
+    spans.emplace_back(t.position.x - half, t.position.x + half);
+  }
+  std::sort(spans.begin(), spans.end());
+  ASSERT_GE(spans.size(), 4u);  // the sparse end keeps its labels
+  for (size_t i = 1; i < spans.size(); ++i) {
+    EXPECT_LT(spans[i - 1].second, spans[i].first) << "labels " << i - 1 << " and " << i;
+  }
+  EXPECT_TRUE(HasText(scene, "-40.0"));
+  EXPECT_TRUE(HasText(scene, "-20.0"));
+  // Every value keeps its tick: the short vertical lines below the panel.
+  size_t ticks = 0;
+  for (const render::SceneShape& shape : scene.shapes()) {
+    if (shape.kind == render::SceneShape::Kind::kLine && shape.points.size() == 2 &&
+        shape.points[0].x == shape.points[1].x && shape.points[1].y - shape.points[0].y == 5.0f) {
+      ++ticks;
+    }
+  }
+  EXPECT_EQ(ticks, values.size());
 }
 
 // A tick at zero reads "0", never "-0" (a sum of steps landing a hair below zero).
