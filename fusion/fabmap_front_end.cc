@@ -69,6 +69,10 @@ class FabmapFrontEnd : public FrontEnd {
   void OnSessionStart(double start_s) override {
     floors_.OnSessionStart(start_s);
     if (settings_.front_end.online_rssi_offset) offset_.OnSessionStart(start_s, size());
+    if (session_start_s_ != start_s) {
+      session_start_s_ = start_s;
+      first_place_of_session_ = size();
+    }
   }
   FrontEndReport Report() const override {
     FrontEndReport r;
@@ -87,6 +91,9 @@ class FabmapFrontEnd : public FrontEnd {
   void SettleForLocalisation() override {
     settled_ = size();
     floors_.SettleForLocalisation();
+    // Every place of the saved map is of an earlier session than the logs localised in it.
+    session_start_s_.reset();
+    first_place_of_session_ = size();
   }
 
   std::string EncodeState() const override {
@@ -115,6 +122,10 @@ class FabmapFrontEnd : public FrontEnd {
       w.Pod(relearnt_);
     }
     if (settings_.front_end.online_rssi_offset) offset_.Encode(&w);  // likewise
+    if (apart()) {                                                   // likewise
+      w.Optional(session_start_s_);
+      w.Pod(first_place_of_session_);
+    }
     floors_.Encode(&w);
     return std::move(w.bytes());
   }
@@ -149,11 +160,19 @@ class FabmapFrontEnd : public FrontEnd {
     uint64_t scans_seen = 0, learned_from = 0, relearnt = 0;
     FloorRule floors = floors_;
     sensors::RssiOffsetTracker offset = offset_;
+    std::optional<double> session_start;
+    uint32_t first_of_session = 0;
     ok = ok && r.Optional(&newest_time) && readings(&newest) &&
          (!online() || (r.Pod(&scans_seen) && r.Pod(&learned_from) && r.Pod(&relearnt))) &&
          (!settings_.front_end.online_rssi_offset || offset.Decode(&r, count)) &&
+         (!apart() || (r.Optional(&session_start) && r.Pod(&first_of_session))) &&
          floors.Decode(&r, count) && (r.AtEnd() || r.Fail("trailing bytes"));
     if (!ok) return Status::Error(r.error());
+    if (first_of_session > count) {
+      return Status::Error("FABMAP front-end state: the session's first place " +
+                           std::to_string(first_of_session) + " is past its " +
+                           std::to_string(count) + " places");
+    }
     if (online() &&
         (scans_seen > resources_->scans.scans.size() || learned_from > scans_seen ||
          (learned_from > 0 &&
@@ -164,7 +183,8 @@ class FabmapFrontEnd : public FrontEnd {
       return std::all_of(scan.begin(), scan.end(),
                          [](const WifiReading& x) { return std::isfinite(x.rssi_dbm); });
     };
-    if (!AllFinite(times) || !FiniteOrAbsent(newest_time) || !readings_ok(newest) ||
+    if (!AllFinite(times) || !FiniteOrAbsent(newest_time) || !FiniteOrAbsent(session_start) ||
+        !readings_ok(newest) ||
         !std::all_of(places.begin(), places.end(),
                      [&](const fabmap::Query& q) { return !q.wifi || readings_ok(*q.wifi); })) {
       return Status::Error("FABMAP front-end state: a time or RSSI is not finite");
@@ -176,6 +196,8 @@ class FabmapFrontEnd : public FrontEnd {
     newest_scan_ = std::move(newest);
     floors_ = std::move(floors);
     offset_ = std::move(offset);
+    session_start_s_ = session_start;
+    first_place_of_session_ = first_of_session;
     for (const fabmap::Query& place : places_) reference_.push_back(Reference(place));
     scans_seen_ = scans_seen;
     relearnt_ = relearnt;
@@ -198,9 +220,13 @@ class FabmapFrontEnd : public FrontEnd {
     return settings_.front_end.wifi_learning == WifiLearning::kOnline && fabmap::UsesWifi(mode());
   }
 
+  bool apart() const { return settings_.front_end.earlier_sessions_apart; }
+
   void Reset() {
     localiser_ =
         online() ? nullptr : std::make_unique<fabmap::Localiser>(*resources_->empty_localiser);
+    session_start_s_.reset();
+    first_place_of_session_ = 0;
     places_.clear();
     created_time_s_.clear();
     reference_.clear();
@@ -259,6 +285,46 @@ class FabmapFrontEnd : public FrontEnd {
                : probability >= settings_.front_end.match_probability;
   }
 
+  // A place's log odds against the new place: the best mapped place's, moved by their posteriors'
+  // ratio (-inf where either posterior underflowed).
+  static double LogOdds(const fabmap::LocalisationResult& r, int64_t place, double probability) {
+    if (place >= 0 && place == r.best_mapped_place) return r.best_mapped_log_odds;
+    const double mapped = r.best_mapped_probability;
+    return place >= 0 && probability > 0.0 && mapped > 0.0
+               ? r.best_mapped_log_odds + std::log(probability / mapped)
+               : -std::numeric_limits<double>::infinity();
+  }
+
+  struct Choice {
+    int64_t place = -1;  // -1: the new place
+    double probability = 0.0;
+    double log_odds = -std::numeric_limits<double>::infinity();
+  };
+
+  // earlier_sessions_apart: the best place of the current session against match_log_odds, the
+  // best of the earlier sessions against earlier_session_log_odds, among the places `allowed`
+  // (every place when empty); of two that pass, the more probable. Needs per-place posteriors.
+  Choice ChooseBySession(const fabmap::LocalisationResult& r,
+                         const std::vector<uint8_t>& allowed) const {
+    Choice earlier, current;
+    for (size_t p = 0; p < r.place_probability.size(); ++p) {
+      if (!allowed.empty() && !allowed[p]) continue;
+      Choice& c = p < first_place_of_session_ ? earlier : current;
+      if (c.place < 0 || r.place_probability[p] > c.probability) {
+        c.place = static_cast<int64_t>(p);
+        c.probability = r.place_probability[p];
+      }
+    }
+    earlier.log_odds = LogOdds(r, earlier.place, earlier.probability);
+    current.log_odds = LogOdds(r, current.place, current.probability);
+    const bool earlier_ok =
+        earlier.place >= 0 && earlier.log_odds >= settings_.front_end.earlier_session_log_odds;
+    const bool current_ok =
+        current.place >= 0 && current.log_odds >= settings_.front_end.match_log_odds;
+    if (earlier_ok && (!current_ok || earlier.probability > current.probability)) return earlier;
+    return current_ok ? current : Choice();
+  }
+
   StatusOr<std::optional<FrameDecision>> Decide(double time_s, fabmap::Query q) {
     if (!localiser_) {  // online, before the first model: every frame is a new place
       AddPlace(std::move(q), time_s);
@@ -279,11 +345,13 @@ class FabmapFrontEnd : public FrontEnd {
     int64_t best = by_log_odds ? r.best_mapped_place : r.best_place;
     double best_probability = by_log_odds ? r.best_mapped_probability : r.best_probability;
     double best_log_odds = r.best_mapped_log_odds;
+    // The posterior is per place except in the sequential modes (per candidate).
+    const bool per_place = r.place_probability.size() == places_.size();
+    const bool by_session = apart() && per_place && first_place_of_session_ > 0;
+    std::vector<uint8_t> agrees;  // the places the barometer allows (empty: no constraint)
     if (floors_.active()) {
-      // The floor rule (front_end.h): the most probable place the barometer allows. The
-      // posterior is per place except in the sequential modes (per candidate): there a
-      // disallowed best place is simply not matched.
-      const bool per_place = r.place_probability.size() == places_.size();
+      // The floor rule (front_end.h): the most probable place the barometer allows. In the
+      // sequential modes a disallowed best place is simply not matched.
       if (per_place) {
         floors_.Vote(
             [&](const std::vector<uint8_t>& mask) {
@@ -297,8 +365,17 @@ class FabmapFrontEnd : public FrontEnd {
             },
             enough);
       }
-      const std::vector<uint8_t> agrees = floors_.BeginFrame(static_cast<uint32_t>(n));
-      if (best >= 0 && !agrees[best]) {
+      agrees = floors_.BeginFrame(static_cast<uint32_t>(n));
+    }
+    bool recognised = false;
+    if (by_session) {
+      best = ChooseBySession(r, agrees).place;
+      recognised = best >= 0;
+      if (!recognised && !agrees.empty() && ChooseBySession(r, {}).place >= 0) {
+        floors_.CountRefused();
+      }
+    } else {
+      if (!agrees.empty() && best >= 0 && !agrees[best]) {
         const bool was_enough = Enough(best, best_probability, best_log_odds);
         best = -1;
         best_probability = 0.0;
@@ -308,16 +385,12 @@ class FabmapFrontEnd : public FrontEnd {
             best_probability = r.place_probability[p];
           }
         }
-        // The allowed place's log odds: the best mapped place's, moved by their posteriors'
-        // ratio (-inf where either posterior underflowed).
-        const double mapped = r.best_mapped_probability;
-        best_log_odds = best >= 0 && best_probability > 0.0 && mapped > 0.0
-                            ? r.best_mapped_log_odds + std::log(best_probability / mapped)
-                            : -std::numeric_limits<double>::infinity();
+        best_log_odds = LogOdds(r, best, best_probability);
         if (was_enough && !Enough(best, best_probability, best_log_odds)) floors_.CountRefused();
       }
+      recognised = Enough(best, best_probability, best_log_odds);
     }
-    if (Enough(best, best_probability, best_log_odds)) {
+    if (recognised) {
       const bool old_enough =
           OldEnough(n, best, time_s, created_time_s_[best], settings_.front_end.recency_templates,
                     settings_.front_end.recency_s, settled_);
@@ -341,6 +414,9 @@ class FabmapFrontEnd : public FrontEnd {
   std::vector<fabmap::Query> places_;
   std::vector<double> created_time_s_;
   int64_t settled_ = 0;  // templates from a saved map (SettleForLocalisation)
+  // The current session's start and its first place: places before it are of earlier sessions.
+  std::optional<double> session_start_s_;
+  uint32_t first_place_of_session_ = 0;
   std::vector<WifiReading> newest_scan_;
   std::optional<double> newest_scan_time_s_;
   uint64_t scans_seen_ = 0;    // Wi-Fi scans received

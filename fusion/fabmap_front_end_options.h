@@ -45,6 +45,14 @@ struct FabmapFrontEndOptions {
   int online_first_scans = 20;      // kOnline: scans before the first Wi-Fi model
   bool decide_by_log_odds = false;  // the best place's log odds, not its posterior, decide
   double match_log_odds = 0.0;      // with decide_by_log_odds: least log odds of the best place
+  // With decide_by_log_odds: places of earlier sessions are judged by their own threshold. A
+  // revisit within one walk and a revisit of another walk's place differ in how well their scans
+  // agree (another day, phone or pose), so one threshold cannot serve both (docs/results/ipin.md,
+  // "The FABMAP front end's new-place threshold"). The best place of the current session must
+  // reach match_log_odds, the best of the earlier sessions earlier_session_log_odds; when both
+  // do, the more probable one wins. Per-place posteriors only: the sequential modes keep one rule.
+  bool earlier_sessions_apart = false;
+  double earlier_session_log_odds = 0.0;
   // Per-device RSSI offset, estimated online as in [fused] (sensors/rssi_offset.h) and removed
   // from a later session's scans before they become Wi-Fi words and places.
   bool online_rssi_offset = false;
@@ -78,6 +86,13 @@ struct FabmapFrontEndOptions {
     v("match_log_odds", match_log_odds,
       "decide_by_log_odds: least log(p(best place) / p(new place)), nats; 0 is the arg-max, "
       "negative values accept places the new place beats",
+      schema::Unit("nats").Within(-1000, 1000));
+    v("earlier_sessions_apart", earlier_sessions_apart,
+      "decide_by_log_odds: places of earlier sessions need earlier_session_log_odds, those of the "
+      "current session match_log_odds; the more probable of two that pass wins",
+      schema::Any());
+    v("earlier_session_log_odds", earlier_session_log_odds,
+      "earlier_sessions_apart: least log odds of the best place of an earlier session, nats",
       schema::Unit("nats").Within(-1000, 1000));
     v("online_rssi_offset", online_rssi_offset,
       "estimate each later session's RSSI offset to the earlier sessions' places online and "

@@ -100,7 +100,12 @@ bool FabmapSettings::IsValid(std::string* error) const {
 }
 
 bool FabmapFrontEndOptions::IsValid(std::string* error) const {
-  return schema::CheckFields(*this, error);
+  if (!schema::CheckFields(*this, error)) return false;
+  if (earlier_sessions_apart && !decide_by_log_odds) {
+    if (error) *error = "earlier_sessions_apart: needs decide_by_log_odds = true";
+    return false;
+  }
+  return true;
 }
 
 std::string ToString(WifiLearning learning) {

@@ -375,6 +375,8 @@ constexpr AddedKey kKeysAddedAfter[] = {
     {9, "evaluation.answer_temperature"},
     {9, "sequence.centred"},
     {9, "fused.rssi_offset_walking_only"},
+    {9, "fabmap_front_end.earlier_sessions_apart"},
+    {9, "fabmap_front_end.earlier_session_log_odds"},
 };
 
 // Whole sections added after a map format version: older maps resume only with every key at its

@@ -5,7 +5,10 @@
 # match_log_odds), run as sweeps (`ratslam sweep`) over every single walk and over each of the six
 # training routes' four repetitions as one multi-session run; the b_out front end
 # (configs/ipin2023-wifi-compass.toml) and dead reckoning (odometry_ate_m) in the same run as
-# baselines. Prints a markdown table of mean map ATE and templates per rule and threshold.
+# baselines; and the log-odds rule with earlier sessions apart (earlier_sessions_apart: the current
+# session's places at match_log_odds 0, earlier sessions' at a grid of earlier_session_log_odds).
+# Prints a markdown table of mean map ATE and templates per rule and threshold, then the
+# multi-session map ATE per route.
 # Usage: scripts/ipin_fabmap_threshold_table.sh [data dir] [out dir] [ratslam binary]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -19,6 +22,9 @@ out=$(realpath "$out")
 sed 's/^match_probability = 0.5$/&\ndecide_by_log_odds = true/' configs/ipin2023-fabmap-wifi.toml \
   > "$out/log-odds.toml"
 grep -q '^decide_by_log_odds = true$' "$out/log-odds.toml" || { echo "rule not set" >&2; exit 1; }
+sed 's/^decide_by_log_odds = true$/&\nmatch_log_odds = 0.0\nearlier_sessions_apart = true/' \
+  "$out/log-odds.toml" > "$out/apart.toml"
+grep -q '^earlier_sessions_apart = true$' "$out/apart.toml" || { echo "apart not set" >&2; exit 1; }
 
 multi=""
 for route in 01 02 03 21 22 23; do
@@ -42,12 +48,14 @@ run_sweep() {  # name, base config, datasets, parameters
 }
 log_odds=$'[parameters]\n"fabmap_front_end.match_log_odds" = [-40.0, -20.0, -10.0, -5.0, -2.0, 0.0, 2.0, 5.0]\n'
 posterior=$'[parameters]\n"fabmap_front_end.match_probability" = [0.1, 0.5, 0.9]\n'
+apart=$'[parameters]\n"fabmap_front_end.earlier_session_log_odds" = [-40.0, -30.0, -20.0, -10.0, -5.0]\n'
 for kind in multi single; do
   sets=$multi
   [[ $kind == single ]] && sets=$single
   run_sweep "$kind-log-odds" "$out/log-odds.toml" "$sets" "$log_odds"
   run_sweep "$kind-posterior" "$root/configs/ipin2023-fabmap-wifi.toml" "$sets" "$posterior"
   run_sweep "$kind-b-out" "$root/configs/ipin2023-wifi-compass.toml" "$sets" ""
+  run_sweep "$kind-apart" "$out/apart.toml" "$sets" "$apart"
 done
 
 /usr/bin/python3 - "$out" <<'EOF'
@@ -68,6 +76,7 @@ def points(name):
             for k, ms in by.items()}
 
 rows = [("log odds (decide_by_log_odds)", "log-odds"), ("posterior (match_probability)", "posterior"),
+        ("log odds 0, earlier sessions apart (earlier_session_log_odds)", "apart"),
         ("b_out (ipin2023-wifi-compass)", "b-out")]
 multi = {name: points(f"multi-{name}") for _, name in rows}
 single = {name: points(f"single-{name}") for _, name in rows}
@@ -84,4 +93,22 @@ for label, name in rows:
 m = next(iter(multi["b-out"].values()))
 s = next(iter(single["b-out"].values()))
 print(f"| dead reckoning (PDR, compass) | - | {m[2]:.2f} | - | {s[2]:.2f} | - |")
+
+# Multi-session map ATE per route (the run's first data set names the route).
+def per_route(name):
+    runs = json.load(open(f"{out}/multi-{name}/results.json"))["runs"]
+    by = {}
+    for r in runs:
+        key = next(iter(r["parameters"].values()), None)
+        route = r["data"][0].split("TrainingTrial")[1][:2]
+        by.setdefault(key, {})[route] = r["metrics"]["map_ate_m"]
+    return by
+print()
+routes = sorted(per_route("b-out")[None])
+print("| rule | threshold | " + " | ".join(f"route {r}" for r in routes) + " |")
+print("|---|---|" + "---|" * len(routes))
+for label, name in rows:
+    for key, ate in per_route(name).items():
+        shown = "-" if key is None else key
+        print(f"| {label} | {shown} | " + " | ".join(f"{ate[r]:.2f}" for r in routes) + " |")
 EOF
