@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # The FABMAP front end of `replay` on the IPIN training logs (all repetitions of a route in one
-# run, configs/ipin2023-fabmap-wifi.toml) deciding by its posterior (shipped, 0.5) and by the
-# best mapped place's log odds at several thresholds ([fabmap_front_end] decide_by_log_odds), and
-# with earlier sessions apart (apart-T: the current session's places at 0 nats, earlier sessions'
-# at T; earlier_sessions_apart).
+# run, configs/ipin2023-fabmap-wifi.toml and variants of it) deciding by its posterior (0.5), by
+# the best mapped place's log odds at several thresholds for every place, and with earlier
+# sessions apart (apart-T, as shipped with T = 30: the current session's places at 0 nats,
+# earlier sessions' at -T; earlier_sessions_apart).
 # Prints per run: rule route templates matches injections map_ate_m odometry_ate_m
 # within_5m cross_session_matches floor_mistakes.
 # Usage: scripts/fabmap_log_odds_table.sh [ratslam binary] [out dir]   (about 40 s)
@@ -12,16 +12,17 @@ cd "$(dirname "$0")/.."; root=$PWD
 bin=$(realpath "${1:-build/apps/ratslam}"); out=${2:-out/fabmap-log-odds}; mkdir -p "$out"
 out=$(realpath "$out"); data=$root/../shared/data/ipin2023-t3
 cd "$out"
+config=$root/configs/ipin2023-fabmap-wifi.toml
 for t in posterior 0 -10 -20 -30 apart-20 apart-30; do
-  if [[ $t == posterior ]]; then
-    cp "$root/configs/ipin2023-fabmap-wifi.toml" cfg-$t.toml
-  elif [[ $t == apart-* ]]; then
-    sed "s/^\[fabmap_front_end\]$/[fabmap_front_end]\ndecide_by_log_odds = true\nmatch_log_odds = 0.0\nearlier_sessions_apart = true\nearlier_session_log_odds = -${t#apart-}/" \
-      "$root/configs/ipin2023-fabmap-wifi.toml" > cfg-$t.toml
-  else
-    sed "s/^\[fabmap_front_end\]$/[fabmap_front_end]\ndecide_by_log_odds = true\nmatch_log_odds = $t/" \
-      "$root/configs/ipin2023-fabmap-wifi.toml" > cfg-$t.toml
-  fi
+  case $t in
+    posterior) rule='s/^decide_by_log_odds = true$/decide_by_log_odds = false/;
+                     s/^earlier_sessions_apart = true$/earlier_sessions_apart = false/' ;;
+    apart-*) rule="s/^earlier_session_log_odds = .*/earlier_session_log_odds = -${t#apart-}.0/" ;;
+    *) rule="s/^earlier_sessions_apart = true$/earlier_sessions_apart = false/;
+             s/^match_log_odds = .*/match_log_odds = $t.0/" ;;
+  esac
+  sed "$rule" "$config" > cfg-$t.toml
+  cmp -s "$config" cfg-$t.toml && [[ $t != apart-30 ]] && { echo "$t: config unchanged" >&2; exit 1; }
   for route in 01 02 03 21 22 23 51; do
     args=()
     for rep in 01 02 03 04; do

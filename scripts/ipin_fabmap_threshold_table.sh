@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
 # The FABMAP front end's new-place rule on the IPIN 2023 routes: how the map depends on the
-# threshold, in single walks and in multi-session runs. configs/ipin2023-fabmap-wifi.toml with its
-# posterior rule (match_probability) and with the log-odds rule (decide_by_log_odds, a grid of
-# match_log_odds), run as sweeps (`ratslam sweep`) over every single walk and over each of the six
-# training routes' four repetitions as one multi-session run; the b_out front end
-# (configs/ipin2023-wifi-compass.toml) and dead reckoning (odometry_ate_m) in the same run as
-# baselines; and the log-odds rule with earlier sessions apart (earlier_sessions_apart: the current
-# session's places at match_log_odds 0, earlier sessions' at a grid of earlier_session_log_odds).
+# threshold, in single walks and in multi-session runs. configs/ipin2023-fabmap-wifi.toml (log
+# odds, earlier sessions apart: a grid of earlier_session_log_odds, match_log_odds 0) and two
+# variants of it, the posterior rule (a grid of match_probability) and one log-odds threshold for
+# every place (a grid of match_log_odds), run as sweeps (`ratslam sweep`) over every single walk
+# and over each of the six training routes' four repetitions as one multi-session run; the b_out
+# front end (configs/ipin2023-wifi-compass.toml) and dead reckoning (odometry_ate_m) in the same
+# run as baselines.
 # Prints a markdown table of mean map ATE and templates per rule and threshold, then the
 # multi-session map ATE per route.
 # Usage: scripts/ipin_fabmap_threshold_table.sh [data dir] [out dir] [ratslam binary]
@@ -19,12 +19,18 @@ ratslam=$(realpath "${3:-build/apps/ratslam}")
 mkdir -p "$out"
 out=$(realpath "$out")
 
-sed 's/^match_probability = 0.5$/&\ndecide_by_log_odds = true/' configs/ipin2023-fabmap-wifi.toml \
-  > "$out/log-odds.toml"
-grep -q '^decide_by_log_odds = true$' "$out/log-odds.toml" || { echo "rule not set" >&2; exit 1; }
-sed 's/^decide_by_log_odds = true$/&\nmatch_log_odds = 0.0\nearlier_sessions_apart = true/' \
-  "$out/log-odds.toml" > "$out/apart.toml"
-grep -q '^earlier_sessions_apart = true$' "$out/apart.toml" || { echo "apart not set" >&2; exit 1; }
+# The shipped config decides by log odds with earlier sessions apart; the other rules are its
+# variants (a line that is not there stops the script).
+config=configs/ipin2023-fabmap-wifi.toml
+variant() {  # out name, sed expression that must change a line
+  sed "$2" "$config" > "$out/$1.toml"
+  cmp -s "$config" "$out/$1.toml" && { echo "$1: $2 changed nothing" >&2; exit 1; }
+  return 0
+}
+cp "$config" "$out/apart.toml"
+variant log-odds 's/^earlier_sessions_apart = true$/earlier_sessions_apart = false/'
+variant posterior 's/^decide_by_log_odds = true$/decide_by_log_odds = false/;
+  s/^earlier_sessions_apart = true$/earlier_sessions_apart = false/'
 
 multi=""
 for route in 01 02 03 21 22 23; do
@@ -53,7 +59,7 @@ for kind in multi single; do
   sets=$multi
   [[ $kind == single ]] && sets=$single
   run_sweep "$kind-log-odds" "$out/log-odds.toml" "$sets" "$log_odds"
-  run_sweep "$kind-posterior" "$root/configs/ipin2023-fabmap-wifi.toml" "$sets" "$posterior"
+  run_sweep "$kind-posterior" "$out/posterior.toml" "$sets" "$posterior"
   run_sweep "$kind-b-out" "$root/configs/ipin2023-wifi-compass.toml" "$sets" ""
   run_sweep "$kind-apart" "$out/apart.toml" "$sets" "$apart"
 done
