@@ -8,6 +8,7 @@
 #include <unordered_map>
 
 #include "common/byte_buffer.h"
+#include "fusion/fabmap/evaluation.h"
 #include "fusion/floor_rule.h"
 #include "fusion/front_end_internal.h"
 #include "sensors/rssi_offset.h"
@@ -72,16 +73,50 @@ class FabmapFrontEnd : public FrontEnd {
     if (session_start_s_ != start_s) {
       session_start_s_ = start_s;
       first_place_of_session_ = size();
+      first_scan_of_session_ = scans_.size();
+      session_queries_.clear();
     }
+  }
+
+  void OnVerifiedRevisit(double current_time_s, double past_time_s) override {
+    if (!learn() || !localiser_) return;
+    const auto find = [this](double t) -> int64_t {
+      const auto it = std::lower_bound(scans_.begin(), scans_.end(), t,
+                                       [](const ScanRecord& x, double v) { return x.time_s < v; });
+      return it != scans_.end() && it->time_s == t ? it - scans_.begin() : -1;
+    };
+    const int64_t now = find(current_time_s);
+    const int64_t then = find(past_time_s);
+    // A scan of this session, not counted yet, showing a place an earlier session made.
+    if (now < static_cast<int64_t>(first_scan_of_session_) || then < 0 ||
+        then >= static_cast<int64_t>(first_scan_of_session_) || scans_[now].labelled ||
+        scans_[then].template_id >= first_place_of_session_) {
+      return;
+    }
+    const fabmap::LocalisationResult r =
+        localiser_->Localise(session_queries_[now - first_scan_of_session_]);
+    const uint32_t place = scans_[then].template_id;
+    if (r.place_probability.size() != places_.size()) return;  // per candidate: no place score
+    scans_[now].labelled = true;
+    // A place whose posterior underflowed (hundreds of nats below the best) no finite threshold
+    // accepts: such a pair says the two scans disagree, not where the threshold belongs.
+    const double log_odds = LogOdds(r, place, r.place_probability[place]);
+    if (!std::isfinite(log_odds)) return;
+    revisit_log_odds_.push_back(log_odds);
+    LearnEarlierThreshold();
   }
   FrontEndReport Report() const override {
     FrontEndReport r;
     if (settings_.front_end.online_rssi_offset) r.rssi_offsets_db = offset_.OffsetsDb();
     r.floors = floors_.Report();
-    r.fabmap_learning = FabmapLearningReport{
-        settings_.front_end.wifi_learning,
-        online() ? learned_from_ : static_cast<uint64_t>(resources_->scans.scans.size()),
-        online() ? relearnt_ : 1, localiser_ ? localiser_->wifi_tree_scans() : 0};
+    FabmapLearningReport& learning = r.fabmap_learning.emplace();
+    learning.wifi_learning = settings_.front_end.wifi_learning;
+    learning.wifi_learned_from_scans =
+        online() ? learned_from_ : static_cast<uint64_t>(resources_->scans.scans.size());
+    learning.wifi_relearnt = online() ? relearnt_ : 1;
+    learning.wifi_tree_scans = localiser_ ? localiser_->wifi_tree_scans() : 0;
+    if (apart()) learning.earlier_session_log_odds = EarlierThreshold();
+    if (learn()) learning.verified_revisits = revisit_log_odds_.size();
     return r;
   }
   std::optional<int> TemplateFloor(uint32_t id) const override { return floors_.TemplateFloor(id); }
@@ -94,6 +129,8 @@ class FabmapFrontEnd : public FrontEnd {
     // Every place of the saved map is of an earlier session than the logs localised in it.
     session_start_s_.reset();
     first_place_of_session_ = size();
+    first_scan_of_session_ = scans_.size();
+    session_queries_.clear();
   }
 
   std::string EncodeState() const override {
@@ -125,6 +162,27 @@ class FabmapFrontEnd : public FrontEnd {
     if (apart()) {                                                   // likewise
       w.Optional(session_start_s_);
       w.Pod(first_place_of_session_);
+    }
+    if (learn()) {  // likewise
+      w.Count(scans_.size());
+      for (const ScanRecord& x : scans_) {
+        w.Pod(x.time_s);
+        w.Pod(x.template_id);
+        w.Bool(x.labelled);
+      }
+      w.Pod(static_cast<uint64_t>(first_scan_of_session_));
+      w.Count(session_queries_.size());
+      for (const fabmap::Query& q : session_queries_) {
+        w.PodVector(q.visual);
+        w.Bool(q.wifi.has_value());
+        const auto& readings = q.wifi ? *q.wifi : std::vector<WifiReading>();
+        w.Count(readings.size());
+        for (const WifiReading& x : readings) {
+          w.String(x.bssid);
+          w.Pod(x.rssi_dbm);
+        }
+      }
+      w.PodVector(revisit_log_odds_);
     }
     floors_.Encode(&w);
     return std::move(w.bytes());
@@ -162,12 +220,45 @@ class FabmapFrontEnd : public FrontEnd {
     sensors::RssiOffsetTracker offset = offset_;
     std::optional<double> session_start;
     uint32_t first_of_session = 0;
+    std::vector<ScanRecord> scans;
+    uint64_t first_scan = 0;
+    std::vector<fabmap::Query> queries;
+    std::vector<double> revisits;
+    auto learning = [&] {
+      size_t n = 0;
+      if (!r.Count(8 + 4 + 1, &n)) return false;
+      scans.resize(n);
+      for (ScanRecord& x : scans) {
+        if (!(r.Pod(&x.time_s) && r.Pod(&x.template_id) && r.Bool(&x.labelled))) return false;
+      }
+      if (!(r.Pod(&first_scan) && r.Count(8 + 1 + 8, &n))) return false;
+      queries.resize(n);
+      for (fabmap::Query& q : queries) {
+        bool has_wifi = false;
+        std::vector<WifiReading> scan;
+        if (!(r.PodVector(&q.visual) && r.Bool(&has_wifi) && readings(&scan))) return false;
+        if (has_wifi) q.wifi = std::move(scan);
+      }
+      return r.PodVector(&revisits);
+    };
     ok = ok && r.Optional(&newest_time) && readings(&newest) &&
          (!online() || (r.Pod(&scans_seen) && r.Pod(&learned_from) && r.Pod(&relearnt))) &&
          (!settings_.front_end.online_rssi_offset || offset.Decode(&r, count)) &&
          (!apart() || (r.Optional(&session_start) && r.Pod(&first_of_session))) &&
-         floors.Decode(&r, count) && (r.AtEnd() || r.Fail("trailing bytes"));
+         (!learn() || learning()) && floors.Decode(&r, count) &&
+         (r.AtEnd() || r.Fail("trailing bytes"));
     if (!ok) return Status::Error(r.error());
+    const bool scans_fit =
+        first_scan <= scans.size() && queries.size() == scans.size() - first_scan &&
+        std::all_of(scans.begin(), scans.end(),
+                    [&](const ScanRecord& x) { return x.template_id < count; }) &&
+        std::is_sorted(scans.begin(), scans.end(), [](const ScanRecord& a, const ScanRecord& b) {
+          return a.time_s < b.time_s;
+        });
+    if (!scans_fit) {
+      return Status::Error(
+          "FABMAP front-end state: the scan records do not fit the places or the session");
+    }
     if (first_of_session > count) {
       return Status::Error("FABMAP front-end state: the session's first place " +
                            std::to_string(first_of_session) + " is past its " +
@@ -183,8 +274,14 @@ class FabmapFrontEnd : public FrontEnd {
       return std::all_of(scan.begin(), scan.end(),
                          [](const WifiReading& x) { return std::isfinite(x.rssi_dbm); });
     };
+    const bool scan_times_ok = std::all_of(
+        scans.begin(), scans.end(), [](const ScanRecord& x) { return std::isfinite(x.time_s); });
+    const bool revisits_ok =
+        std::none_of(revisits.begin(), revisits.end(), [](double x) { return std::isnan(x); });
     if (!AllFinite(times) || !FiniteOrAbsent(newest_time) || !FiniteOrAbsent(session_start) ||
-        !readings_ok(newest) ||
+        !scan_times_ok || !revisits_ok || !readings_ok(newest) ||
+        !std::all_of(queries.begin(), queries.end(),
+                     [&](const fabmap::Query& q) { return !q.wifi || readings_ok(*q.wifi); }) ||
         !std::all_of(places.begin(), places.end(),
                      [&](const fabmap::Query& q) { return !q.wifi || readings_ok(*q.wifi); })) {
       return Status::Error("FABMAP front-end state: a time or RSSI is not finite");
@@ -198,6 +295,11 @@ class FabmapFrontEnd : public FrontEnd {
     offset_ = std::move(offset);
     session_start_s_ = session_start;
     first_place_of_session_ = first_of_session;
+    scans_ = std::move(scans);
+    first_scan_of_session_ = static_cast<size_t>(first_scan);
+    session_queries_ = std::move(queries);
+    revisit_log_odds_ = std::move(revisits);
+    LearnEarlierThreshold();
     for (const fabmap::Query& place : places_) reference_.push_back(Reference(place));
     scans_seen_ = scans_seen;
     relearnt_ = relearnt;
@@ -221,12 +323,40 @@ class FabmapFrontEnd : public FrontEnd {
   }
 
   bool apart() const { return settings_.front_end.earlier_sessions_apart; }
+  bool learn() const { return settings_.front_end.learn_earlier_session_log_odds; }
+
+  // The earlier sessions' threshold: learnt once enough verified revisits are known.
+  double EarlierThreshold() const {
+    return learnt_earlier_ ? *learnt_earlier_ : settings_.front_end.earlier_session_log_odds;
+  }
+  void LearnEarlierThreshold() {
+    learnt_earlier_.reset();
+    if (revisit_log_odds_.size() < static_cast<size_t>(settings_.front_end.learn_min_revisits)) {
+      return;
+    }
+    const fabmap::NewPlaceThreshold t = fabmap::LearnNewPlaceThreshold(
+        revisit_log_odds_, std::vector<bool>(revisit_log_odds_.size(), true),
+        fabmap::NewPlaceRule::kNearRecall, settings_.front_end.learn_near_recall);
+    learnt_earlier_ = std::clamp(t.log_odds, -1000.0, 1000.0);  // finite scores: finite t
+  }
+
+  // learn_earlier_session_log_odds: every Wi-Fi frame decided, in order, with its template.
+  void RecordScan(double time_s, uint32_t template_id, const fabmap::Query& q) {
+    if (!learn() || !q.wifi || fabmap::UsesVision(mode())) return;
+    scans_.push_back({time_s, template_id, false});
+    session_queries_.push_back(q);
+  }
 
   void Reset() {
     localiser_ =
         online() ? nullptr : std::make_unique<fabmap::Localiser>(*resources_->empty_localiser);
     session_start_s_.reset();
     first_place_of_session_ = 0;
+    scans_.clear();
+    first_scan_of_session_ = 0;
+    session_queries_.clear();
+    revisit_log_odds_.clear();
+    learnt_earlier_.reset();
     places_.clear();
     created_time_s_.clear();
     reference_.clear();
@@ -317,8 +447,7 @@ class FabmapFrontEnd : public FrontEnd {
     }
     earlier.log_odds = LogOdds(r, earlier.place, earlier.probability);
     current.log_odds = LogOdds(r, current.place, current.probability);
-    const bool earlier_ok =
-        earlier.place >= 0 && earlier.log_odds >= settings_.front_end.earlier_session_log_odds;
+    const bool earlier_ok = earlier.place >= 0 && earlier.log_odds >= EarlierThreshold();
     const bool current_ok =
         current.place >= 0 && current.log_odds >= settings_.front_end.match_log_odds;
     if (earlier_ok && (!current_ok || earlier.probability > current.probability)) return earlier;
@@ -327,6 +456,7 @@ class FabmapFrontEnd : public FrontEnd {
 
   StatusOr<std::optional<FrameDecision>> Decide(double time_s, fabmap::Query q) {
     if (!localiser_) {  // online, before the first model: every frame is a new place
+      RecordScan(time_s, static_cast<uint32_t>(places_.size()), q);
       AddPlace(std::move(q), time_s);
       FrameDecision d;
       d.view.time_s = time_s;
@@ -394,6 +524,7 @@ class FabmapFrontEnd : public FrontEnd {
       const bool old_enough =
           OldEnough(n, best, time_s, created_time_s_[best], settings_.front_end.recency_templates,
                     settings_.front_end.recency_s, settled_);
+      RecordScan(time_s, static_cast<uint32_t>(best), q);
       d.view.template_id = static_cast<uint32_t>(best);
       d.view.is_new = false;
       d.recent = !old_enough;
@@ -401,6 +532,7 @@ class FabmapFrontEnd : public FrontEnd {
       return std::optional<FrameDecision>(d);
     }
     RATSLAM_RETURN_IF_ERROR(localiser_->AddPlace(q));
+    RecordScan(time_s, static_cast<uint32_t>(n), q);
     AddPlace(std::move(q), time_s);
     d.view.template_id = static_cast<uint32_t>(n);
     d.view.is_new = true;
@@ -417,6 +549,20 @@ class FabmapFrontEnd : public FrontEnd {
   // The current session's start and its first place: places before it are of earlier sessions.
   std::optional<double> session_start_s_;
   uint32_t first_place_of_session_ = 0;
+  // learn_earlier_session_log_odds: the scans decided (time, template, whether a verified revisit
+  // has used it), this session's queries (from first_scan_of_session_ on) to score them again,
+  // the verified revisits' log odds for the place their partner scan joined, and the threshold
+  // learnt from them (none until learn_min_revisits).
+  struct ScanRecord {
+    double time_s = 0.0;
+    uint32_t template_id = 0;
+    bool labelled = false;
+  };
+  std::vector<ScanRecord> scans_;
+  size_t first_scan_of_session_ = 0;
+  std::vector<fabmap::Query> session_queries_;
+  std::vector<double> revisit_log_odds_;
+  std::optional<double> learnt_earlier_;
   std::vector<WifiReading> newest_scan_;
   std::optional<double> newest_scan_time_s_;
   uint64_t scans_seen_ = 0;    // Wi-Fi scans received

@@ -53,6 +53,14 @@ struct FabmapFrontEndOptions {
   // do, the more probable one wins. Per-place posteriors only: the sequential modes keep one rule.
   bool earlier_sessions_apart = false;
   double earlier_session_log_odds = 0.0;
+  // Learn earlier_session_log_odds from revisits verified outside the front end ([wifi_sequence]:
+  // each inlier of an accepted sequence loop pairs a scan of this session with one of an earlier
+  // session): the log odds of each such scan for the place its partner scan became or matched;
+  // once learn_min_revisits are known the threshold accepts learn_near_recall of them (the
+  // near-recall rule of `evaluate`). Until then the configured value holds.
+  bool learn_earlier_session_log_odds = false;
+  double learn_near_recall = 0.9;
+  int learn_min_revisits = 10;
   // Per-device RSSI offset, estimated online as in [fused] (sensors/rssi_offset.h) and removed
   // from a later session's scans before they become Wi-Fi words and places.
   bool online_rssi_offset = false;
@@ -94,6 +102,19 @@ struct FabmapFrontEndOptions {
     v("earlier_session_log_odds", earlier_session_log_odds,
       "earlier_sessions_apart: least log odds of the best place of an earlier session, nats",
       schema::Unit("nats").Within(-1000, 1000));
+    v("learn_earlier_session_log_odds", learn_earlier_session_log_odds,
+      "earlier_sessions_apart: learn earlier_session_log_odds from the Wi-Fi sequence loop "
+      "closer's verified revisits ([wifi_sequence] enabled); the configured value holds until "
+      "learn_min_revisits are known",
+      schema::Any());
+    v("learn_near_recall", learn_near_recall,
+      "learn_earlier_session_log_odds: share of the verified revisits the learnt threshold "
+      "accepts",
+      schema::Unit("").Above(0).AtMost(1));
+    v("learn_min_revisits", learn_min_revisits,
+      "learn_earlier_session_log_odds: verified revisits before the learnt threshold replaces "
+      "the configured one",
+      schema::Unit("revisits").AtLeast(1));
     v("online_rssi_offset", online_rssi_offset,
       "estimate each later session's RSSI offset to the earlier sessions' places online and "
       "remove it from its scans before they become Wi-Fi words (phones that read several dB "
@@ -137,6 +158,10 @@ struct FabmapLearningReport {
   uint64_t wifi_learned_from_scans = 0;  // scans behind the current Wi-Fi model
   uint64_t wifi_relearnt = 0;            // times the model was (re)built during the run
   uint64_t wifi_tree_scans = 0;          // of the scans, those that learnt the Wi-Fi tree
+  // earlier_sessions_apart: the earlier sessions' threshold in use (nats), and with
+  // learn_earlier_session_log_odds the verified revisits it was learnt from (0: configured).
+  std::optional<double> earlier_session_log_odds;
+  std::optional<uint64_t> verified_revisits;
 };
 
 }  // namespace ratslam::fusion

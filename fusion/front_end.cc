@@ -105,6 +105,10 @@ bool FabmapFrontEndOptions::IsValid(std::string* error) const {
     if (error) *error = "earlier_sessions_apart: needs decide_by_log_odds = true";
     return false;
   }
+  if (learn_earlier_session_log_odds && !earlier_sessions_apart) {
+    if (error) *error = "learn_earlier_session_log_odds: needs earlier_sessions_apart = true";
+    return false;
+  }
   return true;
 }
 

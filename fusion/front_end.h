@@ -126,6 +126,10 @@ class FrontEnd {
   // Whether the walker moved just before the next Wi-Fi scan (odometry travelled within the
   // PDR's max_step_interval_s); called before each scan in a replay. Default: nothing.
   virtual void OnWalking(bool /*walking*/) {}
+  // A revisit verified outside the front end (the Wi-Fi sequence loop closer's inliers): the
+  // Wi-Fi scan at `current_time_s` shows the place of the earlier scan at `past_time_s`. Front
+  // ends that learn from revisits use it; by default it is ignored.
+  virtual void OnVerifiedRevisit(double /*current_time_s*/, double /*past_time_s*/) {}
   // What this front end has to say about the run so far, for summaries (default: nothing).
   virtual FrontEndReport Report() const { return {}; }
   // Localisation on a saved map: the templates stored so far were made by another run on

@@ -329,6 +329,7 @@ Status ReplayPipeline::LinkLoop(const std::optional<wifi_sequence::SequenceLoop>
     if (!c.inlier) continue;
     const wifi_sequence::SequencePose& now = wifi_sequence_->pose(c.current_pose);
     const wifi_sequence::SequencePose& then = wifi_sequence_->pose(c.past_pose);
+    front_end_->OnVerifiedRevisit(now.time_s, then.time_s);
     if (now.anchor < 0 || then.anchor < 0) continue;
     // Where the front end has already joined the two places, a second, differently measured
     // link only pulls against its own (on the IPIN routes such links made b_out's maps worse).

@@ -377,6 +377,9 @@ constexpr AddedKey kKeysAddedAfter[] = {
     {9, "fused.rssi_offset_walking_only"},
     {9, "fabmap_front_end.earlier_sessions_apart"},
     {9, "fabmap_front_end.earlier_session_log_odds"},
+    {9, "fabmap_front_end.learn_earlier_session_log_odds"},
+    {9, "fabmap_front_end.learn_near_recall"},
+    {9, "fabmap_front_end.learn_min_revisits"},
 };
 
 // Whole sections added after a map format version: older maps resume only with every key at its

@@ -358,6 +358,12 @@ void AddFrontEndReports(const fusion::ReplayPipeline& pipeline, nlohmann::ordere
     j["fabmap_wifi_learned_from_scans"] = learning->wifi_learned_from_scans;
     j["fabmap_wifi_models_built"] = learning->wifi_relearnt;
     j["fabmap_wifi_tree_scans"] = learning->wifi_tree_scans;
+    if (learning->earlier_session_log_odds) {
+      j["fabmap_earlier_session_log_odds"] = *learning->earlier_session_log_odds;
+    }
+    if (learning->verified_revisits) {
+      j["fabmap_verified_revisits"] = *learning->verified_revisits;
+    }
   }
   if (const std::vector<double> offsets = pipeline.rssi_offsets_db(); !offsets.empty()) {
     j["wifi_rssi_offsets_db"] = offsets;  // removed from each session's scans
