@@ -166,7 +166,7 @@ render::Scene SweepParameterScene(const SweepFigureData& data, int width_px) {
   const float scene_w = left0 + columns * (panel_w + gap_x);
   const std::vector<std::string> lines =
       SubtitleLines(Goal(data) + " of each point; the best in red", scene_w);
-  const float top0 = 90 + 20.0f * (lines.size() - 1);
+  const float top0 = 100 + 20.0f * (lines.size() - 1);  // the value-axis title clears the heading
   render::Scene scene(static_cast<int>(scene_w), static_cast<int>(top0 + rows * (panel_h + gap_y)),
                       render::Rgba{255, 255, 255, 255});
   Heading(scene, data.title, lines);
@@ -305,7 +305,7 @@ render::Scene SweepParetoScene(const SweepFigureData& data, int width_px) {
   const float width = width_px > 0 ? std::max(300.0f, width_px - left - 60.0f) : 700.0f;
   const std::vector<std::string> lines =
       SubtitleLines(Goal(data) + " against run time; the Pareto front in red", left + width + 60);
-  const float top = 90 + 20.0f * (lines.size() - 1);
+  const float top = 100 + 20.0f * (lines.size() - 1);  // likewise
   render::Scene scene(static_cast<int>(left + width + 60), static_cast<int>(top + height + 90),
                       render::Rgba{255, 255, 255, 255});
   Heading(scene, data.title, lines);
