@@ -20,13 +20,23 @@ namespace ratslam::sweep {
 namespace fs = std::filesystem;
 using json = nlohmann::json;
 
+namespace {
+
+// A succeeded run's metrics file (summary.json or evaluation.json); null when it cannot be read.
+json RunMetrics(const std::string& dir, const SweepSpec& spec, int index) {
+  StatusOr<std::string> text = ReadRegularFile(RunFolder(dir, index) + "/" + MetricsFile(spec),
+                                               "run metrics", size_t{1} << 26);
+  return text.ok() ? json::parse(*text, nullptr, false) : json();
+}
+
+}  // namespace
+
 std::optional<double> RunObjective(const Plan& plan, const std::string& dir, int index) {
   StatusOr<TaskOutcome> o = ReadOutcome(dir, index);
   if (!o.ok() || o->status != "ok") return std::nullopt;
-  StatusOr<std::string> text = ReadRegularFile(RunFolder(dir, index) + "/" + MetricsFile(plan.spec),
-                                               "run metrics", size_t{1} << 26);
-  if (!text.ok()) return std::nullopt;
-  return ObjectiveOf(json::parse(*text, nullptr, false), plan.spec.objective);
+  const json metrics = RunMetrics(dir, plan.spec, index);
+  if (metrics.is_null()) return std::nullopt;
+  return ObjectiveOf(metrics, plan.spec.objective);
 }
 
 namespace {
@@ -67,9 +77,7 @@ StatusOr<std::pair<TaskOutcome, json>> ReadTask(const std::string& dir, const Sw
   json summary;
   if (o->status == "ok") {
     ++report->ok;
-    StatusOr<std::string> text = ReadRegularFile(RunFolder(dir, t.index) + "/" + MetricsFile(spec),
-                                                 "run metrics", size_t{1} << 26);
-    if (text.ok()) summary = json::parse(*text, nullptr, false);
+    summary = RunMetrics(dir, spec, t.index);
   } else if (o->status == "pending" && halving_done) {
     o->status = "eliminated";
     ++report->eliminated;
