@@ -8,7 +8,6 @@
 #include <unordered_map>
 
 #include "common/byte_buffer.h"
-#include "fusion/fabmap/evaluation.h"
 #include "fusion/floor_rule.h"
 #include "fusion/front_end_internal.h"
 #include "sensors/rssi_offset.h"
@@ -329,15 +328,18 @@ class FabmapFrontEnd : public FrontEnd {
   double EarlierThreshold() const {
     return learnt_earlier_ ? *learnt_earlier_ : settings_.front_end.earlier_session_log_odds;
   }
+  // The highest threshold a place passes (log odds >= t) that at least learn_near_recall of the
+  // revisits pass: the revisits' score at rank n - ceil(recall n), lowest first. (The midpoint
+  // rule of `evaluate` needs distinct scores: with ties at the bottom it falls to -inf.)
   void LearnEarlierThreshold() {
     learnt_earlier_.reset();
-    if (revisit_log_odds_.size() < static_cast<size_t>(settings_.front_end.learn_min_revisits)) {
-      return;
-    }
-    const fabmap::NewPlaceThreshold t = fabmap::LearnNewPlaceThreshold(
-        revisit_log_odds_, std::vector<bool>(revisit_log_odds_.size(), true),
-        fabmap::NewPlaceRule::kNearRecall, settings_.front_end.learn_near_recall);
-    learnt_earlier_ = std::clamp(t.log_odds, -1000.0, 1000.0);  // finite scores: finite t
+    const size_t n = revisit_log_odds_.size();
+    if (n == 0 || n < static_cast<size_t>(settings_.front_end.learn_min_revisits)) return;
+    const double want = std::ceil(settings_.front_end.learn_near_recall * n - 1e-9);
+    const size_t accepted = std::clamp<size_t>(static_cast<size_t>(want), 1, n);
+    std::vector<double> sorted = revisit_log_odds_;
+    std::nth_element(sorted.begin(), sorted.begin() + (n - accepted), sorted.end());
+    learnt_earlier_ = sorted[n - accepted];
   }
 
   // learn_earlier_session_log_odds: every Wi-Fi frame decided, in order, with its template.

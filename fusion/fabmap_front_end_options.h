@@ -56,8 +56,8 @@ struct FabmapFrontEndOptions {
   // Learn earlier_session_log_odds from revisits verified outside the front end ([wifi_sequence]:
   // each inlier of an accepted sequence loop pairs a scan of this session with one of an earlier
   // session): the log odds of each such scan for the place its partner scan became or matched;
-  // once learn_min_revisits are known the threshold accepts learn_near_recall of them (the
-  // near-recall rule of `evaluate`). Until then the configured value holds.
+  // once learn_min_revisits are known the threshold is the highest that learn_near_recall of
+  // them pass (as `evaluate`'s near-recall rule). Until then the configured value holds.
   bool learn_earlier_session_log_odds = false;
   double learn_near_recall = 0.9;
   int learn_min_revisits = 10;

@@ -63,6 +63,7 @@ dataset::Dataset MakeDataset() {
   for (int t = 0; t < 2 * lap; ++t) {
     d.images.push_back({t + 0.7, std::to_string(t % static_cast<int>(lap)) + ".png", t + 2});
   }
+  d.session_start_times_s = {0.0, lap};  // the second lap is another session
   return d;
 }
 
@@ -118,7 +119,18 @@ struct Setup {
     fusion::PipelineOptions descriptors;
     descriptors.sensors.front_end.kind = fusion::FrontEndKind::kDescriptors;
     descriptors.sensors.descriptors.min_similarity = 0.99;
-    options = {classic, fused, fabmap_wifi, sequence, descriptors};
+    // FABMAP with earlier sessions apart, its threshold learnt from the loop closer's revisits
+    // (scan records, queries and revisit scores in the state; the second lap is a session).
+    fusion::PipelineOptions fabmap_learn = fabmap_wifi;
+    fabmap_learn.sensors.barometer.use_barometer = false;
+    fabmap_learn.sensors.fabmap.front_end.decide_by_log_odds = true;
+    fabmap_learn.sensors.fabmap.front_end.earlier_sessions_apart = true;
+    fabmap_learn.sensors.fabmap.front_end.earlier_session_log_odds = 50.0;
+    fabmap_learn.sensors.fabmap.front_end.learn_earlier_session_log_odds = true;
+    fabmap_learn.sensors.fabmap.front_end.learn_min_revisits = 2;
+    fabmap_learn.wifi_sequence.enabled = true;
+    fabmap_learn.wifi_sequence.min_loop_travel_m = 20.0;
+    options = {classic, fused, fabmap_wifi, sequence, descriptors, fabmap_learn};
     dataset::DescriptorMatrix places{dataset.images.size(), 8, {}};
     for (const ImageRow& image : dataset.images) {
       const int place = std::atoi(image.file.c_str());
