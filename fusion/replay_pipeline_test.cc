@@ -211,14 +211,20 @@ TEST(ReplayPipelineTest, StageTimesSplitTheRunAndChangeNothing) {
   EXPECT_EQ(untimed.state().frames.size(), timed.state().frames.size());
 }
 
-// A front end that notes what the pipeline says about walking before each scan.
+// A front end that notes what the pipeline says about walking before each scan (and, given a
+// list, the verified revisits it hears of).
 class WalkingNotes : public FrontEnd {
  public:
-  explicit WalkingNotes(std::vector<std::pair<double, bool>>* notes) : notes_(notes) {}
+  explicit WalkingNotes(std::vector<std::pair<double, bool>>* notes,
+                        std::vector<std::pair<double, double>>* revisits = nullptr)
+      : notes_(notes), revisits_(revisits) {}
   StatusOr<std::optional<FrameDecision>> OnImage(double, const GrayImage&) override {
     return std::optional<FrameDecision>();
   }
   void OnWalking(bool walking) override { walking_ = walking; }
+  void OnVerifiedRevisit(double now_s, double then_s) override {
+    if (revisits_) revisits_->emplace_back(now_s, then_s);
+  }
   StatusOr<std::optional<FrameDecision>> OnWifi(const WifiScan& scan) override {
     notes_->emplace_back(scan.time_s, walking_);
     return std::optional<FrameDecision>();
@@ -230,6 +236,7 @@ class WalkingNotes : public FrontEnd {
 
  private:
   std::vector<std::pair<double, bool>>* notes_;
+  std::vector<std::pair<double, double>>* revisits_;
   bool walking_ = false;
 };
 
@@ -254,6 +261,30 @@ TEST(ReplayPipelineTest, TellsTheFrontEndWhetherTheWalkerMovedBeforeEachScan) {
     const bool expected = time_s > 10.0 && time_s < 20.0 + 2.0;
     EXPECT_EQ(walking, expected) << "scan at " << time_s << " s";
   }
+}
+
+// Sequence recognition ([sequence] recognise_views) wraps the front end that decides; what the
+// pipeline tells a front end about walking and verified revisits still reaches it (it did not:
+// a fused front end's rssi_offset_walking_only then took every scan as walking).
+TEST(ReplayPipelineTest, SequenceRecognitionPassesWalkingAndRevisitsOn) {
+  std::vector<std::pair<double, bool>> notes;
+  std::vector<std::pair<double, double>> revisits;
+  FrontEndSettings settings;
+  settings.front_end.kind = FrontEndKind::kCustom;
+  settings.sequence.recognise_views = true;
+  FrontEndResources resources;
+  resources.custom = [&] { return std::make_unique<WalkingNotes>(&notes, &revisits); };
+  std::unique_ptr<FrontEnd> f = CreateFrontEnd(settings, resources);
+  ASSERT_TRUE(f->WantsImages());  // the wrapper
+  f->OnWalking(false);
+  ASSERT_TRUE(f->OnWifi({1.0, {{"aa", -50.0}}}).ok());
+  f->OnWalking(true);
+  ASSERT_TRUE(f->OnWifi({2.0, {{"aa", -50.0}}}).ok());
+  f->OnVerifiedRevisit(2.0, 1.0);
+  const std::vector<std::pair<double, bool>> want_notes = {{1.0, false}, {2.0, true}};
+  EXPECT_EQ(notes, want_notes);
+  const std::vector<std::pair<double, double>> want_revisits = {{2.0, 1.0}};
+  EXPECT_EQ(revisits, want_revisits);
 }
 
 TEST(ReplayPipelineTest, RestoreRefusesStatesThatDoNotFit) {

@@ -87,6 +87,10 @@ class SequenceRecognition : public FrontEnd {
   bool NeedsPixels() const override { return true; }
   uint32_t size() const override { return inner_->size(); }
   void OnSessionStart(double start_s) override { inner_->OnSessionStart(start_s); }
+  void OnWalking(bool walking) override { inner_->OnWalking(walking); }
+  void OnVerifiedRevisit(double current_time_s, double past_time_s) override {
+    inner_->OnVerifiedRevisit(current_time_s, past_time_s);
+  }
   FrontEndReport Report() const override { return inner_->Report(); }
   void SettleForLocalisation() override {
     settled_ = static_cast<int64_t>(matcher_.references());
