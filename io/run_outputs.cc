@@ -558,6 +558,8 @@ const std::vector<std::string>& SummaryKeys() {
                                                 "events_done",
                                                 "events_total",
                                                 "experiences",
+                                                "fabmap_earlier_session_log_odds",
+                                                "fabmap_verified_revisits",
                                                 "fabmap_wifi_learned_from_scans",
                                                 "fabmap_wifi_learning",
                                                 "fabmap_wifi_models_built",

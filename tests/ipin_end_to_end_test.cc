@@ -23,6 +23,7 @@
 
 #include "common/median.h"
 #include "dataset/dataset_loader.h"
+#include "io/run_outputs.h"
 #include "tests/documented_keys.h"
 #include "tests/run_ratslam.h"
 #include "tests/test_paths.h"
@@ -363,6 +364,13 @@ TEST(IpinEndToEndTest, FabmapLearnsTheEarlierSessionThresholdFromSequenceLoops) 
   EXPECT_GE(s["fabmap_verified_revisits"].get<int>(), 10);
   EXPECT_LT(s["fabmap_earlier_session_log_odds"].get<double>(), -5.0);
   EXPECT_GT(s["fabmap_earlier_session_log_odds"].get<double>(), -1000.0);
+  EXPECT_TRUE(e2e::UndocumentedKeys(s).empty())
+      << "undocumented: " << e2e::Join(e2e::UndocumentedKeys(s));
+  // A sweep may name every key of this summary as a metric.
+  const std::vector<std::string>& keys = io::SummaryKeys();
+  for (const auto& [key, value] : s.items()) {
+    EXPECT_NE(std::find(keys.begin(), keys.end(), key), keys.end()) << key;
+  }
   fs::remove_all(root);
 }
 
