@@ -137,21 +137,10 @@ class FabmapFrontEnd : public FrontEnd {
     w.Count(places_.size());
     for (size_t i = 0; i < places_.size(); ++i) {
       w.Pod(created_time_s_[i]);
-      w.PodVector(places_[i].visual);
-      w.Bool(places_[i].wifi.has_value());
-      const auto& readings = places_[i].wifi ? *places_[i].wifi : std::vector<WifiReading>();
-      w.Count(readings.size());
-      for (const WifiReading& r : readings) {
-        w.String(r.bssid);
-        w.Pod(r.rssi_dbm);
-      }
+      WriteQuery(&w, places_[i]);
     }
     w.Optional(newest_scan_time_s_);
-    w.Count(newest_scan_.size());
-    for (const WifiReading& r : newest_scan_) {
-      w.String(r.bssid);
-      w.Pod(r.rssi_dbm);
-    }
+    WriteReadings(&w, newest_scan_);
     if (online()) {  // whole-data-set states keep the format of earlier releases
       w.Pod(scans_seen_);
       w.Pod(learned_from_);
@@ -171,16 +160,7 @@ class FabmapFrontEnd : public FrontEnd {
       }
       w.Pod(static_cast<uint64_t>(first_scan_of_session_));
       w.Count(session_queries_.size());
-      for (const fabmap::Query& q : session_queries_) {
-        w.PodVector(q.visual);
-        w.Bool(q.wifi.has_value());
-        const auto& readings = q.wifi ? *q.wifi : std::vector<WifiReading>();
-        w.Count(readings.size());
-        for (const WifiReading& x : readings) {
-          w.String(x.bssid);
-          w.Pod(x.rssi_dbm);
-        }
-      }
+      for (const fabmap::Query& q : session_queries_) WriteQuery(&w, q);
       w.PodVector(revisit_log_odds_);
     }
     floors_.Encode(&w);
@@ -198,6 +178,13 @@ class FabmapFrontEnd : public FrontEnd {
       }
       return true;
     };
+    auto query = [&](fabmap::Query* q) {  // what WriteQuery wrote
+      bool has_wifi = false;
+      std::vector<WifiReading> scan;
+      if (!(r.PodVector(&q->visual) && r.Bool(&has_wifi) && readings(&scan))) return false;
+      if (has_wifi) q->wifi = std::move(scan);
+      return true;
+    };
     size_t count = 0;
     std::vector<double> times;
     std::vector<fabmap::Query> places;
@@ -205,10 +192,7 @@ class FabmapFrontEnd : public FrontEnd {
     for (size_t i = 0; ok && i < count; ++i) {
       double t = 0.0;
       fabmap::Query q;
-      bool has_wifi = false;
-      std::vector<WifiReading> scan;
-      ok = r.Pod(&t) && r.PodVector(&q.visual) && r.Bool(&has_wifi) && readings(&scan);
-      if (has_wifi) q.wifi = std::move(scan);
+      ok = r.Pod(&t) && query(&q);
       times.push_back(t);
       places.push_back(std::move(q));
     }
@@ -233,10 +217,7 @@ class FabmapFrontEnd : public FrontEnd {
       if (!(r.Pod(&first_scan) && r.Count(8 + 1 + 8, &n))) return false;
       queries.resize(n);
       for (fabmap::Query& q : queries) {
-        bool has_wifi = false;
-        std::vector<WifiReading> scan;
-        if (!(r.PodVector(&q.visual) && r.Bool(&has_wifi) && readings(&scan))) return false;
-        if (has_wifi) q.wifi = std::move(scan);
+        if (!query(&q)) return false;
       }
       return r.PodVector(&revisits);
     };
@@ -319,6 +300,20 @@ class FabmapFrontEnd : public FrontEnd {
   // Online learning applies to modes that use Wi-Fi (the visual model never comes from the run).
   bool online() const {
     return settings_.front_end.wifi_learning == WifiLearning::kOnline && fabmap::UsesWifi(mode());
+  }
+
+  static void WriteReadings(ByteWriter* w, const std::vector<WifiReading>& readings) {
+    w->Count(readings.size());
+    for (const WifiReading& r : readings) {
+      w->String(r.bssid);
+      w->Pod(r.rssi_dbm);
+    }
+  }
+  // A place or a scan's query: its visual words and, flagged, its readings.
+  static void WriteQuery(ByteWriter* w, const fabmap::Query& q) {
+    w->PodVector(q.visual);
+    w->Bool(q.wifi.has_value());
+    WriteReadings(w, q.wifi ? *q.wifi : std::vector<WifiReading>());
   }
 
   bool apart() const { return settings_.front_end.earlier_sessions_apart; }
