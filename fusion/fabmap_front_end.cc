@@ -256,8 +256,7 @@ class FabmapFrontEnd : public FrontEnd {
     };
     const bool scan_times_ok = std::all_of(
         scans.begin(), scans.end(), [](const ScanRecord& x) { return std::isfinite(x.time_s); });
-    const bool revisits_ok =
-        std::none_of(revisits.begin(), revisits.end(), [](double x) { return std::isnan(x); });
+    const bool revisits_ok = AllFinite(revisits);  // OnVerifiedRevisit keeps finite ones only
     if (!AllFinite(times) || !FiniteOrAbsent(newest_time) || !FiniteOrAbsent(session_start) ||
         !scan_times_ok || !revisits_ok || !readings_ok(newest) ||
         !std::all_of(queries.begin(), queries.end(),

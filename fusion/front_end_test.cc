@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <functional>
+#include <limits>
 #include <tuple>
 
 #include "common/random.h"
@@ -741,6 +743,13 @@ TEST(FabmapFrontEndTest, EarlierSessionThresholdIsLearntFromVerifiedRevisits) {
   std::string bad = learnt.state_at_60;
   bad.resize(bad.size() / 2);
   EXPECT_FALSE(restored->DecodeState(bad).ok());
+  // The state ends with the revisits' scores (no barometer here): an infinite one is refused.
+  std::string infinite = learnt.state_at_60;
+  const double inf = std::numeric_limits<double>::infinity();
+  std::memcpy(infinite.data() + infinite.size() - sizeof inf, &inf, sizeof inf);
+  const Status refused = restored->DecodeState(infinite);
+  EXPECT_FALSE(refused.ok());
+  EXPECT_NE(refused.message().find("not finite"), std::string::npos) << refused.message();
 
   FabmapFrontEndOptions needs_apart;
   needs_apart.decide_by_log_odds = true;
