@@ -147,11 +147,12 @@ class FabmapFrontEnd : public FrontEnd {
       w.Pod(relearnt_);
     }
     if (settings_.front_end.online_rssi_offset) offset_.Encode(&w);  // likewise
-    if (apart()) {                                                   // likewise
+    // Likewise the session fields and the learning records, only with their options.
+    if (apart()) {
       w.Optional(session_start_s_);
       w.Pod(first_place_of_session_);
     }
-    if (learn()) {  // likewise
+    if (learn()) {
       w.Count(scans_.size());
       for (const ScanRecord& x : scans_) {
         w.Pod(x.time_s);
