@@ -75,9 +75,28 @@ std::pair<double, double> DataTimeSpan(const dataset::Dataset& d) {
 }
 
 // The end of a run on a terminal: what was built and how good it is, in three lines.
-std::string HumanSummary(const io::RunSummary& s, const std::string& out) {
+std::string HumanSummary(const io::RunSummary& s, const session::ReplayResult& result,
+                         const fusion::ReplayPipeline& pipeline, const std::string& out) {
   char line[256];
   std::string text;
+  if (result.calibration) {
+    const std::optional<fusion::FabmapLearningReport> l = pipeline.fabmap_learning();
+    const double in_use = l && l->earlier_session_log_odds ? *l->earlier_session_log_odds : 0.0;
+    if (result.calibration->earlier_session_log_odds) {
+      std::snprintf(line, sizeof line,
+                    "%scalibration pass (%.1f s): earlier sessions' places at %.2f nats, learnt "
+                    "from %llu verified revisits\n",
+                    MessagePrefix().c_str(), result.calibration_wall_seconds, in_use,
+                    static_cast<unsigned long long>(result.calibration->verified_revisits));
+    } else {
+      std::snprintf(line, sizeof line,
+                    "%scalibration pass (%.1f s): %llu verified revisits, too few to learn from; "
+                    "earlier sessions' places at the configured %.2f nats\n",
+                    MessagePrefix().c_str(), result.calibration_wall_seconds,
+                    static_cast<unsigned long long>(result.calibration->verified_revisits), in_use);
+    }
+    text += line;
+  }
   std::snprintf(
       line, sizeof line, "%s%llu frames: %llu templates, %llu experiences, %llu loop closures\n",
       MessagePrefix().c_str(), static_cast<unsigned long long>(s.frames),
@@ -176,7 +195,7 @@ int RunReplay(const ReplayRequest& request) {
   int exit_code = kExitOk;
   if (result.summary) {
     PrintOutcome(request.json, request.quiet, result.summary->json,
-                 HumanSummary(*result.summary, shown(request.out)));
+                 HumanSummary(*result.summary, result, session.pipeline(), shown(request.out)));
   }
   if (!result.outputs.ok()) exit_code = fail(result.outputs);
   if (!result.save.ok()) exit_code = fail(result.save);

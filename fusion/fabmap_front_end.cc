@@ -116,7 +116,34 @@ class FabmapFrontEnd : public FrontEnd {
     learning.wifi_tree_scans = localiser_ ? localiser_->wifi_tree_scans() : 0;
     if (apart()) learning.earlier_session_log_odds = EarlierThreshold();
     if (learn()) learning.verified_revisits = revisit_log_odds_.size();
+    if (calibrate()) {
+      learning.verified_revisits = calibration_revisits_;
+      learning.calibrated = calibrated_earlier_.has_value();
+    }
     return r;
+  }
+  std::optional<FrontEndCalibration> Learnt() const override {
+    if (!learn()) return std::nullopt;
+    FrontEndCalibration c;
+    c.earlier_session_log_odds = learnt_earlier_;
+    c.verified_revisits = revisit_log_odds_.size();
+    return c;
+  }
+  Status Calibrate(const FrontEndCalibration& calibration) override {
+    if (!calibrate()) {
+      return Status::Error(
+          "FABMAP front end: a calibration needs calibrate_earlier_session_log_odds = true");
+    }
+    if (!places_.empty() || scans_seen_ > 0) {
+      return Status::Error("FABMAP front end: a calibration must come before the first frame");
+    }
+    if (calibration.earlier_session_log_odds &&
+        !std::isfinite(*calibration.earlier_session_log_odds)) {
+      return Status::Error("FABMAP front end: the calibrated threshold is not finite");
+    }
+    calibrated_earlier_ = calibration.earlier_session_log_odds;
+    calibration_revisits_ = calibration.verified_revisits;
+    return Status::Ok();
   }
   std::optional<int> TemplateFloor(uint32_t id) const override { return floors_.TemplateFloor(id); }
   std::optional<double> CompassHeading() const override { return std::nullopt; }
@@ -164,6 +191,10 @@ class FabmapFrontEnd : public FrontEnd {
       for (const fabmap::Query& q : session_queries_) WriteQuery(&w, q);
       w.PodVector(revisit_log_odds_);
     }
+    if (calibrate()) {
+      w.Optional(calibrated_earlier_);
+      w.Pod(calibration_revisits_);
+    }
     floors_.Encode(&w);
     return std::move(w.bytes());
   }
@@ -208,6 +239,8 @@ class FabmapFrontEnd : public FrontEnd {
     uint64_t first_scan = 0;
     std::vector<fabmap::Query> queries;
     std::vector<double> revisits;
+    std::optional<double> calibrated;
+    uint64_t calibration_revisits = 0;
     auto learning = [&] {
       size_t n = 0;
       if (!r.Count(8 + 4 + 1, &n)) return false;
@@ -226,8 +259,9 @@ class FabmapFrontEnd : public FrontEnd {
          (!online() || (r.Pod(&scans_seen) && r.Pod(&learned_from) && r.Pod(&relearnt))) &&
          (!settings_.front_end.online_rssi_offset || offset.Decode(&r, count)) &&
          (!apart() || (r.Optional(&session_start) && r.Pod(&first_of_session))) &&
-         (!learn() || learning()) && floors.Decode(&r, count) &&
-         (r.AtEnd() || r.Fail("trailing bytes"));
+         (!learn() || learning()) &&
+         (!calibrate() || (r.Optional(&calibrated) && r.Pod(&calibration_revisits))) &&
+         floors.Decode(&r, count) && (r.AtEnd() || r.Fail("trailing bytes"));
     if (!ok) return Status::Error(r.error());
     const bool scans_fit =
         first_scan <= scans.size() && queries.size() == scans.size() - first_scan &&
@@ -259,7 +293,7 @@ class FabmapFrontEnd : public FrontEnd {
         scans.begin(), scans.end(), [](const ScanRecord& x) { return std::isfinite(x.time_s); });
     const bool revisits_ok = AllFinite(revisits);  // OnVerifiedRevisit keeps finite ones only
     if (!AllFinite(times) || !FiniteOrAbsent(newest_time) || !FiniteOrAbsent(session_start) ||
-        !scan_times_ok || !revisits_ok || !readings_ok(newest) ||
+        !FiniteOrAbsent(calibrated) || !scan_times_ok || !revisits_ok || !readings_ok(newest) ||
         !std::all_of(queries.begin(), queries.end(),
                      [&](const fabmap::Query& q) { return !q.wifi || readings_ok(*q.wifi); }) ||
         !std::all_of(places.begin(), places.end(),
@@ -280,6 +314,8 @@ class FabmapFrontEnd : public FrontEnd {
     session_queries_ = std::move(queries);
     revisit_log_odds_ = std::move(revisits);
     LearnEarlierThreshold();
+    calibrated_earlier_ = calibrated;
+    calibration_revisits_ = calibration_revisits;
     for (const fabmap::Query& place : places_) reference_.push_back(Reference(place));
     scans_seen_ = scans_seen;
     relearnt_ = relearnt;
@@ -318,10 +354,14 @@ class FabmapFrontEnd : public FrontEnd {
 
   bool apart() const { return settings_.front_end.earlier_sessions_apart; }
   bool learn() const { return settings_.front_end.learn_earlier_session_log_odds; }
+  bool calibrate() const { return settings_.front_end.calibrate_earlier_session_log_odds; }
 
-  // The earlier sessions' threshold: learnt once enough verified revisits are known.
+  // The earlier sessions' threshold: learnt once enough verified revisits are known, or given
+  // by a calibration pass; otherwise as configured.
   double EarlierThreshold() const {
-    return learnt_earlier_ ? *learnt_earlier_ : settings_.front_end.earlier_session_log_odds;
+    if (learnt_earlier_) return *learnt_earlier_;
+    if (calibrated_earlier_) return *calibrated_earlier_;
+    return settings_.front_end.earlier_session_log_odds;
   }
   // The highest threshold a place passes (log odds >= t) that at least learn_near_recall of the
   // revisits pass: the revisits' score at rank n - ceil(recall n), lowest first. (The midpoint
@@ -354,6 +394,8 @@ class FabmapFrontEnd : public FrontEnd {
     session_queries_.clear();
     revisit_log_odds_.clear();
     learnt_earlier_.reset();
+    calibrated_earlier_.reset();
+    calibration_revisits_ = 0;
     places_.clear();
     created_time_s_.clear();
     reference_.clear();
@@ -560,6 +602,10 @@ class FabmapFrontEnd : public FrontEnd {
   std::vector<fabmap::Query> session_queries_;
   std::vector<double> revisit_log_odds_;
   std::optional<double> learnt_earlier_;
+  // calibrate_earlier_session_log_odds: the threshold a first pass learnt (none: too few
+  // revisits there) and the revisits it was learnt from.
+  std::optional<double> calibrated_earlier_;
+  uint64_t calibration_revisits_ = 0;
   std::vector<WifiReading> newest_scan_;
   std::optional<double> newest_scan_time_s_;
   uint64_t scans_seen_ = 0;    // Wi-Fi scans received

@@ -61,6 +61,14 @@ struct FabmapFrontEndOptions {
   bool learn_earlier_session_log_odds = false;
   double learn_near_recall = 0.9;
   int learn_min_revisits = 10;
+  // Learn it in a first pass instead, and map in a second: `replay` runs the data twice, first
+  // with the Wi-Fi sequence loop closer and the learner starting from match_log_odds (no
+  // hand-set value), then under this configuration with the learnt threshold from the first
+  // frame on (earlier_session_log_odds when the first pass verified fewer than
+  // learn_min_revisits). Learning inside one pass comes too late: by the time the loop closer
+  // has verified enough revisits, much of the later walk has made places of its own
+  // (docs/results/ipin.md). A resumed or localised map keeps the threshold it was saved with.
+  bool calibrate_earlier_session_log_odds = false;
   // Per-device RSSI offset, estimated online as in [fused] (sensors/rssi_offset.h) and removed
   // from a later session's scans before they become Wi-Fi words and places.
   bool online_rssi_offset = false;
@@ -107,6 +115,10 @@ struct FabmapFrontEndOptions {
       "closer's verified revisits ([wifi_sequence] enabled); the configured value holds until "
       "learn_min_revisits are known",
       schema::Any());
+    v("calibrate_earlier_session_log_odds", calibrate_earlier_session_log_odds,
+      "earlier_sessions_apart: replay twice, learning earlier_session_log_odds in the first pass "
+      "(loop closer and learner on, from match_log_odds) and mapping with it in the second",
+      schema::Any());
     v("learn_near_recall", learn_near_recall,
       "learn_earlier_session_log_odds: share of the verified revisits the learnt threshold "
       "accepts",
@@ -138,6 +150,9 @@ struct FabmapSettings {
   FabmapFrontEndOptions front_end;
 
   bool IsValid(std::string* error) const;
+
+ private:
+  bool LearningFits(std::string* error) const;
 };
 
 // What the FABMAP front end is built from, prepared once per run (PrepareFabmapResources).
@@ -162,6 +177,10 @@ struct FabmapLearningReport {
   // learn_earlier_session_log_odds the verified revisits it was learnt from (0: configured).
   std::optional<double> earlier_session_log_odds;
   std::optional<uint64_t> verified_revisits;
+  // calibrate_earlier_session_log_odds: whether the threshold came from the first pass (false:
+  // too few verified revisits there, the configured value held); verified_revisits are then
+  // the first pass's.
+  std::optional<bool> calibrated;
 };
 
 }  // namespace ratslam::fusion

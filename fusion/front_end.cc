@@ -96,7 +96,25 @@ bool FabmapSettings::IsValid(std::string* error) const {
          check(visual_model.IsValid(&inner), "visual_model") &&
          check(localiser.wifi_words.IsValid(&inner), "wifi_words") &&
          check(localiser.virtual_wifi.IsValid(&inner), "virtual_wifi") &&
-         check(front_end.IsValid(&inner), "fabmap_front_end");
+         check(front_end.IsValid(&inner), "fabmap_front_end") && LearningFits(error);
+}
+
+// The earlier-session threshold is learnt from Wi-Fi scans' scores: a mode without Wi-Fi has
+// none, and one with vision too decides on images, whose frames the learner does not record.
+bool FabmapSettings::LearningFits(std::string* error) const {
+  const fabmap::FabmapMode mode = localiser.localiser.mode;
+  const bool wifi_only = fabmap::UsesWifi(mode) && !fabmap::UsesVision(mode);
+  const char* key = front_end.learn_earlier_session_log_odds
+                        ? "fabmap_front_end.learn_earlier_session_log_odds"
+                    : front_end.calibrate_earlier_session_log_odds
+                        ? "fabmap_front_end.calibrate_earlier_session_log_odds"
+                        : nullptr;
+  if (key == nullptr || wifi_only) return true;
+  if (error) {
+    *error = std::string(key) +
+             ": needs a FABMAP mode of Wi-Fi alone (fabmap.mode = " + fabmap::ToString(mode) + ")";
+  }
+  return false;
 }
 
 bool FabmapFrontEndOptions::IsValid(std::string* error) const {
@@ -107,6 +125,18 @@ bool FabmapFrontEndOptions::IsValid(std::string* error) const {
   }
   if (learn_earlier_session_log_odds && !earlier_sessions_apart) {
     if (error) *error = "learn_earlier_session_log_odds: needs earlier_sessions_apart = true";
+    return false;
+  }
+  if (calibrate_earlier_session_log_odds && !earlier_sessions_apart) {
+    if (error) *error = "calibrate_earlier_session_log_odds: needs earlier_sessions_apart = true";
+    return false;
+  }
+  if (calibrate_earlier_session_log_odds && learn_earlier_session_log_odds) {
+    if (error) {
+      *error =
+          "calibrate_earlier_session_log_odds: learns in its own first pass; set "
+          "learn_earlier_session_log_odds = false";
+    }
     return false;
   }
   return true;

@@ -90,6 +90,14 @@ struct FrontEndReport {
   std::optional<FabmapLearningReport> fabmap_learning;
 };
 
+// What a first pass over a data set taught a front end (FrontEnd::Learnt and Calibrate).
+struct FrontEndCalibration {
+  // The FABMAP front end's earlier-session threshold (nats); none when the pass verified fewer
+  // than learn_min_revisits revisits.
+  std::optional<double> earlier_session_log_odds;
+  uint64_t verified_revisits = 0;
+};
+
 class FrontEnd {
  public:
   virtual ~FrontEnd() = default;
@@ -130,6 +138,13 @@ class FrontEnd {
   // Wi-Fi scan at `current_time_s` shows the place of the earlier scan at `past_time_s`. Front
   // ends that learn from revisits use it; by default it is ignored.
   virtual void OnVerifiedRevisit(double /*current_time_s*/, double /*past_time_s*/) {}
+  // Replay's calibration ([fabmap_front_end] calibrate_earlier_session_log_odds): what this
+  // front end learnt over a first pass, and the same handed to a fresh front end of the second
+  // pass before its first frame. Front ends that learn nothing return none and refuse one.
+  virtual std::optional<FrontEndCalibration> Learnt() const { return std::nullopt; }
+  virtual Status Calibrate(const FrontEndCalibration& /*calibration*/) {
+    return Status::Error("this front end takes no calibration");
+  }
   // What this front end has to say about the run so far, for summaries (default: nothing).
   virtual FrontEndReport Report() const { return {}; }
   // Localisation on a saved map: the templates stored so far were made by another run on

@@ -591,7 +591,7 @@ struct SessionRun {
 // With `verify`, each second-walk scan is then confirmed as a revisit of the first walk's scan at
 // the same place (OnVerifiedRevisit), as the Wi-Fi sequence loop closer would.
 SessionRun RunTwoSessions(const FrontEndSettings& settings, const std::string& restore_at_60 = "",
-                          bool verify = false) {
+                          bool verify = false, const FrontEndCalibration* calibration = nullptr) {
   dataset::Dataset data;
   std::vector<double> x_of_scan;
   for (int session = 0; session < 2; ++session) {
@@ -609,6 +609,10 @@ SessionRun RunTwoSessions(const FrontEndSettings& settings, const std::string& r
   EXPECT_TRUE(resources.ok());
   if (!resources.ok()) return run;
   std::unique_ptr<FrontEnd> f = CreateFrontEnd(settings, *resources);
+  if (calibration != nullptr) {
+    const Status calibrated = f->Calibrate(*calibration);
+    EXPECT_TRUE(calibrated.ok()) << calibrated.message();
+  }
   std::vector<double> x_of_template;
   for (size_t i = 0; i < data.wifi.size(); ++i) {
     if (i == 40) run.first_walk_templates = x_of_template.size();
@@ -757,6 +761,72 @@ TEST(FabmapFrontEndTest, EarlierSessionThresholdIsLearntFromVerifiedRevisits) {
   std::string error;
   EXPECT_FALSE(needs_apart.IsValid(&error));
   EXPECT_NE(error.find("earlier_sessions_apart"), std::string::npos) << error;
+}
+
+// calibrate_earlier_session_log_odds: a calibration handed over before the first scan is the
+// earlier sessions' threshold from the first frame on, so the decisions equal those of a front
+// end configured with that value (the oracle); the saved state carries it, so a front end
+// restored from it (never calibrated itself) goes on the same; a calibration without a learnt
+// value leaves the configured one. Refused: after the first scan, non-finite, to a front end
+// without the option, and the option beside in-run learning or without Wi-Fi alone.
+TEST(FabmapFrontEndTest, CalibrationIsTheThresholdFromTheFirstFrame) {
+  FrontEndSettings configured = FabmapWifiSettings();
+  configured.fabmap.front_end.decide_by_log_odds = true;
+  configured.fabmap.front_end.earlier_sessions_apart = true;
+  configured.fabmap.front_end.earlier_session_log_odds = -5.0;
+  FrontEndSettings calibrated = configured;
+  calibrated.fabmap.front_end.earlier_session_log_odds = 1000.0;
+  calibrated.fabmap.front_end.calibrate_earlier_session_log_odds = true;
+
+  const FrontEndCalibration learnt{-5.0, 17};
+  const SessionRun run = RunTwoSessions(calibrated, "", false, &learnt);
+  const SessionRun oracle = RunTwoSessions(configured);
+  EXPECT_TRUE(SameDecisions(run, oracle));
+  EXPECT_GE(run.cross_close, 10);  // -5 nats re-activates the first walk (measured: 23 of 24)
+  ASSERT_TRUE(run.report.fabmap_learning.has_value());
+  EXPECT_EQ(run.report.fabmap_learning->earlier_session_log_odds, -5.0);
+  EXPECT_EQ(run.report.fabmap_learning->verified_revisits, 17u);
+  EXPECT_EQ(run.report.fabmap_learning->calibrated, true);
+  // Restored after scan 60 into a front end that was never calibrated (its decisions before the
+  // restore are the uncalibrated ones; from scan 61 on they are the calibrated run's).
+  SessionRun restored = RunTwoSessions(calibrated, run.state_at_60);
+  SessionRun after_restore = run;
+  for (SessionRun* r : {&restored, &after_restore}) {
+    r->decisions.erase(r->decisions.begin(), r->decisions.begin() + 61);
+  }
+  EXPECT_TRUE(SameDecisions(restored, after_restore));
+  EXPECT_EQ(restored.report.fabmap_learning->calibrated, true);
+
+  const FrontEndCalibration too_few{std::nullopt, 3};
+  const SessionRun fallback = RunTwoSessions(calibrated, "", false, &too_few);
+  EXPECT_EQ(fallback.cross, 0);  // +1000 nats, as configured
+  EXPECT_EQ(fallback.report.fabmap_learning->earlier_session_log_odds, 1000.0);
+  EXPECT_EQ(fallback.report.fabmap_learning->calibrated, false);
+  EXPECT_EQ(fallback.report.fabmap_learning->verified_revisits, 3u);
+
+  const auto resources = PrepareFabmapResources(calibrated, CorridorTwoLaps(), std::nullopt);
+  ASSERT_TRUE(resources.ok());
+  std::unique_ptr<FrontEnd> started = CreateFrontEnd(calibrated, *resources);
+  ASSERT_TRUE(started->OnWifi(CorridorTwoLaps().wifi.front()).ok());
+  EXPECT_FALSE(started->Calibrate(learnt).ok());
+  const FrontEndCalibration infinite{std::numeric_limits<double>::infinity(), 17};
+  EXPECT_FALSE(CreateFrontEnd(calibrated, *resources)->Calibrate(infinite).ok());
+  EXPECT_FALSE(CreateFrontEnd(configured, *resources)->Calibrate(learnt).ok());
+  EXPECT_FALSE(CreateFrontEnd(FrontEndSettings())->Calibrate(learnt).ok());  // classic camera
+
+  std::string error;
+  FabmapFrontEndOptions both = calibrated.fabmap.front_end;
+  both.learn_earlier_session_log_odds = true;
+  EXPECT_FALSE(both.IsValid(&error));
+  EXPECT_NE(error.find("learn_earlier_session_log_odds = false"), std::string::npos) << error;
+  FabmapFrontEndOptions not_apart = calibrated.fabmap.front_end;
+  not_apart.earlier_sessions_apart = false;
+  EXPECT_FALSE(not_apart.IsValid(&error));
+  EXPECT_NE(error.find("earlier_sessions_apart"), std::string::npos) << error;
+  FabmapSettings with_vision = calibrated.fabmap;
+  with_vision.localiser.localiser.mode = fabmap::FabmapMode::kEarly;
+  EXPECT_FALSE(with_vision.IsValid(&error));
+  EXPECT_NE(error.find("Wi-Fi alone"), std::string::npos) << error;
 }
 
 // Access points replaced one by one over months: in session s (0 to 6) the APs ap0 .. ap(s-1) of

@@ -404,6 +404,28 @@ ReplayPipeline::State ReplayPipeline::Snapshot() const {
   return snapshot;
 }
 
+std::optional<PipelineOptions> CalibrationPassOptions(const PipelineOptions& options) {
+  const FabmapFrontEndOptions& f = options.sensors.fabmap.front_end;
+  if (options.sensors.front_end.kind != FrontEndKind::kFabmap ||
+      !f.calibrate_earlier_session_log_odds) {
+    return std::nullopt;
+  }
+  PipelineOptions first = options;
+  FabmapFrontEndOptions& g = first.sensors.fabmap.front_end;
+  g.calibrate_earlier_session_log_odds = false;
+  g.learn_earlier_session_log_odds = true;
+  g.earlier_session_log_odds = f.match_log_odds;
+  first.wifi_sequence.enabled = true;
+  return first;
+}
+
+Status ReplayPipeline::Calibrate(const FrontEndCalibration& calibration) {
+  if (state_.next_event != 0) {
+    return Status::Error("calibration: the replay has already started");
+  }
+  return front_end_->Calibrate(calibration);
+}
+
 Status ReplayPipeline::Restore(const State& state) {
   if (state.events_total != events_.size()) {
     return Status::Error("saved map was made from a data set with " +

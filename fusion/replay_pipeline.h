@@ -87,6 +87,12 @@ struct ReplayProgress {
   double data_time_s = 0.0;
 };
 
+// The first pass of a calibrated replay ([fabmap_front_end] calibrate_earlier_session_log_odds):
+// `options` with the Wi-Fi sequence loop closer on and the earlier sessions' threshold learnt,
+// starting from match_log_odds so that no hand-set value enters. None when `options` ask for no
+// calibration (another front end, or the key off).
+std::optional<PipelineOptions> CalibrationPassOptions(const PipelineOptions& options);
+
 struct ReplayControl {
   double until_time_s = std::numeric_limits<double>::infinity();  // stop after this data time
   const std::atomic<bool>* stop_requested = nullptr;              // checked between events
@@ -170,6 +176,11 @@ class ReplayPipeline {
   // cells keep the map's final activity; views of known places pull them to the right place,
   // and a view of a known place while lost puts the robot there at once (relocalisation).
   Status AdoptMap(const State& map, double lost_after_m);
+  // Replay's calibration ([fabmap_front_end] calibrate_earlier_session_log_odds): what the
+  // front end learnt so far (FrontEnd::Learnt), and the same handed to this pipeline's front end
+  // before its first event (fails after it, or when the front end takes no calibration).
+  std::optional<FrontEndCalibration> Learnt() const { return front_end_->Learnt(); }
+  Status Calibrate(const FrontEndCalibration& calibration);
   bool localising() const { return slam_->frozen(); }
   const std::vector<LocalisationRecord>& localisation() const { return localisation_; }
   const std::vector<dataset::Event>& events() const { return events_; }

@@ -91,6 +91,10 @@ class SequenceRecognition : public FrontEnd {
   void OnVerifiedRevisit(double current_time_s, double past_time_s) override {
     inner_->OnVerifiedRevisit(current_time_s, past_time_s);
   }
+  std::optional<FrontEndCalibration> Learnt() const override { return inner_->Learnt(); }
+  Status Calibrate(const FrontEndCalibration& calibration) override {
+    return inner_->Calibrate(calibration);
+  }
   FrontEndReport Report() const override { return inner_->Report(); }
   void SettleForLocalisation() override {
     settled_ = static_cast<int64_t>(matcher_.references());

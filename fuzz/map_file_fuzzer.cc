@@ -130,7 +130,11 @@ struct Setup {
     fabmap_learn.sensors.fabmap.front_end.learn_min_revisits = 2;
     fabmap_learn.wifi_sequence.enabled = true;
     fabmap_learn.wifi_sequence.min_loop_travel_m = 20.0;
-    options = {classic, fused, fabmap_wifi, sequence, descriptors, fabmap_learn};
+    // The same threshold from a calibration pass (in the state: the value and its revisits).
+    fusion::PipelineOptions fabmap_calibrated = fabmap_learn;
+    fabmap_calibrated.sensors.fabmap.front_end.learn_earlier_session_log_odds = false;
+    fabmap_calibrated.sensors.fabmap.front_end.calibrate_earlier_session_log_odds = true;
+    options = {classic, fused, fabmap_wifi, sequence, descriptors, fabmap_learn, fabmap_calibrated};
     dataset::DescriptorMatrix places{dataset.images.size(), 8, {}};
     for (const ImageRow& image : dataset.images) {
       const int place = std::atoi(image.file.c_str());
@@ -165,6 +169,10 @@ std::vector<std::string> FuzzSeeds() {
       auto pipeline = Shared().Pipeline(i);
       fusion::ReplayControl control;
       control.until_time_s = until;
+      if (fusion::CalibrationPassOptions(Shared().options[i]) &&
+          !pipeline->Calibrate({-3.0, 12}).ok()) {
+        InvariantFailed("the seed calibration failed");
+      }
       if (!pipeline->Run(control).ok()) InvariantFailed("the seed replay failed");
       io::MapFile map;
       map.dataset_name = Shared().dataset.name;

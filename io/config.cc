@@ -380,6 +380,7 @@ constexpr AddedKey kKeysAddedAfter[] = {
     {9, "fabmap_front_end.learn_earlier_session_log_odds"},
     {9, "fabmap_front_end.learn_near_recall"},
     {9, "fabmap_front_end.learn_min_revisits"},
+    {9, "fabmap_front_end.calibrate_earlier_session_log_odds"},
 };
 
 // Whole sections added after a map format version: older maps resume only with every key at its

@@ -364,6 +364,7 @@ void AddFrontEndReports(const fusion::ReplayPipeline& pipeline, nlohmann::ordere
     if (learning->verified_revisits) {
       j["fabmap_verified_revisits"] = *learning->verified_revisits;
     }
+    if (learning->calibrated) j["fabmap_calibrated"] = *learning->calibrated;
   }
   if (const std::vector<double> offsets = pipeline.rssi_offsets_db(); !offsets.empty()) {
     j["wifi_rssi_offsets_db"] = offsets;  // removed from each session's scans
@@ -516,6 +517,7 @@ RunSummary Summarise(const fusion::ReplayPipeline& pipeline, const dataset::Data
   j["interrupted"] = info.interrupted;
   j["data_time_s"] = state.trajectory.empty() ? 0.0 : state.trajectory.back().time_s;
   j["wall_seconds"] = info.wall_seconds;
+  if (info.calibration_wall_seconds) j["calibration_wall_seconds"] = *info.calibration_wall_seconds;
   j["frames_per_second"] =
       info.wall_seconds > 0 ? static_cast<double>(info.frames_this_run) / info.wall_seconds : 0.0;
   j["config"] = info.config_path.empty() ? "(defaults)" : info.config_path;
@@ -545,6 +547,7 @@ RunSummary Summarise(const fusion::ReplayPipeline& pipeline, const dataset::Data
 const std::vector<std::string>& SummaryKeys() {
   static const std::vector<std::string> keys = {"ate_points",
                                                 "barometer",
+                                                "calibration_wall_seconds",
                                                 "compass_readings",
                                                 "config",
                                                 "config_fingerprint",
@@ -558,6 +561,7 @@ const std::vector<std::string>& SummaryKeys() {
                                                 "events_done",
                                                 "events_total",
                                                 "experiences",
+                                                "fabmap_calibrated",
                                                 "fabmap_earlier_session_log_odds",
                                                 "fabmap_verified_revisits",
                                                 "fabmap_wifi_learned_from_scans",

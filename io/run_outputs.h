@@ -16,7 +16,9 @@
 namespace ratslam::io {
 
 struct RunInfo {
-  double wall_seconds = 0.0;     // of this process's replay (not of earlier resumed parts)
+  double wall_seconds = 0.0;  // of this process's replay (not of earlier resumed parts)
+  // Of its calibration pass ([fabmap_front_end] calibrate_earlier_session_log_odds), if any.
+  std::optional<double> calibration_wall_seconds;
   uint64_t frames_this_run = 0;  // view frames processed by this process
   bool interrupted = false;      // stopped by a signal
   std::string config_path;       // as given, or empty for built-in defaults

@@ -101,6 +101,7 @@ Status ReplaySession::Prepare() {
     }
     resources->custom = env_.custom_front_end;
   }
+  resources_ = *resources;
   auto pipeline = std::make_unique<fusion::ReplayPipeline>(
       options_.pipeline, *dataset_, env_.images, std::move(resources).value());
   if (!options_.load_map.empty()) {
@@ -132,11 +133,15 @@ Status ReplaySession::Replay(const ReplayCheckpoint& checkpoint) {
   control.progress = [this](const fusion::ReplayProgress& p) {
     env_.progress->Update({"replay", p.events_done, p.events_total, p.data_time_s});
   };
+  // A failed calibration pass leaves the configured threshold; the main pass still runs, so
+  // that whatever it makes before meeting the same data error is written and saved.
+  const Status calibrated = CalibrationPass(control);
   control.checkpoint = checkpoint.callback;
   control.checkpoint_every = checkpoint.callback ? checkpoint.every : 0;
   const uint64_t frames_before = pipeline_->state().frames.size();
   const double start = env_.clock->Seconds();
   result_.replay = pipeline_->Run(control);
+  if (result_.replay.ok()) result_.replay = calibrated;
   result_.wall_seconds = env_.clock->Seconds() - start;
   env_.progress->Finish();
   result_.frames_this_run = pipeline_->state().frames.size() - frames_before;
@@ -145,10 +150,36 @@ Status ReplaySession::Replay(const ReplayCheckpoint& checkpoint) {
   return result_.replay;
 }
 
+Status ReplaySession::CalibrationPass(const fusion::ReplayControl& main) {
+  std::optional<fusion::PipelineOptions> first = fusion::CalibrationPassOptions(options_.pipeline);
+  // A map localised on, or resumed after its first event, carries the threshold its run was
+  // calibrated with.
+  if (!first || options_.localise || pipeline_->state().next_event != 0) return Status::Ok();
+  fusion::ReplayControl control;
+  control.until_time_s = main.until_time_s;
+  control.stop_requested = main.stop_requested;
+  control.progress = [this](const fusion::ReplayProgress& p) {
+    env_.progress->Update({"calibrate", p.events_done, p.events_total, p.data_time_s});
+  };
+  const double start = env_.clock->Seconds();
+  fusion::ReplayPipeline pass(*first, *dataset_, env_.images, resources_);
+  Status ran = pass.Run(control);
+  result_.calibration_wall_seconds = env_.clock->Seconds() - start;
+  env_.progress->Finish();
+  RATSLAM_RETURN_IF_ERROR(ran.WithContext("calibration pass"));
+  // Stopped: the main pass stops at once too, and a resume of its map calibrates afresh.
+  if (env_.stop_requested != nullptr && env_.stop_requested->load()) return Status::Ok();
+  std::optional<fusion::FrontEndCalibration> learnt = pass.Learnt();
+  if (!learnt) return Status::Error("calibration pass: the front end learnt nothing");
+  result_.calibration = learnt;
+  return pipeline_->Calibrate(*learnt).WithContext("calibration");
+}
+
 Status ReplaySession::WriteOutputs() {
   if (!pipeline_) return Status::Error("replay session: WriteOutputs before Prepare");
   io::RunInfo info;
   info.wall_seconds = result_.wall_seconds;
+  if (result_.calibration) info.calibration_wall_seconds = result_.calibration_wall_seconds;
   info.frames_this_run = result_.frames_this_run;
   info.interrupted = result_.interrupted;
   info.config_path = options_.config_path;

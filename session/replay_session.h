@@ -3,9 +3,12 @@
 // the environment (output folder, clock, progress, image loader, stop flag), so tests use fakes.
 //
 // Stages, in order: Load (data sets, visual odometry, the resolved config written), Prepare (the
-// FABMAP front end's models, the pipeline, resuming from a saved map), Replay, WriteOutputs,
-// SaveMap. Run() calls them all and returns a ReplayResult; once the replay has started, every
-// later stage runs even when an earlier one failed, so that nothing computed is lost.
+// FABMAP front end's models, the pipeline, resuming from a saved map), Replay (with
+// [fabmap_front_end] calibrate_earlier_session_log_odds first a calibration pass over the same
+// data, fusion::CalibrationPassOptions, whose learnt threshold the main pass starts with),
+// WriteOutputs, SaveMap. Run() calls them all and returns a ReplayResult; once the replay has
+// started, every later stage runs even when an earlier one failed, so that nothing computed is
+// lost.
 #ifndef RATSLAM_SESSION_REPLAY_SESSION_H_
 #define RATSLAM_SESSION_REPLAY_SESSION_H_
 
@@ -75,7 +78,12 @@ struct ReplayResult {
   bool interrupted = false;               // a stop was requested
   bool finished = false;                  // the data set was replayed to its end
   uint64_t frames_this_run = 0;
-  double wall_seconds = 0.0;  // of the replay stage
+  double wall_seconds = 0.0;  // of the replay stage (its calibration pass not included)
+  // [fabmap_front_end] calibrate_earlier_session_log_odds: what the first pass learnt (none
+  // when no calibration pass ran: another configuration, or a resumed or localised map) and
+  // how long it took.
+  std::optional<fusion::FrontEndCalibration> calibration;
+  double calibration_wall_seconds = 0.0;
   bool ok() const { return replay.ok() && outputs.ok() && save.ok(); }
 };
 
@@ -113,6 +121,10 @@ class ReplaySession {
   SilentProgress no_progress_;
   std::unique_ptr<ImageLoader> own_images_;
   std::optional<dataset::Dataset> dataset_;
+  // The calibration pass, before the main replay; Ok when there is none to make.
+  Status CalibrationPass(const fusion::ReplayControl& control);
+
+  fusion::FrontEndResources resources_;  // kept for the calibration pass's pipeline
   std::unique_ptr<fusion::ReplayPipeline> pipeline_;
   uint64_t fingerprint_ = 0;
   ReplayResult result_;
