@@ -5,17 +5,23 @@
 # sessions apart (apart-T, as shipped with T = 30: the current session's places at 0 nats,
 # earlier sessions' at -T; earlier_sessions_apart); then with the Wi-Fi sequence loop closer on,
 # earlier sessions at -T (seq-T), and with their threshold learnt from its verified revisits
-# starting from -T (learn-T; learn_earlier_session_log_odds).
+# starting from -T (learn-T; learn_earlier_session_log_odds); and learnt in a first pass of its
+# own, then mapped with in a second (calibrated: the shipped config, whose second pass has the
+# loop closer off). The variants are made from the shipped config without calibration.
 # Prints per run: rule route templates matches injections map_ate_m odometry_ate_m
 # within_5m cross_session_matches floor_mistakes earlier_session_log_odds verified_revisits.
-# Usage: scripts/fabmap_log_odds_table.sh [ratslam binary] [out dir]   (about 50 s)
+# Usage: scripts/fabmap_log_odds_table.sh [ratslam binary] [out dir]   (about 70 s)
 set -uo pipefail
 cd "$(dirname "$0")/.."; root=$PWD
 bin=$(realpath "${1:-build/apps/ratslam}"); out=${2:-out/fabmap-log-odds}; mkdir -p "$out"
 out=$(realpath "$out"); data=$root/../shared/data/ipin2023-t3
 cd "$out"
-config=$root/configs/ipin2023-fabmap-wifi.toml
-for t in posterior 0 -10 -20 -30 apart-20 apart-30 seq-30 seq-0 learn-0 learn-30; do
+shipped=$root/configs/ipin2023-fabmap-wifi.toml
+config=$out/by-hand.toml
+sed 's/^calibrate_earlier_session_log_odds = true$/calibrate_earlier_session_log_odds = false/' \
+  "$shipped" > "$config"
+cmp -s "$shipped" "$config" && { echo "the shipped config does not calibrate" >&2; exit 1; }
+for t in posterior 0 -10 -20 -30 apart-20 apart-30 seq-30 seq-0 learn-0 learn-30 calibrated; do
   case $t in
     posterior) rule='s/^decide_by_log_odds = true$/decide_by_log_odds = false/;
                      s/^earlier_sessions_apart = true$/earlier_sessions_apart = false/' ;;
@@ -23,6 +29,7 @@ for t in posterior 0 -10 -20 -30 apart-20 apart-30 seq-30 seq-0 learn-0 learn-30
     seq-*) rule="s/^earlier_session_log_odds = .*/earlier_session_log_odds = $((-${t#seq-})).0/" ;;
     learn-*) rule="s/^earlier_session_log_odds = .*/earlier_session_log_odds = $((-${t#learn-})).0\\n"
              rule+="learn_earlier_session_log_odds = true/" ;;
+    calibrated) rule='s/^calibrate_earlier_session_log_odds = false$/calibrate_earlier_session_log_odds = true/' ;;
     *) rule="s/^earlier_sessions_apart = true$/earlier_sessions_apart = false/;
              s/^match_log_odds = .*/match_log_odds = $t.0/" ;;
   esac

@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # The FABMAP front end's new-place rule on the IPIN 2023 routes: how the map depends on the
 # threshold, in single walks and in multi-session runs. configs/ipin2023-fabmap-wifi.toml (log
-# odds, earlier sessions apart: a grid of earlier_session_log_odds, match_log_odds 0) and two
-# variants of it, the posterior rule (a grid of match_probability) and one log-odds threshold for
-# every place (a grid of match_log_odds), run as sweeps (`ratslam sweep`) over every single walk
+# odds, earlier sessions apart, their threshold calibrated in a first pass; match_log_odds 0) and
+# three variants of it: earlier sessions' threshold set by hand (a grid of
+# earlier_session_log_odds), the posterior rule (a grid of match_probability) and one log-odds
+# threshold for every place (a grid of match_log_odds), run as sweeps (`ratslam sweep`) over every single walk
 # and over each of the six training routes' four repetitions as one multi-session run; the b_out
 # front end (configs/ipin2023-wifi-compass.toml) and dead reckoning (odometry_ate_m) in the same
 # run as baselines.
@@ -19,17 +20,19 @@ ratslam=$(realpath "${3:-build/apps/ratslam}")
 mkdir -p "$out"
 out=$(realpath "$out")
 
-# The shipped config decides by log odds with earlier sessions apart; the other rules are its
-# variants (a line that is not there stops the script).
+# The shipped config decides by log odds with earlier sessions apart and calibrates their
+# threshold; the other rules are its variants (a line that is not there stops the script).
 config=configs/ipin2023-fabmap-wifi.toml
 variant() {  # out name, sed expression that must change a line
   sed "$2" "$config" > "$out/$1.toml"
   cmp -s "$config" "$out/$1.toml" && { echo "$1: $2 changed nothing" >&2; exit 1; }
   return 0
 }
-cp "$config" "$out/apart.toml"
-variant log-odds 's/^earlier_sessions_apart = true$/earlier_sessions_apart = false/'
-variant posterior 's/^decide_by_log_odds = true$/decide_by_log_odds = false/;
+by_hand='s/^calibrate_earlier_session_log_odds = true$/calibrate_earlier_session_log_odds = false/'
+cp "$config" "$out/calibrated.toml"
+variant apart "$by_hand"
+variant log-odds "$by_hand;"'s/^earlier_sessions_apart = true$/earlier_sessions_apart = false/'
+variant posterior "$by_hand;"'s/^decide_by_log_odds = true$/decide_by_log_odds = false/;
   s/^earlier_sessions_apart = true$/earlier_sessions_apart = false/'
 
 multi=""
@@ -62,6 +65,7 @@ for kind in multi single; do
   run_sweep "$kind-posterior" "$out/posterior.toml" "$sets" "$posterior"
   run_sweep "$kind-b-out" "$root/configs/ipin2023-wifi-compass.toml" "$sets" ""
   run_sweep "$kind-apart" "$out/apart.toml" "$sets" "$apart"
+  run_sweep "$kind-calibrated" "$out/calibrated.toml" "$sets" ""
 done
 
 /usr/bin/python3 - "$out" <<'EOF'
@@ -83,6 +87,7 @@ def points(name):
 
 rows = [("log odds (decide_by_log_odds)", "log-odds"), ("posterior (match_probability)", "posterior"),
         ("log odds 0, earlier sessions apart (earlier_session_log_odds)", "apart"),
+        ("log odds 0, earlier sessions apart, calibrated (shipped)", "calibrated"),
         ("b_out (ipin2023-wifi-compass)", "b-out")]
 multi = {name: points(f"multi-{name}") for _, name in rows}
 single = {name: points(f"single-{name}") for _, name in rows}

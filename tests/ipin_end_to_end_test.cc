@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -330,7 +331,8 @@ TEST(IpinEndToEndTest, BarometerStateResumesBitForBit) {
 // walks of route 21 (two phones) with learn_earlier_session_log_odds and a starting threshold of
 // 0 nats, revisits are counted and the threshold learnt from them accepts earlier walks' places
 // that lose to the new place (docs/results/ipin.md measured -27 nats here: a revisit of another
-// day's walk loses by tens of nats).
+// day's walk loses by tens of nats). calibrate_earlier_session_log_odds learns the same in a
+// first pass and maps with it as if it had been set by hand.
 TEST(IpinEndToEndTest, FabmapLearnsTheEarlierSessionThresholdFromSequenceLoops) {
   const fs::path data = fs::path(ratslam::test_paths::SharedDataDir()) / "ipin2023-t3";
   std::string args;
@@ -348,7 +350,9 @@ TEST(IpinEndToEndTest, FabmapLearnsTheEarlierSessionThresholdFromSequenceLoops) 
   std::stringstream text;
   text << in.rdbuf();
   std::string config = text.str();
-  const std::string shipped = "earlier_session_log_odds = -30.0";
+  // The shipped config calibrates (below); learning within the run replaces that.
+  const std::string shipped =
+      "earlier_session_log_odds = -30.0\ncalibrate_earlier_session_log_odds = true";
   const size_t at = config.find(shipped);
   ASSERT_NE(at, std::string::npos);
   config.replace(at, shipped.size(),
@@ -371,6 +375,41 @@ TEST(IpinEndToEndTest, FabmapLearnsTheEarlierSessionThresholdFromSequenceLoops) 
   for (const auto& [key, value] : s.items()) {
     EXPECT_NE(std::find(keys.begin(), keys.end(), key), keys.end()) << key;
   }
+
+  // calibrate_earlier_session_log_odds: the shipped config replays twice. Its first pass is the
+  // learning run above (the loop closer on, learning from match_log_odds = 0), so it learns the
+  // same threshold from the same revisits; its second pass is the shipped config with that
+  // threshold set by hand and no calibration (the oracle, a separate run).
+  auto run = [&](const std::string& name, const std::string& replacement) {
+    std::string c = text.str();
+    c.replace(c.find(shipped), shipped.size(), replacement);
+    std::ofstream(root / (name + ".toml")) << c;
+    const std::string replay = std::string(ratslam::test_paths::RatslamBinary()) +
+                               " replay --quiet --config " + (root / (name + ".toml")).string() +
+                               args + " --out " + (root / name).string() + " > /dev/null";
+    EXPECT_EQ(std::system(replay.c_str()), 0) << replay;
+    std::ifstream in(root / name / "summary.json");
+    return nlohmann::json::parse(in);
+  };
+  const nlohmann::json calibrated = run("calibrated", shipped);
+  const double learnt = s["fabmap_earlier_session_log_odds"].get<double>();
+  EXPECT_EQ(calibrated["fabmap_calibrated"], true);
+  EXPECT_EQ(calibrated["fabmap_earlier_session_log_odds"].get<double>(), learnt);
+  EXPECT_EQ(calibrated["fabmap_verified_revisits"], s["fabmap_verified_revisits"]);
+  EXPECT_GT(calibrated["calibration_wall_seconds"].get<double>(), 0.0);
+  EXPECT_FALSE(calibrated.contains("wifi_sequence"));  // the second pass is the shipped config's
+  char by_hand[96];
+  std::snprintf(by_hand, sizeof by_hand, "earlier_session_log_odds = %.17g", learnt);
+  const nlohmann::json oracle = run("by_hand", by_hand);
+  for (const char* key : {"frames", "templates", "experiences", "links", "loop_closures"}) {
+    EXPECT_EQ(calibrated[key], oracle[key]) << key;
+  }
+  EXPECT_EQ(calibrated["map_ate_m"].get<double>(), oracle["map_ate_m"].get<double>());
+  for (const auto& [key, value] : calibrated.items()) {
+    EXPECT_NE(std::find(keys.begin(), keys.end(), key), keys.end()) << key;
+  }
+  EXPECT_TRUE(e2e::UndocumentedKeys(calibrated).empty())
+      << "undocumented: " << e2e::Join(e2e::UndocumentedKeys(calibrated));
   fs::remove_all(root);
 }
 
