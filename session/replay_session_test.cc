@@ -11,7 +11,9 @@
 
 #include "common/scratch_dir.h"
 #include "dataset/synthetic_dataset.h"
+#include "io/config.h"
 #include "io/map_file.h"
+#include "tests/test_paths.h"
 
 namespace ratslam::session {
 namespace {
@@ -195,6 +197,93 @@ TEST_F(ReplaySessionTest, ResumeChecksConfigurationAndDataSet) {
   EXPECT_NE(refused.status().message().find("camera.match_threshold: 0.06 -> 0.07"),
             std::string::npos)
       << refused.status().message();
+}
+
+// [fabmap_front_end] calibrate_earlier_session_log_odds on the four walks of IPIN route 21: the
+// calibration pass reports its own progress phase and learns before the main pass; a stop during
+// it stops the run before any frame (nothing calibrated, the state saved at event 0), and the
+// run resumed from that map calibrates afresh and ends as an uninterrupted run does. A map saved
+// after the first event keeps its threshold: resuming it makes no calibration pass.
+TEST_F(ReplaySessionTest, CalibrationPassRunsFirstAndAStopDuringItLosesNothing) {
+  ReplaySessionOptions options;
+  for (const char* rep : {"01", "02", "03", "04"}) {
+    const fs::path log = fs::path(test_paths::SharedDataDir()) / "ipin2023-t3" /
+                         (std::string("IPIN2023_T3_TrainingTrial21_repetition") + rep + ".txt");
+    if (!fs::exists(log)) GTEST_SKIP() << "missing " << log;
+    options.data.push_back(log.string());
+  }
+  StatusOr<fusion::PipelineOptions> config = io::LoadConfigFile(
+      std::string(test_paths::SourceDir()) + "/configs/ipin2023-fabmap-wifi.toml");
+  ASSERT_TRUE(config.ok()) << config.status().message();
+  ASSERT_TRUE(config->sensors.fabmap.front_end.calibrate_earlier_session_log_odds);
+  options.pipeline = *config;
+
+  MemoryFolder whole_out("mem");
+  RecordingProgress progress;
+  ReplaySession whole(options, {&whole_out, nullptr, &progress, nullptr, nullptr, {}});
+  StatusOr<ReplayResult> uninterrupted = whole.Run();
+  ASSERT_TRUE(uninterrupted.ok() && uninterrupted->ok());
+  ASSERT_TRUE(uninterrupted->calibration.has_value());
+  ASSERT_TRUE(uninterrupted->calibration->earlier_session_log_odds.has_value());
+  EXPECT_GE(uninterrupted->calibration->verified_revisits, 10u);
+  ASSERT_FALSE(progress.updates.empty());
+  EXPECT_EQ(progress.updates.front().phase, "calibrate");
+  EXPECT_EQ(progress.updates.back().phase, "replay");
+  EXPECT_EQ(progress.finishes, 2);
+  const auto summary = nlohmann::json::parse(whole_out.written["summary.json"]);
+  EXPECT_EQ(summary["fabmap_calibrated"], true);
+  EXPECT_EQ(summary["fabmap_earlier_session_log_odds"].get<double>(),
+            *uninterrupted->calibration->earlier_session_log_odds);
+
+  // Stopped half way through the calibration pass (as a signal would).
+  fs::create_directories(dir_->path() / "calibrating");
+  MemoryFolder out((dir_->path() / "calibrating").string());
+  std::atomic<bool> stop{false};
+  struct StopHalfWay : RecordingProgress {
+    std::atomic<bool>* stop = nullptr;
+    void Update(const ProgressUpdate& u) override {
+      if (u.phase == "calibrate" && 2 * u.done >= u.total) stop->store(true);
+    }
+  } stopper;
+  stopper.stop = &stop;
+  ReplaySession stopped(options, {&out, nullptr, &stopper, nullptr, &stop, {}});
+  StatusOr<ReplayResult> result = stopped.Run();
+  ASSERT_TRUE(result.ok());
+  EXPECT_TRUE(result->interrupted);
+  EXPECT_FALSE(result->calibration.has_value());
+  EXPECT_EQ(result->frames_this_run, 0u);
+  EXPECT_EQ(nlohmann::json::parse(out.written["summary.json"])["fabmap_calibrated"], false);
+  StatusOr<io::MapFile> map = io::LoadMapFile(result->saved_map);
+  ASSERT_TRUE(map.ok()) << map.status().message();
+  EXPECT_EQ(map->state.next_event, 0u);
+
+  ReplaySessionOptions resume = options;
+  resume.load_map = result->saved_map;
+  resume.save_map = (dir_->path() / "calibrated.map").string();
+  MemoryFolder resumed_out("mem");
+  ReplaySession resumed(resume, {&resumed_out, nullptr, nullptr, nullptr, nullptr, {}});
+  StatusOr<ReplayResult> resumed_result = resumed.Run();
+  ASSERT_TRUE(resumed_result.ok() && resumed_result->ok());
+  ASSERT_TRUE(resumed_result->calibration.has_value());
+  EXPECT_EQ(resumed_result->calibration->earlier_session_log_odds,
+            uninterrupted->calibration->earlier_session_log_odds);
+  for (const char* file : {"experiences.csv", "links.csv", "frames.csv"}) {
+    EXPECT_EQ(resumed_out.written[file], whole_out.written[file]) << file;
+  }
+
+  // A map made past its first event: resumed (here with nothing left to replay), no second
+  // calibration pass, and the threshold it was saved with.
+  ReplaySessionOptions again = options;
+  again.load_map = resume.save_map;
+  MemoryFolder again_out("mem");
+  ReplaySession kept(again, {&again_out, nullptr, nullptr, nullptr, nullptr, {}});
+  StatusOr<ReplayResult> kept_result = kept.Run();
+  ASSERT_TRUE(kept_result.ok() && kept_result->ok());
+  EXPECT_FALSE(kept_result->calibration.has_value());
+  const auto kept_summary = nlohmann::json::parse(again_out.written["summary.json"]);
+  EXPECT_EQ(kept_summary["fabmap_calibrated"], true);
+  EXPECT_EQ(kept_summary["fabmap_earlier_session_log_odds"],
+            summary["fabmap_earlier_session_log_odds"]);
 }
 
 // A front end of the caller's own: every image a new place (the smallest valid front end; a
