@@ -414,7 +414,8 @@ json PlanToJson(const Plan& plan) {
 
 }  // namespace
 
-// The value at a dotted path of a JSON object ("match_rate_within_m.5"), if it is a number.
+// The value at a dotted path of a JSON object ("match_rate_within_m.5"), if it is a number; true
+// and false count as 1 and 0 (so a point's mean over its data sets is a share).
 std::optional<double> Metric(const json& summary, const std::string& dotted) {
   const json* node = &summary;
   size_t start = 0;
@@ -426,6 +427,7 @@ std::optional<double> Metric(const json& summary, const std::string& dotted) {
     if (dot == std::string::npos) break;
     start = dot + 1;
   }
+  if (node->is_boolean()) return node->get<bool>() ? 1.0 : 0.0;
   if (!node->is_number()) return std::nullopt;
   return node->get<double>();
 }

@@ -18,7 +18,8 @@ std::string MetricsFile(const SweepSpec& spec);
 std::string RunFolder(const std::string& dir, int index);
 // A CSV field, quoted when it holds a separator, a quote or a line break.
 std::string CsvField(const std::string& s);
-// The value at a dotted path of a JSON object ("match_rate_within_m.5"), if it is a number.
+// The value at a dotted path of a JSON object ("match_rate_within_m.5"), if it is a number;
+// true and false count as 1 and 0.
 std::optional<double> Metric(const nlohmann::json& summary, const std::string& dotted);
 // The objective (a metric or an expression of metrics) of one run's summary.
 std::optional<double> ObjectiveOf(const nlohmann::json& summary, const std::string& objective);

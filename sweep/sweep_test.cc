@@ -20,6 +20,7 @@
 #include "dataset/dataset.h"
 #include "io/config.h"
 #include "io/run_outputs.h"
+#include "sweep/sweep_internal.h"
 #include "tests/test_paths.h"
 
 extern char** environ;
@@ -678,6 +679,22 @@ data = ["data/a"]
 }
 
 // An objective may be an expression of metrics; each run's value is computed from its summary.
+// A metric is a number at a dotted path; summary.json's flags (finished, fabmap_calibrated) are
+// metrics too, as 1 and 0, so that a point's mean over its data sets is the share where it held.
+TEST(SweepCollectTest, MetricsAreNumbersOrFlagsAtDottedPaths) {
+  const nlohmann::json summary = nlohmann::json::parse(
+      R"({"map_ate_m": 2.5, "finished": true, "fabmap_calibrated": false,
+          "match_rate_within_m": {"5": 0.75}, "dataset": "route", "run": {"seed": null}})");
+  EXPECT_EQ(Metric(summary, "map_ate_m"), 2.5);
+  EXPECT_EQ(Metric(summary, "finished"), 1.0);
+  EXPECT_EQ(Metric(summary, "fabmap_calibrated"), 0.0);
+  EXPECT_EQ(Metric(summary, "match_rate_within_m.5"), 0.75);
+  EXPECT_EQ(Metric(summary, "dataset"), std::nullopt);
+  EXPECT_EQ(Metric(summary, "run.seed"), std::nullopt);
+  EXPECT_EQ(Metric(summary, "match_rate_within_m.10"), std::nullopt);
+  EXPECT_EQ(Metric(summary, "map_ate_m.x"), std::nullopt);
+}
+
 TEST(SweepRunTest, ObjectiveExpressionsCombineMetrics) {
   SquareWalk("a", 0.0);
   Write("base.toml", kBase);
