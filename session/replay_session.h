@@ -115,15 +115,15 @@ class ReplaySession {
   const ReplayResult& result() const { return result_; }
 
  private:
+  // The calibration pass, before the main replay; Ok when there is none to make.
+  Status CalibrationPass(const fusion::ReplayControl& control);
+
   ReplaySessionOptions options_;
   SessionEnvironment env_;
   SteadyClock system_clock_;
   SilentProgress no_progress_;
   std::unique_ptr<ImageLoader> own_images_;
   std::optional<dataset::Dataset> dataset_;
-  // The calibration pass, before the main replay; Ok when there is none to make.
-  Status CalibrationPass(const fusion::ReplayControl& control);
-
   fusion::FrontEndResources resources_;  // kept for the calibration pass's pipeline
   std::unique_ptr<fusion::ReplayPipeline> pipeline_;
   uint64_t fingerprint_ = 0;
