@@ -36,6 +36,7 @@ std::string WriteScratchFolder(const std::string& name, const std::vector<std::s
   std::filesystem::remove_all(folder);
   std::filesystem::create_directories(folder);
   for (size_t i = 0; i < parts.size() && i < files.size(); ++i) {
+    std::filesystem::create_directories((folder / files[i]).parent_path());
     std::ofstream(folder / files[i], std::ios::binary) << parts[i];
   }
   return folder.string();

@@ -55,7 +55,8 @@ std::string WriteScratchFile(const std::string& name, const uint8_t* data, size_
 std::vector<std::string> SplitParts(const uint8_t* data, size_t size, const std::string& separator);
 
 // A fresh folder `name` in the scratch folder holding parts[i] as files[i] (as many as both
-// have); returns its path. Data sets and run folders are fuzzed as one input this way.
+// have; a file may be in a subfolder); returns its path. Data sets and run folders are fuzzed
+// as one input this way.
 std::string WriteScratchFolder(const std::string& name, const std::vector<std::string>& parts,
                                const std::vector<std::string>& files);
 

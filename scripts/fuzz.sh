@@ -19,7 +19,7 @@ shared=$root/../shared/data
 bash scripts/setup.sh clang-14 libfuzzer-14-dev
 
 harnesses=(config_fuzzer ini_fuzzer map_file_fuzzer visual_model_fuzzer dataset_fuzzer
-           ipin_log_fuzzer msft_log_fuzzer ujiindoorloc_fuzzer uji_long_term_fuzzer world_fuzzer sweep_file_fuzzer wifi_map_fuzzer
+           ipin_log_fuzzer msft_log_fuzzer ujiindoorloc_fuzzer uji_long_term_fuzzer world_fuzzer sweep_file_fuzzer sweep_folder_fuzzer wifi_map_fuzzer
            run_folder_fuzzer output_list_fuzzer rosbag_fuzzer ros2_bag_fuzzer ros2_cdr_fuzzer video_log_fuzzer
            descriptor_fuzzer command_line_fuzzer)
 if (($#)); then harnesses=("$@"); fi

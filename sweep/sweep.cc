@@ -18,9 +18,12 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 #include <thread>
 
 #include "common/file_util.h"
@@ -366,11 +369,57 @@ json SpecToJson(const SweepSpec& s) {
           {"halving_rate", s.halving_rate}};
 }
 
+// A plan.json that does not hold what `sweep plan` writes (edited by hand, or damaged).
+struct PlanError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// An integer field within [lo, hi]: json's own conversion of a fraction or of a number out of
+// the type's range is undefined.
+int64_t IntAt(const json& j, const char* key, int64_t lo, int64_t hi) {
+  const json& v = j.at(key);
+  const bool in_range = v.is_number_unsigned()  ? v.get<uint64_t>() <= static_cast<uint64_t>(hi)
+                        : v.is_number_integer() ? v.get<int64_t>() >= lo && v.get<int64_t>() <= hi
+                                                : false;
+  if (!in_range) {
+    throw PlanError(std::string(key) + " must be an integer from " + std::to_string(lo) + " to " +
+                    std::to_string(hi));
+  }
+  return v.get<int64_t>();
+}
+
+// A number field, finite and within [lo, hi].
+double NumberAt(const json& j, const char* key, double fallback, double lo, double hi) {
+  if (!j.contains(key)) return fallback;
+  const json& v = j.at(key);
+  if (!v.is_number() || !(v.get<double>() >= lo && v.get<double>() <= hi)) {
+    std::ostringstream range;
+    range << " must be a "
+          << (hi < std::numeric_limits<double>::max() ? "number from "
+                                                      : "finite number of at least ")
+          << lo;
+    if (hi < std::numeric_limits<double>::max()) range << " to " << hi;
+    throw PlanError(std::string(key) + range.str());
+  }
+  return v.get<double>();
+}
+
+// A string field that must be one of `allowed`.
+std::string OneOf(const json& j, const char* key, std::initializer_list<const char*> allowed,
+                  const char* fallback = nullptr) {
+  const std::string v =
+      fallback && !j.contains(key) ? std::string(fallback) : j.at(key).get<std::string>();
+  for (const char* a : allowed) {
+    if (v == a) return v;
+  }
+  throw PlanError(std::string(key) + " '" + v + "' is not one the sweep knows");
+}
+
 SweepSpec SpecFromJson(const json& j) {
   SweepSpec s;
   s.source = j.at("source").get<std::string>();
   s.base_config_text = j.at("base_config").get<std::string>();
-  s.command = j.value("command", std::string("replay"));
+  s.command = OneOf(j, "command", {"replay", "evaluate"}, "replay");
   s.datasets = j.at("datasets").get<std::vector<std::vector<std::string>>>();
   for (const json& p : j.at("parameters")) {
     Parameter q;
@@ -380,20 +429,27 @@ SweepSpec SpecFromJson(const json& j) {
     q.integer = p.at("integer").get<bool>();
     q.lo = p.at("lo").get<double>();
     q.hi = p.at("hi").get<double>();
-    q.line = p.at("line").get<int>();
+    q.line = static_cast<int>(IntAt(p, "line", 0, std::numeric_limits<int>::max()));
     s.parameters.push_back(q);
   }
-  s.method = j.at("method").get<std::string>();
-  s.samples = j.at("samples").get<int>();
-  s.seed = j.at("seed").get<uint64_t>();
+  s.method = OneOf(j, "method", {"grid", "random"});
+  s.samples = static_cast<int>(IntAt(j, "samples", 0, std::numeric_limits<int>::max()));
+  const json& seed = j.at("seed");
+  if (!seed.is_number_unsigned() && !(seed.is_number_integer() && seed.get<int64_t>() >= 0)) {
+    throw PlanError("seed must be an integer of at least 0");
+  }
+  s.seed = seed.get<uint64_t>();
   s.metrics = j.at("metrics").get<std::vector<std::string>>();
   s.objective = j.at("objective").get<std::string>();
-  s.aggregate = j.at("aggregate").get<std::string>();
-  s.goal = j.at("goal").get<std::string>();
-  s.timeout_s = j.at("timeout_s").get<double>();
+  if (StatusOr<Expression> e = Expression::Parse(s.objective); !e.ok()) {
+    throw PlanError("objective: " + e.status().message());
+  }
+  s.aggregate = OneOf(j, "aggregate", {"mean", "worst"});
+  s.goal = OneOf(j, "goal", {"minimize", "maximize"});
+  s.timeout_s = NumberAt(j, "timeout_s", 0.0, 0.0, std::numeric_limits<double>::max());
   s.keep_all = j.at("keep_all").get<bool>();
-  s.search = j.value("search", std::string("all"));  // added after the first plans
-  s.halving_rate = j.value("halving_rate", 3.0);
+  s.search = OneOf(j, "search", {"all", "halving"}, "all");  // added after the first plans
+  s.halving_rate = NumberAt(j, "halving_rate", 3.0, 2.0, 100.0);
   return s;
 }
 
@@ -733,24 +789,44 @@ StatusOr<Plan> ReadPlan(const std::string& dir) {
     }
     Plan plan;
     plan.spec = SpecFromJson(j.at("spec"));
-    plan.points = j.at("points").get<int>();
-    for (const json& t : j.at("tasks")) {
+    if (plan.spec.datasets.empty()) throw PlanError("spec: no data sets");
+    const json& tasks = j.at("tasks");
+    if (!tasks.is_array()) throw PlanError("tasks must be an array");
+    // Every point has a task (MakePlan: one per data set, point-major), so a point count above
+    // the tasks' is damage, not a plan.
+    plan.points = static_cast<int>(IntAt(j, "points", 0, static_cast<int64_t>(tasks.size())));
+    std::vector<const Task*> first_of_point(static_cast<size_t>(plan.points), nullptr);
+    plan.tasks.reserve(tasks.size());
+    for (const json& t : tasks) {
+      const size_t i = plan.tasks.size();
       Task task;
-      task.index = t.at("index").get<int>();
-      task.point = t.at("point").get<int>();
-      task.dataset = t.at("dataset").get<int>();
+      task.index = static_cast<int>(IntAt(t, "index", 0, std::numeric_limits<int>::max()));
+      task.point = static_cast<int>(IntAt(t, "point", 0, std::max(plan.points - 1, 0)));
+      task.dataset = static_cast<int>(IntAt(t, "dataset", 0, std::numeric_limits<int>::max()));
       for (const json& o : t.at("overrides")) {
         task.overrides.emplace_back(o.at(0).get<std::string>(), o.at(1).get<std::string>());
       }
-      if (task.index != static_cast<int>(plan.tasks.size()) || task.dataset < 0 ||
-          task.dataset >= static_cast<int>(plan.spec.datasets.size())) {
-        return Status::Error(path + ": task " + std::to_string(plan.tasks.size()) +
-                             " is out of order or names a missing data set");
+      const Task* first =
+          plan.points > 0 ? first_of_point[static_cast<size_t>(task.point)] : nullptr;
+      if (static_cast<size_t>(task.index) != i || plan.points == 0 ||
+          static_cast<size_t>(task.dataset) >= plan.spec.datasets.size() ||
+          (first && first->overrides != task.overrides)) {
+        return Status::Error(path + ": task " + std::to_string(i) +
+                             " is out of order, names a missing data set or point, or differs "
+                             "from its point's parameters");
       }
       plan.tasks.push_back(task);
+      if (!first) first_of_point[static_cast<size_t>(task.point)] = &plan.tasks.back();
+    }
+    for (int p = 0; p < plan.points; ++p) {
+      if (!first_of_point[static_cast<size_t>(p)]) {
+        throw PlanError("point " + std::to_string(p) + " has no task");
+      }
     }
     return plan;
   } catch (const json::exception& e) {
+    return Status::Error(path + ": " + e.what());
+  } catch (const PlanError& e) {
     return Status::Error(path + ": " + e.what());
   }
 }

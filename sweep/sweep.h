@@ -167,7 +167,8 @@ struct CollectReport {
 
 // Writes results.csv and results.json (every task: parameters, metrics, status, error, wall
 // time), points.csv (each parameter combination with its aggregated objective) and best.toml
-// (the best point's full configuration) into `dir`.
+// (the best point's full configuration) into `dir`. When the best point's configuration cannot be
+// made (a damaged plan), the other three are written and the error names plan.json.
 StatusOr<CollectReport> Collect(const std::string& dir);
 
 }  // namespace ratslam::sweep

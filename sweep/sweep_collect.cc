@@ -216,14 +216,18 @@ std::string RankPoints(const Plan& plan, const RunTables& tables, CollectReport*
 }
 
 // best.toml: the best point's whole configuration, its overrides in the header.
-StatusOr<std::string> BestToml(const Plan& plan, const CollectReport& report) {
+StatusOr<std::string> BestToml(const std::string& dir, const Plan& plan,
+                               const CollectReport& report) {
   const SweepSpec& spec = plan.spec;
   const Task* best = nullptr;
   for (const Task& t : plan.tasks) {
     if (t.point == *report.best_point) best = &t;
   }
   StatusOr<fusion::PipelineOptions> config = TaskConfig(plan, *best);
-  if (!config.ok()) return config.status();
+  if (!config.ok()) {  // the plan's base configuration or parameters, edited or damaged
+    return Status::Error((fs::path(dir) / "plan.json").string() + ": best point " +
+                         std::to_string(*report.best_point) + ": " + config.status().message());
+  }
   std::string header = "# Best point " + std::to_string(*report.best_point) + " of " + spec.source +
                        ": " + spec.aggregate + " " + spec.objective + " = " +
                        schema::TomlNumber(report.best_objective) + " over " +
@@ -259,8 +263,11 @@ StatusOr<CollectReport> Collect(const std::string& dir) {
       {(fs::path(dir) / "points.csv").string(), points_csv},
       {(fs::path(dir) / "results.json").string(), results.dump(1) + "\n"}};
   if (report.best_point) {
-    StatusOr<std::string> best = BestToml(*plan, report);
-    if (!best.ok()) return best.status();
+    StatusOr<std::string> best = BestToml(dir, *plan, report);
+    if (!best.ok()) {  // the results are still written
+      RATSLAM_RETURN_IF_ERROR(WriteFilesAtomically(files));
+      return best.status();
+    }
     files.push_back({(fs::path(dir) / "best.toml").string(), *best});
   }
   RATSLAM_RETURN_IF_ERROR(WriteFilesAtomically(files));

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <set>
@@ -765,6 +766,83 @@ data = ["data/a"]
   const std::string bad = Write("bad-expression.toml", "[sweep]\nobjective = \"map_ate_m +\"\n");
   EXPECT_EQ(LoadSweepFile(bad).status().message(),
             bad + ":2: sweep.objective: cannot read the objective 'map_ate_m +' near character 12");
+}
+
+// A plan.json edited by hand or damaged: every command that reads it refuses it naming the file
+// and what is wrong, instead of indexing past its points or converting a fraction to a count;
+// collecting a plan whose base configuration no longer reads still writes the results.
+TEST(SweepCollectTest, ADamagedPlanIsRefusedNamingItAndCollectKeepsTheResults) {
+  SquareWalk("a", 0.0);
+  const std::string path = SweepFile("damaged.toml", R"(
+[[datasets]]
+data = ["data/a"]
+[parameters]
+"wifi.match_threshold" = [0.3, 0.6]
+)");
+  StatusOr<Plan> plan = MakePlan(*LoadSweepFile(path));
+  ASSERT_TRUE(plan.ok()) << plan.status().message();
+  const std::string dir = (Scratch().path() / "sweep-damaged").string();
+  ASSERT_TRUE(WritePlan(*plan, dir).ok());
+  const std::string plan_path = dir + "/plan.json";
+  std::ifstream in(plan_path);
+  const nlohmann::json good = nlohmann::json::parse(in);
+  auto refusal = [&](const std::function<void(nlohmann::json&)>& damage) {
+    nlohmann::json j = good;
+    damage(j);
+    std::ofstream(plan_path) << j.dump();
+    StatusOr<Plan> read = ReadPlan(dir);
+    return read.ok() ? std::string("read") : read.status().message();
+  };
+  EXPECT_EQ(refusal([](nlohmann::json&) {}), "read");
+  EXPECT_EQ(refusal([](nlohmann::json& j) { j["points"] = 1.5; }),
+            plan_path + ": points must be an integer from 0 to 2");
+  EXPECT_EQ(refusal([](nlohmann::json& j) { j["points"] = 2000000000; }),
+            plan_path + ": points must be an integer from 0 to 2");
+  EXPECT_EQ(refusal([](nlohmann::json& j) { j["points"] = 3; }),
+            plan_path + ": points must be an integer from 0 to 2");
+  EXPECT_EQ(refusal([](nlohmann::json& j) { j["points"] = 1; }),
+            plan_path + ": point must be an integer from 0 to 0");
+  EXPECT_EQ(refusal([](nlohmann::json& j) { j["tasks"][1]["point"] = -1; }),
+            plan_path + ": point must be an integer from 0 to 1");
+  EXPECT_EQ(refusal([](nlohmann::json& j) { j["tasks"][1]["point"] = 0; }),
+            plan_path +
+                ": task 1 is out of order, names a missing data set or point, or differs from its "
+                "point's parameters");
+  EXPECT_EQ(refusal([](nlohmann::json& j) { j["tasks"][1]["index"] = 0; }),
+            plan_path +
+                ": task 1 is out of order, names a missing data set or point, or differs from its "
+                "point's parameters");
+  EXPECT_EQ(refusal([](nlohmann::json& j) { j["tasks"][0]["dataset"] = 1; }),
+            plan_path +
+                ": task 0 is out of order, names a missing data set or point, or differs from its "
+                "point's parameters");
+  EXPECT_EQ(refusal([](nlohmann::json& j) { j["spec"]["goal"] = "minimise"; }),
+            plan_path + ": goal 'minimise' is not one the sweep knows");
+  EXPECT_EQ(refusal([](nlohmann::json& j) { j["spec"]["halving_rate"] = 1.5; }),
+            plan_path + ": halving_rate must be a number from 2 to 100");
+  EXPECT_EQ(refusal([](nlohmann::json& j) { j["spec"]["objective"] = "map_ate_m +"; }),
+            plan_path + ": objective: cannot read the objective 'map_ate_m +' near character 12");
+
+  // Both runs succeeded, then the base configuration was damaged: collecting names plan.json
+  // and still writes every run's row.
+  for (int i = 0; i < 2; ++i) {
+    const std::string run = dir + "/runs/0000" + std::to_string(i);
+    Write(fs::relative(run + "/status.json", Scratch().path()).string(),
+          R"({"status": "ok", "exit_code": 0, "wall_s": 1.5, "error": ""})");
+    Write(fs::relative(run + "/summary.json", Scratch().path()).string(),
+          "{\"map_ate_m\": " + std::to_string(2 - i) + ", \"templates\": 4}");
+  }
+  refusal([](nlohmann::json& j) { j["spec"]["base_config"] = "[fused]\nrecency_s = [\n"; });
+  StatusOr<CollectReport> collected = Collect(dir);
+  ASSERT_FALSE(collected.ok());
+  EXPECT_EQ(collected.status().message().rfind(plan_path + ": best point 1: ", 0), 0u)
+      << collected.status().message();
+  std::ifstream results(dir + "/results.csv");
+  std::string line;
+  int rows = 0;
+  while (std::getline(results, line)) ++rows;
+  EXPECT_EQ(rows, 3);  // the header and both runs
+  EXPECT_FALSE(fs::exists(dir + "/best.toml"));
 }
 
 }  // namespace
