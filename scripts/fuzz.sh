@@ -71,7 +71,9 @@ if [[ -z ${TMPDIR:-} && -d /dev/shm && -w /dev/shm ]]; then export TMPDIR=/dev/s
 run_one() {
   local h=$1
   local log=$build/logs/$h.log
-  ASAN_OPTIONS=detect_leaks=0 "$build/fuzz/$h" "$build/corpus/$h" -max_total_time="$seconds" \
+  local dict=()  # tokens a harness's mutations rarely make by chance (fuzz/<harness>.dict)
+  [[ -f fuzz/$h.dict ]] && dict=(-dict="fuzz/$h.dict")
+  ASAN_OPTIONS=detect_leaks=0 "$build/fuzz/$h" "$build/corpus/$h" "${dict[@]}" -max_total_time="$seconds" \
     -seed="${FUZZ_SEED:-1}" -timeout=60 -report_slow_units=30 -rss_limit_mb=4096 -max_len=262144 -print_final_stats=1 \
     -artifact_prefix="$build/findings/$h/" >"$log" 2>&1 || true
 }

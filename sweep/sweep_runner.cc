@@ -12,6 +12,7 @@
 #include <cerrno>
 #include <charconv>
 #include <chrono>
+#include <climits>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -49,8 +50,17 @@ StatusOr<TaskOutcome> ReadOutcome(const std::string& dir, int index) {
   try {
     const json j = json::parse(*text);
     o.status = j.at("status").get<std::string>();
-    o.exit_code = j.at("exit_code").get<int>();
-    o.wall_s = j.at("wall_s").get<double>();
+    // json's own conversion of a fraction or an out-of-range number to int is undefined.
+    const json& exit_code = j.at("exit_code");
+    const json& wall_s = j.at("wall_s");
+    if (!exit_code.is_number_integer() ||
+        exit_code.get<int64_t>() != static_cast<int>(exit_code.get<int64_t>()) ||
+        (exit_code.is_number_unsigned() && exit_code.get<uint64_t>() > INT_MAX) ||
+        !wall_s.is_number() || !(wall_s.get<double>() >= 0.0)) {
+      throw json::type_error::create(302, "exit_code or wall_s out of range", &j);
+    }
+    o.exit_code = static_cast<int>(exit_code.get<int64_t>());
+    o.wall_s = wall_s.get<double>();
     o.error = j.at("error").get<std::string>();
     o.program = j.value("program", std::string());
     o.host = j.value("host", std::string());
