@@ -12,7 +12,7 @@ old=$(realpath "$1")
 new=$(realpath "$2")
 work=${3:-$(mktemp -d)}
 data=$root/../shared/data
-ignore="wall_seconds frames_per_second query_time_ms wall_time_s run ${IGNORE_KEYS:-}"
+ignore="wall_seconds calibration_wall_seconds frames_per_second query_time_ms wall_time_s run ${IGNORE_KEYS:-}"
 
 run_all() {  # binary, folder
   local b=$1 o=$2 c=$root/configs r=$data/ipin2023-t3/IPIN2023_T3_TrainingTrial01
